@@ -1,0 +1,51 @@
+# symrot — run `make help` for the list of targets.
+PYTHON ?= python3
+PIP ?= $(PYTHON) -m pip
+PYTEST_ARGS ?=
+
+.DEFAULT_GOAL := help
+.PHONY: help setup setup-system setup-python test lint typecheck pytest generate check-generated bench clean
+
+help: ## List the targets with what they do
+	@grep -E '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-16s %s\n", $$1, $$2}'
+
+setup: setup-system setup-python ## Install everything the tests need (Debian packages and Python dev extras)
+
+setup-system: ## Install gcc, clang, a TeX engine and poppler from Debian when missing (needs root)
+	@missing=""; \
+	command -v gcc >/dev/null || missing="$$missing gcc"; \
+	command -v clang >/dev/null || missing="$$missing clang"; \
+	command -v pdflatex >/dev/null || missing="$$missing texlive-latex-base texlive-latex-recommended texlive-latex-extra"; \
+	command -v pdftotext >/dev/null || missing="$$missing poppler-utils"; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing:$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
+	fi
+
+setup-python: ## pip install symrot in editable mode with its dev extras
+	$(PIP) install -q -e '.[dev]'
+
+test: lint typecheck pytest check-generated ## ruff, mypy, the test suite and the generated-code check
+
+lint: ## ruff over the package, tests and benchmarks
+	$(PYTHON) -m ruff check symrot tests bench
+
+typecheck: ## mypy over the package
+	$(PYTHON) -m mypy
+
+pytest: ## The test suite only
+	$(PYTHON) -m pytest $(PYTEST_ARGS)
+
+generate: ## Rewrite generated/ for the named parameterizations (deterministic)
+	$(PYTHON) -m symrot.generate generated
+
+check-generated: ## Fail with a diff when generated/ is stale
+	$(PYTHON) -m symrot.generate --check generated
+
+bench: ## Benchmarks (accuracy and speed); writes docs/*.md
+	$(PYTHON) -m symrot.generate --list >/dev/null
+	@for script in bench/*.py; do echo "== $$script"; $(PYTHON) $$script || exit 1; done
+
+clean: ## Remove build and cache files
+	rm -rf build dist *.egg-info .pytest_cache .mypy_cache .ruff_cache .hypothesis

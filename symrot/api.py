@@ -1,0 +1,110 @@
+"""The Python API: ``symrot.derive('4*tan(phi/4)')`` mirrors ``symrot derive``.
+
+:class:`DerivationResult` wraps the symbolic core's :class:`~symrot.core.Derivation` with the
+registry identity, a JSON-ready dictionary and a LaTeX display for Jupyter (``_repr_latex_``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import sympy as sp
+
+from .core import SCALAR_NAMES, TENSOR_NAMES, Derivation, Tensor, derive_expression
+from .errors import SymrotError
+from .parsing import parse_expression
+from .registry import NamedParameterization, find_by_expression, is_identifier, lookup
+from .timeouts import time_limit
+
+DERIVE_TIME_LIMIT = 60.0
+DEFAULT_SERIES_TERMS = 6
+COEFFICIENT_KEYS = ("I", "px", "px2")
+
+
+def resolve(expression: str | sp.Expr) -> tuple[sp.Expr, NamedParameterization | None]:
+    """A registry identifier or an expression (parsed safely) → (p(φ), registry entry)."""
+    if isinstance(expression, sp.Expr):
+        return expression, find_by_expression(expression)
+    text = expression.strip() if isinstance(expression, str) else expression
+    if isinstance(text, str) and is_identifier(text):
+        entry = lookup(text)
+        return entry.expression, entry
+    expr = parse_expression(text)
+    return expr, find_by_expression(expr)
+
+
+@dataclass
+class DerivationResult:
+    """Every derived quantity of one generating function, ready to display or serialize."""
+
+    derivation: Derivation
+    entry: NamedParameterization | None
+    normalized: bool = False
+
+    # -- direct access ------------------------------------------------------------------------
+    @property
+    def p(self) -> sp.Expr:
+        return self.derivation.p
+
+    @property
+    def kappa(self) -> sp.Expr:
+        return self.derivation.kappa
+
+    def __getattr__(self, name: str) -> Any:
+        if name in SCALAR_NAMES:
+            return self.derivation.scalars[name]
+        if name in TENSOR_NAMES:
+            return self.derivation.tensors[name]
+        raise AttributeError(name)
+
+    def series(self, name: str, n_terms: int = DEFAULT_SERIES_TERMS) -> list[sp.Expr]:
+        """Exact Taylor coefficients of coefficient ``name`` (e.g. 'H_2', 'nu') in x = |p|²."""
+        return self.derivation.series_in_x(name, n_terms)
+
+    # -- serialization ----------------------------------------------------------------------
+    def to_dict(self, series_terms: int = DEFAULT_SERIES_TERMS) -> dict[str, Any]:
+        d = self.derivation
+        out: dict[str, Any] = {
+            "expression": str(d.p),
+            "name": self.entry.identifier if self.entry else None,
+            "equation": self.entry.equation if self.entry else None,
+            "kappa": str(d.kappa),
+            "normalized": self.normalized,
+        }
+        out.update({name: str(d.scalars[name]) for name in SCALAR_NAMES})
+        for name in TENSOR_NAMES:
+            tensor = d.tensors[name]
+            out[name] = dict(zip(COEFFICIENT_KEYS, map(str, tensor.simplified), strict=True))
+        out["canonical"] = {name: _canonical_dict(d.tensors[name]) for name in TENSOR_NAMES}
+        out["series"] = {
+            name: [str(c) for c in d.series_in_x(name, series_terms)]
+            for name in d.coefficient_expressions()
+        }
+        return out
+
+    def _repr_latex_(self) -> str:
+        from .backends.latex import derivation_display
+
+        return derivation_display(self)
+
+
+def _canonical_dict(tensor: Tensor) -> dict[str, str]:
+    matrix = tensor.canonical
+    return {"axial": str(matrix[0, 0]), "real": str(matrix[1, 1]), "imag": str(matrix[2, 1])}
+
+
+def derive(expression: str | sp.Expr, normalize: bool = False) -> DerivationResult:
+    """Derive everything for a generating function (expression or registry identifier).
+
+    Raises :class:`~symrot.errors.SymrotError` subclasses for invalid input; bounded in time.
+    """
+    expr, entry = resolve(expression)
+    with time_limit(DERIVE_TIME_LIMIT, "derivation"):
+        derivation = derive_expression(expr, normalize=normalize)
+    if normalize and derivation.p != expr:
+        entry = find_by_expression(derivation.p)
+    return DerivationResult(derivation, entry, normalized=normalize and derivation.p != expr)
+
+
+__all__ = ["DerivationResult", "SymrotError", "derive", "resolve"]

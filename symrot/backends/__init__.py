@@ -1,0 +1,1 @@
+"""Backends: modules that print evaluation plans or derivations through templates."""

@@ -1,0 +1,86 @@
+"""``symrot derive EXPR|NAME``: the derived scalar functions, tensors and series."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
+from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
+
+SCALAR_LABELS = {
+    "p_prime": "p'",
+    "nu": "nu",
+    "epsilon": "epsilon",
+    "mu": "mu",
+    "det_H": "det H",
+}
+TENSOR_LABELS = {"R": "R", "H": "H", "H_inverse": "H^-1", "G": "G", "K": "K"}
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "derive",
+        help="derive p', nu, epsilon, mu, det H, R, H, H^-1, G, K and their series",
+        description="Derive every quantity of the vectorial parameterization for a generating "
+        "function p(phi) given as an expression (e.g. 'cbrt(6*(phi-sin(phi)))') or a "
+        "registry name (e.g. wiener_milenkovic, sine_m4, tangent_m3, cayley_m2).",
+    )
+    parser.add_argument("expression", help="p(phi) or a registry identifier")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--normalize", action="store_true", help="divide p by kappa (eq 12)")
+    parser.add_argument(
+        "--terms", type=int, default=DEFAULT_SERIES_TERMS, choices=range(1, 25),
+        metavar="N", help=f"series terms in x = |p|^2 (default {DEFAULT_SERIES_TERMS}, max 24)",
+    )
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    result = derive(args.expression, normalize=args.normalize)
+    if args.json:
+        print(json.dumps(result.to_dict(series_terms=args.terms), indent=2))
+    else:
+        print(summary(result, args.terms))
+    return 0
+
+
+def _series_text(coefficients: list[Any]) -> str:
+    terms = []
+    for j, c in enumerate(coefficients):
+        if c == 0:
+            continue
+        power = "" if j == 0 else (" x" if j == 1 else f" x^{j}")
+        terms.append(f"({c}){power}" if j else f"{c}")
+    return " + ".join(terms) + f" + O(x^{len(coefficients)})" if terms else "0 (identically)"
+
+
+def summary(result: DerivationResult, terms: int) -> str:
+    d = result.derivation
+    lines = []
+    title = f"p(phi) = {d.p}"
+    if result.entry:
+        title += f"    [{result.entry.identifier}, eq {result.entry.equation}]"
+    lines.append(title)
+    kappa_note = "" if d.kappa == 1 else "   (not unit-normalized; --normalize divides p by it)"
+    lines.append(f"kappa = lim p/phi (eq 12) = {d.kappa}{kappa_note}")
+    lines.append("")
+    lines.append("Scalar functions")
+    for name, label in SCALAR_LABELS.items():
+        lines.append(f"  {label:<8} (eq {SCALAR_EQUATIONS[name]:>2}) = {d.scalars[name]}")
+    lines.append("")
+    lines.append("Tensors  T = c0 I + c1 (p x) + c2 (p x)^2   [canonical basis: axial; re +- i im]")
+    for name in TENSOR_NAMES:
+        tensor = d.tensors[name]
+        label = f"{TENSOR_LABELS[name]} (eq {TENSOR_EQUATIONS[name]})"
+        lines.append(f"  {label}")
+        for k, c in enumerate(tensor.simplified):
+            lines.append(f"      c{k} = {c}")
+        axial, real, imag = tensor.canonical[0, 0], tensor.canonical[1, 1], tensor.canonical[2, 1]
+        lines.append(f"      eigenvalues: {axial};  {real} +- i ({imag})")
+    lines.append("")
+    lines.append(f"Leading series in x = |p|^2 (exact, {terms} terms)")
+    for name in ("nu", "mu", "det_H", "R_1", "R_2", "H_2", "H_inverse_2"):
+        lines.append(f"  {name:<12} = {_series_text(d.series_in_x(name, terms))}")
+    return "\n".join(lines)

@@ -1,0 +1,188 @@
+"""Symbolic core: everything the vectorial parameterization derives from a generating function.
+
+Pure SymPy: no printing, no I/O. The tensors are *derived*, not copied from the paper:
+
+* R from Euler's formula (1): R = I + sin φ U + (1 − cos φ) U², U = (u×).
+* H from the angular velocity (10) with p = p(φ) u (eq 11): since φ̇ = μ u·ṗ (eq 21) and
+  u̇ = −U² ṗ / p, ω = [μ I + ((1 − cos φ)/p) U + (μ − sin φ / p) U²] ṗ, which is eq (22).
+* The m-th root G_(m) (76) and its tangent K_(m) (79, 80) the same way with φ/m in place of φ:
+  K_(m) = (μ/m) I + ((1 − cos(φ/m))/p) U + (μ/m − sin(φ/m)/p) U²; H = K_(1), G = G_(2), K = K_(2).
+* H⁻¹ by inversion in the axial-tensor algebra (:mod:`symrot.axial`), which gives eq (26).
+
+The paper's printed forms (14), (22), (26), (81), (83) are then *checked* against these (tests,
+audit). Scalars: p′, ν (15), ε (16), μ (21), det H (24) = μ ν².
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import mpmath
+import sympy as sp
+
+from .axial import AxialTensor
+from .errors import InvalidGeneratingFunction
+from .parsing import PHI
+from .series import Series, coefficient_list, compose_even_in_x, revert, taylor_series
+from .simplify import simplest
+from .validation import ValidatedFunction, evaluate, validate
+
+SCALAR_NAMES = ("p_prime", "nu", "epsilon", "mu", "det_H")
+TENSOR_NAMES = ("R", "H", "H_inverse", "G", "K")
+TENSOR_EQUATIONS = {"R": "14", "H": "22", "H_inverse": "26", "G": "81", "K": "83"}
+SCALAR_EQUATIONS = {"p_prime": "21", "nu": "15", "epsilon": "16", "mu": "21", "det_H": "24"}
+
+
+def root_tensor(p: sp.Expr, m: int) -> AxialTensor:
+    """G_(m), the m-th root of R (eq 76), in the u-basis."""
+    angle = PHI / m
+    return AxialTensor(sp.S.One, sp.sin(angle), 1 - sp.cos(angle))
+
+
+def root_tangent(p: sp.Expr, m: int) -> AxialTensor:
+    """K_(m) with γ_(m) = K_(m) ṗ (eqs 79-80), in the u-basis; H = K_(1) (eq 22)."""
+    mu = 1 / sp.diff(p, PHI)
+    angle = PHI / m
+    return AxialTensor(mu / m, (1 - sp.cos(angle)) / p, mu / m - sp.sin(angle) / p)
+
+
+@dataclass(frozen=True)
+class Tensor:
+    """A derived tensor: its u-basis form and its coefficients on I, (p×), (p×)²."""
+
+    name: str
+    u_basis: AxialTensor
+    coefficients: tuple[sp.Expr, sp.Expr, sp.Expr]
+    """Raw (unsimplified) coefficients on I, (p×), (p×)²."""
+    simplified: tuple[sp.Expr, sp.Expr, sp.Expr]
+    canonical: sp.Matrix
+    """Simplified components in a canonical basis {u, v, w} (eqs 17, 23, 27)."""
+
+    def coefficient_names(self) -> tuple[str, str, str]:
+        return (f"{self.name}_0", f"{self.name}_1", f"{self.name}_2")
+
+    @property
+    def eigenvalues(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+        axial = self.canonical[0, 0]
+        real, imag = self.canonical[1, 1], self.canonical[2, 1]
+        return axial, real + sp.I * imag, real - sp.I * imag
+
+
+@dataclass
+class Derivation:
+    """All derived quantities of one generating function (Section 3.1, Appendix B)."""
+
+    function: ValidatedFunction
+    scalars_raw: dict[str, sp.Expr]
+    scalars: dict[str, sp.Expr]
+    tensors: dict[str, Tensor]
+    _series_cache: dict[tuple[str, int], list[sp.Expr]] = field(default_factory=dict, repr=False)
+
+    @property
+    def p(self) -> sp.Expr:
+        return self.function.expression
+
+    @property
+    def kappa(self) -> sp.Expr:
+        return self.function.kappa
+
+    def coefficient_expressions(self) -> dict[str, sp.Expr]:
+        """Every scalar coefficient c(φ) the backends evaluate, raw, by stable name."""
+        out = dict(self.scalars_raw)
+        for tensor in self.tensors.values():
+            out.update(zip(tensor.coefficient_names(), tensor.coefficients, strict=True))
+        return out
+
+    def simplified_coefficients(self) -> dict[str, sp.Expr]:
+        out = dict(self.scalars)
+        for tensor in self.tensors.values():
+            out.update(zip(tensor.coefficient_names(), tensor.simplified, strict=True))
+        return out
+
+    # -- series -----------------------------------------------------------------------------
+    def taylor_in_phi(self, name: str, order: int) -> list[sp.Expr]:
+        """Exact Taylor coefficients of coefficient ``name`` in φ (index k ↔ φ^k)."""
+        series: Series = taylor_series(self.coefficient_expressions()[name], order)
+        if not series.is_zero and series.shift < 0:
+            raise InvalidGeneratingFunction(f"coefficient {name} has a pole at phi = 0")
+        return coefficient_list(series, 0, order)
+
+    def phi_of_p(self, order: int) -> list[sp.Expr]:
+        """φ as a series in p (reversion of p(φ)), exact through p^(order-1)."""
+        key = ("__phi_of_p__", order)
+        if key not in self._series_cache:
+            p_series = coefficient_list(taylor_series(self.p, order), 0, order)
+            self._series_cache[key] = revert(p_series, order)
+        return self._series_cache[key]
+
+    def series_in_x(self, name: str, n_terms: int) -> list[sp.Expr]:
+        """Exact Taylor coefficients d_j of coefficient ``name`` in x = |p|², j < n_terms."""
+        key = (name, n_terms)
+        if key not in self._series_cache:
+            order = 2 * n_terms
+            in_phi = self.taylor_in_phi(name, order)
+            odd = [k for k in range(1, order, 2) if in_phi[k] != 0]
+            if odd:
+                raise InvalidGeneratingFunction(f"coefficient {name} is not even in phi")
+            self._series_cache[key] = compose_even_in_x(in_phi, self.phi_of_p(order), n_terms)
+        return self._series_cache[key]
+
+    # -- numeric evaluation -------------------------------------------------------------------
+    def evaluate(self, name: str, angle: mpmath.mpf | str, digits: int = 50) -> mpmath.mpf:
+        """Coefficient ``name`` at φ = angle to ``digits`` digits (raw closed form)."""
+        return evaluate(self.coefficient_expressions()[name], angle, digits)
+
+
+def scalar_definitions(p: sp.Expr) -> dict[str, sp.Expr]:
+    """p′, ν (15), ε (16), μ (21), det H = μ ν² (24) as raw expressions in φ."""
+    p_prime = sp.diff(p, PHI)
+    nu = 2 * sp.sin(PHI / 2) / p
+    epsilon = 2 * sp.tan(PHI / 2) / p
+    mu = 1 / p_prime
+    return {"p_prime": p_prime, "nu": nu, "epsilon": epsilon, "mu": mu, "det_H": mu * nu**2}
+
+
+def tensor_definitions(p: sp.Expr) -> dict[str, AxialTensor]:
+    """R (1), H = K_(1) (10), H⁻¹, G = G_(2) (76), K = K_(2) (79) in the u-basis."""
+    rotation = root_tensor(p, 1)
+    tangent = root_tangent(p, 1)
+    return {
+        "R": rotation,
+        "H": tangent,
+        "H_inverse": tangent.inverse(),
+        "G": root_tensor(p, 2),
+        "K": root_tangent(p, 2),
+    }
+
+
+def _build_tensor(name: str, u_basis: AxialTensor, p: sp.Expr) -> Tensor:
+    coefficients = u_basis.in_p_basis(p)
+    simplified = tuple(simplest(c) for c in coefficients)
+    real, imag = u_basis.planar
+    canonical = sp.Matrix(
+        [
+            [simplest(u_basis.a), 0, 0],
+            [0, simplest(real), -simplest(imag)],
+            [0, simplest(imag), simplest(real)],
+        ]
+    )
+    a, b, c = simplified
+    return Tensor(name, u_basis, coefficients, (a, b, c), canonical)
+
+
+def derive_function(function: ValidatedFunction) -> Derivation:
+    p = function.expression
+    raw = scalar_definitions(p)
+    scalars = {name: simplest(expr) for name, expr in raw.items()}
+    tensors = {
+        name: _build_tensor(name, u_basis, p) for name, u_basis in tensor_definitions(p).items()
+    }
+    return Derivation(function, raw, scalars, tensors)
+
+
+def derive_expression(expr: sp.Expr, normalize: bool = False) -> Derivation:
+    """Validate ``expr`` as p(φ) and derive everything; ``normalize`` divides p by κ."""
+    function = validate(expr)
+    if normalize and function.kappa != 1:
+        function = validate(sp.expand(expr / function.kappa) if expr.is_Add else expr / function.kappa)
+    return derive_function(function)

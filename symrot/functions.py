@@ -1,0 +1,75 @@
+"""SymPy functions symrot adds: the real (odd) cube root.
+
+SymPy's ``cbrt(x)`` is ``x**(1/3)``, the principal root, which is complex for x < 0. A generating
+function such as eq (35), p = cbrt(6(phi - sin phi)), must be odd, so symrot's ``cbrt`` is the real
+cube root, ``sign(x) |x|^(1/3)``, everywhere: in the parser, the series engine, the printers and
+numeric evaluation.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mpmath
+import sympy as sp
+
+
+class RealCbrt(sp.Function):
+    """Real cube root: odd, real for every real argument, derivative 1/(3 cbrt(x)^2)."""
+
+    nargs = 1
+
+    @classmethod
+    def eval(cls, arg: sp.Expr) -> sp.Expr | None:
+        if arg.is_Number:
+            if arg.is_zero:
+                return sp.S.Zero
+            if arg.is_extended_real:
+                root = sp.real_root(arg, 3)
+                return root if not isinstance(root, sp.Piecewise) else None
+        if arg.could_extract_minus_sign():
+            return -cls(-arg)
+        if isinstance(arg, sp.Pow) and arg.exp == 3 and arg.base.is_extended_real:
+            return arg.base
+        return None
+
+    def fdiff(self, argindex: int = 1) -> sp.Expr:
+        return sp.Rational(1, 3) / RealCbrt(self.args[0]) ** 2
+
+    def _eval_is_extended_real(self) -> bool | None:
+        return self.args[0].is_extended_real
+
+    def _eval_is_zero(self) -> bool | None:
+        return self.args[0].is_zero
+
+    def _eval_is_positive(self) -> bool | None:
+        return self.args[0].is_positive
+
+    def _eval_is_negative(self) -> bool | None:
+        return self.args[0].is_negative
+
+    def _eval_power(self, exponent: sp.Expr) -> sp.Expr | None:
+        if exponent.is_Integer and int(exponent) % 3 == 0:
+            return self.args[0] ** (int(exponent) // 3)
+        return None
+
+    def _eval_evalf(self, prec: int) -> sp.Expr | None:
+        value = self.args[0]._eval_evalf(prec)
+        if value is None or not value.is_Number or not value.is_extended_real:
+            return None
+        with mpmath.workprec(prec):
+            return sp.Float(mpmath.cbrt(value._to_mpmath(prec)), precision=prec)
+
+    def _eval_rewrite_as_Pow(self, arg: sp.Expr, **kwargs: Any) -> sp.Expr:
+        return sp.sign(arg) * sp.Abs(arg) ** sp.Rational(1, 3)
+
+    def _sympystr(self, printer: Any) -> str:
+        return f"cbrt({printer._print(self.args[0])})"
+
+    def _latex(self, printer: Any) -> str:
+        return r"\sqrt[3]{%s}" % printer._print(self.args[0])
+
+
+def mpmath_namespace() -> dict[str, Any]:
+    """Names for ``sympy.lambdify(..., modules=[mpmath_namespace(), 'mpmath'])``."""
+    return {"RealCbrt": mpmath.cbrt}

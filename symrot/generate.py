@@ -1,0 +1,110 @@
+"""``make generate`` / ``make check-generated``: the complete outputs for the named parameterizations.
+
+Each producer maps a registry entry (or the whole registry) to ``{relative path: text}``. Writing
+is deterministic (sorted, no timestamps), so a rerun is byte-identical, and ``--check`` fails with
+a unified diff and the fix command when ``generated/`` is stale.
+
+Run as ``python -m symrot.generate [--check] [--only PREFIX] DIR``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+import json
+import sys
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+from .api import derive
+from .registry import NAMED
+
+Producer = Callable[[], dict[str, str]]
+
+
+def derivation_json() -> dict[str, str]:
+    """generated/derivations/NAME.json: ``symrot derive NAME --json`` for each named entry."""
+    out = {}
+    for name in NAMED:
+        data = derive(name).to_dict(series_terms=8)
+        out[f"derivations/{name}.json"] = json.dumps(data, indent=2, sort_keys=True) + "\n"
+    return out
+
+
+def producers() -> list[tuple[str, Producer]]:
+    """All producers, by the path prefix they own. Backends add theirs here."""
+    return [("derivations/", derivation_json)]
+
+
+def render(only: str | None = None) -> dict[str, str]:
+    files: dict[str, str] = {}
+    for prefix, producer in producers():
+        if only and not prefix.startswith(only):
+            continue
+        files.update(producer())
+    return dict(sorted(files.items()))
+
+
+def owned(root: Path, prefixes: Iterable[str]) -> set[str]:
+    found: set[str] = set()
+    for prefix in prefixes:
+        base = root / prefix
+        if base.is_dir():
+            found.update(str(p.relative_to(root)) for p in base.rglob("*") if p.is_file())
+    return found
+
+
+def write(root: Path, files: dict[str, str], prefixes: list[str]) -> None:
+    for stale in owned(root, prefixes) - set(files):
+        (root / stale).unlink()
+    for relative, text in files.items():
+        path = root / relative
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if not path.exists() or path.read_text(encoding="utf-8") != text:
+            path.write_text(text, encoding="utf-8")
+
+
+def check(root: Path, files: dict[str, str], prefixes: list[str]) -> list[str]:
+    """Unified diffs between ``root`` and what would be generated (empty when current)."""
+    diffs = []
+    for relative in sorted(owned(root, prefixes) | set(files)):
+        path = root / relative
+        old = path.read_text(encoding="utf-8") if path.exists() else ""
+        new = files.get(relative, "")
+        if old != new:
+            diffs.append("".join(difflib.unified_diff(
+                old.splitlines(keepends=True), new.splitlines(keepends=True),
+                f"a/{relative}", f"b/{relative}", n=2,
+            )) or f"{relative}: differs\n")
+    return diffs
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m symrot.generate")
+    parser.add_argument("directory", nargs="?", default="generated")
+    parser.add_argument("--check", action="store_true", help="compare instead of writing")
+    parser.add_argument("--only", help="only producers whose prefix starts with this")
+    parser.add_argument("--list", action="store_true", help="list producer prefixes")
+    args = parser.parse_args(argv)
+    prefixes = [prefix for prefix, _ in producers() if not args.only or prefix.startswith(args.only)]
+    if args.list:
+        print("\n".join(prefixes))
+        return 0
+    root = Path(args.directory)
+    files = render(args.only)
+    if args.check:
+        diffs = check(root, files, prefixes)
+        if diffs:
+            sys.stdout.writelines(d if d.endswith("\n") else d + "\n" for d in diffs[:20])
+            print(f"generated/ is stale ({len(diffs)} files differ). Fix: make generate",
+                  file=sys.stderr)
+            return 1
+        print(f"generated/ is current ({len(files)} files)")
+        return 0
+    write(root, files, prefixes)
+    print(f"wrote {len(files)} files under {root}/")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,222 @@
+"""Safe parsing of untrusted generating-function expressions.
+
+User strings never reach ``sympify``/``parse_expr`` (both evaluate Python). The text is parsed
+by :func:`ast.parse` (which only builds a tree), every node is checked against a whitelist, and
+the SymPy expression is built directly from the checked tree. Caps on length, depth, node count,
+literal size and exponents keep both parsing and SymPy's automatic evaluation fast.
+
+Grammar: numbers, ``phi`` (or ``φ``), ``pi`` (or ``π``), ``+ - * / **`` (``^`` is accepted as
+``**``), parentheses, and calls of one argument to the functions in :data:`FUNCTIONS`.
+``cbrt`` is the real (odd) cube root, see :mod:`symrot.functions`.
+"""
+
+from __future__ import annotations
+
+import ast
+import unicodedata
+from collections.abc import Callable
+from fractions import Fraction
+
+import sympy as sp
+
+from .errors import ParseError
+from .functions import RealCbrt
+
+PHI = sp.Symbol("phi", real=True)
+"""The rotation angle symbol used throughout symrot."""
+
+MAX_LENGTH = 400
+MAX_DEPTH = 32
+MAX_NODES = 160
+MAX_LITERAL_DIGITS = 30
+MAX_EXPONENT = 64
+MAX_EXPONENT_DENOMINATOR = 64
+
+FUNCTIONS: dict[str, Callable[[sp.Expr], sp.Expr]] = {
+    "sin": sp.sin,
+    "cos": sp.cos,
+    "tan": sp.tan,
+    "asin": sp.asin,
+    "acos": sp.acos,
+    "atan": sp.atan,
+    "sinh": sp.sinh,
+    "cosh": sp.cosh,
+    "tanh": sp.tanh,
+    "asinh": sp.asinh,
+    "acosh": sp.acosh,
+    "atanh": sp.atanh,
+    "exp": sp.exp,
+    "log": sp.log,
+    "sqrt": sp.sqrt,
+    "cbrt": RealCbrt,
+}
+
+_VARIABLES = {"phi": PHI, "φ": PHI}
+_CONSTANTS = {"pi": sp.pi, "π": sp.pi}
+_BINARY = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.BitXor)
+
+
+def parse_expression(text: object) -> sp.Expr:
+    """Parse ``text`` into a SymPy expression in :data:`PHI`, or raise :class:`ParseError`."""
+    if not isinstance(text, str):
+        raise ParseError("expression must be a string")
+    if len(text) > MAX_LENGTH:
+        raise ParseError(f"expression is too long ({len(text)} characters, at most {MAX_LENGTH})")
+    if "\x00" in text:
+        raise ParseError("expression contains a NUL character")
+    stripped = unicodedata.normalize("NFKC", text).strip()
+    if not stripped:
+        raise ParseError("expression is empty")
+    if "\n" in stripped or "\r" in stripped or ";" in stripped:
+        raise ParseError("expression must be a single line with a single expression")
+    depth = _bracket_depth(stripped)
+    if depth > MAX_DEPTH:
+        raise ParseError(f"expression is nested too deeply (depth {depth}, at most {MAX_DEPTH})")
+    try:
+        tree = ast.parse(stripped, mode="eval")
+    except (SyntaxError, ValueError, RecursionError, MemoryError) as exc:
+        msg = exc.msg if isinstance(exc, SyntaxError) else type(exc).__name__
+        raise ParseError(f"not a valid expression: {msg}") from None
+    nodes = sum(1 for _ in ast.walk(tree))
+    if nodes > MAX_NODES:
+        raise ParseError(f"expression is too large ({nodes} syntax nodes, at most {MAX_NODES})")
+    builder = _Builder(stripped)
+    expr = builder.build(tree.body, 0)
+    if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
+        raise ParseError("expression evaluates to an infinity or NaN (division by zero?)")
+    if expr.has(sp.I):
+        raise ParseError("expression is not real")
+    return expr
+
+
+def _bracket_depth(text: str) -> int:
+    depth = deepest = 0
+    for ch in text:
+        if ch in "([{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch in ")]}":
+            depth -= 1
+    return deepest
+
+
+class _Builder:
+    """Turns a whitelisted AST into SymPy, rejecting everything else with a clear message."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def build(self, node: ast.AST, depth: int) -> sp.Expr:
+        if depth > MAX_DEPTH:
+            raise ParseError(f"expression is nested too deeply (more than {MAX_DEPTH} levels)")
+        if isinstance(node, ast.Constant):
+            return self._number(node)
+        if isinstance(node, ast.Name):
+            return self._name(node)
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.UAdd | ast.USub):
+            operand = self.build(node.operand, depth + 1)
+            return -operand if isinstance(node.op, ast.USub) else operand
+        if isinstance(node, ast.BinOp) and isinstance(node.op, _BINARY):
+            return self._binary(node, depth)
+        if isinstance(node, ast.Call):
+            return self._call(node, depth)
+        raise ParseError(f"'{_describe(node)}' is not allowed in an expression")
+
+    def _number(self, node: ast.Constant) -> sp.Expr:
+        value = node.value
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ParseError(f"literal {value!r} is not a real number")
+        literal = ast.get_source_segment(self.source, node) or repr(value)
+        digits = sum(ch.isdigit() for ch in literal)
+        if digits > MAX_LITERAL_DIGITS:
+            raise ParseError(f"number literal has too many digits (at most {MAX_LITERAL_DIGITS})")
+        if isinstance(value, int):
+            return sp.Integer(value)
+        if any(ch in literal for ch in "jJ"):
+            raise ParseError("complex literals are not allowed")
+        try:
+            exact = Fraction(literal.replace("_", ""))
+        except (ValueError, ZeroDivisionError):
+            raise ParseError(f"number literal {literal!r} is not valid") from None
+        if abs(exact.numerator).bit_length() > 256 or exact.denominator.bit_length() > 256:
+            raise ParseError(f"number literal {literal!r} is out of range")
+        return sp.Rational(exact.numerator, exact.denominator)
+
+    def _name(self, node: ast.Name) -> sp.Expr:
+        if node.id in _VARIABLES:
+            return _VARIABLES[node.id]
+        if node.id in _CONSTANTS:
+            return _CONSTANTS[node.id]
+        if node.id in FUNCTIONS:
+            raise ParseError(f"function '{node.id}' must be called with one argument")
+        known = ", ".join(sorted(_VARIABLES) + sorted(_CONSTANTS))
+        raise ParseError(f"unknown name '{node.id[:40]}' (allowed names: {known})")
+
+    def _binary(self, node: ast.BinOp, depth: int) -> sp.Expr:
+        left = self.build(node.left, depth + 1)
+        right = self.build(node.right, depth + 1)
+        if isinstance(node.op, ast.Add):
+            return left + right
+        if isinstance(node.op, ast.Sub):
+            return left - right
+        if isinstance(node.op, ast.Mult):
+            return left * right
+        if isinstance(node.op, ast.Div):
+            if right.is_zero:
+                raise ParseError("division by zero")
+            return left / right
+        return self._power(left, right)
+
+    def _power(self, base: sp.Expr, exponent: sp.Expr) -> sp.Expr:
+        if exponent.free_symbols or not exponent.is_Rational:
+            raise ParseError("exponents must be rational constants such as 2, -1 or 1/3")
+        exp_rational = sp.Rational(exponent)
+        if abs(exp_rational.p) > MAX_EXPONENT * exp_rational.q:
+            raise ParseError(f"exponent {exp_rational} is too large (|exponent| <= {MAX_EXPONENT})")
+        if exp_rational.q > MAX_EXPONENT_DENOMINATOR:
+            raise ParseError(f"exponent {exp_rational} has too large a denominator")
+        if base.is_zero and exp_rational.is_negative:
+            raise ParseError("division by zero")
+        if base.is_Number and base.is_negative and exp_rational.q != 1:
+            raise ParseError("a fractional power of a negative number is not real (use cbrt)")
+        return sp.Pow(base, exp_rational)
+
+    def _call(self, node: ast.Call, depth: int) -> sp.Expr:
+        if not isinstance(node.func, ast.Name):
+            raise ParseError(f"'{_describe(node.func)}' cannot be called")
+        name = node.func.id
+        if name not in FUNCTIONS:
+            allowed = ", ".join(FUNCTIONS)
+            raise ParseError(f"unknown function '{name[:40]}' (allowed: {allowed})")
+        if node.keywords or len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
+            raise ParseError(f"function '{name}' takes exactly one argument")
+        argument = self.build(node.args[0], depth + 1)
+        return FUNCTIONS[name](argument)
+
+
+def _describe(node: ast.AST) -> str:
+    names = {
+        ast.Attribute: "attribute access",
+        ast.Subscript: "subscript",
+        ast.Lambda: "lambda",
+        ast.Compare: "comparison",
+        ast.BoolOp: "boolean operator",
+        ast.IfExp: "conditional expression",
+        ast.NamedExpr: "assignment expression",
+        ast.JoinedStr: "f-string",
+        ast.List: "list",
+        ast.Tuple: "tuple",
+        ast.Dict: "dict",
+        ast.Set: "set",
+        ast.ListComp: "comprehension",
+        ast.GeneratorExp: "generator",
+        ast.Await: "await",
+        ast.Yield: "yield",
+        ast.Starred: "starred argument",
+    }
+    for cls, label in names.items():
+        if isinstance(node, cls):
+            return label
+    if isinstance(node, ast.BinOp | ast.UnaryOp):
+        return f"operator {type(node.op).__name__}"
+    return type(node).__name__

@@ -1,0 +1,115 @@
+"""Named parameterizations of the paper, with stable identifiers.
+
+Eqs (30)-(35), the sine and tangent families p = m sin(φ/m), m tan(φ/m) of any order m (36), and
+the m-th order Cayley vector ζ_(m) = tan(φ/(2m)) u (101, κ = 1/(2m)). Each entry also records the
+property of Section 3.2 that defines it, so that ``symrot solve`` can derive it back.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import sympy as sp
+
+from .errors import UnknownName
+from .functions import RealCbrt
+from .parsing import PHI
+
+MAX_FAMILY_ORDER = 1000
+
+
+@dataclass(frozen=True)
+class NamedParameterization:
+    identifier: str
+    title: str
+    equation: str
+    expression: sp.Expr
+    defining_property: str | None = None
+    """The property of Section 3.2 that yields it (input of ``symrot solve``), if any."""
+
+
+_FIXED = {
+    "rotation_vector": NamedParameterization(
+        "rotation_vector", "Rotation vector (exponential map)", "30", PHI, "mu = 1"
+    ),
+    "linear": NamedParameterization(
+        "linear", "Linear parameters", "31", sp.sin(PHI), "nu**2 = c*eps"
+    ),
+    "euler_rodrigues": NamedParameterization(
+        "euler_rodrigues", "Reduced Euler-Rodrigues parameters", "32", 2 * sp.sin(PHI / 2),
+        "nu**2 = 2*c",
+    ),
+    "cayley_gibbs_rodrigues": NamedParameterization(
+        "cayley_gibbs_rodrigues", "Cayley-Gibbs-Rodrigues parameters", "33",
+        2 * sp.tan(PHI / 2), "mu = nu**2/eps",
+    ),
+    "wiener_milenkovic": NamedParameterization(
+        "wiener_milenkovic", "Wiener-Milenkovic parameters", "34", 4 * sp.tan(PHI / 4),
+        "2*p_prime*sin(phi/2) = p",
+    ),
+    "det_h_one": NamedParameterization(
+        "det_h_one", "Constant det H parameterization", "35",
+        RealCbrt(6 * (PHI - sp.sin(PHI))), "det_H = const",
+    ),
+}
+
+TABLE_1 = (
+    "rotation_vector",
+    "cayley_gibbs_rodrigues",
+    "wiener_milenkovic",
+    "linear",
+    "euler_rodrigues",
+    "sine_m4",
+)
+"""The six rows of the paper's Table 1, in its order."""
+
+NAMED = (*_FIXED, "sine_m4")
+"""The named parameterizations that ``make generate`` writes (Table 1 and eq 35)."""
+
+_FAMILY = re.compile(r"^(sine|tangent|cayley)_m([1-9][0-9]*)$")
+
+
+def family_member(family: str, m: int) -> NamedParameterization:
+    """m sin(φ/m), m tan(φ/m) (eq 36) or the m-th order Cayley vector tan(φ/(2m)) (eq 101)."""
+    if not 1 <= m <= MAX_FAMILY_ORDER:
+        raise UnknownName(f"family order m must be between 1 and {MAX_FAMILY_ORDER}")
+    if family == "sine":
+        return NamedParameterization(
+            f"sine_m{m}", f"Sine family, m = {m}", "36", m * sp.sin(PHI / m),
+            f"p_prime = sqrt(1 - p**2/{m ** 2})",
+        )
+    if family == "tangent":
+        return NamedParameterization(
+            f"tangent_m{m}", f"Tangent family, m = {m}", "36", m * sp.tan(PHI / m),
+            f"p_prime = 1 + p**2/{m ** 2}",
+        )
+    return NamedParameterization(
+        f"cayley_m{m}", f"Cayley vector of order {m}", "101", sp.tan(PHI / (2 * m)), None
+    )
+
+
+def lookup(identifier: str) -> NamedParameterization:
+    """The named parameterization ``identifier`` (raises :class:`UnknownName`)."""
+    if identifier in _FIXED:
+        return _FIXED[identifier]
+    match = _FAMILY.match(identifier)
+    if match and len(match.group(2)) <= 4:
+        return family_member(match.group(1), int(match.group(2)))
+    known = ", ".join([*_FIXED, "sine_mN", "tangent_mN", "cayley_mN"])
+    raise UnknownName(f"unknown parameterization '{identifier[:60]}' (known: {known})")
+
+
+def is_identifier(text: str) -> bool:
+    return text in _FIXED or bool(_FAMILY.match(text))
+
+
+def find_by_expression(expr: sp.Expr) -> NamedParameterization | None:
+    """The registry entry whose p(φ) is structurally ``expr`` (fixed entries and m ≤ 12)."""
+    candidates = [*_FIXED.values()] + [
+        family_member(f, m) for f in ("sine", "tangent", "cayley") for m in range(1, 13)
+    ]
+    for entry in candidates:
+        if entry.expression == expr:
+            return entry
+    return None

@@ -1,0 +1,132 @@
+"""Bounded simplification: present derived scalar functions in their simplest form.
+
+``sympy.simplify`` can run for minutes on these expressions. The strategy here cannot:
+
+1. *Base-angle reduction.* Every trigonometric argument that is a rational multiple of φ is
+   written as n·θ with θ = φ/L (L the lcm of the denominators), expanded to polynomials in
+   s = sin θ, c = cos θ, and numerator and denominator are reduced modulo s² + c² − 1 before
+   cancelling. Non-trigonometric functions (e.g. the real cube root of eq 35) become opaque
+   symbols so that powers of them cancel. This is plain polynomial algebra.
+2. A time-bounded ``trigsimp`` of the candidates, which contracts 2cos²θ − 1 into cos 2θ.
+
+The shortest candidate (by operation count, then by printed length) wins; every step has a
+time bound and falls back to the unsimplified input, which is always correct.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache, reduce
+from math import lcm
+
+import sympy as sp
+
+from .parsing import PHI
+from .timeouts import bounded
+
+_TRIG = (sp.sin, sp.cos, sp.tan)
+
+
+def _vanishing_denominators(expr: sp.Expr) -> int:
+    """Number of divisors that vanish at φ = 0: each hides a 0/0 form from the reader."""
+    count = 0
+    for power in expr.atoms(sp.Pow):
+        if power.exp.is_negative and power.base.has(PHI):
+            at_zero: sp.Expr | None = bounded(0.2, None, power.base.subs, PHI, 0)
+            count += bool(at_zero is not None and at_zero.is_zero)
+    return count
+
+
+def complexity(expr: sp.Expr) -> tuple[int, int, int]:
+    """Ranking key: size, with sums and hidden 0/0 quotients penalised, then printed length."""
+    sums = sum(1 for node in sp.preorder_traversal(expr) if isinstance(node, sp.Add))
+    size = int(sp.count_ops(expr, visual=False)) + sums + 3 * _vanishing_denominators(expr)
+    return (size, sums, len(str(expr)))
+
+
+def _trig_multiples(expr: sp.Expr) -> list[sp.Rational] | None:
+    """Rational multiples k with trig(k φ) in expr, or None if some argument is not of that form."""
+    multiples = []
+    for atom in expr.atoms(*_TRIG):
+        k = sp.simplify(atom.args[0] / PHI) if atom.args[0].has(PHI) else None
+        if k is None or not k.is_Rational:
+            return None
+        multiples.append(sp.Rational(k))
+    return multiples
+
+
+def base_angle_reduction(expr: sp.Expr) -> sp.Expr | None:
+    """Reduce a rational function of φ and trig(kφ) modulo sin² + cos² = 1 (see module doc)."""
+    opaque: dict[sp.Expr, sp.Symbol] = {}
+    for function in sorted(expr.atoms(sp.Function), key=sp.default_sort_key):
+        if not isinstance(function, _TRIG) and function.has(PHI):
+            opaque[function] = sp.Dummy("f")
+    # Powers with symbolic bases and fractional exponents are opaque too (e.g. sqrt(1 - p^2)).
+    for power in sorted(expr.atoms(sp.Pow), key=sp.default_sort_key):
+        if power.has(PHI) and not power.exp.is_Integer and power not in opaque:
+            opaque[power] = sp.Dummy("r")
+    hidden = expr.xreplace(opaque)
+    multiples = _trig_multiples(hidden)
+    if multiples is None:
+        return None
+    if not multiples:
+        reduced = sp.cancel(sp.together(hidden))
+        return reduced.xreplace({v: k for k, v in opaque.items()})
+    denominator = reduce(lcm, (k.q for k in multiples), 1)
+    theta = sp.Dummy("theta")
+    s, c = sp.Dummy("s"), sp.Dummy("c")
+
+    def expand(atom: sp.Expr) -> sp.Expr:
+        n = int(sp.Rational(atom.args[0] / PHI) * denominator)
+        sin_n = sp.expand_trig(sp.sin(n * theta)).subs({sp.sin(theta): s, sp.cos(theta): c})
+        cos_n = sp.expand_trig(sp.cos(n * theta)).subs({sp.sin(theta): s, sp.cos(theta): c})
+        if isinstance(atom, sp.sin):
+            return sin_n
+        if isinstance(atom, sp.cos):
+            return cos_n
+        return sin_n / cos_n
+
+    polynomial_form = hidden.xreplace({atom: expand(atom) for atom in hidden.atoms(*_TRIG)})
+    numerator, denom = sp.fraction(sp.together(polynomial_form))
+    relation = s**2 + c**2 - 1
+    best: sp.Expr | None = None
+    for order in ((s, c), (c, s)):
+        others = sorted(numerator.free_symbols | denom.free_symbols - {s, c}, key=sp.default_sort_key)
+        gens = [*order, *others]
+        gens = list(dict.fromkeys(gens))
+        num_r = sp.reduced(sp.expand(numerator), [relation], *gens, order="lex")[1]
+        den_r = sp.reduced(sp.expand(denom), [relation], *gens, order="lex")[1]
+        candidate = sp.factor(sp.cancel(num_r / den_r))
+        if best is None or complexity(candidate) < complexity(best):
+            best = candidate
+    assert best is not None
+    back = {s: sp.sin(PHI / denominator), c: sp.cos(PHI / denominator)}
+    result = best.xreplace(back).xreplace({v: k for k, v in opaque.items()})
+    return result
+
+
+def contract_sums(expr: sp.Expr, seconds: float) -> sp.Expr:
+    """trigsimp each trigonometric sum factor separately (small inputs keep it fast)."""
+    factors = sp.Mul.make_args(sp.factor_terms(expr))
+    out = []
+    for factor in factors:
+        base, exponent = factor.as_base_exp()
+        if isinstance(base, sp.Add) and base.has(*_TRIG):
+            base = bounded(seconds, base, sp.trigsimp, base)
+        out.append(base**exponent)
+    return sp.Mul(*out)
+
+
+@lru_cache(maxsize=4096)
+def simplest(expr: sp.Expr, seconds: float = 0.5) -> sp.Expr:
+    """The simplest equivalent form of ``expr`` that bounded strategies find (cached)."""
+    expr = sp.sympify(expr)
+    if expr.is_Number:
+        return expr
+    candidates = [expr]
+    reduced: sp.Expr | None = bounded(seconds, None, base_angle_reduction, expr)
+    if reduced is not None:
+        candidates.append(reduced)
+    for candidate in list(candidates):
+        contracted: sp.Expr = bounded(seconds, candidate, contract_sums, candidate, seconds)
+        candidates.append(contracted)
+    return min(candidates, key=complexity)
