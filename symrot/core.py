@@ -30,6 +30,8 @@ from .validation import ValidatedFunction, evaluate, validate
 SCALAR_NAMES = ("p_prime", "nu", "epsilon", "mu", "det_H")
 TENSOR_NAMES = ("R", "H", "H_inverse", "G", "K")
 TENSOR_EQUATIONS = {"R": "14", "H": "22", "H_inverse": "26", "G": "81", "K": "83"}
+CONSTANT_ORDER = 24
+CONSTANT_CHECK_ANGLES = ("0.213", "0.577", "0.911", "1.307")
 SCALAR_EQUATIONS = {"p_prime": "21", "nu": "15", "epsilon": "16", "mu": "21", "det_H": "24"}
 
 
@@ -77,6 +79,7 @@ class Derivation:
     scalars: dict[str, sp.Expr]
     tensors: dict[str, Tensor]
     _series_cache: dict[tuple[str, int], list[sp.Expr]] = field(default_factory=dict, repr=False)
+    _constants: dict[str, sp.Expr | None] = field(default_factory=dict, repr=False)
 
     @property
     def p(self) -> sp.Expr:
@@ -126,6 +129,33 @@ class Derivation:
                 raise InvalidGeneratingFunction(f"coefficient {name} is not even in phi")
             self._series_cache[key] = compose_even_in_x(in_phi, self.phi_of_p(order), n_terms)
         return self._series_cache[key]
+
+    def constant_value(self, name: str) -> sp.Expr | None:
+        """The constant c if coefficient ``name`` is identically c, else None.
+
+        Detected before any series/limit work (SymPy's ``series`` hangs on identically zero
+        inputs such as (1/ε − 1/μ)/p² for 2 sin(φ/2)): either the bounded simplification already
+        returned a number, or the exact Taylor series is constant through φ^(CONSTANT_ORDER−1)
+        *and* the closed form equals that constant to 45 digits at four angles.
+        """
+        if name not in self._constants:
+            self._constants[name] = self._find_constant(name)
+        return self._constants[name]
+
+    def _find_constant(self, name: str) -> sp.Expr | None:
+        simplified = self.simplified_coefficients()[name]
+        if simplified.is_Number:
+            return simplified
+        in_phi = self.taylor_in_phi(name, CONSTANT_ORDER)
+        if any(c != 0 for c in in_phi[1:]):
+            return None
+        constant = in_phi[0]
+        tolerance = mpmath.mpf(10) ** -45
+        for angle in CONSTANT_CHECK_ANGLES:
+            value = self.evaluate(name, angle)
+            if abs(value - mpmath.mpf(sp.N(constant, 60))) > tolerance * max(1, abs(value)):
+                return None
+        return constant
 
     # -- numeric evaluation -------------------------------------------------------------------
     def evaluate(self, name: str, angle: mpmath.mpf | str, digits: int = 50) -> mpmath.mpf:

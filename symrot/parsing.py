@@ -5,8 +5,9 @@ by :func:`ast.parse` (which only builds a tree), every node is checked against a
 the SymPy expression is built directly from the checked tree. Caps on length, depth, node count,
 literal size and exponents keep both parsing and SymPy's automatic evaluation fast.
 
-Grammar: numbers, ``phi`` (or ``φ``), ``pi`` (or ``π``), ``+ - * / **`` (``^`` is accepted as
-``**``), parentheses, and calls of one argument to the functions in :data:`FUNCTIONS`.
+Grammar: numbers, ``phi`` (or ``φ``), ``pi`` (or ``π``), ``+ - * / **`` (``^`` is accepted
+as ``**``, with the same precedence), parentheses, and calls of one argument to the
+functions in :data:`FUNCTIONS`.
 ``cbrt`` is the real (odd) cube root, see :mod:`symrot.functions`.
 """
 
@@ -53,7 +54,7 @@ FUNCTIONS: dict[str, Callable[[sp.Expr], sp.Expr]] = {
 
 _VARIABLES = {"phi": PHI, "φ": PHI}
 _CONSTANTS = {"pi": sp.pi, "π": sp.pi}
-_BINARY = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.BitXor)
+_BINARY = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow)
 
 
 def parse_expression(text: object) -> sp.Expr:
@@ -69,6 +70,9 @@ def parse_expression(text: object) -> sp.Expr:
         raise ParseError("expression is empty")
     if "\n" in stripped or "\r" in stripped or ";" in stripped:
         raise ParseError("expression must be a single line with a single expression")
+    # '^' means power with the precedence of '**' (Python's XOR would bind looser than '+').
+    # No string literals are allowed, so a textual replacement cannot change a literal.
+    stripped = stripped.replace("^", "**")
     depth = _bracket_depth(stripped)
     if depth > MAX_DEPTH:
         raise ParseError(f"expression is nested too deeply (depth {depth}, at most {MAX_DEPTH})")
@@ -134,6 +138,9 @@ class _Builder:
             return sp.Integer(value)
         if any(ch in literal for ch in "jJ"):
             raise ParseError("complex literals are not allowed")
+        _, _, exponent = literal.lower().replace("_", "").partition("e")
+        if exponent and (not exponent.lstrip("+-").isdigit() or abs(int(exponent)) > 400):
+            raise ParseError(f"number literal {literal[:40]!r} is out of range")
         try:
             exact = Fraction(literal.replace("_", ""))
         except (ValueError, ZeroDivisionError):

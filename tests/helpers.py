@@ -1,0 +1,40 @@
+"""Shared test helpers: 50-digit numeric evaluation of derived quantities."""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Callable
+
+import mpmath
+import sympy as sp
+
+from symrot.axial import AxialTensor
+from symrot.functions import mpmath_namespace
+from symrot.parsing import PHI
+
+DIGITS = 50
+
+
+def mp_function(expr: sp.Expr) -> Callable[[mpmath.mpf], mpmath.mpf]:
+    """``expr`` (in φ) as an mpmath function."""
+    return sp.lambdify(PHI, expr, modules=[mpmath_namespace(), "mpmath"])
+
+
+def skew(v: mpmath.matrix) -> mpmath.matrix:
+    return mpmath.matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def axial_matrix(tensor: AxialTensor, angle: mpmath.mpf, axis: mpmath.matrix) -> mpmath.matrix:
+    """a I + b (u×) + c (u×)² at φ = angle, u = axis (unit), at working precision."""
+    a, b, c = (mp_function(e)(angle) for e in (tensor.a, tensor.b, tensor.c))
+    u = skew(axis)
+    return a * mpmath.eye(3) + b * u + c * u * u
+
+
+def random_axis(rng: random.Random) -> mpmath.matrix:
+    v = mpmath.matrix([mpmath.mpf(rng.gauss(0, 1)) for _ in range(3)])
+    return v / mpmath.norm(v)
+
+
+def max_abs(m: mpmath.matrix) -> mpmath.mpf:
+    return max(abs(m[i, j]) for i in range(m.rows) for j in range(m.cols))

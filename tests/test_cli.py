@@ -1,0 +1,77 @@
+"""The command line: outputs, JSON contract, errors without tracebacks, wall-clock bounds."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+
+import pytest
+
+from symrot.cli import main
+
+
+def run_cli(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "symrot", *args], capture_output=True,
+                          text=True, timeout=timeout, check=False)
+
+
+def test_derive_eq_35_shows_det_h_one_within_five_seconds() -> None:
+    started = time.monotonic()
+    result = run_cli("derive", "cbrt(6*(phi-sin(phi)))")
+    elapsed = time.monotonic() - started
+    assert result.returncode == 0, result.stderr
+    assert "det H    (eq 24) = 1" in result.stdout
+    assert "det_h_one" in result.stdout
+    assert elapsed < 5.0
+
+
+def test_json_contract() -> None:
+    result = run_cli("derive", "4*tan(phi/4)", "--json")
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    for key in ("expression", "kappa", "p_prime", "nu", "epsilon", "mu", "det_H", "R", "H",
+                "H_inverse", "series"):
+        assert key in data
+    assert data["nu"] == "cos(phi/4)**2"
+    assert data["kappa"] == "1"
+    assert data["H"] == {"I": "cos(phi/4)**2", "px": "cos(phi/4)**4/2", "px2": "cos(phi/4)**4/8"}
+    assert data["series"]["H_2"][:3] == ["1/8", "-1/64", "3/2048"]
+    assert data["name"] == "wiener_milenkovic"
+
+
+def test_registry_name_and_normalization(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["derive", "cayley_m2", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["kappa"] == "1/4" and data["expression"] == "tan(phi/4)"
+    assert main(["derive", "tan(phi/4)", "--normalize", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["expression"] == "4*tan(phi/4)" and data["kappa"] == "1"
+    assert data["name"] == "wiener_milenkovic" and data["normalized"] is True
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["derive", "cos(phi)"], "p(0) must be 0"),
+        (["derive", "sqrt(phi)"], "not real-analytic"),
+        (["derive", "__import__('os').system('true')"], "cannot be called"),
+        (["derive", "x + phi"], "unknown name 'x'"),
+        (["derive", "nonexistent_m0"], "unknown name"),
+        (["derive", "phi**3"], "kappa"),
+        (["derive", "(" * 100 + "phi" + ")" * 100], "nested too deeply"),
+    ],
+)
+def test_bad_input_gives_one_line_and_exit_two(args: list[str], message: str) -> None:
+    result = run_cli(*args, timeout=10)
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("symrot: error:") and message in lines[0]
+
+
+def test_usage_errors_exit_two() -> None:
+    result = run_cli("derive")
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert run_cli("frobnicate").returncode == 2

@@ -1,0 +1,176 @@
+"""Safe parsing: valid expressions build the right SymPy tree; hostile input executes nothing."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import pytest
+import sympy as sp
+
+from symrot.errors import ParseError
+from symrot.functions import RealCbrt
+from symrot.parsing import PHI, parse_expression
+
+VALID = {
+    "cbrt(6*(phi-sin(phi)))": RealCbrt(6 * PHI - 6 * sp.sin(PHI)),
+    "4*tan(φ/4)": 4 * sp.tan(PHI / 4),
+    "2 * sin(phi / 2)": 2 * sp.sin(PHI / 2),
+    "phi^3 + phi": PHI**3 + PHI,
+    "phi^2*3": 3 * PHI**2,
+    "0.5*phi": PHI / 2,
+    "1e-3*phi": PHI / 1000,
+    "-(-phi)": PHI,
+    "sin(pi*phi)/pi": sp.sin(sp.pi * PHI) / sp.pi,
+    "atanh(phi/2)*2": 2 * sp.atanh(PHI / 2),
+    "phi**(1/3)": PHI ** sp.Rational(1, 3),
+    "sqrt(1+phi**2)*phi": sp.sqrt(1 + PHI**2) * PHI,
+    "  phi  ": PHI,
+}
+
+HOSTILE = [
+    "__import__('os').system('echo pwned')",
+    "__import__('subprocess').call(['true'])",
+    "eval('1+1')",
+    "exec('import os')",
+    "open('/etc/passwd')",
+    "compile('1', 'f', 'eval')",
+    "globals()",
+    "locals()",
+    "vars()",
+    "getattr(phi, 'func')",
+    "phi.func",
+    "phi.__class__",
+    "().__class__.__bases__[0].__subclasses__()",
+    "sin.__call__(phi)",
+    "sympy.sin(phi)",
+    "Symbol('x')",
+    "lambda: 1",
+    "(lambda x: x)(phi)",
+    "[phi]",
+    "(phi, phi)",
+    "{phi}",
+    "{1: phi}",
+    "[x for x in range(10**9)]",
+    "phi[0]",
+    "phi if phi else 1",
+    "phi < 1",
+    "not phi",
+    "phi and 1",
+    "phi or 1",
+    "phi % 2",
+    "phi // 2",
+    "phi @ phi",
+    "phi << 2",
+    "~phi",
+    "(x := 1)",
+    "f'{phi}'",
+    "'string'",
+    "b'bytes'",
+    "None",
+    "True * phi",
+    "...",
+    "1j * phi",
+    "x",
+    "e * phi",
+    "sin",
+    "sin()",
+    "sin(phi, 2)",
+    "sin(x=phi)",
+    "sin(*[phi])",
+    "sin(**{})",
+    "import os",
+    "phi; import os",
+    "phi\nimport os",
+    "await phi",
+    "yield phi",
+    "",
+    "   ",
+    "\x00phi",
+    "2**2**2**2**2",
+    "phi**10**100",
+    "phi**(10**6)",
+    "phi**phi",
+    "phi**sqrt(2)",
+    "9" * 5000,
+    "1" * 40 + "*phi",
+    "1e999999 * phi",
+    "1e99999999999 * phi",
+    "(" * 300 + "phi" + ")" * 300,
+    "sin(" * 100 + "phi" + ")" * 100,
+    "-" * 5000 + "phi",
+    "+".join(["phi"] * 500),
+    "1/0",
+    "phi/0",
+    "(-8)**(1/3)",
+    "0**-1",
+    "exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(phi))))))))))))))))))))))))))))))))))",
+    "ᵖʰⁱ.__class__",
+    "φ.__class__.__mro__",
+    "breakpoint()",
+    "help()",
+    "quit()",
+    "print(phi)",
+    "__builtins__",
+    "phi.evalf(10**9)",
+]
+
+
+def test_corpus_has_at_least_fifty_hostile_inputs() -> None:
+    assert len(HOSTILE) >= 50
+
+
+@pytest.mark.parametrize("text, expected", list(VALID.items()))
+def test_valid_expressions(text: str, expected: sp.Expr) -> None:
+    assert parse_expression(text) == expected
+
+
+class _AuditRecorder:
+    """Records audit events that would mean user text was executed or reached the OS."""
+
+    FORBIDDEN = ("exec", "import", "os.system", "subprocess.Popen", "open", "builtins.input",
+                 "os.exec", "os.posix_spawn", "ctypes.dlopen", "socket.connect")
+
+    def __init__(self) -> None:
+        self.active = False
+        self.events: list[str] = []
+
+    def __call__(self, event: str, args: tuple[object, ...]) -> None:
+        if self.active and event.startswith(self.FORBIDDEN):
+            self.events.append(event)
+
+
+_RECORDER = _AuditRecorder()
+sys.addaudithook(_RECORDER)
+
+
+@pytest.mark.parametrize("text", HOSTILE, ids=[repr(t)[:40] for t in HOSTILE])
+def test_hostile_input_is_rejected_quickly_and_executes_nothing(text: str) -> None:
+    _RECORDER.events.clear()
+    started = time.monotonic()
+    _RECORDER.active = True
+    try:
+        with pytest.raises(ParseError) as info:
+            parse_expression(text)
+    finally:
+        _RECORDER.active = False
+    assert time.monotonic() - started < 2.0
+    assert _RECORDER.events == []
+    message = str(info.value)
+    assert message and "\n" not in message and "Traceback" not in message
+
+
+def test_non_string_input_is_rejected() -> None:
+    with pytest.raises(ParseError):
+        parse_expression(42)
+
+
+def test_cbrt_is_the_real_odd_cube_root() -> None:
+    expr = parse_expression("cbrt(phi)")
+    assert expr.subs(PHI, -8) == -2
+    assert sp.N(expr.subs(PHI, sp.Rational(-27, 1000))) == pytest.approx(-0.3)
+    assert parse_expression("cbrt(-phi)") == -parse_expression("cbrt(phi)")
+    assert sp.diff(expr, PHI) == sp.Rational(1, 3) / RealCbrt(PHI) ** 2
+    assert str(parse_expression("cbrt(6*(phi-sin(phi)))")) == "cbrt(6*phi - 6*sin(phi))"
+    # Printed form parses back to the same expression.
+    assert parse_expression(str(expr)) == expr
