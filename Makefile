@@ -29,7 +29,7 @@ setup-python: ## pip install symrot in editable mode with its dev extras
 test: lint typecheck pytest check-generated ## ruff, mypy, the test suite and the generated-code check
 
 lint: ## ruff over the package, tests and benchmarks
-	$(PYTHON) -m ruff check symrot tests bench
+	$(PYTHON) -m ruff check $(wildcard symrot tests bench)
 
 typecheck: ## mypy over the package
 	$(PYTHON) -m mypy
