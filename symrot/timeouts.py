@@ -3,6 +3,9 @@
 SymPy is pure Python, so a SIGALRM raised through ``signal.setitimer`` interrupts it cleanly.
 Signals only work in the main thread of the main interpreter; elsewhere the bound cannot be
 enforced and :func:`time_limit` runs the body unbounded (documented, never silently wrong).
+
+Limits nest: an inner limit never extends an outer one, and each limit's :class:`SymrotTimeout`
+carries a marker so that :func:`bounded` absorbs only its own expiry, never an outer one.
 """
 
 from __future__ import annotations
@@ -24,25 +27,22 @@ def _can_use_signals() -> bool:
 
 
 @contextmanager
-def time_limit(seconds: float, what: str = "symbolic step") -> Iterator[None]:
-    """Raise :class:`SymrotTimeout` if the body runs longer than ``seconds``.
-
-    Nested limits are honoured: the inner limit never extends an outer one.
-    """
+def time_limit(seconds: float, what: str = "symbolic step", marker: object = None) -> Iterator[None]:
+    """Raise :class:`SymrotTimeout` (with ``.marker``) if the body runs longer than ``seconds``."""
     if not _can_use_signals() or seconds <= 0:
         yield
         return
+    outer_remaining, _ = signal.getitimer(signal.ITIMER_REAL)
+    if outer_remaining and outer_remaining <= seconds:
+        yield  # the outer limit expires first and is reported as the outer one
+        return
 
     def _on_alarm(signum: int, frame: object) -> None:
-        raise SymrotTimeout(f"{what} took longer than {seconds:g} s")
+        error = SymrotTimeout(f"{what} took longer than {seconds:g} s")
+        error.marker = marker  # type: ignore[attr-defined]
+        raise error
 
-    outer_remaining, _ = signal.getitimer(signal.ITIMER_REAL)
     previous = signal.signal(signal.SIGALRM, _on_alarm)
-    if outer_remaining and outer_remaining < seconds:
-        # The outer bound fires first and keeps its own handler semantics.
-        signal.signal(signal.SIGALRM, previous)
-        yield
-        return
     started = time.monotonic()
     signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
@@ -51,7 +51,6 @@ def time_limit(seconds: float, what: str = "symbolic step") -> Iterator[None]:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
         if outer_remaining:
-            # Re-arm the outer timer with what is left of it (never less than a tick).
             elapsed = time.monotonic() - started
             signal.setitimer(signal.ITIMER_REAL, max(outer_remaining - elapsed, 1e-3))
 
@@ -59,12 +58,16 @@ def time_limit(seconds: float, what: str = "symbolic step") -> Iterator[None]:
 def bounded(seconds: float, fallback: T, func: Callable[..., T], *args: Any) -> T:
     """Return ``func(*args)`` if it finishes within ``seconds``, else ``fallback``.
 
-    Used for optional simplification: a slow simplify never blocks a derivation.
+    Used for optional work such as simplification: a slow simplify never blocks a derivation,
+    while an enclosing limit that expires meanwhile still propagates.
     """
+    marker = object()
     try:
-        with time_limit(seconds, "simplification"):
+        with time_limit(seconds, "simplification", marker):
             return func(*args)
-    except SymrotTimeout:
-        return fallback
+    except SymrotTimeout as exc:
+        if getattr(exc, "marker", None) is marker:
+            return fallback
+        raise
     except RecursionError:
         return fallback

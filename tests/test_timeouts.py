@@ -1,0 +1,40 @@
+"""Time bounds: inner limits fall back, outer limits always propagate."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from symrot.errors import SymrotTimeout
+from symrot.timeouts import bounded, time_limit
+
+
+def spin(seconds: float) -> str:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        pass
+    return "finished"
+
+
+def test_bounded_returns_fallback_when_slow() -> None:
+    started = time.monotonic()
+    assert bounded(0.05, "fallback", spin, 5) == "fallback"
+    assert time.monotonic() - started < 1
+
+
+def test_bounded_returns_result_when_fast() -> None:
+    assert bounded(1, "fallback", spin, 0.001) == "finished"
+
+
+def test_outer_limit_is_not_swallowed_by_inner_bounded() -> None:
+    started = time.monotonic()
+    with pytest.raises(SymrotTimeout, match="outer"), time_limit(0.1, "outer"):
+        bounded(5, "fallback", spin, 5)
+    assert time.monotonic() - started < 1
+
+
+def test_outer_limit_is_rearmed_after_an_inner_one() -> None:
+    with pytest.raises(SymrotTimeout, match="outer"), time_limit(0.3, "outer"):
+        assert bounded(0.05, "fallback", spin, 1) == "fallback"
+        spin(2)
