@@ -58,7 +58,7 @@ class RealCbrt(sp.Function):
         if value is None or not value.is_Number or not value.is_extended_real:
             return None
         with mpmath.workprec(prec):
-            return sp.Float(mpmath.cbrt(value._to_mpmath(prec)), precision=prec)
+            return sp.Float(real_cbrt(value._to_mpmath(prec)), precision=prec)
 
     def _eval_rewrite_as_Pow(self, arg: sp.Expr, **kwargs: Any) -> sp.Expr:
         return sp.sign(arg) * sp.Abs(arg) ** sp.Rational(1, 3)
@@ -70,6 +70,11 @@ class RealCbrt(sp.Function):
         return r"\sqrt[3]{%s}" % printer._print(self.args[0])
 
 
+def real_cbrt(x: Any) -> Any:
+    """Real cube root in mpmath (``mpmath.cbrt`` is the complex principal root for x < 0)."""
+    return mpmath.sign(x) * mpmath.cbrt(abs(x))
+
+
 def mpmath_namespace() -> dict[str, Any]:
     """Names for ``sympy.lambdify(..., modules=[mpmath_namespace(), 'mpmath'])``."""
-    return {"RealCbrt": mpmath.cbrt}
+    return {"RealCbrt": real_cbrt}

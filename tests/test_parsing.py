@@ -174,3 +174,13 @@ def test_cbrt_is_the_real_odd_cube_root() -> None:
     assert str(parse_expression("cbrt(6*(phi-sin(phi)))")) == "cbrt(6*phi - 6*sin(phi))"
     # Printed form parses back to the same expression.
     assert parse_expression(str(expr)) == expr
+
+
+def test_real_cube_root_in_mpmath_evaluation() -> None:
+    import mpmath
+
+    from symrot.functions import mpmath_namespace
+
+    f = sp.lambdify(PHI, RealCbrt(PHI), modules=[mpmath_namespace(), "mpmath"])
+    assert f(mpmath.mpf(-8)) == -2
+    assert sp.N(RealCbrt(PHI).subs(PHI, sp.Float(-27)), 30) == -3
