@@ -11,10 +11,12 @@ help: ## List the targets with what they do
 
 setup: setup-system setup-python ## Install everything the tests need (Debian packages and Python dev extras)
 
-setup-system: ## Install gcc, clang, a TeX engine and poppler from Debian when missing (needs root)
+setup-system: ## Install gcc, clang (+ sanitizer runtime), Eigen (bench peer), a TeX engine and poppler from Debian when missing (needs root)
 	@missing=""; \
 	command -v gcc >/dev/null || missing="$$missing gcc"; \
 	command -v clang >/dev/null || missing="$$missing clang"; \
+	test -f "$$(clang -print-file-name=libclang_rt.asan-x86_64.a 2>/dev/null)" || missing="$$missing libclang-rt-dev"; \
+	test -f /usr/include/eigen3/Eigen/Geometry || missing="$$missing libeigen3-dev"; \
 	command -v pdflatex >/dev/null || missing="$$missing texlive-latex-base texlive-latex-recommended texlive-latex-extra"; \
 	command -v pdftotext >/dev/null || missing="$$missing poppler-utils"; \
 	if [ -n "$$missing" ]; then \

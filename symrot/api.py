@@ -77,6 +77,7 @@ class DerivationResult:
             tensor = d.tensors[name]
             out[name] = dict(zip(COEFFICIENT_KEYS, map(str, tensor.simplified), strict=True))
         out["canonical"] = {name: _canonical_dict(d.tensors[name]) for name in TENSOR_NAMES}
+        out["validity"] = validity_dict(self.derivation)
         out["series"] = {
             name: [str(c) for c in d.series_in_x(name, series_terms)]
             for name in d.coefficient_expressions()
@@ -87,6 +88,24 @@ class DerivationResult:
         from .backends.latex import derivation_display
 
         return derivation_display(self)
+
+
+def validity_dict(derivation: Derivation) -> dict[str, Any]:
+    """The validity range and singular angles (Section 3.4) as JSON-ready data."""
+    from .singularities import validity
+
+    result = validity(derivation)
+    return {
+        "phi_max": str(result.phi_max),
+        "phi_max_float": result.phi_max_float,
+        "p_max_float": result.p_max_float,
+        "numeric_only": result.numeric_only,
+        "singularities": [
+            {"phi": str(s.phi), "phi_float": s.phi_float, "cause": s.cause,
+             "quantity": s.quantity, "limit": s.limit}
+            for s in result.singularities
+        ],
+    }
 
 
 def _canonical_dict(tensor: Tensor) -> dict[str, str]:

@@ -66,9 +66,6 @@ class RealCbrt(sp.Function):
     def _sympystr(self, printer: Any) -> str:
         return f"cbrt({printer._print(self.args[0])})"
 
-    def _latex(self, printer: Any) -> str:
-        return r"\sqrt[3]{%s}" % printer._print(self.args[0])
-
 
 def real_cbrt(x: Any) -> Any:
     """Real cube root in mpmath (``mpmath.cbrt`` is the complex principal root for x < 0)."""

@@ -19,25 +19,51 @@ from pathlib import Path
 from .api import derive
 from .registry import NAMED
 
-Producer = Callable[[], dict[str, str]]
+Producer = Callable[[], dict[str, str | bytes]]
+Content = str | bytes
 
 
-def derivation_json() -> dict[str, str]:
+def derivation_json() -> dict[str, str | bytes]:
     """generated/derivations/NAME.json: ``symrot derive NAME --json`` for each named entry."""
-    out = {}
+    out: dict[str, str | bytes] = {}
     for name in NAMED:
         data = derive(name).to_dict(series_terms=8)
         out[f"derivations/{name}.json"] = json.dumps(data, indent=2, sort_keys=True) + "\n"
     return out
 
 
+def latex_documents() -> dict[str, str | bytes]:
+    """generated/latex/: Table 1 and the derivation sheets of the named parameterizations,
+    each as a fragment (NAME.tex) and a complete document (NAME_standalone.tex)."""
+    from .backends.latex import sheet, standalone, table
+    from .registry import PAPER_TABLE_1_VALIDITY, TABLE_1
+
+    out: dict[str, str | bytes] = {}
+    rows = table([derive(name) for name in TABLE_1], (), PAPER_TABLE_1_VALIDITY)
+    out["latex/table1.tex"] = rows
+    out["latex/table1_standalone.tex"] = standalone(rows, landscape=True)
+    for name in NAMED:
+        body = sheet(derive(name))
+        out[f"latex/{name}.tex"] = body
+        out[f"latex/{name}_standalone.tex"] = standalone(body)
+    return out
+
+
+def figures() -> dict[str, str | bytes]:
+    """generated/figures/: the paper's Figures 1–4, as PDF (for papers) and PNG."""
+    from .backends.figures import FIGURES
+    from .backends.figures import render as render_figure
+
+    return {f"figures/figure{n}.{fmt}": render_figure(n, fmt) for n in FIGURES for fmt in ("pdf", "png")}
+
+
 def producers() -> list[tuple[str, Producer]]:
     """All producers, by the path prefix they own. Backends add theirs here."""
-    return [("derivations/", derivation_json)]
+    return [("derivations/", derivation_json), ("latex/", latex_documents), ("figures/", figures)]
 
 
-def render(only: str | None = None) -> dict[str, str]:
-    files: dict[str, str] = {}
+def render(only: str | None = None) -> dict[str, Content]:
+    files: dict[str, Content] = {}
     for prefix, producer in producers():
         if only and not prefix.startswith(only):
             continue
@@ -54,23 +80,34 @@ def owned(root: Path, prefixes: Iterable[str]) -> set[str]:
     return found
 
 
-def write(root: Path, files: dict[str, str], prefixes: list[str]) -> None:
+def _encode(content: Content) -> bytes:
+    return content.encode("utf-8") if isinstance(content, str) else content
+
+
+def write(root: Path, files: dict[str, Content], prefixes: list[str]) -> None:
     for stale in owned(root, prefixes) - set(files):
         (root / stale).unlink()
-    for relative, text in files.items():
+    for relative, content in files.items():
         path = root / relative
         path.parent.mkdir(parents=True, exist_ok=True)
-        if not path.exists() or path.read_text(encoding="utf-8") != text:
-            path.write_text(text, encoding="utf-8")
+        data = _encode(content)
+        if not path.exists() or path.read_bytes() != data:
+            path.write_bytes(data)
 
 
-def check(root: Path, files: dict[str, str], prefixes: list[str]) -> list[str]:
+def check(root: Path, files: dict[str, Content], prefixes: list[str]) -> list[str]:
     """Unified diffs between ``root`` and what would be generated (empty when current)."""
     diffs = []
     for relative in sorted(owned(root, prefixes) | set(files)):
         path = root / relative
-        old = path.read_text(encoding="utf-8") if path.exists() else ""
-        new = files.get(relative, "")
+        old_bytes = path.read_bytes() if path.exists() else b""
+        new_content = files.get(relative, "")
+        if old_bytes == _encode(new_content):
+            continue
+        if isinstance(new_content, bytes):
+            diffs.append(f"{relative}: binary content differs\n")
+            continue
+        old, new = old_bytes.decode("utf-8", "replace"), new_content
         if old != new:
             diffs.append("".join(difflib.unified_diff(
                 old.splitlines(keepends=True), new.splitlines(keepends=True),

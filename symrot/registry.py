@@ -64,6 +64,17 @@ TABLE_1 = (
 )
 """The six rows of the paper's Table 1, in its order."""
 
+PAPER_TABLE_1_VALIDITY = {
+    "rotation_vector": 2 * sp.pi,
+    "cayley_gibbs_rodrigues": sp.pi,
+    "wiener_milenkovic": 2 * sp.pi,
+    "linear": sp.pi,
+    "euler_rodrigues": sp.pi,
+    "sine_m4": 2 * sp.pi,
+}
+"""The validity bound |φ| < … as *printed* in the paper's Table 1 (transcribed, for comparison
+only: symrot's own ranges come from :mod:`symrot.singularities`)."""
+
 NAMED = (*_FIXED, "sine_m4")
 """The named parameterizations that ``make generate`` writes (Table 1 and eq 35)."""
 

@@ -56,6 +56,21 @@ def _series_text(coefficients: list[Any]) -> str:
     return " + ".join(terms) + f" + O(x^{len(coefficients)})" if terms else "0 (identically)"
 
 
+def validity_lines(derivation: Any) -> list[str]:
+    from ..singularities import validity
+
+    result = validity(derivation)
+    if not result.singularities:
+        return ["Validity (Section 3.4): no singular angle in (0, 4 pi]"]
+    p_max = "oo" if result.p_max_float == float("inf") else f"{result.p_max_float:.15g}"
+    lines = [f"Validity (Section 3.4): |phi| < {result.phi_max} = {result.phi_max_float:.15g}, "
+             f"|p| < {p_max}" + ("  (located numerically)" if result.numeric_only else "")]
+    for s in result.singularities:
+        if s.phi_float <= 2 * result.phi_max_float:
+            lines.append(f"  phi = {s.phi}: {s.cause}")
+    return lines
+
+
 def summary(result: DerivationResult, terms: int) -> str:
     d = result.derivation
     lines = []
@@ -79,6 +94,8 @@ def summary(result: DerivationResult, terms: int) -> str:
             lines.append(f"      c{k} = {c}")
         axial, real, imag = tensor.canonical[0, 0], tensor.canonical[1, 1], tensor.canonical[2, 1]
         lines.append(f"      eigenvalues: {axial};  {real} +- i ({imag})")
+    lines.append("")
+    lines.extend(validity_lines(d))
     lines.append("")
     lines.append(f"Leading series in x = |p|^2 (exact, {terms} terms)")
     for name in ("nu", "mu", "det_H", "R_1", "R_2", "H_2", "H_inverse_2"):

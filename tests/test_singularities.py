@@ -1,0 +1,77 @@
+"""Singular angles and validity ranges (Section 3.4, Table 1's last column)."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+import sympy as sp
+
+from symrot.core import derive_expression
+from symrot.parsing import parse_expression
+from symrot.registry import PAPER_TABLE_1_VALIDITY, family_member, lookup
+from symrot.singularities import _validity_of, validity
+
+pi = sp.pi
+EXPECTED = {
+    "cayley_gibbs_rodrigues": (pi, "p"),
+    "wiener_milenkovic": (2 * pi, "p"),
+    "rotation_vector": (2 * pi, "nu"),
+    "euler_rodrigues": (pi, "p_prime"),
+    "linear": (pi / 2, "p_prime"),
+    "sine_m4": (2 * pi, "nu"),
+    "det_h_one": (2 * pi, "nu"),
+    "tangent_m3": (3 * pi / 2, "p"),
+}
+# Families: sine m -> min(m pi/2, 2 pi) (p' = cos(phi/m) -> 0 or nu -> 0);
+# tangent m -> min(m pi/2, 2 pi) (p -> oo or nu -> 0).
+for m in range(1, 7):
+    EXPECTED[f"sine_m{m}"] = (min(sp.Rational(m, 2) * pi, 2 * pi), "p_prime" if m < 4 else "nu")
+    EXPECTED[f"tangent_m{m}"] = (min(sp.Rational(m, 2) * pi, 2 * pi), "p" if m <= 4 else "nu")
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_validity_range(name: str) -> None:
+    result = validity(derive_expression(lookup(name).expression))
+    phi_max, first_cause = EXPECTED[name]
+    assert result.phi_max == phi_max
+    assert not result.numeric_only
+    assert first_cause in {s.quantity for s in result.singularities if s.phi == phi_max}
+
+
+def test_det_h_one_has_det_h_one_throughout() -> None:
+    result = validity(derive_expression(lookup("det_h_one").expression))
+    assert all(s.quantity != "det_H" for s in result.singularities)
+
+
+def test_table_1_differs_only_for_linear_parameters() -> None:
+    differences = {name for name, printed in PAPER_TABLE_1_VALIDITY.items()
+                   if validity(derive_expression(lookup(name).expression)).phi_max != printed}
+    assert differences == {"linear"}
+    linear = validity(derive_expression(lookup("linear").expression))
+    causes = {s.quantity for s in linear.singularities if s.phi == pi / 2}
+    assert causes == {"p_prime", "det_H", "monotonicity"}
+
+
+def test_edge_values() -> None:
+    assert validity(derive_expression(lookup("euler_rodrigues").expression)).p_max_float == pytest.approx(2)
+    assert validity(derive_expression(lookup("wiener_milenkovic").expression)).p_max_float == float("inf")
+    rv = validity(derive_expression(lookup("rotation_vector").expression))
+    assert rv.p_max_float == pytest.approx(2 * 3.141592653589793)
+
+
+def test_non_pi_multiple_is_reported_numerically() -> None:
+    # p = phi (1 + phi^2/10): p' > 0 always; nu -> 0 at 2 pi; det H involves 1/p'.
+    result = validity(derive_expression(parse_expression("atan(phi)*2")))
+    # atan is bounded: p' = 2/(1+phi^2) never vanishes, nu -> 0 at 2 pi.
+    assert result.phi_max == 2 * pi
+
+
+def test_analysis_is_fast() -> None:
+    _validity_of.cache_clear()
+    for name in ("cayley_gibbs_rodrigues", "det_h_one", "tangent_m5", "sine_m3"):
+        d = derive_expression(family_member("tangent", 5).expression if name == "tangent_m5"
+                              else lookup(name).expression)
+        started = time.monotonic()
+        validity(d)
+        assert time.monotonic() - started < 1.5
