@@ -57,8 +57,11 @@ _CONSTANTS = {"pi": sp.pi, "π": sp.pi}
 _BINARY = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow)
 
 
-def parse_expression(text: object) -> sp.Expr:
-    """Parse ``text`` into a SymPy expression in :data:`PHI`, or raise :class:`ParseError`."""
+def parse_expression(text: object, extra_names: dict[str, sp.Expr] | None = None) -> sp.Expr:
+    """Parse ``text`` into a SymPy expression in :data:`PHI`, or raise :class:`ParseError`.
+
+    ``extra_names`` adds identifiers (e.g. ``nu``, ``mu`` in ``symrot solve`` properties).
+    """
     if not isinstance(text, str):
         raise ParseError("expression must be a string")
     if len(text) > MAX_LENGTH:
@@ -84,7 +87,7 @@ def parse_expression(text: object) -> sp.Expr:
     nodes = sum(1 for _ in ast.walk(tree))
     if nodes > MAX_NODES:
         raise ParseError(f"expression is too large ({nodes} syntax nodes, at most {MAX_NODES})")
-    builder = _Builder(stripped)
+    builder = _Builder(stripped, extra_names or {})
     expr = builder.build(tree.body, 0)
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise ParseError("expression evaluates to an infinity or NaN (division by zero?)")
@@ -107,8 +110,9 @@ def _bracket_depth(text: str) -> int:
 class _Builder:
     """Turns a whitelisted AST into SymPy, rejecting everything else with a clear message."""
 
-    def __init__(self, source: str) -> None:
+    def __init__(self, source: str, extra_names: dict[str, sp.Expr]) -> None:
         self.source = source
+        self.extra_names = extra_names
 
     def build(self, node: ast.AST, depth: int) -> sp.Expr:
         if depth > MAX_DEPTH:
@@ -154,9 +158,11 @@ class _Builder:
             return _VARIABLES[node.id]
         if node.id in _CONSTANTS:
             return _CONSTANTS[node.id]
+        if node.id in self.extra_names:
+            return self.extra_names[node.id]
         if node.id in FUNCTIONS:
             raise ParseError(f"function '{node.id}' must be called with one argument")
-        known = ", ".join(sorted(_VARIABLES) + sorted(_CONSTANTS))
+        known = ", ".join(sorted(_VARIABLES) + sorted(_CONSTANTS) + sorted(self.extra_names))
         raise ParseError(f"unknown name '{node.id[:40]}' (allowed names: {known})")
 
     def _binary(self, node: ast.BinOp, depth: int) -> sp.Expr:
@@ -175,7 +181,7 @@ class _Builder:
         return self._power(left, right)
 
     def _power(self, base: sp.Expr, exponent: sp.Expr) -> sp.Expr:
-        if exponent.free_symbols or not exponent.is_Rational:
+        if exponent.has(PHI) or not exponent.is_Rational:
             raise ParseError("exponents must be rational constants such as 2, -1 or 1/3")
         exp_rational = sp.Rational(exponent)
         if abs(exp_rational.p) > MAX_EXPONENT * exp_rational.q:

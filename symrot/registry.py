@@ -88,12 +88,12 @@ def family_member(family: str, m: int) -> NamedParameterization:
     if family == "sine":
         return NamedParameterization(
             f"sine_m{m}", f"Sine family, m = {m}", "36", m * sp.sin(PHI / m),
-            f"p_prime = sqrt(1 - p**2/{m ** 2})",
+            f"mu = 1/sqrt(1 - p**2/{m ** 2})",
         )
     if family == "tangent":
         return NamedParameterization(
             f"tangent_m{m}", f"Tangent family, m = {m}", "36", m * sp.tan(PHI / m),
-            f"p_prime = 1 + p**2/{m ** 2}",
+            f"mu = 1/(1 + p**2/{m ** 2})",
         )
     return NamedParameterization(
         f"cayley_m{m}", f"Cayley vector of order {m}", "101", sp.tan(PHI / (2 * m)), None
@@ -120,7 +120,8 @@ def find_by_expression(expr: sp.Expr) -> NamedParameterization | None:
     candidates = [*_FIXED.values()] + [
         family_member(f, m) for f in ("sine", "tangent", "cayley") for m in range(1, 13)
     ]
+    expanded = sp.expand(expr)
     for entry in candidates:
-        if entry.expression == expr:
+        if entry.expression == expr or sp.expand(entry.expression) == expanded:
             return entry
     return None
