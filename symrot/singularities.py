@@ -11,11 +11,14 @@ Sources of singularity, for 0 < φ ≤ 4π:
 Method (bounded, numeric-first): each scalar function is scanned in double precision on a fine
 grid; sign changes, near-touching zeros (local minima of |f|) and poles (local maxima of |f|)
 are bracketed and polished at 50 digits with mpmath; one-sided values at φ* ± 10⁻²⁰ classify the
-limit. Identically constant functions (e.g. ν for 2 sin(φ/2), det H for eq 35) have no
-singularity. The exact angle is identified by matching the 50-digit root against rational
-multiples of π (denominators ≤ 24, to 25 digits: multiple roots polish to fewer
-digits than simple ones); otherwise it is reported as a Float and ``numeric_only`` is
-set. The validity range is the smallest singular angle.
+limit. Symbolic candidates, each bounded by :func:`symrot.timeouts.bounded`, are bracketed too and
+preferred as exact angles: the poles of p from ``sympy.calculus.util.singularities`` (the only
+SymPy tool that finds poles inside tan) and the zeros of p′ from ``solveset``. When ``solveset``
+returns a ConditionSet or times out, the analysis is numeric and ``numeric_only`` is set.
+Identically constant functions (e.g. ν for 2 sin(φ/2), det H for eq 35) have no singularity.
+Other angles are matched against rational multiples of π (denominators ≤ 24, to 25 digits:
+multiple roots polish to fewer digits than simple ones); an angle matching neither is reported
+as a Float and ``numeric_only`` is set. The validity range is the smallest singular angle.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ import sympy as sp
 from .core import Derivation, derive_expression
 from .functions import mpmath_namespace
 from .parsing import PHI
+from .timeouts import bounded
 
 SCAN_END = 4 * np.pi
 SCAN_POINTS = 4001
@@ -66,6 +70,10 @@ class Validity:
     numeric_only: bool
 
 
+SYMBOLIC_TIME_LIMIT = 0.5
+SCAN_INTERVAL = sp.Interval.Lopen(0, 4 * sp.pi)
+
+
 def validity(derivation: Derivation) -> Validity:
     """The validity range of ``derivation``'s parameterization and every singular angle."""
     return _validity_of(derivation.p)
@@ -74,16 +82,18 @@ def validity(derivation: Derivation) -> Validity:
 @lru_cache(maxsize=256)
 def _validity_of(p: sp.Expr) -> Validity:
     derivation = derive_expression(p)
+    candidates, confirmed = _symbolic_candidates(p, derivation.scalars_raw["p_prime"])
+    brackets = tuple(float(c) for c in candidates)
     found: list[Singularity] = []
-    numeric_only = False
+    numeric_only = not confirmed
     for quantity in QUANTITIES:
         if quantity != "p" and derivation.constant_value(quantity) is not None:
             continue
         expr = p if quantity == "p" else derivation.scalars_raw[quantity]
-        for angle, limit, sign_change in _events(expr):
+        for angle, limit, sign_change in _events(expr, brackets):
             if (quantity, limit) not in CAUSES:
                 continue  # p = 0 away from the origin is caught through nu and p'
-            exact = _exact_angle(angle)
+            exact = _exact_angle(angle, candidates)
             numeric_only |= exact is None
             phi = exact if exact is not None else sp.Float(mpmath.nstr(angle, 30), 30)
             found.append(Singularity(phi, float(angle), CAUSES[(quantity, limit)], quantity, limit))
@@ -104,8 +114,34 @@ def _mp(expr: sp.Expr) -> Callable[[mpmath.mpf], mpmath.mpf]:
     return sp.lambdify(PHI, expr, modules=[mpmath_namespace(), "mpmath"])
 
 
-def _events(expr: sp.Expr) -> list[tuple[mpmath.mpf, str, bool]]:
-    """(angle, limit '0'|'oo', sign change?) for the zeros and poles of ``expr`` in (0, 4π]."""
+def _symbolic_candidates(p: sp.Expr, p_prime: sp.Expr) -> tuple[tuple[sp.Expr, ...], bool]:
+    """Exact poles of p and zeros of p′ in (0, 4π]; False when SymPy could not list them all."""
+
+    def poles() -> sp.Set | None:
+        return sp.calculus.util.singularities(p, PHI, SCAN_INTERVAL)
+
+    def zeros() -> sp.Set | None:
+        return sp.solveset(p_prime, PHI, SCAN_INTERVAL)
+
+    found: list[sp.Expr] = []
+    confirmed = True
+    for compute in (poles, zeros):
+        try:
+            result = bounded(SYMBOLIC_TIME_LIMIT, None, compute)
+        except (NotImplementedError, ValueError, TypeError, AttributeError):
+            result = None
+        if not isinstance(result, sp.FiniteSet):
+            confirmed &= result is sp.S.EmptySet
+            continue
+        found.extend(x for x in result if x.is_real and x.is_number)
+    return tuple(found), confirmed
+
+
+def _events(expr: sp.Expr, extra: tuple[float, ...] = ()) -> list[tuple[mpmath.mpf, str, bool]]:
+    """(angle, limit '0'|'oo', sign change?) for the zeros and poles of ``expr`` in (0, 4π].
+
+    ``extra`` are candidate angles from the symbolic analysis, bracketed in addition to the scan.
+    """
     grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
     numeric = sp.lambdify(PHI, expr, modules=[{"RealCbrt": np.cbrt}, "numpy"])
     with np.errstate(all="ignore"):
@@ -129,6 +165,12 @@ def _events(expr: sp.Expr) -> list[tuple[mpmath.mpf, str, bool]]:
             event = _polish(exact, mpmath.mpf(low), mpmath.mpf(high))
             if event is not None and not any(abs(event[0] - e[0]) < 1e-9 for e in events):
                 events.append(event)
+        for candidate in extra:  # exact angles: classify in place, no root search
+            angle = mpmath.mpf(sp.N(candidate, DIGITS))
+            if not any(abs(angle - e[0]) < 1e-9 for e in events):
+                event = _classify(_safe(exact), angle)
+                if event is not None:
+                    events.append(event)
     return events
 
 
@@ -136,12 +178,7 @@ def _polish(f: Callable[[mpmath.mpf], mpmath.mpf], low: mpmath.mpf, high: mpmath
             ) -> tuple[mpmath.mpf, str, bool] | None:
     """Locate a zero or pole of f in [low, high] at 50 digits and classify it."""
 
-    def safe(t: mpmath.mpf) -> mpmath.mpf:
-        try:
-            value = f(t)
-        except (ZeroDivisionError, ValueError):
-            return mpmath.inf
-        return value.real if isinstance(value, mpmath.mpc) else value
+    safe = _safe(f)
 
     def reciprocal(t: mpmath.mpf) -> mpmath.mpf:
         value = safe(t)
@@ -162,6 +199,25 @@ def _polish(f: Callable[[mpmath.mpf], mpmath.mpf], low: mpmath.mpf, high: mpmath
             break
     if angle is None:
         return None
+    return _classify(safe, angle)
+
+
+def _safe(f: Callable[[mpmath.mpf], mpmath.mpf]) -> Callable[[mpmath.mpf], mpmath.mpf]:
+    """``f`` with division by zero read as a pole and complex rounding noise dropped."""
+
+    def safe(t: mpmath.mpf) -> mpmath.mpf:
+        try:
+            value = f(t)
+        except (ZeroDivisionError, ValueError):
+            return mpmath.inf
+        return value.real if isinstance(value, mpmath.mpc) else value
+
+    return safe
+
+
+def _classify(safe: Callable[[mpmath.mpf], mpmath.mpf], angle: mpmath.mpf
+              ) -> tuple[mpmath.mpf, str, bool] | None:
+    """Zero ('0') or pole ('oo') of ``safe`` at ``angle`` from one-sided values at ± 10⁻²⁰."""
     delta = mpmath.mpf(10) ** -20
     left, right = safe(angle - delta), safe(angle + delta)
     tiny, huge = mpmath.mpf(10) ** -12, mpmath.mpf(10) ** 12
@@ -173,9 +229,12 @@ def _polish(f: Callable[[mpmath.mpf], mpmath.mpf], low: mpmath.mpf, high: mpmath
     return None
 
 
-def _exact_angle(angle: mpmath.mpf) -> sp.Expr | None:
-    """k π / n when the 50-digit root matches one (n ≤ 24), else None."""
+def _exact_angle(angle: mpmath.mpf, candidates: tuple[sp.Expr, ...] = ()) -> sp.Expr | None:
+    """The symbolic candidate, or k π / n, that the 50-digit root matches (n ≤ 24), else None."""
     with mpmath.workdps(DIGITS):
+        for candidate in candidates:
+            if abs(angle - mpmath.mpf(sp.N(candidate, DIGITS))) < mpmath.mpf(10) ** -25:
+                return candidate
         for n in range(1, 25):
             k = int(mpmath.nint(angle * n / mpmath.pi))
             if k and abs(angle - k * mpmath.pi / n) < mpmath.mpf(10) ** -25:

@@ -56,8 +56,12 @@ class Solution:
     method: str = ""
 
 
-def property_equation(text: str) -> sp.Expr:
-    """The property as ``lhs - rhs`` in terms of the unknown function p(φ)."""
+def property_equation(text: str, m: int | None = None) -> sp.Expr:
+    """The property as ``lhs - rhs`` in terms of the unknown function p(φ).
+
+    ``m``, when given, is the value of the name ``m`` (the family order of eq 37), so that
+    ``'mu = 1/sqrt(1 - p**2/m**2)'`` can be written literally.
+    """
     if not isinstance(text, str) or text.count("=") != 1 or "==" in text:
         raise SolveError("a property is one relation 'LHS = RHS', e.g. 'mu = nu**2/eps'")
     p = _P(PHI)
@@ -67,6 +71,10 @@ def property_equation(text: str) -> sp.Expr:
     mu = 1 / p_prime
     names = {"p": p, "p_prime": p_prime, "nu": nu, "eps": eps, "epsilon": eps, "mu": mu,
              "det_H": mu * nu**2, "c": _C, "const": _C}
+    if m is not None:
+        if isinstance(m, bool) or not isinstance(m, int) or m < 1:
+            raise SolveError(f"the family order m must be a positive integer, not {m!r}")
+        names["m"] = sp.Integer(m)
     left, right = text.split("=")
     sides = [parse_expression(side, names) for side in (left, right)]
     equation = sides[0] - sides[1]
@@ -75,9 +83,9 @@ def property_equation(text: str) -> sp.Expr:
     return equation
 
 
-def solve_property(text: str) -> Solution:
+def solve_property(text: str, m: int | None = None) -> Solution:
     """Solve ``text`` for the generating function with κ = 1 (see module docstring)."""
-    equation = property_equation(text)
+    equation = property_equation(text, m)
     p = _P(PHI)
     try:
         with time_limit(SOLVE_TIME_LIMIT, "solving the property"):

@@ -75,3 +75,22 @@ def test_analysis_is_fast() -> None:
         started = time.monotonic()
         validity(d)
         assert time.monotonic() - started < 1.5
+
+
+def test_symbolic_candidates_find_poles_inside_tan_and_zeros_of_p_prime() -> None:
+    from symrot.singularities import _symbolic_candidates
+
+    p = 2 * sp.tan(parse_expression("phi") / 2)
+    poles, confirmed = _symbolic_candidates(p, sp.diff(p, parse_expression("phi")))
+    assert set(poles) == {pi, 3 * pi} and confirmed
+
+
+def test_transcendental_angle_falls_back_to_numeric() -> None:
+    # p = phi cos(phi): p' = cos(phi) - phi sin(phi) = 0 at phi tan(phi) = 1; solveset gives a
+    # ConditionSet, so the angle is numeric only.
+    result = validity(derive_expression(parse_expression("phi*cos(phi)")))
+    assert result.numeric_only
+    assert isinstance(result.phi_max, sp.Float)
+    assert result.phi_max_float == pytest.approx(0.8603335890193798, abs=1e-15)
+    assert "monotonicity" in {s.quantity for s in result.singularities
+                              if s.phi_float == result.phi_max_float}

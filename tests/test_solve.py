@@ -76,3 +76,17 @@ def test_cli_json(capsys: pytest.CaptureFixture[str]) -> None:
     data = json.loads(capsys.readouterr().out)
     assert data["name"] == "det_h_one" and data["constant"] == "1"
     assert data["taylor"][:4] == ["0", "1", "0", "-1/60"]
+
+
+@pytest.mark.parametrize("m", range(1, 7))
+def test_eq_37_families_with_literal_m(m: int) -> None:
+    sine = solve_property("mu = 1/sqrt(1 - p**2/m**2)", m=m)
+    tangent = solve_property("mu = 1/(1 + p**2/m**2)", m=m)
+    assert sine.expression == m * sp.sin(PHI / m)
+    assert tangent.expression == m * sp.tan(PHI / m)
+
+
+def test_family_order_must_be_positive() -> None:
+    assert main(["solve", "--m", "0", "mu = 1/sqrt(1 - p**2/m**2)"]) == 2
+    with pytest.raises(SymrotError, match="unknown name 'm'"):
+        solve_property("mu = 1/sqrt(1 - p**2/m**2)")

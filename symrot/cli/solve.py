@@ -19,12 +19,15 @@ def register(subparsers: Any) -> None:
         "Constants are fixed by p(0) = 0 and p/phi -> 1 (eq 13).",
     )
     parser.add_argument("property", help="'LHS = RHS'")
+    parser.add_argument("--m", type=int, default=None, metavar="M",
+                        help="value of the name m (family order, eq 37), e.g. "
+                        "--m 3 'mu = 1/sqrt(1 - p**2/m**2)'")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    solution = solve_property(args.property)
+    solution = solve_property(args.property, args.m)
     entry = find_by_expression(solution.expression) if solution.expression is not None else None
     data = {
         "property": solution.property,
