@@ -4,10 +4,13 @@ PIP ?= $(PYTHON) -m pip
 PYTEST_ARGS ?=
 
 .DEFAULT_GOAL := help
-.PHONY: help setup setup-system setup-python test lint typecheck pytest generate check-generated bench clean
+.PHONY: audit help setup setup-system setup-python test lint typecheck pytest generate check-generated bench clean
 
 help: ## List the targets with what they do
 	@grep -E '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-16s %s\n", $$1, $$2}'
+
+audit: ## Check the paper's equations by machine and regenerate docs/errata.md
+	$(PYTHON) -m symrot audit --write docs/errata.md
 
 setup: setup-system setup-python ## Install everything the tests need (Debian packages and Python dev extras)
 

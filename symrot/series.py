@@ -493,5 +493,6 @@ def compose_even_in_x(even_coeffs: list[sp.Expr], phi_of_p: list[sp.Expr], n_ter
     phi_squared = rs_mul(phi, phi, x, order)
     halves = [domain.from_sympy(even_coeffs[2 * j]) for j in range(n_terms)]
     in_p = compose(halves, phi_squared, order)
-    return [sp.nsimplify(domain.to_sympy(in_p.coeff(x ** (2 * j)))) if j else
-            domain.to_sympy(in_p.coeff(1)) for j in range(n_terms)]
+    values = [domain.to_sympy(in_p.coeff(x ** (2 * j)) if j else in_p.coeff(1)) for j in range(n_terms)]
+    # nsimplify only non-rationals: on a large exact Rational it can return a wrong algebraic number
+    return [v if (v.is_Rational or not j) else sp.nsimplify(v) for j, v in enumerate(values)]

@@ -11,9 +11,9 @@ import sys
 from collections.abc import Sequence
 
 from ..errors import SymrotError
-from . import derive, latex_commands, plot, solve
+from . import audit, derive, latex_commands, plot, solve
 
-COMMANDS = [derive, solve, latex_commands, plot]
+COMMANDS = [derive, solve, latex_commands, plot, audit]
 """Subcommand modules, in the order ``symrot --help`` lists them."""
 
 EXIT_USAGE = 2
