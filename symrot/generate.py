@@ -57,9 +57,26 @@ def figures() -> dict[str, str | bytes]:
     return {f"figures/figure{n}.{fmt}": render_figure(n, fmt) for n in FIGURES for fmt in ("pdf", "png")}
 
 
+def numpy_modules() -> dict[str, str | bytes]:
+    """generated/numpy/NAME.py: the NumPy kernels of every named parameterization."""
+    from .backends.numpy_backend import module_source
+    from .plan import evaluation_plan
+
+    return {f"numpy/{name}.py": module_source(evaluation_plan(derive(name).derivation, name))
+            for name in NAMED}
+
+
+def c_headers() -> dict[str, str | bytes]:
+    """generated/c/symrot_NAME.h: the C99 headers (Table 1, eq 35, sine/tangent m <= 6)."""
+    from .backends.c_backend import generated_headers
+
+    return dict(generated_headers())
+
+
 def producers() -> list[tuple[str, Producer]]:
     """All producers, by the path prefix they own. Backends add theirs here."""
-    return [("derivations/", derivation_json), ("latex/", latex_documents), ("figures/", figures)]
+    return [("derivations/", derivation_json), ("latex/", latex_documents), ("figures/", figures),
+            ("numpy/", numpy_modules), ("c/", c_headers)]
 
 
 def render(only: str | None = None) -> dict[str, Content]:

@@ -34,11 +34,31 @@ def register(subparsers: Any) -> None:
         "--terms", type=int, default=DEFAULT_SERIES_TERMS, choices=range(1, 25),
         metavar="N", help=f"series terms in x = |p|^2 (default {DEFAULT_SERIES_TERMS}, max 24)",
     )
+    parser.add_argument("--emit", metavar="BACKEND", help="write code with this backend (e.g. numpy)")
+    parser.add_argument("--name", help="module name for --emit (default: registry name or 'rotation')")
+    parser.add_argument("--out", default=".", help="output directory for --emit (default: .)")
     parser.set_defaults(run=run)
+
+
+def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
+    import re
+    from pathlib import Path
+
+    from ..backends import emitter
+    from ..errors import SymrotError
+
+    name = args.name or (result.entry.identifier if result.entry else "rotation")
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+        raise SymrotError(f"--name {name!r} is not a valid identifier")
+    for path in emitter(args.emit)(result.derivation, name, Path(args.out)):
+        print(path)
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
     result = derive(args.expression, normalize=args.normalize)
+    if getattr(args, "emit", None):
+        return emit_code(result, args)
     if args.json:
         print(json.dumps(result.to_dict(series_terms=args.terms), indent=2))
     else:

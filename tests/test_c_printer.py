@@ -1,0 +1,108 @@
+"""The C99 printer subclass: only what differs from SymPy's C99CodePrinter."""
+
+from __future__ import annotations
+
+import re
+from fractions import Fraction
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from symrot.backends.c_printer import SymrotCPrinter, print_c
+from symrot.functions import RealCbrt
+
+X, Y = sp.symbols("x y", real=True)
+
+
+def literal_value(text: str, precision: str) -> Fraction:
+    """The exact value a C compiler gives the literal ``text``."""
+    if precision == "float":
+        assert text.endswith("F"), text
+        return Fraction(float(np.float32(text[:-1])))
+    assert not text.endswith(("F", "f", "L")), text
+    return Fraction(float(text))
+
+
+def is_correctly_rounded(value: Fraction, exact: Fraction, precision: str) -> bool:
+    """|value − exact| ≤ half an ulp of value's binade (ties checked by the exact comparison)."""
+    bits = 53 if precision == "double" else 24
+    if exact == 0:
+        return value == 0
+    exponent = Fraction(2) ** (abs(exact).numerator.bit_length() - abs(exact).denominator.bit_length())
+    while exponent > abs(exact):
+        exponent /= 2
+    while exponent * 2 <= abs(exact):
+        exponent *= 2
+    half_ulp = exponent / 2**bits
+    return abs(value - exact) <= half_ulp
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(-(2**90), 2**90), st.integers(1, 2**90), st.sampled_from(["double", "float"]))
+def test_rational_literals_are_correctly_rounded(numerator: int, denominator: int, precision: str) -> None:
+    exact = Fraction(numerator, denominator)
+    printer = SymrotCPrinter(precision)
+    text = printer.doprint(sp.Rational(numerator, denominator))
+    if re.fullmatch(r"-?\d+", text):  # a C int constant: converted exactly
+        assert exact.denominator == 1 and abs(exact) < 2**31 and int(text) == exact
+    elif "/" in text:  # a quotient of two exact literals, rounded once by IEEE division
+        num_text, den_text = text.strip("()").split("/")
+        num, den = literal_value(num_text, precision), literal_value(den_text, precision)
+        assert (num, den) == (exact.numerator, exact.denominator)
+    else:
+        assert is_correctly_rounded(literal_value(text, precision), exact, precision), text
+
+
+def test_large_rational_is_one_literal_not_an_inexact_quotient() -> None:
+    big = sp.Rational(2**60 + 1, 3**40)
+    assert "/" not in print_c(big, "double")
+    assert is_correctly_rounded(literal_value(print_c(big, "double"), "double"),
+                                Fraction(2**60 + 1, 3**40), "double")
+    assert print_c(sp.Rational(1, 7), "double") == "1.0/7.0"
+    assert print_c(sp.Rational(1, 7), "float") == "1.0F/7.0F"
+    assert print_c(sp.Rational(2**30 + 1, 7), "float") != "1073741825.0F/7.0F"
+
+
+@pytest.mark.parametrize("precision", ["double", "float"])
+def test_pi_is_a_correctly_rounded_literal_not_a_posix_macro(precision: str) -> None:
+    text = print_c(sp.pi * X, precision)
+    assert "M_PI" not in text
+    number = text.split("*")[0]
+    assert is_correctly_rounded(literal_value(number, precision),
+                                Fraction(sp.Rational(sp.N(sp.pi, 60))), precision)
+
+
+def test_real_cube_root_prints_as_cbrt() -> None:
+    assert print_c(RealCbrt(X - Y), "double") == "cbrt(x - y)"
+    assert print_c(RealCbrt(X - Y), "float") == "cbrtf(x - y)"
+
+
+def test_small_integer_powers_of_a_symbol_are_parenthesized_products() -> None:
+    assert print_c(X**2, "double") == "(x*x)"
+    assert print_c(X**4 * Y, "double") == "(x*x*x*x)*y"
+    assert print_c(Y / X**2, "double") == "y/(x*x)"
+    assert print_c(X**-3, "double") == "1.0/(x*x*x)"
+    assert print_c(X**-2, "float") == "1.0F/(x*x)"
+    assert print_c(X**9, "double") == "pow(x, 9)"
+    assert print_c((X + Y) ** 2, "double") == "pow(x + y, 2)"
+    assert print_c(1 / sp.sqrt(X), "float") == "1.0F/sqrtf(x)"
+
+
+def test_float_variant_calls_only_float_functions_and_float_literals() -> None:
+    expr = sp.sin(X) / 3 + sp.cos(Y) + sp.atan2(Y, X) + sp.sqrt(X) + sp.tan(X) + sp.Abs(Y) + sp.Float("0.1")
+    text = print_c(expr, "float")
+    for name in ("sin", "cos", "atan2", "sqrt", "tan", "fabs"):
+        assert f"{name}f(" in text
+        assert not re.search(rf"\b{name}\(", text), text
+    literals = re.findall(r"\d+\.\d*(?:e[-+]?\d+)?[Ff]?", text)
+    assert literals and all(lit.endswith("F") for lit in literals), literals
+    double_text = print_c(expr, "double")
+    assert "F" not in double_text and "sinf" not in double_text
+
+
+def test_unknown_precision_is_rejected() -> None:
+    with pytest.raises(ValueError, match="precision"):
+        SymrotCPrinter("half")  # type: ignore[arg-type]

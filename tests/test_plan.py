@@ -1,0 +1,67 @@
+"""Evaluation plans (issue 4): constants, algebraic forms, branches per precision, the angle."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from symrot.api import derive
+from symrot.plan import Algebraic, Branch, ClosedAngle, Constant, NewtonAngle, X, evaluation_plan
+
+
+@pytest.fixture(scope="module")
+def det_h_one_plan():
+    return evaluation_plan(derive("det_h_one").derivation, "det_h_one")
+
+
+def test_identically_constant_coefficients_are_constants() -> None:
+    derivation = derive("euler_rodrigues").derivation
+    plan = evaluation_plan(derivation, "euler_rodrigues")
+    coefficient = plan.precisions["float64"].coefficients["H_inverse_2"]
+    assert isinstance(coefficient, Constant)
+    assert coefficient.value == derivation.constant_value("H_inverse_2")
+
+
+def test_algebraic_coefficients_have_no_branch() -> None:
+    plan = evaluation_plan(derive("cayley_gibbs_rodrigues").derivation, "cgr")
+    h_inverse_0 = plan.precisions["float64"].coefficients["H_inverse_0"]
+    assert isinstance(h_inverse_0, Algebraic)
+    assert sp.simplify(h_inverse_0.expression - (1 + X / 4)) == 0
+    assert isinstance(plan.precisions["float64"].angle, ClosedAngle)
+
+
+def test_wiener_milenkovic_nu_squared_over_epsilon_is_rational_in_x() -> None:
+    derivation = derive("wiener_milenkovic").derivation
+    plan = evaluation_plan(derivation, "wiener_milenkovic")
+    coefficients = plan.precisions["float64"].coefficients
+    nu, epsilon = coefficients["nu"], coefficients["epsilon"]
+    assert isinstance(nu, Algebraic) and isinstance(epsilon, Algebraic)
+    ratio = sp.simplify(nu.expression ** 2 / epsilon.expression - 16 * (16 - X) / (16 + X) ** 2)
+    assert ratio == 0
+
+
+def test_branches_use_exact_series_and_differ_per_precision(det_h_one_plan) -> None:
+    derivation = derive("det_h_one").derivation
+    wide = det_h_one_plan.precisions["float64"].coefficients["R_2"]
+    narrow = det_h_one_plan.precisions["float32"].coefficients["R_2"]
+    assert isinstance(wide, Branch) and isinstance(narrow, Branch)
+    series = derivation.series_in_x("R_2", len(wide.horner))
+    assert list(wide.horner) == series
+    assert len(narrow.horner) < len(wide.horner)
+    # not the usual |p| ~ 1e-3 switch with 2-3 terms: the switch sits where the closed form is good
+    assert wide.threshold > 1e-2 and len(wide.horner) > 3
+    assert wide.measured_ulp <= 2
+
+
+def test_angle_without_closed_inverse_uses_newton(det_h_one_plan) -> None:
+    angle = det_h_one_plan.precisions["float64"].angle
+    assert isinstance(angle, NewtonAngle)
+    assert angle.start[:2] == (1, sp.Rational(1, 60))
+    assert angle.phi_max == pytest.approx(2 * np.pi)
+
+
+def test_sine_family_inverse_is_closed_form() -> None:
+    plan = evaluation_plan(derive("sine_m4").derivation, "sine_m4")
+    angle = plan.precisions["float32"].angle
+    assert isinstance(angle, ClosedAngle) and angle.expression.has(sp.asin)
