@@ -1,9 +1,10 @@
-"""Machine audit of the paper's numbered equations (issue 8).
+"""Machine audit of every numbered equation of Bauchau & Trainelli (2003) and of Table 1 (issue 8).
 
-Each :class:`~symrot.audit.checks.Check` states an equation as printed and proves or refutes it;
-:func:`run_all` runs the registry :data:`CHECKS` and :mod:`symrot.audit.report` writes the errata.
+Each :class:`~symrot.audit.checks.Check` quotes a statement as printed and proves or refutes it,
+symbolically under a time limit or at 50 digits on random points and trajectories;
+:func:`run_all` runs them and :mod:`symrot.audit.report` renders the table and ``docs/errata.md``.
 """
 
-from .checks import CHECKS, Check, Outcome, run_all
+from .checks import Check, Outcome, Result, all_checks, run_all
 
-__all__ = ["CHECKS", "Check", "Outcome", "run_all"]
+__all__ = ["Check", "Outcome", "Result", "all_checks", "run_all"]
