@@ -1,7 +1,8 @@
 """Accuracy of the generated NumPy kernels against mpmath (issue 4).
 
 For each parameterization, every public function of its generated module is evaluated at
-p = p(φ) u for |φ| ∈ {0} ∪ log-spaced [1e-300, φ_max − 1e-6] with random unit axes u, in float64
+p = p(φ) u for |φ| ∈ {0} ∪ log-spaced [1e-300, φ_max − 1e-6] ∪ uniform [0.5, φ_max − 1e-6] ∪
+{φ_max − 10⁻ᵏ, k = 1…6} (:func:`sweep`) with random unit axes u, in float64
 and float32, and compared with a 50-digit mpmath reference computed at the *rounded* input p.
 Reference: for x = |p|² < 1e-4 the exact rational series in x (24 terms, truncation < 1e-90
 relative), else the closed forms at φ = p⁻¹(|p|) found by mpmath.findroot.  Errors in ulp:
@@ -19,6 +20,8 @@ import importlib.util
 import sys
 import tempfile
 import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -43,6 +46,7 @@ FUNCTIONS = (*TENSORS, *VECTORS, *SCALARS)
 DTYPES = {"float64": np.float64, "float32": np.float32}
 SERIES_TERMS = 24
 DIGITS = 50
+TARGET_ULP = 4.0
 
 
 def default_parameterizations() -> list[str]:
@@ -132,17 +136,74 @@ def _ulp(value: np.ndarray, reference: Any, epsilon: float, matrix: bool, tiny: 
     return error / (scale * epsilon)
 
 
-def measure(name: str, points: int, seed: int = 1, edge: float = 1e-6
-            ) -> dict[tuple[str, str, str], tuple[float, float]]:
-    """{(function, precision, kind): (worst ulp, phi where)} with kind 'plan' or 'naive'."""
+@dataclass
+class Worst:
+    """The worst point of one (function, precision, kind) over the sweep."""
+
+    ulp: float = 0.0
+    at: float = 0.0
+    kappa: float = 1.0
+    excess: float = 0.0
+    """max over points of ulp / max(1, κ): ≤ 4 means at most the error of a 4 ε relative input change."""
+
+    def add(self, ulp: float, at: float, kappa: float) -> None:
+        ulp = float("inf") if np.isnan(ulp) else ulp
+        if ulp > self.ulp or (ulp == self.ulp == 0 and at == 0):
+            self.ulp, self.at, self.kappa = ulp, at, kappa
+        self.excess = max(self.excess, ulp / max(1.0, kappa))
+
+
+def condition(reference: Callable[[list[Any]], dict[str, Any]], inputs: list[Any],
+              base: dict[str, Any], scales: dict[str, float]) -> dict[str, float]:
+    """κ_f = max over output entries of Σ_i |∂f/∂x_i| |x_i| / scale_f (50-digit differences).
+
+    The relative condition number of each output with respect to componentwise relative changes of
+    the input: an algorithm whose error is ≤ 4 κ ulp is as accurate as a 4 ε change of its input.
+    """
+    delta = mpmath.mpf(10) ** -30
+    totals: dict[str, np.ndarray] = {}
+    for i, value in enumerate(inputs):
+        if value == 0:
+            continue
+        moved = list(inputs)
+        moved[i] = value * (1 + delta)
+        other = reference(moved)
+        for f, ref in base.items():
+            pairs = zip(_entries(other[f]), _entries(ref), strict=True)
+            diff = np.array([float(abs(a - b)) for a, b in pairs])
+            totals[f] = totals.get(f, 0) + diff / float(delta)
+    return {f: float(np.max(totals[f])) / scales[f] if f in totals and scales[f] > 0 else 0.0
+            for f in base}
+
+
+def _entries(value: Any) -> list[Any]:
+    if isinstance(value, mpmath.matrix):
+        return [value[i, j] for i in range(value.rows) for j in range(value.cols)]
+    return list(value)
+
+
+def _scale(ref: Any, matrix: bool, tiny: float) -> float:
+    biggest = max(float(abs(v)) for v in _entries(ref))
+    return max(1.0, biggest) if matrix else max(tiny, biggest)
+
+
+def sweep(phi_max: float, points: int, edge: float = 1e-6) -> np.ndarray:
+    """|φ|: 0, log-spaced [1e-300, φ_max − edge], uniform over the upper range and φ_max − 10⁻ᵏ."""
+    top = phi_max - edge
+    return np.unique(np.concatenate([
+        [0.0], np.geomspace(1e-300, top, points), np.linspace(0.5, top, max(2, points // 3)),
+        phi_max - np.geomspace(0.1, edge, 6)]))
+
+
+def measure(name: str, points: int, seed: int = 1, edge: float = 1e-6) -> dict[tuple[str, str, str], Worst]:
+    """{(function, precision, kind): Worst} with kind 'plan' or 'naive'."""
     derivation = derive(name).derivation
     plan = evaluation_plan(derivation, name)
     reference = Reference(derivation)
     naive = {n: numpy_function(e) for n, e in derivation.simplified_coefficients().items()}
-    top = plan.phi_max - edge
-    angles = np.concatenate([[0.0], np.geomspace(1e-300, top, points)])
+    angles = sweep(plan.phi_max, points, edge)
     rng = np.random.default_rng(seed)
-    worst: dict[tuple[str, str, str], tuple[float, float]] = {}
+    worst: dict[tuple[str, str, str], Worst] = {}
     with tempfile.TemporaryDirectory() as tmp, mpmath.workdps(DIGITS):
         module = load_module(plan, Path(tmp))
         for angle in angles:
@@ -155,32 +216,37 @@ def measure(name: str, points: int, seed: int = 1, edge: float = 1e-6
             for label, dtype in DTYPES.items():
                 epsilon = float(np.finfo(dtype).eps)
                 p = p_exact.astype(dtype)
-                p_mp = [mpmath.mpf(float(v)) for v in p]
-                x = sum(v * v for v in p_mp)
                 if not np.all(np.isfinite(p)):
                     continue
-                if mpmath.sqrt(x) >= min(plan.p_max, reference.p_of_phi(reference.phi_max)):
-                    continue  # rounding moved p outside the validity range: the module returns NaN
-                c = reference.coefficients(x, float(angle) if angle > 0 else 1.0)
-                phi_ref = c["__phi__"]
+                p_mp = [mpmath.mpf(float(v)) for v in p]
+                edge_of_range = min(plan.p_max, reference.p_of_phi(reference.phi_max))
+                if mpmath.sqrt(sum(v * v for v in p_mp)) >= edge_of_range * (1 - 2 * epsilon):
+                    continue  # within 2 ulp of the edge: |p| rounds onto it and the module returns NaN
                 w_d = w.astype(dtype)
                 w_mp = [mpmath.mpf(float(v)) for v in w_d]
+                guess = float(angle) if angle > 0 else 1.0
+
+                def refs_at(inputs: list[Any], guess: float = guess, w_mp: list[Any] = w_mp
+                            ) -> dict[str, Any]:
+                    c = reference.coefficients(sum(v * v for v in inputs), guess)
+                    return _references(c, inputs, w_mp, c["__phi__"])
+
+                refs = refs_at(p_mp)
+                tiny = float(np.finfo(dtype).tiny)
+                scales = {f: _scale(refs[f], f in TENSORS, tiny) for f in FUNCTIONS}
+                kappas = condition(refs_at, p_mp, refs, scales)
                 with warnings.catch_warnings():
                     warnings.simplefilter("error")
                     results = _evaluate(module, p, w_d)
-                refs = _references(c, p_mp, w_mp, phi_ref)
                 naive_results = _naive(module, naive, p, w_d)
                 for function in FUNCTIONS:
                     matrix = function in TENSORS
                     for kind, values in (("plan", results), ("naive", naive_results)):
                         if function not in values:
                             continue
-                        ulp = _ulp(values[function], refs[function], epsilon, matrix,
-                                   float(np.finfo(dtype).tiny))
-                        ulp = float("inf") if np.isnan(ulp) else ulp
-                        key = (function, label, kind)
-                        if key not in worst or ulp > worst[key][0] or np.isnan(worst[key][0]):
-                            worst[key] = (ulp if not np.isnan(ulp) else float("inf"), float(angle))
+                        ulp = _ulp(values[function], refs[function], epsilon, matrix, tiny)
+                        worst.setdefault((function, label, kind), Worst()).add(ulp, float(angle),
+                                                                               kappas[function])
     return worst
 
 
@@ -223,47 +289,82 @@ def _naive(module: ModuleType, naive: dict[str, Any], p: np.ndarray, w: np.ndarr
 TENSORS_BY_NAME = {t: f for f, t in TENSORS.items()}
 
 
-def table(results: dict[str, dict[tuple[str, str, str], tuple[float, float]]]) -> str:
-    lines = ["| parameterization | function | float64 ulp (at φ) | naive float64 | float32 ulp (at φ) "
-             "| naive float32 |", "|---|---|---|---|---|---|"]
+def _cell(entry: Worst | None) -> str:
+    if entry is None:
+        return "—"
+    return f"{entry.ulp:.3g} ({entry.at:.3g}; κ {entry.kappa:.2g})"
+
+
+def _verdict(entries: list[Worst]) -> str:
+    if all(e.ulp <= TARGET_ULP for e in entries):
+        return "meets"
+    if all(e.excess <= TARGET_ULP for e in entries):
+        return "conditioned"
+    return "**miss**"
+
+
+def table(results: dict[str, dict[tuple[str, str, str], Worst]], functions: tuple[str, ...]) -> str:
+    lines = ["| parameterization | function | float64 ulp (at φ; κ there) | ulp/κ | naive float64 "
+             "| float32 ulp (at φ; κ there) | ulp/κ | naive float32 | verdict |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for name, worst in results.items():
-        for function in FUNCTIONS:
-            cells = []
+        for function in functions:
+            cells, plans = [], []
             for label in DTYPES:
-                for kind in ("plan", "naive"):
-                    if (function, label, kind) not in worst:
-                        cells.append("—")
-                        continue
-                    ulp, where = worst[(function, label, kind)]
-                    mark = " **miss**" if kind == "plan" and ulp > 4 else ""
-                    cells.append(f"{ulp:.3g} ({where:.3g}){mark}" if kind == "plan" else f"{ulp:.3g}")
-            lines.append(f"| {name} | {function} | " + " | ".join(cells) + " |")
+                plan = worst.get((function, label, "plan"))
+                naive = worst.get((function, label, "naive"))
+                cells += [_cell(plan), f"{plan.excess:.3g}" if plan else "—",
+                          f"{naive.ulp:.3g}" if naive else "—"]
+                plans += [plan] if plan else []
+            if plans:
+                lines.append(f"| {name} | {function} | " + " | ".join(cells) + f" | {_verdict(plans)} |")
     return "\n".join(lines)
 
 
+def summary(name: str, worst: dict[tuple[str, str, str], Worst]) -> str:
+    plans = {k: v for k, v in worst.items() if k[2] == "plan"}
+    parts = []
+    for label in DTYPES:
+        mine = [v for k, v in plans.items() if k[1] == label]
+        parts.append(f"{label} worst {max(v.ulp for v in mine):.3g} ulp, "
+                     f"worst ulp/κ {max(v.excess for v in mine):.3g}")
+    misses = sum(v.excess > TARGET_ULP for v in plans.values())
+    return f"{name}: " + "; ".join(parts) + f"; {misses} misses"
+
+
 def main(argv: list[str] | None = None) -> int:
+    from accuracy_operations import OPERATIONS, measure_operations
+
     parser = argparse.ArgumentParser()
     parser.add_argument("--points", type=int, default=60)
     parser.add_argument("--only", nargs="*")
     parser.add_argument("--out", default="docs/accuracy.md")
     args = parser.parse_args(argv)
     names = args.only or default_parameterizations()
-    results = {}
+    results, operations = {}, {}
     for name in names:
         results[name] = measure(name, args.points)
-        misses = [(k, v) for k, v in results[name].items() if k[2] == "plan" and v[0] > 4]
-        print(f"{name}: worst plan ulp float64 "
-              f"{max(v[0] for k, v in results[name].items() if k[1:] == ('float64', 'plan')):.3g}, "
-              f"float32 {max(v[0] for k, v in results[name].items() if k[1:] == ('float32', 'plan')):.3g}; "
-              f"{len(misses)} misses", flush=True)
+        operations[name] = measure_operations(name, args.points)
+        print(summary(name, results[name]), "|", summary("operations", operations[name]), flush=True)
     command = "python bench/accuracy.py " + " ".join(argv if argv is not None else sys.argv[1:])
     text = ("# Accuracy of the generated NumPy kernels\n\n"
-            f"Produced by `{command.strip()}` ({args.points} log-spaced angles in "
-            "[1e-300, φ_max − 1e-6] plus 0, "
-            "random axes; reference: mpmath at 50 digits at the rounded input). Worst error in ulp "
-            "(matrices relative to max(1, max|entry|), vectors and scalars relative to their max entry) "
-            "and the |φ| where it occurs; target ≤ 4. *naive*: the closed forms in φ without branches "
-            "(inf = NaN/inf, typically at p = 0).\n\n" + table(results) + "\n")
+            f"Produced by `{command.strip()}` (|φ| = 0, {args.points} log-spaced angles in "
+            f"[1e-300, φ_max − 1e-6], {max(2, args.points // 3)} uniform in [0.5, φ_max − 1e-6] and "
+            "φ_max − 10⁻ᵏ for k = 1…6, random axes; reference: mpmath at 50 digits at the "
+            "rounded input; inputs within 2 ulp of the edge of the range, which the kernels may "
+            "classify as outside it, are skipped).\n\n"
+            "Worst error in ulp (matrices relative to max(1, max|entry|), vectors and scalars relative "
+            "to their largest entry), the |φ| where it occurs and κ there: the relative condition "
+            "number of the output with respect to componentwise relative changes of the input "
+            "(50-digit differences). *ulp/κ* is the worst of error / max(1, κ) over the sweep. "
+            f"Verdict: *meets* — every error ≤ {TARGET_ULP:g} ulp; *conditioned* — some error exceeds "
+            f"{TARGET_ULP:g} ulp but never {TARGET_ULP:g} κ ulp, i.e. never more than a "
+            f"{TARGET_ULP:g} ε relative change of the input p itself causes (the input is ill-conditioned "
+            "there: near the edge of the range, a function that vanishes or blows up); *miss* — "
+            "neither. *naive*: the closed forms in φ without branches (inf = NaN/inf, typically at "
+            "p = 0).\n\n## Kinematic functions (issue 4)\n\n" + table(results, FUNCTIONS)
+            + "\n\n## Operations on rotations of any size (issue 6)\n\n" + table(operations, OPERATIONS)
+            + "\n")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(text, encoding="utf-8")
     return 0

@@ -1,64 +1,97 @@
 """Evaluation plans: how each scalar coefficient c(x), x = |p|², is evaluated safely.
 
 Generated code takes the parameter vector p, never φ. Every quantity is a scalar coefficient of
-x = |p|²: ν, ε, μ, p′, det H (eqs 17–24) and the coefficients on I, (p×), (p×)² of R (16), H (20),
-H⁻¹ (26), G (81) and K (83) (names as in ``Derivation.coefficient_expressions``), and φ itself.
-The plan decides this once per coefficient and per precision; backends only print it.
+x = |p|²: ν, ε, μ, p′, det H (eqs 17–24), the coefficients on I, (p×), (p×)² of R (16), H (20),
+H⁻¹ (26), G (81) and K (83) (names as in ``Derivation.coefficient_expressions``), e₀ = cos(φ/2)
+(``e_0``, eq 74) and φ itself. The plan decides this once per coefficient and per precision;
+backends only print it.
 
-IR (all frozen dataclasses, SymPy expressions in the symbols ``PHI`` and ``S``):
+IR (all frozen dataclasses, SymPy expressions in the symbols ``PHI``, ``S`` = |p|, ``X`` = x and,
+for the sine family, ``D`` = p_max² − x):
 
 ``EvaluationPlan``
     ``name``, ``p`` (generating function), ``p_max`` (float, ``inf`` when unbounded: outside
     |p| < p_max every output is NaN), ``phi_max`` (float), ``precisions``: {"float64": …,
-    "float32": …} → ``PrecisionPlan``.
+    "float32": …} → ``PrecisionPlan``, ``e0_min`` (operations, :mod:`symrot.quaternion_plan`) and
+    ``complement`` (p_max² when expressions use ``D``, which backends compute with compensated
+    arithmetic: :func:`symrot.algebraic.fold_complement`).
 ``PrecisionPlan``
     ``dtype``, ``epsilon``, ``angle`` (``ClosedAngle`` or ``NewtonAngle``), ``coefficients``:
-    {name → ``Constant`` or ``Branch``}.
+    {name → ``Constant``, ``Algebraic`` or ``Branch``}, ``quaternion_scale`` (σ = p(φ)/sin(φ/2)).
 ``Algebraic(expression)``
-    the coefficient as a rational function of the symbol ``X`` = x with no branch (e.g. 1 + x/4 for
-    H⁻¹₀ of 2 tan(φ/2)); found by substituting the closed inverse φ(s) and checking x = 0 is regular.
+    the coefficient as an algebraic function of x (and d) with no branch (e.g. 1 + x/4 for H⁻¹₀ of
+    2 tan(φ/2)); found by substituting the closed inverse φ(s) (:mod:`symrot.algebraic`) and
+    accepted only when it is accurate in float64 on a log grid of x, p = 0 exactly.
 ``Constant(value)``
     identically constant coefficient (e.g. H⁻¹₂ = 1/4 for 2 sin(φ/2)): emit the number.
-``Branch(threshold, horner, closed, safe_phi)``
-    with ``t`` the branch variable (x = |p|² for coefficients, φ² inside ``NewtonAngle``):
+``Branch(threshold, horner, closed, safe_phi, measured_ulp, edge_ulp)``
+    with ``t`` the branch variable (x = |p|² for coefficients, φ² inside ``NewtonAngle`` and σ):
     if t < threshold evaluate the polynomial Σ horner[j] t^j (exact rationals, Horner order);
-    else evaluate ``closed`` (an expression in ``PHI``).  Both branches must be computed on
-    guarded inputs: t replaced by 0 where t ≥ threshold, φ replaced by ``safe_phi`` where
-    t < threshold, so neither branch ever divides by zero.  Common subexpressions may only be
-    shared *inside* one branch.
+    else evaluate ``closed`` (an expression in ``PHI``, and ``S``/``D`` where the base angle of a
+    closed inverse was substituted).  Each branch is evaluated only where it applies (or on
+    guarded inputs), so neither ever divides by zero.  Common subexpressions may only be shared
+    *inside* one branch.
 ``ClosedAngle(expression)``
-    φ = expression(S), S = |p| = √x, the closed-form inverse of p(φ) (e.g. 4 atan(S/4)).
-``NewtonAngle(start, ratio, slope, iterations, phi_max)``
+    φ = expression(S), S = |p| = √x, the closed-form inverse of p(φ) (e.g. 4 atan(S/4); for the
+    sine family k asin(S/k) becomes k atan2(S, √D), accurate up to the fold).
+``NewtonAngle(start, ratio, slope, iterations, phi_max, far)``
     φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s, started from the odd reverted series
-    φ ≈ Σ start[k] s^(2k+1), where ``ratio`` = g (Branch in t = φ² for p(φ)/φ, Taylor-safe) and
-    ``slope`` (Branch in t = φ² for p′(φ)).  Safeguard: keep a bracket [lo, hi] ⊂ [0, phi_max],
-    shrink it by the sign of r and take the bisection point when a step leaves it.
+    φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from the fold-aware interpolant ``far``
+    (:mod:`symrot.newton_start`) above it, where ``ratio`` = g (Branch in t = φ² for p(φ)/φ,
+    Taylor-safe) and ``slope`` (Branch in t = φ² for p′(φ)).  Safeguard: keep a bracket
+    [lo, hi] ⊂ [0, phi_max], shrink it by the sign of r and bisect when a step leaves it.
 
 Thresholds and degrees come from an error model per precision: the closed form's error is
-measured against 30-digit mpmath on a log grid of φ (cancellation in the closed form grows as
-x → 0); the Horner tail is bounded by its next two terms at the threshold.  The switch is the
-grid point minimising the worse of the two, and the degree is the smallest meeting the target.
+measured against 30-digit mpmath on a log grid of φ plus points approaching φ_max, each point
+taking the worst of a few nearby arguments (a cancellation must not hide behind one lucky
+rounding); the Horner tail is bounded by its next two terms at the threshold.  The switch is
+the grid point minimising the worse of the two, and the degree is the smallest meeting the
+target.  Among equivalent closed forms (as derived, half-angle forms of cos φ, everything in
+sin(φ/2), cos(φ/2)) the plan takes the one whose worst error is smallest, then the shortest
+polynomial, then the fewest distinct trigonometric arguments (sin a and cos a: one sincos).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import mpmath
 import numpy as np
 import sympy as sp
 
+from .algebraic import (
+    S,
+    algebraic_in_x,
+    angle_with_complement,
+    closed_with_base_angle,
+    closed_with_complement,
+    fold_complement,
+    with_complement,
+)
+from .algebraic import X as X  # re-exported: the symbol of the coefficients' variable x = |p|²
 from .core import Derivation, derive_expression
 from .functions import RealCbrt, mpmath_namespace
+from .newton_start import FarStart, far_start
 from .parsing import PHI
+from .quaternion_plan import (
+    QUATERNION_SCALAR,
+    QuaternionScale,
+    e0_min,
+    quaternion_scalar,
+    quaternion_scalar_series,
+    scale_expression,
+    scale_in_e0,
+    scale_series,
+)
 from .series import coefficient_list, taylor_series
 from .timeouts import bounded
 
-S = sp.Symbol("s", nonnegative=True)
-X = sp.Symbol("x", nonnegative=True)
 MAX_TERMS = 24
 GRID_POINTS = 56
+EDGE_POINTS = 12
+JITTER = 0.0137
+JITTER_SAMPLES = 6
 PRECISIONS: dict[str, type[np.floating]] = {"float64": np.float64, "float32": np.float32}
 CLOSED_TOLERANCE_ULP = 1.5
 NEWTON_ITERATIONS = 6
@@ -77,6 +110,8 @@ class Branch:
     closed: sp.Expr
     safe_phi: float
     measured_ulp: float
+    edge_ulp: float = 0.0
+    """Worst error of the closed form on the upper half of the range (towards φ_max)."""
 
 
 @dataclass(frozen=True)
@@ -96,6 +131,8 @@ class NewtonAngle:
     slope: Branch
     iterations: int
     phi_max: float
+    far: FarStart
+    """The start for s ≥ far.switch (see :mod:`symrot.newton_start`)."""
 
 
 Coefficient = Constant | Algebraic | Branch
@@ -107,6 +144,8 @@ class PrecisionPlan:
     epsilon: float
     angle: ClosedAngle | NewtonAngle
     coefficients: dict[str, Coefficient]
+    quaternion_scale: QuaternionScale
+    """σ with **p** = σ **e** for from_quaternion (see :mod:`symrot.quaternion_plan`)."""
 
 
 @dataclass(frozen=True)
@@ -116,11 +155,30 @@ class EvaluationPlan:
     p_max: float
     phi_max: float
     precisions: dict[str, PrecisionPlan]
+    e0_min: float | None
+    """from_quaternion (e₀ ≥ 0) is valid iff e₀ > e0_min; None: every rotation is representable."""
+    complement: sp.Rational | None = None
+    """p_max² when expressions use the symbol ``D`` = p_max² − x, which backends must compute with
+    compensated arithmetic (:func:`symrot.algebraic.fold_complement`)."""
 
 
 def well_conditioned(expr: sp.Expr) -> sp.Expr:
     """Replace cos(a) by 1 − 2 sin²(a/2): the half-angle form keeps 1 − cos φ accurate."""
     return expr.replace(lambda e: isinstance(e, sp.cos), lambda e: 1 - 2 * sp.sin(e.args[0] / 2) ** 2)
+
+
+def half_angle(expr: sp.Expr) -> sp.Expr:
+    """sin φ → 2 sin(φ/2) cos(φ/2), cos φ → 1 − 2 sin²(φ/2): every call on the one argument φ/2, so
+    that a compiler can evaluate them with a single sincos (and 1 − cos φ stays accurate)."""
+    half = PHI / 2
+    return expr.xreplace({sp.sin(PHI): 2 * sp.sin(half) * sp.cos(half),
+                          sp.cos(PHI): 1 - 2 * sp.sin(half) ** 2})
+
+
+def trig_arguments(expr: sp.Expr) -> int:
+    """Distinct arguments of sin/cos/tan calls other than φ/2, which every function shares (sin a and
+    cos a cost one sincos)."""
+    return len({e.args[0] for e in expr.atoms(sp.sin, sp.cos, sp.tan)} - {PHI / 2})
 
 
 def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
@@ -140,23 +198,6 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
     return None
 
 
-def algebraic_in_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
-    """c(φ(√x)) as a rational function of x when trigonometry disappears and x = 0 is regular."""
-    substituted = closed.subs(PHI, inverse)
-    reduced = bounded(4, None, lambda e: sp.factor(sp.simplify(sp.expand_trig(e))), substituted)
-    if reduced is None:
-        return None
-    in_x = reduced.subs(S, sp.sqrt(X))
-    in_x = bounded(2, in_x, sp.factor, in_x)
-    if any(isinstance(a, (sp.Function, sp.Pow)) and not (isinstance(a, sp.Pow) and a.exp.is_Rational)
-           for a in sp.preorder_traversal(in_x)) or in_x.free_symbols - {X}:
-        return None
-    at_zero = in_x.subs(X, 0)
-    if not at_zero.is_finite:
-        return None
-    return in_x
-
-
 def _mp_function(expr: sp.Expr) -> object:
     return sp.lambdify(PHI, expr, modules=[mpmath_namespace(), "mpmath"])
 
@@ -168,16 +209,28 @@ def _np_function(expr: sp.Expr) -> object:
 
 
 def _angle_grid(phi_max: float) -> np.ndarray:
-    top = min(phi_max, 4 * np.pi) * (1 - 1e-6)
-    return np.geomspace(1e-7, top, GRID_POINTS)
+    """Log grid towards 0 plus points approaching the edge of the range (φ_max − 10⁻ᵏ φ_max)."""
+    end = min(phi_max, 4 * np.pi)
+    edge = end * (1 - np.geomspace(0.25, 1e-6, EDGE_POINTS))
+    return np.unique(np.concatenate([np.geomspace(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
 
 
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type) -> Branch:
     """Choose the switch t₀ and Horner degree for one coefficient in one precision."""
-    candidates = ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]  # half-angle first
+    candidates = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
+    candidates += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
     branches = [_branch_for(form, series, variable_of_phi, phi_max, dtype) for form in candidates]
-    return min(branches, key=lambda b: (b.measured_ulp > CLOSED_TOLERANCE_ULP, len(b.horner), b.measured_ulp))
+    return min(branches, key=lambda b: (max(_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
+                                        len(b.horner), trig_arguments(b.closed), b.edge_ulp, b.measured_ulp))
+
+
+def _error_class(ulp: float) -> float:
+    """0 within tolerance, else the error's binary order of magnitude (inf for inf/NaN results):
+    a form 2 ulp off everywhere beats one that is exact inside but infinite next to φ_max."""
+    if ulp <= CLOSED_TOLERANCE_ULP:
+        return 0.0
+    return float(np.ceil(np.log2(ulp / CLOSED_TOLERANCE_ULP))) if np.isfinite(ulp) else np.inf
 
 
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
@@ -191,13 +244,21 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     t_values = np.zeros(len(angles))
     with mpmath.workdps(30):
         for k, angle in enumerate(angles):
-            a = mpmath.mpf(float(dtype(angle)))
-            reference = float(mp_closed(a))  # type: ignore[operator]
-            t_values[k] = float(to_t(a))
+            t_values[k] = float(to_t(mpmath.mpf(float(dtype(angle)))))
+            # rounding errors fluctuate from one argument to the next: take the worst of a few
+            # nearby arguments, so that a cancellation cannot hide behind one lucky grid point
+            samples: np.ndarray = np.unique(np.asarray(angle * (1 - JITTER * np.arange(JITTER_SAMPLES)),
+                                                       dtype=dtype))
+            samples = samples[samples.astype(np.float64) < phi_max * (1 - 2 * epsilon)]  # rounded inside
             with np.errstate(all="ignore"):
-                value = float(np_closed(np.asarray(a, dtype=dtype)))  # type: ignore[operator]
-            scale = max(abs(reference), scale0)
-            closed_error[k] = abs(value - reference) / (scale * epsilon) if np.isfinite(value) else np.inf
+                values = np.asarray(np_closed(samples), dtype=np.float64)  # type: ignore[operator]
+            worst = 0.0
+            for sample, value in zip(samples, np.broadcast_to(values, samples.shape), strict=True):
+                reference = float(mp_closed(mpmath.mpf(float(sample))))  # type: ignore[operator]
+                scale = max(abs(reference), scale0)
+                error = abs(value - reference) / (scale * epsilon) if np.isfinite(value) else np.inf
+                worst = max(worst, error)
+            closed_error[k] = worst
     floats = [abs(float(c)) for c in series]
 
     def tail(t: float, n: int) -> float:
@@ -218,7 +279,8 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     threshold = float(t_values[best_k])
     target = max(0.25, tail(threshold, MAX_TERMS - 2))
     degree = next((n for n in range(1, MAX_TERMS - 1) if tail(threshold, n) <= target), MAX_TERMS - 2)
-    return Branch(threshold, tuple(series[:degree]), closed, float(angles[best_k]), best)
+    edge = float(np.max(closed_error[near_zero:])) if near_zero < len(angles) else 0.0
+    return Branch(threshold, tuple(series[:degree]), closed, float(angles[best_k]), best, edge)
 
 
 @lru_cache(maxsize=64)
@@ -230,6 +292,8 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     phi_max = float(limits.phi_max_float) if np.isfinite(limits.phi_max_float) else 4 * float(np.pi)
     inverse = closed_inverse(p, derivation.kappa)
     x_of_phi = p ** 2
+    p_max = float(limits.p_max_float)
+    complement = fold_complement(inverse, p_max)
     precisions = {}
     for label, dtype in PRECISIONS.items():
         coefficients: dict[str, Coefficient] = {}
@@ -239,19 +303,60 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                 coefficients[coefficient] = Constant(constant)
                 continue
             if inverse is not None:
-                algebraic = algebraic_in_x(closed, inverse)
+                simplest_form = derivation.simplified_coefficients()[coefficient]
+                algebraic = (algebraic_in_x(simplest_form, inverse, p_max)
+                             or algebraic_in_x(closed, inverse, p_max))
                 if algebraic is not None:
                     coefficients[coefficient] = Algebraic(algebraic)
                     continue
             series = derivation.series_in_x(coefficient, MAX_TERMS)
             simplest_form = derivation.simplified_coefficients()[coefficient]
             coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype)
-        angle = ClosedAngle(inverse) if inverse is not None else _newton_angle(derivation, phi_max, dtype)
-        precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients)
-    return EvaluationPlan(name, p, float(limits.p_max_float), phi_max, precisions)
+        coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, phi_max, p_max, dtype)
+        scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
+        angle = (ClosedAngle(inverse) if inverse is not None
+                 else _newton_angle(derivation, phi_max, p_max, dtype))
+        if complement is not None:
+            assert inverse is not None
+            coefficients = {n: _use_complement(c, inverse, complement) for n, c in coefficients.items()}
+            angle = ClosedAngle(angle_with_complement(inverse))
+        elif inverse is not None:
+            coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
+                            if isinstance(c, Branch) else c for n, c in coefficients.items()}
+        precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale)
+    return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement)
 
 
-def _newton_angle(derivation: Derivation, phi_max: float, dtype: type) -> NewtonAngle:
+def _use_complement(coefficient: Coefficient, inverse: sp.Expr, complement: sp.Rational) -> Coefficient:
+    """The same coefficient with k² − x written as the accurately computed D (fold of the sine family)."""
+    if isinstance(coefficient, Algebraic):
+        return Algebraic(with_complement(coefficient.expression, complement))
+    if isinstance(coefficient, Branch):
+        return replace(coefficient, closed=closed_with_complement(coefficient.closed, inverse, complement))
+    return coefficient
+
+
+def _quaternion_scalar(derivation: Derivation, inverse: sp.Expr | None, phi_max: float,
+                       p_max: float, dtype: type) -> Coefficient:
+    """e₀ = cos(φ/2) as a coefficient of x (eq 74)."""
+    if inverse is not None:
+        algebraic = algebraic_in_x(quaternion_scalar(), inverse, p_max)
+        if algebraic is not None:
+            return Algebraic(algebraic)
+    series = quaternion_scalar_series(derivation, MAX_TERMS)
+    return plan_branch(quaternion_scalar(), series, derivation.p ** 2, phi_max, dtype)
+
+
+def _quaternion_scale(p: sp.Expr, phi_top: float, dtype: type) -> QuaternionScale:
+    """σ = p(φ)/sin(φ/2) on 0 ≤ φ ≤ min(φ_max, π): trig-free in e₀ if possible, else a Branch in φ²."""
+    algebraic = scale_in_e0(p)
+    if algebraic is not None:
+        return QuaternionScale(algebraic, None)
+    closed = sp.simplify(scale_expression(p)) if not p.has(RealCbrt) else scale_expression(p)
+    return QuaternionScale(None, plan_branch(closed, scale_series(p, MAX_TERMS), PHI ** 2, phi_top, dtype))
+
+
+def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: type) -> NewtonAngle:
     order = 2 * MAX_TERMS
     p = derivation.p
     ratio_series = coefficient_list(taylor_series(p / PHI, order), 0, order)[0::2]
@@ -261,7 +366,8 @@ def _newton_angle(derivation: Derivation, phi_max: float, dtype: type) -> Newton
                         phi_max, dtype)
     reverted = derivation.phi_of_p(2 * START_TERMS)
     start = tuple(reverted[1::2][:START_TERMS])
-    return NewtonAngle(start, ratio, slope, NEWTON_ITERATIONS, phi_max)
+    far = far_start(p, p_max, phi_max, start)
+    return NewtonAngle(start, ratio, slope, NEWTON_ITERATIONS, phi_max, far)
 
 
 def evaluation_plan(derivation: Derivation, name: str) -> EvaluationPlan:

@@ -64,4 +64,6 @@ def test_angle_without_closed_inverse_uses_newton(det_h_one_plan) -> None:
 def test_sine_family_inverse_is_closed_form() -> None:
     plan = evaluation_plan(derive("sine_m4").derivation, "sine_m4")
     angle = plan.precisions["float32"].angle
-    assert isinstance(angle, ClosedAngle) and angle.expression.has(sp.asin)
+    # 4 asin(s/4) rewritten as 4 atan2(s, sqrt(d)), d = 16 - |p|^2 computed with compensated sums
+    assert isinstance(angle, ClosedAngle) and angle.expression.has(sp.atan2)
+    assert plan.complement == 16

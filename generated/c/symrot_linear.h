@@ -13,6 +13,11 @@
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -26,21 +31,42 @@
 extern "C" {
 #endif
 
-/* symrot_linear__phi: internal: phi from s = |p| (eq 11).
- * phi = asin(s) (closed inverse of p(phi))
- * ops: 1 */
-static inline double symrot_linear__phi(double s)
+/* symrot_linear__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
+ * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
+ * rounded would leave no correct digit of p_max^2 - x (error-free products by
+ * fma, TwoSum).
+ * ops: 31 */
+static inline double symrot_linear__complement(const double p[3])
 {
-    return asin(s);
+    double high = 1.0, low = 0;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        const double square = p[i] * p[i];
+        const double error = fma(p[i], p[i], -square);
+        const double total = high - square;
+        const double virtual_ = total - high;
+        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        high = total;
+    }
+    return high + low;
+}
+
+/* symrot_linear__phi: internal: phi from s = |p| (eq 11).
+ * phi = atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 3 */
+static inline double symrot_linear__phi(double s, double d)
+{
+    return atan2(s, sqrt(d));
 }
 
 /* symrot_linear_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * phi = asin(s) (closed inverse of p(phi))
- * ops: 19 */
+ * phi = atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 41 */
 static inline double symrot_linear_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         return NAN;
     }
@@ -53,18 +79,19 @@ static inline double symrot_linear_angle(const double p[3])
     } else {
         s = sqrt(x);
     }
-    return symrot_linear__phi(s);
+    return symrot_linear__phi(s, d);
 }
 
 /* symrot_linear_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 1 (constant)
- * R_2: Horner degree 1 in x below x = 1e-14, else 1/(cos(phi) + 1)
- * ops: 46 */
+ * R_2 = 1/(sqrt(d) + 1) (algebraic in x)
+ * ops: 63 */
 static inline void symrot_linear_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -77,13 +104,7 @@ static inline void symrot_linear_rotation_matrix(const double p[3], double R[9])
         R[8] = NAN;
         return;
     }
-    double c_R_2;
-    if (x < 9.999999999999965e-15) {
-        c_R_2 = (1.0/8.0)*x + 1.0/2.0;
-    } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        c_R_2 = 1.0/(cos(phi) + 1);
-    }
+    const double c_R_2 = 1.0/(sqrt(d) + 1);
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = c_R_2*p[0]*p[1] - p[2];
     R[2] = c_R_2*p[0]*p[2] + p[1];
@@ -107,13 +128,14 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
 
 /* symrot_linear_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/(sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1)) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 1e-14, else 1/(cos(phi) + 1)
- * H_2: Horner degree 1 in x below x = 1e-14, else 1/((1 - 2*sin(phi/2)**2)*(2 - 2*sin(phi/2)**2))
- * ops: 72 */
+ * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
+ * H_2: Horner degree 1 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 78 */
 static inline void symrot_linear_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -126,16 +148,14 @@ static inline void symrot_linear_tangent(const double p[3], double H[9])
         H[8] = NAN;
         return;
     }
-    const double c_H_0 = 1/(sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1));
-    double c_H_1, c_H_2;
+    const double c_H_0 = 1.0/sqrt(d);
+    const double c_H_1 = 1.0/(sqrt(d) + 1);
+    double c_H_2;
     if (x < 9.999999999999965e-15) {
-        c_H_1 = (1.0/8.0)*x + 1.0/2.0;
         c_H_2 = (3.0/8.0)*x + 1.0/2.0;
     } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/2.0)*phi), 2);
-        c_H_1 = 1.0/(cos(phi) + 1);
-        c_H_2 = 1/((1 - w0)*(2 - w0));
+        const double w0 = sqrt(d);
+        c_H_2 = 1/(w0*(w0 + 1));
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -160,13 +180,14 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
 
 /* symrot_linear_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1) (algebraic in x)
+ * H_inverse_0 = sqrt(d) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 1 in x below x = 1e-14, else -1/(2*(cos(phi) + 1))
- * ops: 65 */
+ * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
+ * ops: 73 */
 static inline void symrot_linear_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -179,14 +200,8 @@ static inline void symrot_linear_tangent_inverse(const double p[3], double Hinv[
         Hinv[8] = NAN;
         return;
     }
-    const double c_H_inverse_0 = sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1);
-    double c_H_inverse_2;
-    if (x < 9.999999999999965e-15) {
-        c_H_inverse_2 = (-1.0/16.0)*x - 1.0/4.0;
-    } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        c_H_inverse_2 = -(1.0/2.0)/(cos(phi) + 1);
-    }
+    const double c_H_inverse_0 = sqrt(d);
+    const double c_H_inverse_2 = -(1.0/2.0)/(sqrt(d) + 1);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -210,11 +225,12 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
 
 /* symrot_linear_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 1 in x below x = 1e-14, else 1/((1 - 2*sin(phi/4)**2)**2*(1 - 2*sin(phi/2)**2))
- * ops: 23 */
+ * det_H: Horner degree 1 in x below x = 1e-14, else 1/(sqrt(d)*cos(phi/2)**2)
+ * ops: 39 */
 static inline double symrot_linear_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         return NAN;
     }
@@ -222,8 +238,8 @@ static inline double symrot_linear_tangent_det(const double p[3])
     if (x < 9.999999999999965e-15) {
         c_det_H = (3.0/4.0)*x + 1;
     } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        c_det_H = 1/(pow(1 - 2*pow(sin((1.0/4.0)*phi), 2), 2)*(1 - 2*pow(sin((1.0/2.0)*phi), 2)));
+        const double phi = symrot_linear__phi(sqrt(x), d);
+        c_det_H = 1/(sqrt(d)*pow(cos((1.0/2.0)*phi), 2));
     }
     return c_det_H;
 }
@@ -231,12 +247,13 @@ static inline double symrot_linear_tangent_det(const double p[3])
 /* symrot_linear_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 1e-14, else 1/(2*(1 - 2*sin(phi/4)**2))
- * G_2: Horner degree 5 in x below x = 0.00326076, else 2*sin(phi/4)**2/sin(phi)**2
- * ops: 73 */
+ * G_1 = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
+ * G_2: Horner degree 15 in x below x = 0.116472, else 2*sin(phi/4)**2/s**2
+ * ops: 121 */
 static inline void symrot_linear_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -249,15 +266,14 @@ static inline void symrot_linear_root_matrix(const double p[3], double G[9])
         G[8] = NAN;
         return;
     }
-    double c_G_1, c_G_2;
-    if (x < 9.999999999999965e-15) {
-        c_G_1 = (1.0/16.0)*x + 1.0/2.0;
-        c_G_2 = x*(x*(x*(x*((29393.0/4194304.0)*x + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+    const double c_G_1 = (1.0/2.0)*sqrt(2)/sqrt(sqrt(d) + 1);
+    double c_G_2;
+    if (x < 0.11647220631481629) {
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
     } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/4.0)*phi), 2);
-        c_G_1 = (1.0/2.0)/(1 - w0);
-        c_G_2 = x < 0.003260757485899967 ? x*(x*(x*(x*((29393.0/4194304.0)*x + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0 : w0/pow(sin(phi), 2);
+        const double phi = symrot_linear__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -282,13 +298,14 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
 
 /* symrot_linear_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * K_0 = 1/(2*sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1)) (algebraic in x)
- * K_1: Horner degree 5 in x below x = 0.00326076, else 2*sin(phi/4)**2/sin(phi)**2
- * K_2: Horner degree 21 in x below x = 0.20569, else (1/(2*(1 - 2*sin(phi/2)**2)) - 1/(2*(1 - 2*sin(phi/4)**2)))/sin(phi)**2
- * ops: 139 */
+ * K_0 = 1/(2*sqrt(d)) (algebraic in x)
+ * K_1: Horner degree 15 in x below x = 0.116472, else 2*sin(phi/4)**2/s**2
+ * K_2: Horner degree 21 in x below x = 0.20569, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/s**2
+ * ops: 180 */
 static inline void symrot_linear_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -301,17 +318,17 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
         K[8] = NAN;
         return;
     }
-    const double c_K_0 = (1.0/2.0)/(sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1));
+    const double c_K_0 = (1.0/2.0)/sqrt(d);
     double c_K_1, c_K_2;
-    if (x < 0.003260757485899967) {
-        c_K_1 = x*(x*(x*(x*((29393.0/4194304.0)*x + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+    if (x < 0.11647220631481629) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.05885971719125154)*x + 0.06018356076598873) + 0.061600857483278565) + 0.0631231337187008) + 0.06476400687636197) + 0.06653969900370939) + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0;
     } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        const double w0 = pow(sin(phi), -2);
-        const double w1 = 2*pow(sin((1.0/4.0)*phi), 2);
-        c_K_1 = w0*w1;
-        c_K_2 = x < 0.20569005717897368 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.05885971719125154)*x + 0.06018356076598873) + 0.061600857483278565) + 0.0631231337187008) + 0.06476400687636197) + 0.06653969900370939) + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0 : w0*((1.0/2.0)/(1 - 2*pow(sin((1.0/2.0)*phi), 2)) - (1.0/2.0)/(1 - w1));
+        const double phi = symrot_linear__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 0.20569005717897526 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.05885971719125154)*x + 0.06018356076598873) + 0.061600857483278565) + 0.0631231337187008) + 0.06476400687636197) + 0.06653969900370939) + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0 : w0*(-(1.0/2.0)/cos((1.0/2.0)*phi) + (1.0/2.0)/sqrt(d));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -336,27 +353,22 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
 
 /* symrot_linear_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1) (algebraic in x)
+ * H_inverse_0 = sqrt(d) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 1 in x below x = 1e-14, else -1/(2*(cos(phi) + 1))
- * ops: 59 */
+ * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
+ * ops: 67 */
 static inline void symrot_linear_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
-    const double c_H_inverse_0 = sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1);
-    double c_H_inverse_2;
-    if (x < 9.999999999999965e-15) {
-        c_H_inverse_2 = (-1.0/16.0)*x - 1.0/4.0;
-    } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        c_H_inverse_2 = -(1.0/2.0)/(cos(phi) + 1);
-    }
+    const double c_H_inverse_0 = sqrt(d);
+    const double c_H_inverse_2 = -(1.0/2.0)/(sqrt(d) + 1);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -367,29 +379,28 @@ static inline void symrot_linear_pdot(const double p[3], const double omega[3], 
 
 /* symrot_linear_omega: omega = H pdot (eq 20).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/(sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1)) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 1e-14, else 1/(cos(phi) + 1)
- * H_2: Horner degree 1 in x below x = 1e-14, else 1/((1 - 2*sin(phi/2)**2)*(2 - 2*sin(phi/2)**2))
- * ops: 66 */
+ * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
+ * H_2: Horner degree 1 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 72 */
 static inline void symrot_linear_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
-    const double c_H_0 = 1/(sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1));
-    double c_H_1, c_H_2;
+    const double c_H_0 = 1.0/sqrt(d);
+    const double c_H_1 = 1.0/(sqrt(d) + 1);
+    double c_H_2;
     if (x < 9.999999999999965e-15) {
-        c_H_1 = (1.0/8.0)*x + 1.0/2.0;
         c_H_2 = (3.0/8.0)*x + 1.0/2.0;
     } else {
-        const double phi = symrot_linear__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/2.0)*phi), 2);
-        c_H_1 = 1.0/(cos(phi) + 1);
-        c_H_2 = 1/((1 - w0)*(2 - w0));
+        const double w0 = sqrt(d);
+        c_H_2 = 1/(w0*(w0 + 1));
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -399,21 +410,194 @@ static inline void symrot_linear_omega(const double p[3], const double pdot[3], 
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
 }
 
-/* symrot_linear__phi_f: internal: phi from s = |p| (eq 11).
- * phi = asin(s) (closed inverse of p(phi))
- * ops: 1 */
-static inline float symrot_linear__phi_f(float s)
+/* symrot_linear_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 1 in x below x = 1e-14, else cos(phi/2)
+ * nu = sqrt(2)/sqrt(sqrt(d) + 1) (algebraic in x)
+ * ops: 46 */
+static inline void symrot_linear_to_quaternion(const double p[3], double e[4])
 {
-    return asinf(s);
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_linear__complement(p);
+    if (!(x < 1.0)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_nu = sqrt(2)/sqrt(sqrt(d) + 1);
+    double c_e_0;
+    if (x < 9.999999999999965e-15) {
+        c_e_0 = 1 + (-1.0/8.0)*x;
+    } else {
+        const double phi = symrot_linear__phi(sqrt(x), d);
+        c_e_0 = cos((1.0/2.0)*phi);
+    }
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_linear__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 2*e0 (trig-free in e0)
+ * ops: 51 */
+static inline int symrot_linear__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    if (!(c0 > 0.7071067811865476)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    e_norm = e_norm / n;
+    const double sigma = 2*c0;
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 1.0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_linear_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 0 */
+static inline int symrot_linear_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_linear__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_linear_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_linear_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_linear__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_linear__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_linear__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_linear__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_linear_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 28 */
+static inline int symrot_linear_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_linear_to_quaternion(p1, a);
+    symrot_linear_to_quaternion(p2, b);
+    return symrot_linear__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_linear_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_linear_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_linear_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_linear__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_linear__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
+ * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
+ * rounded would leave no correct digit of p_max^2 - x (error-free products by
+ * fma, TwoSum).
+ * ops: 31 */
+static inline float symrot_linear__complement_f(const float p[3])
+{
+    float high = 1.0F, low = 0;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        const float square = p[i] * p[i];
+        const float error = fmaf(p[i], p[i], -square);
+        const float total = high - square;
+        const float virtual_ = total - high;
+        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        high = total;
+    }
+    return high + low;
+}
+
+/* symrot_linear__phi_f: internal: phi from s = |p| (eq 11).
+ * phi = atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 3 */
+static inline float symrot_linear__phi_f(float s, float d)
+{
+    return atan2f(s, sqrtf(d));
 }
 
 /* symrot_linear_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * phi = asin(s) (closed inverse of p(phi))
- * ops: 19 */
+ * phi = atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 41 */
 static inline float symrot_linear_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         return NAN;
     }
@@ -426,18 +610,19 @@ static inline float symrot_linear_angle_f(const float p[3])
     } else {
         s = sqrtf(x);
     }
-    return symrot_linear__phi_f(s);
+    return symrot_linear__phi_f(s, d);
 }
 
 /* symrot_linear_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 1 (constant)
- * R_2: Horner degree 0 in x below x = 1e-14, else 1/(2 - 2*sin(phi/2)**2)
- * ops: 49 */
+ * R_2 = 1/(sqrt(d) + 1) (algebraic in x)
+ * ops: 63 */
 static inline void symrot_linear_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -450,13 +635,7 @@ static inline void symrot_linear_rotation_matrix_f(const float p[3], float R[9])
         R[8] = NAN;
         return;
     }
-    float c_R_2;
-    if (x < 1e-14F) {
-        c_R_2 = 1.0F/2.0F;
-    } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        c_R_2 = 1.0F/(2 - 2*powf(sinf((1.0F/2.0F)*phi), 2));
-    }
+    const float c_R_2 = 1.0F/(sqrtf(d) + 1);
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = c_R_2*p[0]*p[1] - p[2];
     R[2] = c_R_2*p[0]*p[2] + p[1];
@@ -480,13 +659,14 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
 
 /* symrot_linear_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/(sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1)) (algebraic in x)
- * H_1: Horner degree 0 in x below x = 1e-14, else 1/(2 - 2*sin(phi/2)**2)
- * H_2: Horner degree 0 in x below x = 1e-14, else 1/((1 - 2*sin(phi/2)**2)*(2 - 2*sin(phi/2)**2))
- * ops: 69 */
+ * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
+ * H_2: Horner degree 0 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 78 */
 static inline void symrot_linear_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -499,17 +679,14 @@ static inline void symrot_linear_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 1/(sqrtf(1 - sqrtf(x))*sqrtf(sqrtf(x) + 1));
-    float c_H_1, c_H_2;
+    const float c_H_0 = 1.0F/sqrtf(d);
+    const float c_H_1 = 1.0F/(sqrtf(d) + 1);
+    float c_H_2;
     if (x < 1e-14F) {
-        c_H_1 = 1.0F/2.0F;
         c_H_2 = 1.0F/2.0F;
     } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        const float w0 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w1 = 1.0F/(2 - w0);
-        c_H_1 = w1;
-        c_H_2 = w1/(1 - w0);
+        const float w0 = sqrtf(d);
+        c_H_2 = 1/(w0*(w0 + 1));
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -534,13 +711,14 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
 
 /* symrot_linear_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1) (algebraic in x)
+ * H_inverse_0 = sqrt(d) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1e-14, else -1/(2*(2 - 2*sin(phi/2)**2))
- * ops: 67 */
+ * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
+ * ops: 73 */
 static inline void symrot_linear_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -553,14 +731,8 @@ static inline void symrot_linear_tangent_inverse_f(const float p[3], float Hinv[
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = sqrtf(1 - sqrtf(x))*sqrtf(sqrtf(x) + 1);
-    float c_H_inverse_2;
-    if (x < 1e-14F) {
-        c_H_inverse_2 = -1.0F/4.0F;
-    } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        c_H_inverse_2 = -(1.0F/2.0F)/(2 - 2*powf(sinf((1.0F/2.0F)*phi), 2));
-    }
+    const float c_H_inverse_0 = sqrtf(d);
+    const float c_H_inverse_2 = -(1.0F/2.0F)/(sqrtf(d) + 1);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -584,11 +756,12 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
 
 /* symrot_linear_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 0 in x below x = 1e-14, else 1/((1 - 2*sin(phi/4)**2)**2*(1 - 2*sin(phi/2)**2))
- * ops: 23 */
+ * det_H: Horner degree 0 in x below x = 1e-14, else 1/(sqrt(d)*cos(phi/2)**2)
+ * ops: 39 */
 static inline float symrot_linear_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         return NAN;
     }
@@ -596,8 +769,8 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
     if (x < 1e-14F) {
         c_det_H = 1;
     } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        c_det_H = 1/(powf(1 - 2*powf(sinf((1.0F/4.0F)*phi), 2), 2)*(1 - 2*powf(sinf((1.0F/2.0F)*phi), 2)));
+        const float phi = symrot_linear__phi_f(sqrtf(x), d);
+        c_det_H = 1/(sqrtf(d)*powf(cosf((1.0F/2.0F)*phi), 2));
     }
     return c_det_H;
 }
@@ -605,12 +778,13 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
 /* symrot_linear_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 1e-14, else 1/(2*(1 - 2*sin(phi/4)**2))
- * G_2: Horner degree 0 in x below x = 1e-14, else 2*sin(phi/4)**2/sin(phi)**2
- * ops: 59 */
+ * G_1 = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
+ * G_2: Horner degree 2 in x below x = 0.00326076, else 2*sin(phi/4)**2/s**2
+ * ops: 88 */
 static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -623,15 +797,14 @@ static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
         G[8] = NAN;
         return;
     }
-    float c_G_1, c_G_2;
-    if (x < 1e-14F) {
-        c_G_1 = 1.0F/2.0F;
-        c_G_2 = 1.0F/8.0F;
+    const float c_G_1 = (1.0F/2.0F)*sqrtf(2)/sqrtf(sqrtf(d) + 1);
+    float c_G_2;
+    if (x < 0.0032607575F) {
+        c_G_2 = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
     } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        const float w0 = 2*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_G_1 = (1.0F/2.0F)/(1 - w0);
-        c_G_2 = w0/powf(sinf(phi), 2);
+        const float phi = symrot_linear__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -656,13 +829,14 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
 
 /* symrot_linear_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * K_0 = 1/(2*sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1)) (algebraic in x)
- * K_1: Horner degree 0 in x below x = 1e-14, else 2*sin(phi/4)**2/sin(phi)**2
- * K_2: Horner degree 15 in x below x = 0.35302, else (1/(2*(1 - 2*sin(phi/2)**2)) - 1/(2*(1 - 2*sin(phi/4)**2)))/sin(phi)**2
- * ops: 117 */
+ * K_0 = 1/(2*sqrt(d)) (algebraic in x)
+ * K_1: Horner degree 2 in x below x = 0.00326076, else 2*sin(phi/4)**2/s**2
+ * K_2: Horner degree 15 in x below x = 0.35302, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/s**2
+ * ops: 131 */
 static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -675,17 +849,17 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (1.0F/2.0F)/(sqrtf(1 - sqrtf(x))*sqrtf(sqrtf(x) + 1));
+    const float c_K_0 = (1.0F/2.0F)/sqrtf(d);
     float c_K_1, c_K_2;
-    if (x < 1e-14F) {
-        c_K_1 = 1.0F/8.0F;
+    if (x < 0.0032607575F) {
+        c_K_1 = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
     } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        const float w0 = powf(sinf(phi), -2);
-        const float w1 = 2*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_1 = w0*w1;
-        c_K_2 = x < 0.35302037F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F : w0*((1.0F/2.0F)/(1 - 2*powf(sinf((1.0F/2.0F)*phi), 2)) - (1.0F/2.0F)/(1 - w1));
+        const float phi = symrot_linear__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = x < 0.35302037F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F : w0*(-(1.0F/2.0F)/cosf((1.0F/2.0F)*phi) + (1.0F/2.0F)/sqrtf(d));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -710,27 +884,22 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
 
 /* symrot_linear_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1) (algebraic in x)
+ * H_inverse_0 = sqrt(d) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1e-14, else -1/(2*(2 - 2*sin(phi/2)**2))
- * ops: 61 */
+ * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
+ * ops: 67 */
 static inline void symrot_linear_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = sqrtf(1 - sqrtf(x))*sqrtf(sqrtf(x) + 1);
-    float c_H_inverse_2;
-    if (x < 1e-14F) {
-        c_H_inverse_2 = -1.0F/4.0F;
-    } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        c_H_inverse_2 = -(1.0F/2.0F)/(2 - 2*powf(sinf((1.0F/2.0F)*phi), 2));
-    }
+    const float c_H_inverse_0 = sqrtf(d);
+    const float c_H_inverse_2 = -(1.0F/2.0F)/(sqrtf(d) + 1);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -741,30 +910,28 @@ static inline void symrot_linear_pdot_f(const float p[3], const float omega[3], 
 
 /* symrot_linear_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/(sqrt(1 - sqrt(x))*sqrt(sqrt(x) + 1)) (algebraic in x)
- * H_1: Horner degree 0 in x below x = 1e-14, else 1/(2 - 2*sin(phi/2)**2)
- * H_2: Horner degree 0 in x below x = 1e-14, else 1/((1 - 2*sin(phi/2)**2)*(2 - 2*sin(phi/2)**2))
- * ops: 63 */
+ * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
+ * H_2: Horner degree 0 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 72 */
 static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
     if (!(x < 1.0F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 1/(sqrtf(1 - sqrtf(x))*sqrtf(sqrtf(x) + 1));
-    float c_H_1, c_H_2;
+    const float c_H_0 = 1.0F/sqrtf(d);
+    const float c_H_1 = 1.0F/(sqrtf(d) + 1);
+    float c_H_2;
     if (x < 1e-14F) {
-        c_H_1 = 1.0F/2.0F;
         c_H_2 = 1.0F/2.0F;
     } else {
-        const float phi = symrot_linear__phi_f(sqrtf(x));
-        const float w0 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w1 = 1.0F/(2 - w0);
-        c_H_1 = w1;
-        c_H_2 = w1/(1 - w0);
+        const float w0 = sqrtf(d);
+        c_H_2 = 1/(w0*(w0 + 1));
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -772,6 +939,158 @@ static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], 
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_linear_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 0 in x below x = 1e-14, else cos(phi/2)
+ * nu = sqrt(2)/sqrt(sqrt(d) + 1) (algebraic in x)
+ * ops: 46 */
+static inline void symrot_linear_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_linear__complement_f(p);
+    if (!(x < 1.0F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_nu = sqrtf(2)/sqrtf(sqrtf(d) + 1);
+    float c_e_0;
+    if (x < 1e-14F) {
+        c_e_0 = 1;
+    } else {
+        const float phi = symrot_linear__phi_f(sqrtf(x), d);
+        c_e_0 = cosf((1.0F/2.0F)*phi);
+    }
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_linear__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 2*e0 (trig-free in e0)
+ * ops: 51 */
+static inline int symrot_linear__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    if (!(c0 > 0.70710677F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    e_norm = e_norm / n;
+    const float sigma = 2*c0;
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 1.0F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_linear_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 0 */
+static inline int symrot_linear_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_linear__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_linear_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_linear_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_linear__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_linear__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_linear__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_linear__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_linear_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 28 */
+static inline int symrot_linear_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_linear_to_quaternion_f(p1, a);
+    symrot_linear_to_quaternion_f(p2, b);
+    return symrot_linear__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_linear_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_linear_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_linear_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_linear__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

@@ -13,6 +13,11 @@
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -59,9 +64,9 @@ static inline double symrot_rotation_vector_angle(const double p[3])
 /* symrot_rotation_vector_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 1 in x below x = 5.0283e-13, else sin(phi)/phi
+ * R_1: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)*cos(phi/2)/phi
  * R_2: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * ops: 56 */
+ * ops: 58 */
 static inline void symrot_rotation_vector_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -83,8 +88,10 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
         c_R_2 = 1.0/2.0 + (-1.0/24.0)*x;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        c_R_1 = sin(phi)/phi;
-        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        c_R_1 = 2*w1*cos(w0)/phi;
+        c_R_2 = 2*(w1*w1)/(phi*phi);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -111,8 +118,8 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 0.408665, else -(-phi + sin(phi))/phi**3
- * ops: 73 */
+ * H_2: Horner degree 8 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
+ * ops: 79 */
 static inline void symrot_rotation_vector_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -131,11 +138,11 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
     double c_H_1, c_H_2;
     if (x < 5.028297529613113e-13) {
         c_H_1 = 1.0/2.0 + (-1.0/24.0)*x;
-        c_H_2 = x*(x*(x*(x*(x*((1.0/1307674368000.0)*x - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
-        c_H_2 = x < 0.4086652777619201 ? x*(x*(x*(x*(x*((1.0/1307674368000.0)*x - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0 : -(-phi + sin(phi))/(phi*phi*phi);
+        c_H_2 = x < 1.5083706105984414 ? x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0 : -(-phi + sin(phi))/(phi*phi*phi);
     }
     H[0] = -c_H_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -162,8 +169,8 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 11 in x below x = 1.50837, else (-phi*sin(phi)/(4*sin(phi/2)**2) + 1)/phi**2
- * ops: 80 */
+ * H_inverse_2: Horner degree 18 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
+ * ops: 101 */
 static inline void symrot_rotation_vector_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -180,11 +187,12 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
         return;
     }
     double c_H_inverse_2;
-    if (x < 1.5083706105984414) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.3954464685812522e-19)*x + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
+    if (x < 5.56734820089753) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.336734257095045e-31)*x + 3.6859949406653103e-29) + 1.455172475614865e-27) + 5.744790668872202e-26) + 2.267952452337683e-24) + 8.953517427037546e-23) + 3.534707039629467e-21) + 1.3954464685812522e-19) + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        c_H_inverse_2 = (-1.0/4.0*phi*sin(phi)/pow(sin((1.0/2.0)*phi), 2) + 1)/(phi*phi);
+        const double w0 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (-w0*cos(w0)/sin(w0) + 1)/(phi*phi);
     }
     Hinv[0] = -c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -231,8 +239,8 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 1 in x below x = 1.85593e-12, else sin(phi/2)/phi
- * G_2: Horner degree 1 in x below x = 1.85593e-12, else 2*sin(phi/4)**2/phi**2
- * ops: 57 */
+ * G_2: Horner degree 1 in x below x = 9.01516e-09, else 2*sin(phi/4)**2/phi**2
+ * ops: 58 */
 static inline void symrot_rotation_vector_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -255,7 +263,7 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_G_1 = sin((1.0/2.0)*phi)/phi;
-        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
+        c_G_2 = x < 9.015158901432458e-09 ? 1.0/8.0 + (-1.0/384.0)*x : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -281,9 +289,9 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
 /* symrot_rotation_vector_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
- * K_1: Horner degree 1 in x below x = 1.85593e-12, else 2*sin(phi/4)**2/phi**2
- * K_2: Horner degree 7 in x below x = 2.89787, else -(-phi + 2*sin(phi/2))/(2*phi**3)
- * ops: 80 */
+ * K_1: Horner degree 1 in x below x = 9.01516e-09, else 2*sin(phi/4)**2/phi**2
+ * K_2: Horner degree 8 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
+ * ops: 82 */
 static inline void symrot_rotation_vector_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -300,13 +308,13 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         return;
     }
     double c_K_1, c_K_2;
-    if (x < 1.855928709321803e-12) {
+    if (x < 9.015158901432458e-09) {
         c_K_1 = 1.0/8.0 + (-1.0/384.0)*x;
-        c_K_2 = x*(x*(x*(x*(x*(x*(2.333729166204778e-17 + (-2.1449716601146855e-20)*x) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
-        c_K_2 = x < 2.897865491219691 ? x*(x*(x*(x*(x*(x*(2.333729166204778e-17 + (-2.1449716601146855e-20)*x) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
+        c_K_2 = x < 5.56734820089753 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0/2.0;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -333,8 +341,8 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 11 in x below x = 1.50837, else (-phi*sin(phi)/(4*sin(phi/2)**2) + 1)/phi**2
- * ops: 71 */
+ * H_inverse_2: Horner degree 18 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
+ * ops: 92 */
 static inline void symrot_rotation_vector_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -345,11 +353,12 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
         return;
     }
     double c_H_inverse_2;
-    if (x < 1.5083706105984414) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.3954464685812522e-19)*x + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
+    if (x < 5.56734820089753) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.336734257095045e-31)*x + 3.6859949406653103e-29) + 1.455172475614865e-27) + 5.744790668872202e-26) + 2.267952452337683e-24) + 8.953517427037546e-23) + 3.534707039629467e-21) + 1.3954464685812522e-19) + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        c_H_inverse_2 = (-1.0/4.0*phi*sin(phi)/pow(sin((1.0/2.0)*phi), 2) + 1)/(phi*phi);
+        const double w0 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (-w0*cos(w0)/sin(w0) + 1)/(phi*phi);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -363,8 +372,8 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 0.408665, else -(-phi + sin(phi))/phi**3
- * ops: 64 */
+ * H_2: Horner degree 8 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
+ * ops: 70 */
 static inline void symrot_rotation_vector_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -377,11 +386,11 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
     double c_H_1, c_H_2;
     if (x < 5.028297529613113e-13) {
         c_H_1 = 1.0/2.0 + (-1.0/24.0)*x;
-        c_H_2 = x*(x*(x*(x*(x*((1.0/1307674368000.0)*x - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
-        c_H_2 = x < 0.4086652777619201 ? x*(x*(x*(x*(x*((1.0/1307674368000.0)*x - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0 : -(-phi + sin(phi))/(phi*phi*phi);
+        c_H_2 = x < 1.5083706105984414 ? x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0 : -(-phi + sin(phi))/(phi*phi*phi);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -389,6 +398,160 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
     omega[0] = c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1) + pdot[0];
     omega[1] = c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0) + pdot[1];
     omega[2] = c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0) + pdot[2];
+}
+
+/* symrot_rotation_vector_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 1 in x below x = 1.85593e-12, else cos(phi/2)
+ * nu: Horner degree 1 in x below x = 1.85593e-12, else 2*sin(phi/2)/phi
+ * ops: 18 */
+static inline void symrot_rotation_vector_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 39.47841760435743)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    double c_e_0, c_nu;
+    if (x < 1.855928709321803e-12) {
+        c_e_0 = 1 + (-1.0/8.0)*x;
+        c_nu = 1 + (-1.0/24.0)*x;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        c_e_0 = cos(w0);
+        c_nu = 2*sin(w0)/phi;
+    }
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_rotation_vector__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 1 in t = phi^2 below 6.57462e-14, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 56 */
+static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double phi = 2*atan2(e_norm, c0);
+    const double t = (phi*phi);
+    double sigma;
+    if (t < 6.574622895991269e-14) {
+        sigma = (1.0/12.0)*t + 2;
+    } else {
+        sigma = phi/sin((1.0/2.0)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 39.47841760435743)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_rotation_vector_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_rotation_vector_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_rotation_vector__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_rotation_vector_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_rotation_vector_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_rotation_vector__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_rotation_vector__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_rotation_vector__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_rotation_vector__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_rotation_vector_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_rotation_vector_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_rotation_vector_to_quaternion(p1, a);
+    symrot_rotation_vector_to_quaternion(p2, b);
+    return symrot_rotation_vector__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_rotation_vector_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_rotation_vector_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_rotation_vector_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_rotation_vector__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 /* symrot_rotation_vector__phi_f: internal: phi from s = |p| (eq 11).
@@ -424,9 +587,9 @@ static inline float symrot_rotation_vector_angle_f(const float p[3])
 /* symrot_rotation_vector_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 0 in x below x = 5.0283e-13, else sin(phi)/phi
+ * R_1: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)*cos(phi/2)/phi
  * R_2: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * ops: 56 */
+ * ops: 58 */
 static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -448,8 +611,10 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
         c_R_2 = 1.0F/2.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        c_R_1 = sinf(phi)/phi;
-        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_1 = 2*w1*cosf(w0)/phi;
+        c_R_2 = 2*(w1*w1)/(phi*phi);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -476,8 +641,8 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 3 in x below x = 0.408665, else -(-phi + sin(phi))/phi**3
- * ops: 65 */
+ * H_2: Horner degree 4 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
+ * ops: 67 */
 static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -496,11 +661,11 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
     float c_H_1, c_H_2;
     if (x < 5.028297e-13F) {
         c_H_1 = 1.0F/2.0F;
-        c_H_2 = x*(x*(1.0F/5040.0F + (-1.0F/362880.0F)*x) - 1.0F/120.0F) + 1.0F/6.0F;
+        c_H_2 = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
-        c_H_2 = x < 0.4086653F ? x*(x*(1.0F/5040.0F + (-1.0F/362880.0F)*x) - 1.0F/120.0F) + 1.0F/6.0F : -(-phi + sinf(phi))/(phi*phi*phi);
+        c_H_2 = x < 1.5083706F ? x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F : -(-phi + sinf(phi))/(phi*phi*phi);
     }
     H[0] = -c_H_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -527,8 +692,8 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 2.89787, else (-phi*sin(phi)/(4*sin(phi/2)**2) + 1)/phi**2
- * ops: 64 */
+ * H_inverse_2: Horner degree 8 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
+ * ops: 71 */
 static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -545,11 +710,12 @@ static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], fl
         return;
     }
     float c_H_inverse_2;
-    if (x < 2.8978653F) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*((1.3382536e-11F)*x + 5.2841903e-10F) + 2.0876756e-08F) + 1.0F/1209600.0F) + 1.0F/30240.0F) + 1.0F/720.0F) + 1.0F/12.0F;
+    if (x < 5.567348F) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*((8.586062e-15F)*x + 3.3896803e-13F) + 1.3382536e-11F) + 5.2841903e-10F) + 2.0876756e-08F) + 1.0F/1209600.0F) + 1.0F/30240.0F) + 1.0F/720.0F) + 1.0F/12.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        c_H_inverse_2 = (-1.0F/4.0F*phi*sinf(phi)/powf(sinf((1.0F/2.0F)*phi), 2) + 1)/(phi*phi);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (-w0*cosf(w0)/sinf(w0) + 1)/(phi*phi);
     }
     Hinv[0] = -c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -647,8 +813,8 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
  * K_1: Horner degree 0 in x below x = 1.85593e-12, else 2*sin(phi/4)**2/phi**2
- * K_2: Horner degree 3 in x below x = 1.50837, else -(-phi + 2*sin(phi/2))/(2*phi**3)
- * ops: 68 */
+ * K_2: Horner degree 4 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
+ * ops: 70 */
 static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -667,11 +833,11 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
     float c_K_1, c_K_2;
     if (x < 1.8559286e-12F) {
         c_K_1 = 1.0F/8.0F;
-        c_K_2 = x*(x*(1.0F/645120.0F + (-5.382289e-09F)*x) - 1.0F/3840.0F) + 1.0F/48.0F;
+        c_K_2 = x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
-        c_K_2 = x < 1.5083706F ? x*(x*(1.0F/645120.0F + (-5.382289e-09F)*x) - 1.0F/3840.0F) + 1.0F/48.0F : -1.0F/2.0F*(-phi + 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
+        c_K_2 = x < 5.567348F ? x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F : -1.0F/2.0F*(-phi + 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0F/2.0F;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -698,8 +864,8 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 2.89787, else (-phi*sin(phi)/(4*sin(phi/2)**2) + 1)/phi**2
- * ops: 55 */
+ * H_inverse_2: Horner degree 8 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
+ * ops: 62 */
 static inline void symrot_rotation_vector_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -710,11 +876,12 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
         return;
     }
     float c_H_inverse_2;
-    if (x < 2.8978653F) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*((1.3382536e-11F)*x + 5.2841903e-10F) + 2.0876756e-08F) + 1.0F/1209600.0F) + 1.0F/30240.0F) + 1.0F/720.0F) + 1.0F/12.0F;
+    if (x < 5.567348F) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*((8.586062e-15F)*x + 3.3896803e-13F) + 1.3382536e-11F) + 5.2841903e-10F) + 2.0876756e-08F) + 1.0F/1209600.0F) + 1.0F/30240.0F) + 1.0F/720.0F) + 1.0F/12.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        c_H_inverse_2 = (-1.0F/4.0F*phi*sinf(phi)/powf(sinf((1.0F/2.0F)*phi), 2) + 1)/(phi*phi);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (-w0*cosf(w0)/sinf(w0) + 1)/(phi*phi);
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -728,8 +895,8 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 3 in x below x = 0.408665, else -(-phi + sin(phi))/phi**3
- * ops: 56 */
+ * H_2: Horner degree 4 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
+ * ops: 58 */
 static inline void symrot_rotation_vector_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -742,11 +909,11 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
     float c_H_1, c_H_2;
     if (x < 5.028297e-13F) {
         c_H_1 = 1.0F/2.0F;
-        c_H_2 = x*(x*(1.0F/5040.0F + (-1.0F/362880.0F)*x) - 1.0F/120.0F) + 1.0F/6.0F;
+        c_H_2 = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
-        c_H_2 = x < 0.4086653F ? x*(x*(1.0F/5040.0F + (-1.0F/362880.0F)*x) - 1.0F/120.0F) + 1.0F/6.0F : -(-phi + sinf(phi))/(phi*phi*phi);
+        c_H_2 = x < 1.5083706F ? x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F : -(-phi + sinf(phi))/(phi*phi*phi);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -754,6 +921,160 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
     omega[0] = c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1) + pdot[0];
     omega[1] = c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0) + pdot[1];
     omega[2] = c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0) + pdot[2];
+}
+
+/* symrot_rotation_vector_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 0 in x below x = 1.85593e-12, else cos(phi/2)
+ * nu: Horner degree 0 in x below x = 1.85593e-12, else 2*sin(phi/2)/phi
+ * ops: 18 */
+static inline void symrot_rotation_vector_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 39.478416F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    float c_e_0, c_nu;
+    if (x < 1.8559286e-12F) {
+        c_e_0 = 1;
+        c_nu = 1;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        c_e_0 = cosf(w0);
+        c_nu = 2*sinf(w0)/phi;
+    }
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_rotation_vector__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 0 in t = phi^2 below 6.57462e-14, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 56 */
+static inline int symrot_rotation_vector__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float phi = 2*atan2f(e_norm, c0);
+    const float t = (phi*phi);
+    float sigma;
+    if (t < 6.5746237e-14F) {
+        sigma = 2;
+    } else {
+        sigma = phi/sinf((1.0F/2.0F)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 39.478416F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_rotation_vector_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_rotation_vector_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_rotation_vector__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_rotation_vector_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_rotation_vector_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_rotation_vector__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_rotation_vector__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_rotation_vector__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_rotation_vector__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_rotation_vector_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_rotation_vector_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_rotation_vector_to_quaternion_f(p1, a);
+    symrot_rotation_vector_to_quaternion_f(p2, b);
+    return symrot_rotation_vector__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_rotation_vector_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_rotation_vector_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_rotation_vector_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_rotation_vector__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

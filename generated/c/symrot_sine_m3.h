@@ -13,6 +13,11 @@
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -26,21 +31,42 @@
 extern "C" {
 #endif
 
-/* symrot_sine_m3__phi: internal: phi from s = |p| (eq 11).
- * phi = 3*asin(s/3) (closed inverse of p(phi))
- * ops: 3 */
-static inline double symrot_sine_m3__phi(double s)
+/* symrot_sine_m3__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
+ * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
+ * rounded would leave no correct digit of p_max^2 - x (error-free products by
+ * fma, TwoSum).
+ * ops: 31 */
+static inline double symrot_sine_m3__complement(const double p[3])
 {
-    return 3*asin((1.0/3.0)*s);
+    double high = 9.0, low = 0;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        const double square = p[i] * p[i];
+        const double error = fma(p[i], p[i], -square);
+        const double total = high - square;
+        const double virtual_ = total - high;
+        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        high = total;
+    }
+    return high + low;
+}
+
+/* symrot_sine_m3__phi: internal: phi from s = |p| (eq 11).
+ * phi = 3*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 4 */
+static inline double symrot_sine_m3__phi(double s, double d)
+{
+    return 3*atan2(s, sqrt(d));
 }
 
 /* symrot_sine_m3_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * phi = 3*asin(s/3) (closed inverse of p(phi))
- * ops: 21 */
+ * phi = 3*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 42 */
 static inline double symrot_sine_m3_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         return NAN;
     }
@@ -53,18 +79,19 @@ static inline double symrot_sine_m3_angle(const double p[3])
     } else {
         s = sqrt(x);
     }
-    return symrot_sine_m3__phi(s);
+    return symrot_sine_m3__phi(s, d);
 }
 
 /* symrot_sine_m3_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/(9*sin(phi/3)**2)
- * ops: 66 */
+ * R_2: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/s**2
+ * ops: 86 */
 static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -82,8 +109,9 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
     if (x < 0.018918233509283077) {
         c_R_2 = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
     } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        c_R_2 = (2.0/9.0)*pow(sin((1.0/2.0)*phi), 2)/pow(sin((1.0/3.0)*phi), 2);
+        const double phi = symrot_sine_m3__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -108,13 +136,14 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
 
 /* symrot_sine_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/(sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)) (algebraic in x)
- * H_1: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/(9*sin(phi/3)**2)
- * H_2: Horner degree 7 in x below x = 0.0682556, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(27*(1 - 2*sin(phi/6)**2)*sin(phi/3)**2)
- * ops: 99 */
+ * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_1: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 14 in x below x = 0.864806, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
+ * ops: 130 */
 static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -127,18 +156,19 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
         H[8] = NAN;
         return;
     }
-    const double c_H_0 = 3/(sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3));
+    const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
     if (x < 0.018918233509283077) {
         c_H_1 = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*((715.0/156728328192.0)*x + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/3.0)*phi), -2);
-        const double w1 = pow(sin((1.0/2.0)*phi), 2);
-        const double w2 = pow(sin((1.0/6.0)*phi), 2);
-        c_H_1 = (2.0/9.0)*w0*w1;
-        c_H_2 = x < 0.0682555592920889 ? x*(x*(x*(x*(x*(x*((715.0/156728328192.0)*x + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0 : (1.0/27.0)*w0*(2*w1 + 4*w2)/(1 - 2*w2);
+        const double phi = symrot_sine_m3__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        const double w1 = 2*pow(sin((1.0/2.0)*phi), 2);
+        const double w2 = sqrt(d);
+        c_H_1 = w0*w1;
+        c_H_2 = x < 0.8648056668462036 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0 : w0*(w1 - 2.0/3.0*w2 + 2)/w2;
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -163,13 +193,14 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
 
 /* symrot_sine_m3_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)/3 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/3 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 1 in x below x = 1.9012e-14, else (5 - 4*sin(phi/6)**2)/(18*(2 - 2*sin(phi/6)**2)*(3 - 4*sin(phi/6)**2))
- * ops: 74 */
+ * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
+ * ops: 80 */
 static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -182,16 +213,8 @@ static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/3.0)*sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3);
-    double c_H_inverse_2;
-    if (x < 1.9011961863057287e-14) {
-        c_H_inverse_2 = (23.0/11664.0)*x + 5.0/108.0;
-    } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/6.0)*phi), 2);
-        const double w1 = 4*w0;
-        c_H_inverse_2 = (1.0/18.0)*(5 - w1)/((2 - 2*w0)*(3 - w1));
-    }
+    const double c_H_inverse_0 = (1.0/3.0)*sqrt(d);
+    const double c_H_inverse_2 = -1.0/6.0*(2*sqrt(d) + 9)/(-9*sqrt(d) + 2*x - 27);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -215,20 +238,22 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m3_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 7 in x below x = 0.0682556, else 4*sin(phi/2)**2/(9*(1 - 2*sin(phi/6)**2)*sin(phi/3)**2)
- * ops: 28 */
+ * det_H: Horner degree 14 in x below x = 0.864806, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
+ * ops: 69 */
 static inline double symrot_sine_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         return NAN;
     }
     double c_det_H;
-    if (x < 0.0682555592920889) {
-        c_det_H = x*(x*(x*(x*(x*(x*((715.0/78364164096.0)*x + 143.0/1632586752.0) + 77.0/90699264.0) + 7.0/839808.0) + 35.0/419904.0) + 5.0/5832.0) + 1.0/108.0) + 1;
+    if (x < 0.8648056668462036) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4033090849969884e-15)*x + 1.3065291481006443e-14) + 1.2194272048939348e-13) + 1.141383863780723e-12) + 29393.0/2742118830047232.0) + 46189.0/457019805007872.0) + 12155.0/12694994583552.0) + 715.0/78364164096.0) + 143.0/1632586752.0) + 77.0/90699264.0) + 7.0/839808.0) + 35.0/419904.0) + 5.0/5832.0) + 1.0/108.0) + 1;
     } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        c_det_H = (4.0/9.0)*pow(sin((1.0/2.0)*phi), 2)/((1 - 2*pow(sin((1.0/6.0)*phi), 2))*pow(sin((1.0/3.0)*phi), 2));
+        const double phi = symrot_sine_m3__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        c_det_H = 12*pow(sin((1.0/2.0)*phi), 2)/(sqrt(d)*(s*s));
     }
     return c_det_H;
 }
@@ -236,12 +261,13 @@ static inline double symrot_sine_m3_tangent_det(const double p[3])
 /* symrot_sine_m3_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 1.9012e-14, else sin(phi/2)/(3*sin(phi/3))
- * G_2: Horner degree 6 in x below x = 0.0682556, else 2*sin(phi/4)**2/(9*sin(phi/3)**2)
- * ops: 77 */
+ * G_1: Horner degree 1 in x below x = 1.9012e-14, else sin(phi/2)/s
+ * G_2: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/s**2
+ * ops: 118 */
 static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -257,12 +283,12 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
     double c_G_1, c_G_2;
     if (x < 1.9011961863057287e-14) {
         c_G_1 = 1.0/2.0 + (-5.0/432.0)*x;
-        c_G_2 = x*(x*(x*(x*(x*((7429.0/1981355655168.0)*x + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
     } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        const double w0 = sin((1.0/3.0)*phi);
-        c_G_1 = (1.0/3.0)*sin((1.0/2.0)*phi)/w0;
-        c_G_2 = x < 0.0682555592920889 ? x*(x*(x*(x*(x*((7429.0/1981355655168.0)*x + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : (2.0/9.0)*pow(sin((1.0/4.0)*phi), 2)/(w0*w0);
+        const double phi = symrot_sine_m3__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        c_G_1 = sin((1.0/2.0)*phi)/s;
+        c_G_2 = x < 0.8648056668462036 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -287,13 +313,14 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
 
 /* symrot_sine_m3_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/(2*sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)) (algebraic in x)
- * K_1: Horner degree 6 in x below x = 0.0682556, else 2*sin(phi/4)**2/(9*sin(phi/3)**2)
- * K_2: Horner degree 15 in x below x = 0.864806, else (-2*sin(phi/2)/sin(phi/3) + 3/(1 - 2*sin(phi/6)**2))/(54*sin(phi/3)**2)
- * ops: 124 */
+ * K_0 = 3/(2*sqrt(d)) (algebraic in x)
+ * K_1: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/s**2
+ * K_2: Horner degree 20 in x below x = 1.59536, else (-6*sin(phi/2)/s + 9/sqrt(d))/(6*s**2)
+ * ops: 171 */
 static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -306,17 +333,17 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
         K[8] = NAN;
         return;
     }
-    const double c_K_0 = (3.0/2.0)/(sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3));
+    const double c_K_0 = (3.0/2.0)/sqrt(d);
     double c_K_1, c_K_2;
-    if (x < 0.0682555592920889) {
-        c_K_1 = x*(x*(x*(x*(x*((7429.0/1981355655168.0)*x + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.860077032999521e-17)*x + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
+    if (x < 0.8648056668462036) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
     } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        const double w0 = sin((1.0/3.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_K_1 = (2.0/9.0)*w1*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 0.8648056668462036 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.860077032999521e-17)*x + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/54.0)*w1*(3/(1 - 2*pow(sin((1.0/6.0)*phi), 2)) - 2*sin((1.0/2.0)*phi)/w0);
+        const double phi = symrot_sine_m3__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 1.5953637712864257 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*w0*(-6*sin((1.0/2.0)*phi)/s + 9/sqrt(d));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -341,29 +368,22 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
 
 /* symrot_sine_m3_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)/3 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/3 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 1 in x below x = 1.9012e-14, else (5 - 4*sin(phi/6)**2)/(18*(2 - 2*sin(phi/6)**2)*(3 - 4*sin(phi/6)**2))
- * ops: 68 */
+ * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
+ * ops: 74 */
 static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/3.0)*sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3);
-    double c_H_inverse_2;
-    if (x < 1.9011961863057287e-14) {
-        c_H_inverse_2 = (23.0/11664.0)*x + 5.0/108.0;
-    } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/6.0)*phi), 2);
-        const double w1 = 4*w0;
-        c_H_inverse_2 = (1.0/18.0)*(5 - w1)/((2 - 2*w0)*(3 - w1));
-    }
+    const double c_H_inverse_0 = (1.0/3.0)*sqrt(d);
+    const double c_H_inverse_2 = -1.0/6.0*(2*sqrt(d) + 9)/(-9*sqrt(d) + 2*x - 27);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -374,31 +394,33 @@ static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3],
 
 /* symrot_sine_m3_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/(sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)) (algebraic in x)
- * H_1: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/(9*sin(phi/3)**2)
- * H_2: Horner degree 7 in x below x = 0.0682556, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(27*(1 - 2*sin(phi/6)**2)*sin(phi/3)**2)
- * ops: 93 */
+ * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_1: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 14 in x below x = 0.864806, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
+ * ops: 124 */
 static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
     if (!(x < 9.0)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
-    const double c_H_0 = 3/(sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3));
+    const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
     if (x < 0.018918233509283077) {
         c_H_1 = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*((715.0/156728328192.0)*x + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
-        const double phi = symrot_sine_m3__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/3.0)*phi), -2);
-        const double w1 = pow(sin((1.0/2.0)*phi), 2);
-        const double w2 = pow(sin((1.0/6.0)*phi), 2);
-        c_H_1 = (2.0/9.0)*w0*w1;
-        c_H_2 = x < 0.0682555592920889 ? x*(x*(x*(x*(x*(x*((715.0/156728328192.0)*x + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0 : (1.0/27.0)*w0*(2*w1 + 4*w2)/(1 - 2*w2);
+        const double phi = symrot_sine_m3__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        const double w1 = 2*pow(sin((1.0/2.0)*phi), 2);
+        const double w2 = sqrt(d);
+        c_H_1 = w0*w1;
+        c_H_2 = x < 0.8648056668462036 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0 : w0*(w1 - 2.0/3.0*w2 + 2)/w2;
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -408,21 +430,198 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
 }
 
-/* symrot_sine_m3__phi_f: internal: phi from s = |p| (eq 11).
- * phi = 3*asin(s/3) (closed inverse of p(phi))
- * ops: 3 */
-static inline float symrot_sine_m3__phi_f(float s)
+/* symrot_sine_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 1 in x below x = 1.9012e-14, else cos(phi/2)
+ * nu: Horner degree 1 in x below x = 1.9012e-14, else 2*sin(phi/2)/s
+ * ops: 44 */
+static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
 {
-    return 3*asinf((1.0F/3.0F)*s);
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m3__complement(p);
+    if (!(x < 9.0)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    double c_e_0, c_nu;
+    if (x < 1.9011961863057287e-14) {
+        c_e_0 = 1 + (-1.0/8.0)*x;
+        c_nu = 1 + (-5.0/216.0)*x;
+    } else {
+        const double phi = symrot_sine_m3__phi(sqrt(x), d);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        c_e_0 = cos(w0);
+        c_nu = 2*sin(w0)/s;
+    }
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m3__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 3 in t = phi^2 below 0.00281963, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 62 */
+static inline int symrot_sine_m3__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double phi = 2*atan2(e_norm, c0);
+    const double t = (phi*phi);
+    double sigma;
+    if (t < 0.002819628356600472) {
+        sigma = t*(t*((91.0/3359232.0)*t + 17.0/15552.0) + 5.0/108.0) + 2;
+    } else {
+        sigma = 3*sin((1.0/3.0)*phi)/sin((1.0/2.0)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 9.0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m3_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m3_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_sine_m3__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m3_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m3_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m3__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m3__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m3__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m3__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m3_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m3_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_sine_m3_to_quaternion(p1, a);
+    symrot_sine_m3_to_quaternion(p2, b);
+    return symrot_sine_m3__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m3_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m3_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_sine_m3_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m3__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_sine_m3__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
+ * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
+ * rounded would leave no correct digit of p_max^2 - x (error-free products by
+ * fma, TwoSum).
+ * ops: 31 */
+static inline float symrot_sine_m3__complement_f(const float p[3])
+{
+    float high = 9.0F, low = 0;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        const float square = p[i] * p[i];
+        const float error = fmaf(p[i], p[i], -square);
+        const float total = high - square;
+        const float virtual_ = total - high;
+        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        high = total;
+    }
+    return high + low;
+}
+
+/* symrot_sine_m3__phi_f: internal: phi from s = |p| (eq 11).
+ * phi = 3*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 4 */
+static inline float symrot_sine_m3__phi_f(float s, float d)
+{
+    return 3*atan2f(s, sqrtf(d));
 }
 
 /* symrot_sine_m3_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * phi = 3*asin(s/3) (closed inverse of p(phi))
- * ops: 21 */
+ * phi = 3*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 42 */
 static inline float symrot_sine_m3_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         return NAN;
     }
@@ -435,18 +634,19 @@ static inline float symrot_sine_m3_angle_f(const float p[3])
     } else {
         s = sqrtf(x);
     }
-    return symrot_sine_m3__phi_f(s);
+    return symrot_sine_m3__phi_f(s, d);
 }
 
 /* symrot_sine_m3_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 2 in x below x = 0.0189182, else 2*sin(phi/2)**2/(9*sin(phi/3)**2)
- * ops: 63 */
+ * R_2: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
+ * ops: 101 */
 static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -461,11 +661,12 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
     }
     const float c_R_1 = 1 - 4.0F/27.0F*x;
     float c_R_2;
-    if (x < 0.018918235F) {
-        c_R_2 = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
+    if (x < 2.8627653F) {
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
     } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        c_R_2 = (2.0F/9.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(sinf((1.0F/3.0F)*phi), 2);
+        const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -490,13 +691,14 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
 
 /* symrot_sine_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/(sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)) (algebraic in x)
- * H_1: Horner degree 2 in x below x = 0.0189182, else 2*sin(phi/2)**2/(9*sin(phi/3)**2)
- * H_2: Horner degree 5 in x below x = 0.462107, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(27*(1 - 2*sin(phi/6)**2)*sin(phi/3)**2)
- * ops: 93 */
+ * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_1: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 5 in x below x = 0.462107, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
+ * ops: 125 */
 static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -509,18 +711,18 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 3/(sqrtf(3 - sqrtf(x))*sqrtf(sqrtf(x) + 3));
+    const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
-    if (x < 0.018918235F) {
-        c_H_1 = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
+    if (x < 0.46210724F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        const float w0 = powf(sinf((1.0F/3.0F)*phi), -2);
-        const float w1 = powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w2 = powf(sinf((1.0F/6.0F)*phi), 2);
-        c_H_1 = (2.0F/9.0F)*w0*w1;
-        c_H_2 = x < 0.46210724F ? x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : (1.0F/27.0F)*w0*(2*w1 + 4*w2)/(1 - 2*w2);
+        const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        const float w1 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
+        c_H_1 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*w1;
+        c_H_2 = w0*(w1 + 4*powf(sinf((1.0F/6.0F)*phi), 2))/sqrtf(d);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -545,13 +747,14 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
 
 /* symrot_sine_m3_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)/3 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/3 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1.9012e-14, else (2*cos(phi/3) + 3)/(18*(cos(phi/3) + 1)*(2*cos(phi/3) + 1))
- * ops: 72 */
+ * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
+ * ops: 80 */
 static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -564,16 +767,8 @@ static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/3.0F)*sqrtf(3 - sqrtf(x))*sqrtf(sqrtf(x) + 3);
-    float c_H_inverse_2;
-    if (x < 1.9011963e-14F) {
-        c_H_inverse_2 = 5.0F/108.0F;
-    } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        const float w0 = cosf((1.0F/3.0F)*phi);
-        const float w1 = 2*w0;
-        c_H_inverse_2 = (1.0F/18.0F)*(w1 + 3)/((w0 + 1)*(w1 + 1));
-    }
+    const float c_H_inverse_0 = (1.0F/3.0F)*sqrtf(d);
+    const float c_H_inverse_2 = -1.0F/6.0F*(2*sqrtf(d) + 9)/(-9*sqrtf(d) + 2*x - 27);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -597,20 +792,22 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m3_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 4 in x below x = 0.462107, else 4*sin(phi/2)**2/(9*(1 - 2*sin(phi/6)**2)*sin(phi/3)**2)
- * ops: 27 */
+ * det_H: Horner degree 12 in x below x = 2.86277, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
+ * ops: 63 */
 static inline float symrot_sine_m3_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         return NAN;
     }
     float c_det_H;
-    if (x < 0.46210724F) {
-        c_det_H = x*(x*(x*((7.0F/839808.0F)*x + 35.0F/419904.0F) + 5.0F/5832.0F) + 1.0F/108.0F) + 1;
+    if (x < 2.8627653F) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.2194273e-13F)*x + 1.1413839e-12F) + 1.0719084e-11F) + 1.0106564e-10F) + 9.57464e-10F) + 9.124069e-09F) + 8.7591054e-08F) + 8.489595e-07F) + 7.0F/839808.0F) + 35.0F/419904.0F) + 5.0F/5832.0F) + 1.0F/108.0F) + 1;
     } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        c_det_H = (4.0F/9.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/((1 - 2*powf(sinf((1.0F/6.0F)*phi), 2))*powf(sinf((1.0F/3.0F)*phi), 2));
+        const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        c_det_H = 12*powf(sinf((1.0F/2.0F)*phi), 2)/(sqrtf(d)*(s*s));
     }
     return c_det_H;
 }
@@ -618,12 +815,13 @@ static inline float symrot_sine_m3_tangent_det_f(const float p[3])
 /* symrot_sine_m3_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 1.9012e-14, else sin(phi/2)/(3*sin(phi/3))
- * G_2: Horner degree 2 in x below x = 0.0682556, else 2*sin(phi/4)**2/(9*sin(phi/3)**2)
- * ops: 65 */
+ * G_1: Horner degree 0 in x below x = 1.9012e-14, else sin(phi/2)/s
+ * G_2: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi/2))/s**2
+ * ops: 100 */
 static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -639,12 +837,13 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
     float c_G_1, c_G_2;
     if (x < 1.9011963e-14F) {
         c_G_1 = 1.0F/2.0F;
-        c_G_2 = x*((77.0F/746496.0F)*x + 7.0F/3456.0F) + 1.0F/8.0F;
+        c_G_2 = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
     } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/3.0F)*phi);
-        c_G_1 = (1.0F/3.0F)*sinf((1.0F/2.0F)*phi)/w0;
-        c_G_2 = x < 0.068255566F ? x*((77.0F/746496.0F)*x + 7.0F/3456.0F) + 1.0F/8.0F : (2.0F/9.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/(w0*w0);
+        const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_G_1 = sinf(w0)/s;
+        c_G_2 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F : (1 - cosf(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -669,13 +868,14 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
 
 /* symrot_sine_m3_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/(2*sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)) (algebraic in x)
- * K_1: Horner degree 2 in x below x = 0.0682556, else 2*sin(phi/4)**2/(9*sin(phi/3)**2)
- * K_2: Horner degree 6 in x below x = 0.864806, else (-2*sin(phi/2)/sin(phi/3) + 3/(1 - 2*sin(phi/6)**2))/(54*sin(phi/3)**2)
- * ops: 94 */
+ * K_0 = 3/(2*sqrt(d)) (algebraic in x)
+ * K_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi/2))/s**2
+ * K_2: Horner degree 13 in x below x = 2.86277, else (-6*sin(phi/2)/s + 9/sqrt(d))/(6*s**2)
+ * ops: 132 */
 static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -688,17 +888,18 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (3.0F/2.0F)/(sqrtf(3 - sqrtf(x))*sqrtf(sqrtf(x) + 3));
+    const float c_K_0 = (3.0F/2.0F)/sqrtf(d);
     float c_K_1, c_K_2;
-    if (x < 0.068255566F) {
-        c_K_1 = x*((77.0F/746496.0F)*x + 7.0F/3456.0F) + 1.0F/8.0F;
-        c_K_2 = x*(x*(x*(x*(x*((2.3016428e-08F)*x + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
+    if (x < 1.5953637F) {
+        c_K_1 = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
     } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/3.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_K_1 = (2.0F/9.0F)*w1*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 0.8648057F ? x*(x*(x*(x*(x*((2.3016428e-08F)*x + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (1.0F/54.0F)*w1*(3/(1 - 2*powf(sinf((1.0F/6.0F)*phi), 2)) - 2*sinf((1.0F/2.0F)*phi)/w0);
+        const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_K_1 = w0*(1 - cosf(w1));
+        c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (1.0F/6.0F)*w0*(-6*sinf(w1)/s + 9/sqrtf(d));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -723,29 +924,22 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
 
 /* symrot_sine_m3_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)/3 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/3 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1.9012e-14, else (2*cos(phi/3) + 3)/(18*(cos(phi/3) + 1)*(2*cos(phi/3) + 1))
- * ops: 66 */
+ * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
+ * ops: 74 */
 static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/3.0F)*sqrtf(3 - sqrtf(x))*sqrtf(sqrtf(x) + 3);
-    float c_H_inverse_2;
-    if (x < 1.9011963e-14F) {
-        c_H_inverse_2 = 5.0F/108.0F;
-    } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        const float w0 = cosf((1.0F/3.0F)*phi);
-        const float w1 = 2*w0;
-        c_H_inverse_2 = (1.0F/18.0F)*(w1 + 3)/((w0 + 1)*(w1 + 1));
-    }
+    const float c_H_inverse_0 = (1.0F/3.0F)*sqrtf(d);
+    const float c_H_inverse_2 = -1.0F/6.0F*(2*sqrtf(d) + 9)/(-9*sqrtf(d) + 2*x - 27);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -756,31 +950,32 @@ static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3],
 
 /* symrot_sine_m3_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/(sqrt(3 - sqrt(x))*sqrt(sqrt(x) + 3)) (algebraic in x)
- * H_1: Horner degree 2 in x below x = 0.0189182, else 2*sin(phi/2)**2/(9*sin(phi/3)**2)
- * H_2: Horner degree 5 in x below x = 0.462107, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(27*(1 - 2*sin(phi/6)**2)*sin(phi/3)**2)
- * ops: 87 */
+ * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_1: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 5 in x below x = 0.462107, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
+ * ops: 119 */
 static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
     if (!(x < 9.0F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 3/(sqrtf(3 - sqrtf(x))*sqrtf(sqrtf(x) + 3));
+    const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
-    if (x < 0.018918235F) {
-        c_H_1 = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
+    if (x < 0.46210724F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
-        const float phi = symrot_sine_m3__phi_f(sqrtf(x));
-        const float w0 = powf(sinf((1.0F/3.0F)*phi), -2);
-        const float w1 = powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w2 = powf(sinf((1.0F/6.0F)*phi), 2);
-        c_H_1 = (2.0F/9.0F)*w0*w1;
-        c_H_2 = x < 0.46210724F ? x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : (1.0F/27.0F)*w0*(2*w1 + 4*w2)/(1 - 2*w2);
+        const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        const float w1 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
+        c_H_1 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*w1;
+        c_H_2 = w0*(w1 + 4*powf(sinf((1.0F/6.0F)*phi), 2))/sqrtf(d);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -788,6 +983,162 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_sine_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 0 in x below x = 1.9012e-14, else cos(phi/2)
+ * nu: Horner degree 0 in x below x = 1.9012e-14, else 2*sin(phi/2)/s
+ * ops: 44 */
+static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m3__complement_f(p);
+    if (!(x < 9.0F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    float c_e_0, c_nu;
+    if (x < 1.9011963e-14F) {
+        c_e_0 = 1;
+        c_nu = 1;
+    } else {
+        const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_e_0 = cosf(w0);
+        c_nu = 2*sinf(w0)/s;
+    }
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m3__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 1 in t = phi^2 below 3.48198e-05, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
+static inline int symrot_sine_m3__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float phi = 2*atan2f(e_norm, c0);
+    const float t = (phi*phi);
+    float sigma;
+    if (t < 3.4819823e-05F) {
+        sigma = (5.0F/108.0F)*t + 2;
+    } else {
+        sigma = 3*sinf((1.0F/3.0F)*phi)/sinf((1.0F/2.0F)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 9.0F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m3_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m3_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_sine_m3__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m3_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m3_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m3__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m3__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m3__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m3__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m3_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m3_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_sine_m3_to_quaternion_f(p1, a);
+    symrot_sine_m3_to_quaternion_f(p2, b);
+    return symrot_sine_m3__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m3_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m3_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_sine_m3_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m3__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

@@ -13,6 +13,11 @@
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -26,21 +31,42 @@
 extern "C" {
 #endif
 
-/* symrot_sine_m4__phi: internal: phi from s = |p| (eq 11).
- * phi = 4*asin(s/4) (closed inverse of p(phi))
- * ops: 3 */
-static inline double symrot_sine_m4__phi(double s)
+/* symrot_sine_m4__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
+ * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
+ * rounded would leave no correct digit of p_max^2 - x (error-free products by
+ * fma, TwoSum).
+ * ops: 31 */
+static inline double symrot_sine_m4__complement(const double p[3])
 {
-    return 4*asin((1.0/4.0)*s);
+    double high = 16.0, low = 0;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        const double square = p[i] * p[i];
+        const double error = fma(p[i], p[i], -square);
+        const double total = high - square;
+        const double virtual_ = total - high;
+        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        high = total;
+    }
+    return high + low;
+}
+
+/* symrot_sine_m4__phi: internal: phi from s = |p| (eq 11).
+ * phi = 4*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 4 */
+static inline double symrot_sine_m4__phi(double s, double d)
+{
+    return 4*atan2(s, sqrt(d));
 }
 
 /* symrot_sine_m4_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * phi = 4*asin(s/4) (closed inverse of p(phi))
- * ops: 21 */
+ * phi = 4*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 42 */
 static inline double symrot_sine_m4_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         return NAN;
     }
@@ -53,18 +79,19 @@ static inline double symrot_sine_m4_angle(const double p[3])
     } else {
         s = sqrt(x);
     }
-    return symrot_sine_m4__phi(s);
+    return symrot_sine_m4__phi(s, d);
 }
 
 /* symrot_sine_m4_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)*(x - 8)/32 (algebraic in x)
- * R_2 = -(sqrt(x) - 4)*(sqrt(x) + 4)/32 (algebraic in x)
- * ops: 69 */
+ * R_1 = -sqrt(d)*(x - 8)/32 (algebraic in x)
+ * R_2 = d/32 (algebraic in x)
+ * ops: 72 */
 static inline void symrot_sine_m4_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -77,8 +104,8 @@ static inline void symrot_sine_m4_rotation_matrix(const double p[3], double R[9]
         R[8] = NAN;
         return;
     }
-    const double c_R_1 = -1.0/32.0*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)*(x - 8);
-    const double c_R_2 = -1.0/32.0*(sqrt(x) - 4)*(sqrt(x) + 4);
+    const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
+    const double c_R_2 = (1.0/32.0)*d;
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -102,13 +129,14 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
 
 /* symrot_sine_m4_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * H_1 = -(sqrt(x) - 4)*(sqrt(x) + 4)/32 (algebraic in x)
- * H_2 = -(x - 24)/(32*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 81 */
+ * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_1 = d/32 (algebraic in x)
+ * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
+ * ops: 75 */
 static inline void symrot_sine_m4_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -121,9 +149,9 @@ static inline void symrot_sine_m4_tangent(const double p[3], double H[9])
         H[8] = NAN;
         return;
     }
-    const double c_H_0 = 4/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
-    const double c_H_1 = -1.0/32.0*(sqrt(x) - 4)*(sqrt(x) + 4);
-    const double c_H_2 = -1.0/32.0*(x - 24)/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
+    const double c_H_0 = 4/sqrt(d);
+    const double c_H_1 = (1.0/32.0)*d;
+    const double c_H_2 = -1.0/32.0*(x - 24)/sqrt(d);
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -147,13 +175,14 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
 
 /* symrot_sine_m4_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/4 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = 1/(4*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 70 */
+ * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
+ * ops: 72 */
 static inline void symrot_sine_m4_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -166,8 +195,8 @@ static inline void symrot_sine_m4_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/4.0)*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4);
-    const double c_H_inverse_2 = (1.0/4.0)/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
+    const double c_H_inverse_0 = (1.0/4.0)*sqrt(d);
+    const double c_H_inverse_2 = (1.0/4.0)/sqrt(d);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -191,27 +220,29 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m4_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/4 (algebraic in x)
- * ops: 18 */
+ * det_H = sqrt(d)/4 (algebraic in x)
+ * ops: 29 */
 static inline double symrot_sine_m4_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         return NAN;
     }
-    const double c_det_H = (1.0/4.0)*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4);
+    const double c_det_H = (1.0/4.0)*sqrt(d);
     return c_det_H;
 }
 
 /* symrot_sine_m4_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1 = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/8 (algebraic in x)
+ * G_1 = sqrt(d)/8 (algebraic in x)
  * G_2 = 1/8 (constant)
- * ops: 60 */
+ * ops: 71 */
 static inline void symrot_sine_m4_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -224,7 +255,7 @@ static inline void symrot_sine_m4_root_matrix(const double p[3], double G[9])
         G[8] = NAN;
         return;
     }
-    const double c_G_1 = (1.0/8.0)*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4);
+    const double c_G_1 = (1.0/8.0)*sqrt(d);
     G[0] = -1.0/8.0*(p[1]*p[1]) - 1.0/8.0*(p[2]*p[2]) + 1;
     G[1] = -c_G_1*p[2] + (1.0/8.0)*p[0]*p[1];
     G[2] = c_G_1*p[1] + (1.0/8.0)*p[0]*p[2];
@@ -248,13 +279,14 @@ static inline void symrot_sine_m4_root_matrix_batch(size_t n, const double *p, d
 
 /* symrot_sine_m4_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 2/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
+ * K_0 = 2/sqrt(d) (algebraic in x)
  * K_1 = 1/8 (constant)
- * K_2 = 1/(8*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 70 */
+ * K_2 = 1/(8*sqrt(d)) (algebraic in x)
+ * ops: 72 */
 static inline void symrot_sine_m4_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -267,8 +299,8 @@ static inline void symrot_sine_m4_root_tangent(const double p[3], double K[9])
         K[8] = NAN;
         return;
     }
-    const double c_K_0 = 2/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
-    const double c_K_2 = (1.0/8.0)/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
+    const double c_K_0 = 2/sqrt(d);
+    const double c_K_2 = (1.0/8.0)/sqrt(d);
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = c_K_2*p[0]*p[1] - 1.0/8.0*p[2];
     K[2] = c_K_2*p[0]*p[2] + (1.0/8.0)*p[1];
@@ -292,21 +324,22 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
 
 /* symrot_sine_m4_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/4 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = 1/(4*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 64 */
+ * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
+ * ops: 66 */
 static inline void symrot_sine_m4_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/4.0)*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4);
-    const double c_H_inverse_2 = (1.0/4.0)/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
+    const double c_H_inverse_0 = (1.0/4.0)*sqrt(d);
+    const double c_H_inverse_2 = (1.0/4.0)/sqrt(d);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -317,22 +350,23 @@ static inline void symrot_sine_m4_pdot(const double p[3], const double omega[3],
 
 /* symrot_sine_m4_omega: omega = H pdot (eq 20).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * H_1 = -(sqrt(x) - 4)*(sqrt(x) + 4)/32 (algebraic in x)
- * H_2 = -(x - 24)/(32*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 75 */
+ * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_1 = d/32 (algebraic in x)
+ * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
+ * ops: 69 */
 static inline void symrot_sine_m4_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
     if (!(x < 16.0)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
-    const double c_H_0 = 4/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
-    const double c_H_1 = -1.0/32.0*(sqrt(x) - 4)*(sqrt(x) + 4);
-    const double c_H_2 = -1.0/32.0*(x - 24)/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4));
+    const double c_H_0 = 4/sqrt(d);
+    const double c_H_1 = (1.0/32.0)*d;
+    const double c_H_2 = -1.0/32.0*(x - 24)/sqrt(d);
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
@@ -341,21 +375,182 @@ static inline void symrot_sine_m4_omega(const double p[3], const double pdot[3],
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
 }
 
-/* symrot_sine_m4__phi_f: internal: phi from s = |p| (eq 11).
- * phi = 4*asin(s/4) (closed inverse of p(phi))
- * ops: 3 */
-static inline float symrot_sine_m4__phi_f(float s)
+/* symrot_sine_m4_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -(x - 8)/8 (algebraic in x)
+ * nu = sqrt(d)/4 (algebraic in x)
+ * ops: 35 */
+static inline void symrot_sine_m4_to_quaternion(const double p[3], double e[4])
 {
-    return 4*asinf((1.0F/4.0F)*s);
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const double d = symrot_sine_m4__complement(p);
+    if (!(x < 16.0)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_e_0 = 1 - 1.0/8.0*x;
+    const double c_nu = (1.0/4.0)*sqrt(d);
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m4__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 2*sqrt(2)/sqrt(e0 + 1) (trig-free in e0)
+ * ops: 56 */
+static inline int symrot_sine_m4__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double sigma = 2*sqrt(2)/sqrt(c0 + 1);
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 16.0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m4_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m4_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_sine_m4__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m4_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m4_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m4__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m4__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m4__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m4__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m4_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m4_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_sine_m4_to_quaternion(p1, a);
+    symrot_sine_m4_to_quaternion(p2, b);
+    return symrot_sine_m4__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m4_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m4_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_sine_m4_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m4__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_sine_m4__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
+ * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
+ * rounded would leave no correct digit of p_max^2 - x (error-free products by
+ * fma, TwoSum).
+ * ops: 31 */
+static inline float symrot_sine_m4__complement_f(const float p[3])
+{
+    float high = 16.0F, low = 0;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        const float square = p[i] * p[i];
+        const float error = fmaf(p[i], p[i], -square);
+        const float total = high - square;
+        const float virtual_ = total - high;
+        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        high = total;
+    }
+    return high + low;
+}
+
+/* symrot_sine_m4__phi_f: internal: phi from s = |p| (eq 11).
+ * phi = 4*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 4 */
+static inline float symrot_sine_m4__phi_f(float s, float d)
+{
+    return 4*atan2f(s, sqrtf(d));
 }
 
 /* symrot_sine_m4_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * phi = 4*asin(s/4) (closed inverse of p(phi))
- * ops: 21 */
+ * phi = 4*atan2(s, sqrt(d)) (closed inverse of p(phi))
+ * ops: 42 */
 static inline float symrot_sine_m4_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         return NAN;
     }
@@ -368,18 +563,19 @@ static inline float symrot_sine_m4_angle_f(const float p[3])
     } else {
         s = sqrtf(x);
     }
-    return symrot_sine_m4__phi_f(s);
+    return symrot_sine_m4__phi_f(s, d);
 }
 
 /* symrot_sine_m4_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)*(x - 8)/32 (algebraic in x)
- * R_2 = -(sqrt(x) - 4)*(sqrt(x) + 4)/32 (algebraic in x)
- * ops: 69 */
+ * R_1 = -sqrt(d)*(x - 8)/32 (algebraic in x)
+ * R_2 = d/32 (algebraic in x)
+ * ops: 72 */
 static inline void symrot_sine_m4_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -392,8 +588,8 @@ static inline void symrot_sine_m4_rotation_matrix_f(const float p[3], float R[9]
         R[8] = NAN;
         return;
     }
-    const float c_R_1 = -1.0F/32.0F*sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4)*(x - 8);
-    const float c_R_2 = -1.0F/32.0F*(sqrtf(x) - 4)*(sqrtf(x) + 4);
+    const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
+    const float c_R_2 = (1.0F/32.0F)*d;
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -417,13 +613,14 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
 
 /* symrot_sine_m4_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * H_1 = -(sqrt(x) - 4)*(sqrt(x) + 4)/32 (algebraic in x)
- * H_2 = -(x - 24)/(32*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 81 */
+ * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_1 = d/32 (algebraic in x)
+ * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
+ * ops: 75 */
 static inline void symrot_sine_m4_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -436,9 +633,9 @@ static inline void symrot_sine_m4_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 4/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
-    const float c_H_1 = -1.0F/32.0F*(sqrtf(x) - 4)*(sqrtf(x) + 4);
-    const float c_H_2 = -1.0F/32.0F*(x - 24)/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
+    const float c_H_0 = 4/sqrtf(d);
+    const float c_H_1 = (1.0F/32.0F)*d;
+    const float c_H_2 = -1.0F/32.0F*(x - 24)/sqrtf(d);
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -462,13 +659,14 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
 
 /* symrot_sine_m4_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/4 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = 1/(4*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 70 */
+ * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
+ * ops: 72 */
 static inline void symrot_sine_m4_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -481,8 +679,8 @@ static inline void symrot_sine_m4_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/4.0F)*sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4);
-    const float c_H_inverse_2 = (1.0F/4.0F)/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
+    const float c_H_inverse_0 = (1.0F/4.0F)*sqrtf(d);
+    const float c_H_inverse_2 = (1.0F/4.0F)/sqrtf(d);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -506,27 +704,29 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m4_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/4 (algebraic in x)
- * ops: 18 */
+ * det_H = sqrt(d)/4 (algebraic in x)
+ * ops: 29 */
 static inline float symrot_sine_m4_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         return NAN;
     }
-    const float c_det_H = (1.0F/4.0F)*sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4);
+    const float c_det_H = (1.0F/4.0F)*sqrtf(d);
     return c_det_H;
 }
 
 /* symrot_sine_m4_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1 = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/8 (algebraic in x)
+ * G_1 = sqrt(d)/8 (algebraic in x)
  * G_2 = 1/8 (constant)
- * ops: 60 */
+ * ops: 71 */
 static inline void symrot_sine_m4_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -539,7 +739,7 @@ static inline void symrot_sine_m4_root_matrix_f(const float p[3], float G[9])
         G[8] = NAN;
         return;
     }
-    const float c_G_1 = (1.0F/8.0F)*sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4);
+    const float c_G_1 = (1.0F/8.0F)*sqrtf(d);
     G[0] = -1.0F/8.0F*(p[1]*p[1]) - 1.0F/8.0F*(p[2]*p[2]) + 1;
     G[1] = -c_G_1*p[2] + (1.0F/8.0F)*p[0]*p[1];
     G[2] = c_G_1*p[1] + (1.0F/8.0F)*p[0]*p[2];
@@ -563,13 +763,14 @@ static inline void symrot_sine_m4_root_matrix_f_batch(size_t n, const float *p, 
 
 /* symrot_sine_m4_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 2/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
+ * K_0 = 2/sqrt(d) (algebraic in x)
  * K_1 = 1/8 (constant)
- * K_2 = 1/(8*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 70 */
+ * K_2 = 1/(8*sqrt(d)) (algebraic in x)
+ * ops: 72 */
 static inline void symrot_sine_m4_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -582,8 +783,8 @@ static inline void symrot_sine_m4_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 2/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
-    const float c_K_2 = (1.0F/8.0F)/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
+    const float c_K_0 = 2/sqrtf(d);
+    const float c_K_2 = (1.0F/8.0F)/sqrtf(d);
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = c_K_2*p[0]*p[1] - 1.0F/8.0F*p[2];
     K[2] = c_K_2*p[0]*p[2] + (1.0F/8.0F)*p[1];
@@ -607,21 +808,22 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
 
 /* symrot_sine_m4_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)/4 (algebraic in x)
+ * H_inverse_0 = sqrt(d)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = 1/(4*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 64 */
+ * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
+ * ops: 66 */
 static inline void symrot_sine_m4_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/4.0F)*sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4);
-    const float c_H_inverse_2 = (1.0F/4.0F)/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
+    const float c_H_inverse_0 = (1.0F/4.0F)*sqrtf(d);
+    const float c_H_inverse_2 = (1.0F/4.0F)/sqrtf(d);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -632,28 +834,169 @@ static inline void symrot_sine_m4_pdot_f(const float p[3], const float omega[3],
 
 /* symrot_sine_m4_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/(sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * H_1 = -(sqrt(x) - 4)*(sqrt(x) + 4)/32 (algebraic in x)
- * H_2 = -(x - 24)/(32*sqrt(4 - sqrt(x))*sqrt(sqrt(x) + 4)) (algebraic in x)
- * ops: 75 */
+ * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_1 = d/32 (algebraic in x)
+ * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
+ * ops: 69 */
 static inline void symrot_sine_m4_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
     if (!(x < 16.0F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 4/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
-    const float c_H_1 = -1.0F/32.0F*(sqrtf(x) - 4)*(sqrtf(x) + 4);
-    const float c_H_2 = -1.0F/32.0F*(x - 24)/(sqrtf(4 - sqrtf(x))*sqrtf(sqrtf(x) + 4));
+    const float c_H_0 = 4/sqrtf(d);
+    const float c_H_1 = (1.0F/32.0F)*d;
+    const float c_H_2 = -1.0F/32.0F*(x - 24)/sqrtf(d);
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_sine_m4_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -(x - 8)/8 (algebraic in x)
+ * nu = sqrt(d)/4 (algebraic in x)
+ * ops: 35 */
+static inline void symrot_sine_m4_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    const float d = symrot_sine_m4__complement_f(p);
+    if (!(x < 16.0F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_e_0 = 1 - 1.0F/8.0F*x;
+    const float c_nu = (1.0F/4.0F)*sqrtf(d);
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m4__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 2*sqrt(2)/sqrt(e0 + 1) (trig-free in e0)
+ * ops: 56 */
+static inline int symrot_sine_m4__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float sigma = 2*sqrtf(2)/sqrtf(c0 + 1);
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 16.0F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m4_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m4_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_sine_m4__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m4_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m4_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m4__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m4__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m4__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m4__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m4_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m4_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_sine_m4_to_quaternion_f(p1, a);
+    symrot_sine_m4_to_quaternion_f(p2, b);
+    return symrot_sine_m4__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m4_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m4_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_sine_m4_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m4__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

@@ -13,6 +13,11 @@
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -60,7 +65,7 @@ static inline double symrot_sine_m5_angle(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * R_2: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
  * ops: 67 */
 static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9])
 {
@@ -79,8 +84,8 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     double c_R_2;
-    if (x < 3.690968361342376e-14) {
-        c_R_2 = 1.0/2.0 + (-7.0/200.0)*x;
+    if (x < 0.00423011441675066) {
+        c_R_2 = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         c_R_2 = (2.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/pow(sin((1.0/5.0)*phi), 2);
@@ -108,10 +113,10 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
 
 /* symrot_sine_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/(sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 8 in x below x = 0.406443, else (-sin(phi)/(5*sin(phi/5)) + 1/(1 - 2*sin(phi/10)**2))/(25*sin(phi/5)**2)
- * ops: 99 */
+ * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_1: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 112 */
 static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -127,17 +132,20 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
         H[8] = NAN;
         return;
     }
-    const double c_H_0 = 5/(sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5));
+    const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 3.690968361342376e-14) {
-        c_H_1 = 1.0/2.0 + (-7.0/200.0)*x;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*((4.862e-14)*x + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.00423011441675066) {
+        c_H_1 = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = sin((1.0/5.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_H_1 = (2.0/25.0)*w1*pow(sin((1.0/2.0)*phi), 2);
-        c_H_2 = x < 0.40644336131551395 ? x*(x*(x*(x*(x*(x*(x*((4.862e-14)*x + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w1*(1.0/(1 - 2*pow(sin((1.0/10.0)*phi), 2)) - 1.0/5.0*sin(phi)/w0);
+        const double w0 = (1.0/5.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = 1.0/(w1*w1);
+        const double w3 = (1.0/2.0)*phi;
+        const double w4 = sin(w3);
+        c_H_1 = (2.0/25.0)*w2*(w4*w4);
+        c_H_2 = x < 2.7876134135933768 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -162,10 +170,10 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
 
 /* symrot_sine_m5_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)/5 (algebraic in x)
+ * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-2*sin(phi/10)**2 - 5*sin(phi/5)*sin(phi)/(4*sin(phi/2)**2) + 1)/(25*sin(phi/5)**2)
- * ops: 110 */
+ * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
+ * ops: 102 */
 static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -181,14 +189,16 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/5.0)*sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5);
+    const double c_H_inverse_0 = (1.0/5.0)*sqrt(25 - x);
     double c_H_inverse_2;
     if (x < 2.7876134135933768) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = sin((1.0/5.0)*phi);
-        c_H_inverse_2 = (1.0/25.0)*(-5.0/4.0*w0*sin(phi)/pow(sin((1.0/2.0)*phi), 2) - 2*pow(sin((1.0/10.0)*phi), 2) + 1)/(w0*w0);
+        const double w0 = (1.0/5.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (1.0/25.0)*(-5.0/2.0*w1*cos(w2)/sin(w2) + cos(w0))/(w1*w1);
     }
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -213,8 +223,8 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m5_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 1 in x below x = 3.69097e-14, else 4*sin(phi/2)**2/(25*(1 - 2*sin(phi/10)**2)*sin(phi/5)**2)
- * ops: 27 */
+ * det_H: Horner degree 15 in x below x = 2.78761, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
+ * ops: 52 */
 static inline double symrot_sine_m5_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -222,11 +232,12 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 3.690968361342376e-14) {
-        c_det_H = 1 + (-1.0/20.0)*x;
+    if (x < 2.7876134135933768) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.20216078e-23)*x + 3.1023504e-22) + 8.02332e-21) + 2.08012e-19) + 5.408312e-18) + 1.410864e-16) + 3.69512e-15) + 9.724e-14) + 1287.0/500000000000000.0) + 429.0/6250000000000.0) + 231.0/125000000000.0) + 63.0/1250000000.0) + 7.0/5000000.0) + 1.0/25000.0) - 1.0/20.0) + 1;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        c_det_H = (4.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/((1 - 2*pow(sin((1.0/10.0)*phi), 2))*pow(sin((1.0/5.0)*phi), 2));
+        const double w0 = (1.0/5.0)*phi;
+        c_det_H = (4.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/(pow(sin(w0), 2)*cos(w0));
     }
     return c_det_H;
 }
@@ -234,9 +245,9 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
 /* symrot_sine_m5_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 3.69097e-14, else sin(phi/2)/(5*sin(phi/5))
- * G_2: Horner degree 1 in x below x = 7.09105e-14, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
- * ops: 65 */
+ * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
+ * G_2: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * ops: 79 */
 static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -252,15 +263,13 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
         G[8] = NAN;
         return;
     }
-    double c_G_1, c_G_2;
-    if (x < 3.690968361342376e-14) {
-        c_G_1 = 1.0/2.0 + (-7.0/400.0)*x;
-        c_G_2 = 1.0/8.0 + (-3.0/3200.0)*x;
+    const double c_G_1 = -1.0/250.0*sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/sqrt(sqrt(25 - x) + 5);
+    double c_G_2;
+    if (x < 0.00423011441675066) {
+        c_G_2 = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = sin((1.0/5.0)*phi);
-        c_G_1 = (1.0/5.0)*sin((1.0/2.0)*phi)/w0;
-        c_G_2 = x < 7.091048955981833e-14 ? 1.0/8.0 + (-3.0/3200.0)*x : (2.0/25.0)*pow(sin((1.0/4.0)*phi), 2)/(w0*w0);
+        c_G_2 = (2.0/25.0)*pow(sin((1.0/4.0)*phi), 2)/pow(sin((1.0/5.0)*phi), 2);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -285,10 +294,10 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
 
 /* symrot_sine_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 5/(2*sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)) (algebraic in x)
- * K_1: Horner degree 1 in x below x = 7.09105e-14, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
- * K_2: Horner degree 21 in x below x = 5.16615, else (-2*sin(phi/2)/sin(phi/5) + 5/(1 - 2*sin(phi/10)**2))/(250*sin(phi/5)**2)
- * ops: 139 */
+ * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
+ * K_1: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * K_2: Horner degree 21 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
+ * ops: 131 */
 static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -304,17 +313,18 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
         K[8] = NAN;
         return;
     }
-    const double c_K_0 = (5.0/2.0)/(sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5));
+    const double c_K_0 = (5.0/2.0)/sqrt(25 - x);
     double c_K_1, c_K_2;
-    if (x < 7.091048955981833e-14) {
-        c_K_1 = 1.0/8.0 + (-3.0/3200.0)*x;
+    if (x < 0.00423011441675066) {
+        c_K_1 = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = sin((1.0/5.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_K_1 = (2.0/25.0)*w1*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 5.166154456090218 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*w1*(5/(1 - 2*pow(sin((1.0/10.0)*phi), 2)) - 2*sin((1.0/2.0)*phi)/w0);
+        const double w0 = (1.0/5.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = 1.0/(w1*w1);
+        c_K_1 = (2.0/25.0)*w2*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 5.166154456090218 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*w2*(5/cos(w0) - 2*sin((1.0/2.0)*phi)/w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -339,10 +349,10 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
 
 /* symrot_sine_m5_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)/5 (algebraic in x)
+ * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-2*sin(phi/10)**2 - 5*sin(phi/5)*sin(phi)/(4*sin(phi/2)**2) + 1)/(25*sin(phi/5)**2)
- * ops: 104 */
+ * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
+ * ops: 96 */
 static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -352,14 +362,16 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
         pdot[2] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/5.0)*sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5);
+    const double c_H_inverse_0 = (1.0/5.0)*sqrt(25 - x);
     double c_H_inverse_2;
     if (x < 2.7876134135933768) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = sin((1.0/5.0)*phi);
-        c_H_inverse_2 = (1.0/25.0)*(-5.0/4.0*w0*sin(phi)/pow(sin((1.0/2.0)*phi), 2) - 2*pow(sin((1.0/10.0)*phi), 2) + 1)/(w0*w0);
+        const double w0 = (1.0/5.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (1.0/25.0)*(-5.0/2.0*w1*cos(w2)/sin(w2) + cos(w0))/(w1*w1);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -371,10 +383,10 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
 
 /* symrot_sine_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/(sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 8 in x below x = 0.406443, else (-sin(phi)/(5*sin(phi/5)) + 1/(1 - 2*sin(phi/10)**2))/(25*sin(phi/5)**2)
- * ops: 93 */
+ * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_1: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 106 */
 static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -384,17 +396,20 @@ static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3],
         omega[2] = NAN;
         return;
     }
-    const double c_H_0 = 5/(sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5));
+    const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 3.690968361342376e-14) {
-        c_H_1 = 1.0/2.0 + (-7.0/200.0)*x;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*((4.862e-14)*x + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.00423011441675066) {
+        c_H_1 = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = sin((1.0/5.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_H_1 = (2.0/25.0)*w1*pow(sin((1.0/2.0)*phi), 2);
-        c_H_2 = x < 0.40644336131551395 ? x*(x*(x*(x*(x*(x*(x*((4.862e-14)*x + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w1*(1.0/(1 - 2*pow(sin((1.0/10.0)*phi), 2)) - 1.0/5.0*sin(phi)/w0);
+        const double w0 = (1.0/5.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = 1.0/(w1*w1);
+        const double w3 = (1.0/2.0)*phi;
+        const double w4 = sin(w3);
+        c_H_1 = (2.0/25.0)*w2*(w4*w4);
+        c_H_2 = x < 2.7876134135933768 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -402,6 +417,152 @@ static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3],
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_sine_m5_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(10)*sqrt(sqrt(25 - x) + 5)*(4*x + 10*sqrt(25 - x) - 75)/250 (algebraic in x)
+ * nu = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(125*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
+ * ops: 48 */
+static inline void symrot_sine_m5_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 22.612712429686844)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_e_0 = -1.0/250.0*sqrt(10)*sqrt(sqrt(25 - x) + 5)*(4*x + 10*sqrt(25 - x) - 75);
+    const double c_nu = -1.0/125.0*sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/sqrt(sqrt(25 - x) + 5);
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m5__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 5 in t = phi^2 below 0.0650594, else 5*sin(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 68 */
+static inline int symrot_sine_m5__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double phi = 2*atan2(e_norm, c0);
+    const double t = (phi*phi);
+    double sigma;
+    if (t < 0.06505938434722405) {
+        sigma = t*(t*(t*(t*((81801313.0/2592000000000000.0)*t + 358487.0/288000000000.0) + 17623.0/360000000.0) + 1141.0/600000.0) + 7.0/100.0) + 2;
+    } else {
+        sigma = 5*sin((1.0/5.0)*phi)/sin((1.0/2.0)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 22.612712429686844)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m5_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m5_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_sine_m5__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m5_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m5_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m5__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m5__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m5__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m5__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m5_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m5_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_sine_m5_to_quaternion(p1, a);
+    symrot_sine_m5_to_quaternion(p2, b);
+    return symrot_sine_m5__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m5_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m5_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_sine_m5_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m5__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 /* symrot_sine_m5__phi_f: internal: phi from s = |p| (eq 11).
@@ -438,8 +599,8 @@ static inline float symrot_sine_m5_angle_f(const float p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 3 in x below x = 0.212112, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * ops: 67 */
+ * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * ops: 72 */
 static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -457,8 +618,8 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
     }
     const float c_R_1 = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
     float c_R_2;
-    if (x < 0.21211211F) {
-        c_R_2 = x*(x*((33.0F/10000000.0F)*x + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+    if (x < 2.7876132F) {
+        c_R_2 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         c_R_2 = (2.0F/25.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(sinf((1.0F/5.0F)*phi), 2);
@@ -486,10 +647,10 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
 
 /* symrot_sine_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/(sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)) (algebraic in x)
- * H_1: Horner degree 3 in x below x = 0.212112, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 6 in x below x = 2.78761, else (-sin(phi)/(5*sin(phi/5)) + 1/(1 - 2*sin(phi/10)**2))/(25*sin(phi/5)**2)
- * ops: 93 */
+ * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 97 */
 static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -505,17 +666,20 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 5/(sqrtf(5 - sqrtf(x))*sqrtf(sqrtf(x) + 5));
+    const float c_H_0 = 5/sqrtf(25 - x);
     float c_H_1, c_H_2;
-    if (x < 0.21211211F) {
-        c_H_1 = x*(x*((33.0F/10000000.0F)*x + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+    if (x < 2.7876132F) {
+        c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_H_1 = (2.0F/25.0F)*w1*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_H_2 = x < 2.7876132F ? x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : (1.0F/25.0F)*w1*(1.0F/(1 - 2*powf(sinf((1.0F/10.0F)*phi), 2)) - 1.0F/5.0F*sinf(phi)/w0);
+        const float w0 = (1.0F/5.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = 1.0F/(w1*w1);
+        const float w3 = (1.0F/2.0F)*phi;
+        const float w4 = sinf(w3);
+        c_H_1 = (2.0F/25.0F)*w2*(w4*w4);
+        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : (1.0F/25.0F)*w2*(1.0F/cosf(w0) - 2.0F/5.0F*w4*cosf(w3)/w1);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -540,10 +704,10 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
 
 /* symrot_sine_m5_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)/5 (algebraic in x)
+ * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-2*sin(phi/10)**2 - 5*sin(phi/5)*sin(phi)/(4*sin(phi/2)**2) + 1)/(25*sin(phi/5)**2)
- * ops: 92 */
+ * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
+ * ops: 84 */
 static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -559,14 +723,16 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/5.0F)*sqrtf(5 - sqrtf(x))*sqrtf(sqrtf(x) + 5);
+    const float c_H_inverse_0 = (1.0F/5.0F)*sqrtf(25 - x);
     float c_H_inverse_2;
     if (x < 5.1661544F) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/4.0F*w0*sinf(phi)/powf(sinf((1.0F/2.0F)*phi), 2) - 2*powf(sinf((1.0F/10.0F)*phi), 2) + 1)/(w0*w0);
+        const float w0 = (1.0F/5.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/2.0F*w1*cosf(w2)/sinf(w2) + cosf(w0))/(w1*w1);
     }
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -591,8 +757,8 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m5_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 2 in x below x = 0.212112, else 4*sin(phi/2)**2/(25*(1 - 2*sin(phi/10)**2)*sin(phi/5)**2)
- * ops: 27 */
+ * det_H: Horner degree 4 in x below x = 1.47828, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
+ * ops: 23 */
 static inline float symrot_sine_m5_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -600,11 +766,12 @@ static inline float symrot_sine_m5_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 0.21211211F) {
-        c_det_H = x*((1.0F/25000.0F)*x - 1.0F/20.0F) + 1;
+    if (x < 1.4782778F) {
+        c_det_H = x*(x*(x*((5.04e-08F)*x + 7.0F/5000000.0F) + 1.0F/25000.0F) - 1.0F/20.0F) + 1;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        c_det_H = (4.0F/25.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/((1 - 2*powf(sinf((1.0F/10.0F)*phi), 2))*powf(sinf((1.0F/5.0F)*phi), 2));
+        const float w0 = (1.0F/5.0F)*phi;
+        c_det_H = (4.0F/25.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/(powf(sinf(w0), 2)*cosf(w0));
     }
     return c_det_H;
 }
@@ -612,9 +779,9 @@ static inline float symrot_sine_m5_tangent_det_f(const float p[3])
 /* symrot_sine_m5_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi/2)/(5*sin(phi/5))
- * G_2: Horner degree 1 in x below x = 1.18644e-05, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
- * ops: 65 */
+ * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
+ * G_2: Horner degree 2 in x below x = 0.212112, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * ops: 79 */
 static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -630,15 +797,13 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
         G[8] = NAN;
         return;
     }
-    float c_G_1, c_G_2;
-    if (x < 3.6909684e-14F) {
-        c_G_1 = 1.0F/2.0F;
-        c_G_2 = 1.0F/8.0F + (-3.0F/3200.0F)*x;
+    const float c_G_1 = -1.0F/250.0F*sqrtf(10)*(4*x - 10*sqrtf(25 - x) - 75)/sqrtf(sqrtf(25 - x) + 5);
+    float c_G_2;
+    if (x < 0.21211211F) {
+        c_G_2 = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        c_G_1 = (1.0F/5.0F)*sinf((1.0F/2.0F)*phi)/w0;
-        c_G_2 = x < 1.1864381e-05F ? 1.0F/8.0F + (-3.0F/3200.0F)*x : (2.0F/25.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/(w0*w0);
+        c_G_2 = (2.0F/25.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/powf(sinf((1.0F/5.0F)*phi), 2);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -663,10 +828,10 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
 
 /* symrot_sine_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 5/(2*sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)) (algebraic in x)
- * K_1: Horner degree 1 in x below x = 1.18644e-05, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
- * K_2: Horner degree 7 in x below x = 2.78761, else (-2*sin(phi/2)/sin(phi/5) + 5/(1 - 2*sin(phi/10)**2))/(250*sin(phi/5)**2)
- * ops: 97 */
+ * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
+ * K_1: Horner degree 2 in x below x = 0.212112, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * K_2: Horner degree 9 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
+ * ops: 95 */
 static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -682,17 +847,18 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (5.0F/2.0F)/(sqrtf(5 - sqrtf(x))*sqrtf(sqrtf(x) + 5));
+    const float c_K_0 = (5.0F/2.0F)/sqrtf(25 - x);
     float c_K_1, c_K_2;
-    if (x < 1.1864381e-05F) {
-        c_K_1 = 1.0F/8.0F + (-3.0F/3200.0F)*x;
-        c_K_2 = x*(x*(x*(x*(x*(x*((6.76057e-13F)*x + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
+    if (x < 0.21211211F) {
+        c_K_1 = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_K_1 = (2.0F/25.0F)*w1*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 2.7876132F ? x*(x*(x*(x*(x*(x*((6.76057e-13F)*x + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F : (1.0F/250.0F)*w1*(5/(1 - 2*powf(sinf((1.0F/10.0F)*phi), 2)) - 2*sinf((1.0F/2.0F)*phi)/w0);
+        const float w0 = (1.0F/5.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = 1.0F/(w1*w1);
+        c_K_1 = (2.0F/25.0F)*w2*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F : (1.0F/250.0F)*w2*(5/cosf(w0) - 2*sinf((1.0F/2.0F)*phi)/w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -717,10 +883,10 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
 
 /* symrot_sine_m5_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)/5 (algebraic in x)
+ * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-2*sin(phi/10)**2 - 5*sin(phi/5)*sin(phi)/(4*sin(phi/2)**2) + 1)/(25*sin(phi/5)**2)
- * ops: 86 */
+ * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
+ * ops: 78 */
 static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -730,14 +896,16 @@ static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3],
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/5.0F)*sqrtf(5 - sqrtf(x))*sqrtf(sqrtf(x) + 5);
+    const float c_H_inverse_0 = (1.0F/5.0F)*sqrtf(25 - x);
     float c_H_inverse_2;
     if (x < 5.1661544F) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/4.0F*w0*sinf(phi)/powf(sinf((1.0F/2.0F)*phi), 2) - 2*powf(sinf((1.0F/10.0F)*phi), 2) + 1)/(w0*w0);
+        const float w0 = (1.0F/5.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/2.0F*w1*cosf(w2)/sinf(w2) + cosf(w0))/(w1*w1);
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -749,10 +917,10 @@ static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3],
 
 /* symrot_sine_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/(sqrt(5 - sqrt(x))*sqrt(sqrt(x) + 5)) (algebraic in x)
- * H_1: Horner degree 3 in x below x = 0.212112, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 6 in x below x = 2.78761, else (-sin(phi)/(5*sin(phi/5)) + 1/(1 - 2*sin(phi/10)**2))/(25*sin(phi/5)**2)
- * ops: 87 */
+ * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 91 */
 static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -762,17 +930,20 @@ static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3],
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 5/(sqrtf(5 - sqrtf(x))*sqrtf(sqrtf(x) + 5));
+    const float c_H_0 = 5/sqrtf(25 - x);
     float c_H_1, c_H_2;
-    if (x < 0.21211211F) {
-        c_H_1 = x*(x*((33.0F/10000000.0F)*x + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+    if (x < 2.7876132F) {
+        c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_H_1 = (2.0F/25.0F)*w1*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_H_2 = x < 2.7876132F ? x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : (1.0F/25.0F)*w1*(1.0F/(1 - 2*powf(sinf((1.0F/10.0F)*phi), 2)) - 1.0F/5.0F*sinf(phi)/w0);
+        const float w0 = (1.0F/5.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = 1.0F/(w1*w1);
+        const float w3 = (1.0F/2.0F)*phi;
+        const float w4 = sinf(w3);
+        c_H_1 = (2.0F/25.0F)*w2*(w4*w4);
+        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : (1.0F/25.0F)*w2*(1.0F/cosf(w0) - 2.0F/5.0F*w4*cosf(w3)/w1);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -780,6 +951,152 @@ static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3],
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_sine_m5_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(10)*sqrt(sqrt(25 - x) + 5)*(4*x + 10*sqrt(25 - x) - 75)/250 (algebraic in x)
+ * nu = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(125*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
+ * ops: 48 */
+static inline void symrot_sine_m5_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 22.612713F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_e_0 = -1.0F/250.0F*sqrtf(10)*sqrtf(sqrtf(25 - x) + 5)*(4*x + 10*sqrtf(25 - x) - 75);
+    const float c_nu = -1.0F/125.0F*sqrtf(10)*(4*x - 10*sqrtf(25 - x) - 75)/sqrtf(sqrtf(25 - x) + 5);
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m5__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 1 in t = phi^2 below 0.000803424, else 5*sin(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
+static inline int symrot_sine_m5__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float phi = 2*atan2f(e_norm, c0);
+    const float t = (phi*phi);
+    float sigma;
+    if (t < 0.0008034237F) {
+        sigma = (7.0F/100.0F)*t + 2;
+    } else {
+        sigma = 5*sinf((1.0F/5.0F)*phi)/sinf((1.0F/2.0F)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 22.612713F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m5_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m5_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_sine_m5__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m5_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m5_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m5__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m5__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m5__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m5__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m5_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m5_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_sine_m5_to_quaternion_f(p1, a);
+    symrot_sine_m5_to_quaternion_f(p2, b);
+    return symrot_sine_m5__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m5_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m5_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_sine_m5_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m5__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

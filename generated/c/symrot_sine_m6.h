@@ -13,6 +13,11 @@
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -59,9 +64,9 @@ static inline double symrot_sine_m6_angle(const double p[3])
 /* symrot_sine_m6_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = sqrt(6 - sqrt(x))*(sqrt(x) - 3)*(sqrt(x) + 3)*sqrt(sqrt(x) + 6)*(x - 27)/1458 (algebraic in x)
- * R_2 = (x - 27)**2/1458 (algebraic in x)
- * ops: 70 */
+ * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
+ * R_2: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * ops: 69 */
 static inline void symrot_sine_m6_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -77,8 +82,14 @@ static inline void symrot_sine_m6_rotation_matrix(const double p[3], double R[9]
         R[8] = NAN;
         return;
     }
-    const double c_R_1 = (1.0/1458.0)*sqrt(6 - sqrt(x))*(sqrt(x) - 3)*(sqrt(x) + 3)*sqrt(sqrt(x) + 6)*(x - 27);
-    const double c_R_2 = (1.0/1458.0)*pow(x - 27, 2);
+    const double c_R_1 = -1.0/1458.0*(x - 36)*(x - 27)*(x - 9)/sqrt(36 - x);
+    double c_R_2;
+    if (x < 5.286206912907958) {
+        c_R_2 = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
+    } else {
+        const double phi = symrot_sine_m6__phi(sqrt(x));
+        c_R_2 = (1.0/18.0)*pow(4*pow(sin((1.0/6.0)*phi), 2) - 3, 2);
+    }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -102,10 +113,10 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
 
 /* symrot_sine_m6_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * H_1 = (x - 27)**2/1458 (algebraic in x)
- * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * ops: 77 */
+ * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
+ * ops: 71 */
 static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -121,9 +132,15 @@ static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
         H[8] = NAN;
         return;
     }
-    const double c_H_0 = 6/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6));
-    const double c_H_1 = (1.0/1458.0)*pow(x - 27, 2);
-    const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6));
+    const double c_H_0 = 6/sqrt(36 - x);
+    const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/sqrt(36 - x);
+    double c_H_1;
+    if (x < 5.286206912907958) {
+        c_H_1 = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
+    } else {
+        const double phi = symrot_sine_m6__phi(sqrt(x));
+        c_H_1 = (1.0/18.0)*pow(4*pow(sin((1.0/6.0)*phi), 2) - 3, 2);
+    }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -147,10 +164,10 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
 
 /* symrot_sine_m6_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/6 (algebraic in x)
+ * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = -sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/(3*(x - 27)) (algebraic in x)
- * ops: 72 */
+ * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
+ * ops: 56 */
 static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -166,8 +183,8 @@ static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/6.0)*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6);
-    const double c_H_inverse_2 = -1.0/3.0*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/(x - 27);
+    const double c_H_inverse_0 = (1.0/6.0)*sqrt(36 - x);
+    const double c_H_inverse_2 = -1.0/3.0*sqrt(36 - x)/(x - 27);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -191,15 +208,15 @@ static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m6_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H = 2*(x - 27)**2/(243*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * ops: 22 */
+ * det_H = -2*sqrt(36 - x)*(x - 27)**2/(243*(x - 36)) (algebraic in x)
+ * ops: 17 */
 static inline double symrot_sine_m6_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 27.0)) {
         return NAN;
     }
-    const double c_det_H = (2.0/243.0)*pow(x - 27, 2)/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6));
+    const double c_det_H = -2.0/243.0*sqrt(36 - x)*pow(x - 27, 2)/(x - 36);
     return c_det_H;
 }
 
@@ -207,8 +224,8 @@ static inline double symrot_sine_m6_tangent_det(const double p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
- * G_2: Horner degree 1 in x below x = 9.01516e-09, else sin(phi/4)**2/(18*sin(phi/6)**2)
- * ops: 62 */
+ * G_2: Horner degree 16 in x below x = 5.28621, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
+ * ops: 99 */
 static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -226,11 +243,11 @@ static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = 1.0/2.0 - 1.0/54.0*x;
     double c_G_2;
-    if (x < 9.01515890067993e-09) {
-        c_G_2 = 1.0/8.0 + (-5.0/3456.0)*x;
+    if (x < 5.286206912907958) {
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        c_G_2 = (1.0/18.0)*pow(sin((1.0/4.0)*phi), 2)/pow(sin((1.0/6.0)*phi), 2);
+        c_G_2 = (1.0/36.0)*(1 - cos((1.0/2.0)*phi))/pow(sin((1.0/6.0)*phi), 2);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -255,10 +272,10 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
 
 /* symrot_sine_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * K_1: Horner degree 1 in x below x = 9.01516e-09, else sin(phi/4)**2/(18*sin(phi/6)**2)
- * K_2: Horner degree 2 in x below x = 1.67315e-06, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(216*(1 - 2*sin(phi/12)**2)*sin(phi/6)**2)
- * ops: 83 */
+ * K_0 = 3/sqrt(36 - x) (algebraic in x)
+ * K_1: Horner degree 16 in x below x = 5.28621, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
+ * K_2: Horner degree 7 in x below x = 0.407121, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(216*(1 - 2*sin(phi/12)**2)*sin(phi/6)**2)
+ * ops: 123 */
 static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -274,18 +291,17 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
         K[8] = NAN;
         return;
     }
-    const double c_K_0 = 3/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6));
+    const double c_K_0 = 3/sqrt(36 - x);
     double c_K_1, c_K_2;
-    if (x < 9.01515890067993e-09) {
-        c_K_1 = 1.0/8.0 + (-5.0/3456.0)*x;
-        c_K_2 = x*((5.0/1492992.0)*x + 1.0/6912.0) + 11.0/432.0;
+    if (x < 0.40712125242855757) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*((3.4805559101996437e-14)*x + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
         const double w0 = pow(sin((1.0/6.0)*phi), -2);
-        const double w1 = pow(sin((1.0/4.0)*phi), 2);
-        const double w2 = pow(sin((1.0/12.0)*phi), 2);
-        c_K_1 = (1.0/18.0)*w0*w1;
-        c_K_2 = x < 1.6731491965060182e-06 ? x*((5.0/1492992.0)*x + 1.0/6912.0) + 11.0/432.0 : (1.0/216.0)*w0*(2*w1 + 4*w2)/(1 - 2*w2);
+        const double w1 = pow(sin((1.0/12.0)*phi), 2);
+        c_K_1 = x < 5.286206912907958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0 : (1.0/36.0)*w0*(1 - cos((1.0/2.0)*phi));
+        c_K_2 = (1.0/216.0)*w0*(4*w1 + 2*pow(sin((1.0/4.0)*phi), 2))/(1 - 2*w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -310,10 +326,10 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
 
 /* symrot_sine_m6_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/6 (algebraic in x)
+ * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = -sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/(3*(x - 27)) (algebraic in x)
- * ops: 66 */
+ * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
+ * ops: 50 */
 static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -323,8 +339,8 @@ static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3],
         pdot[2] = NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/6.0)*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6);
-    const double c_H_inverse_2 = -1.0/3.0*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/(x - 27);
+    const double c_H_inverse_0 = (1.0/6.0)*sqrt(36 - x);
+    const double c_H_inverse_2 = -1.0/3.0*sqrt(36 - x)/(x - 27);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -335,10 +351,10 @@ static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3],
 
 /* symrot_sine_m6_omega: omega = H pdot (eq 20).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * H_1 = (x - 27)**2/1458 (algebraic in x)
- * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * ops: 71 */
+ * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
+ * ops: 65 */
 static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -348,15 +364,167 @@ static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3],
         omega[2] = NAN;
         return;
     }
-    const double c_H_0 = 6/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6));
-    const double c_H_1 = (1.0/1458.0)*pow(x - 27, 2);
-    const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6));
+    const double c_H_0 = 6/sqrt(36 - x);
+    const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/sqrt(36 - x);
+    double c_H_1;
+    if (x < 5.286206912907958) {
+        c_H_1 = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
+    } else {
+        const double phi = symrot_sine_m6__phi(sqrt(x));
+        c_H_1 = (1.0/18.0)*pow(4*pow(sin((1.0/6.0)*phi), 2) - 3, 2);
+    }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_sine_m6_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(36 - x)*(x - 9)/54 (algebraic in x)
+ * nu = -(x - 27)/27 (algebraic in x)
+ * ops: 19 */
+static inline void symrot_sine_m6_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 27.0)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_e_0 = -1.0/54.0*sqrt(36 - x)*(x - 9);
+    const double c_nu = 1 - 1.0/27.0*x;
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m6__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 1 in t = phi^2 below 3.49114e-08, else 6*sin(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
+static inline int symrot_sine_m6__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double phi = 2*atan2(e_norm, c0);
+    const double t = (phi*phi);
+    double sigma;
+    if (t < 3.4911361219455e-08) {
+        sigma = (2.0/27.0)*t + 2;
+    } else {
+        sigma = 6*sin((1.0/6.0)*phi)/sin((1.0/2.0)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 27.0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m6_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m6_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_sine_m6__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m6_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m6_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m6__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m6__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m6__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m6__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m6_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m6_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_sine_m6_to_quaternion(p1, a);
+    symrot_sine_m6_to_quaternion(p2, b);
+    return symrot_sine_m6__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m6_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m6_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_sine_m6_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m6__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 /* symrot_sine_m6__phi_f: internal: phi from s = |p| (eq 11).
@@ -392,9 +560,9 @@ static inline float symrot_sine_m6_angle_f(const float p[3])
 /* symrot_sine_m6_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = sqrt(6 - sqrt(x))*(sqrt(x) - 3)*(sqrt(x) + 3)*sqrt(sqrt(x) + 6)*(x - 27)/1458 (algebraic in x)
- * R_2 = (x - 27)**2/1458 (algebraic in x)
- * ops: 70 */
+ * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
+ * R_2: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * ops: 69 */
 static inline void symrot_sine_m6_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -410,8 +578,14 @@ static inline void symrot_sine_m6_rotation_matrix_f(const float p[3], float R[9]
         R[8] = NAN;
         return;
     }
-    const float c_R_1 = (1.0F/1458.0F)*sqrtf(6 - sqrtf(x))*(sqrtf(x) - 3)*(sqrtf(x) + 3)*sqrtf(sqrtf(x) + 6)*(x - 27);
-    const float c_R_2 = (1.0F/1458.0F)*powf(x - 27, 2);
+    const float c_R_1 = -1.0F/1458.0F*(x - 36)*(x - 27)*(x - 9)/sqrtf(36 - x);
+    float c_R_2;
+    if (x < 5.2862067F) {
+        c_R_2 = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
+    } else {
+        const float phi = symrot_sine_m6__phi_f(sqrtf(x));
+        c_R_2 = (1.0F/18.0F)*powf(4*powf(sinf((1.0F/6.0F)*phi), 2) - 3, 2);
+    }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -435,10 +609,10 @@ static inline void symrot_sine_m6_rotation_matrix_f_batch(size_t n, const float 
 
 /* symrot_sine_m6_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * H_1 = (x - 27)**2/1458 (algebraic in x)
- * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * ops: 77 */
+ * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
+ * ops: 71 */
 static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -454,9 +628,15 @@ static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 6/(sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6));
-    const float c_H_1 = (1.0F/1458.0F)*powf(x - 27, 2);
-    const float c_H_2 = (1.0F/1458.0F)*((x*x) - 72*x + 1539)/(sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6));
+    const float c_H_0 = 6/sqrtf(36 - x);
+    const float c_H_2 = (1.0F/1458.0F)*((x*x) - 72*x + 1539)/sqrtf(36 - x);
+    float c_H_1;
+    if (x < 5.2862067F) {
+        c_H_1 = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
+    } else {
+        const float phi = symrot_sine_m6__phi_f(sqrtf(x));
+        c_H_1 = (1.0F/18.0F)*powf(4*powf(sinf((1.0F/6.0F)*phi), 2) - 3, 2);
+    }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -480,10 +660,10 @@ static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, floa
 
 /* symrot_sine_m6_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/6 (algebraic in x)
+ * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = -sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/(3*(x - 27)) (algebraic in x)
- * ops: 72 */
+ * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
+ * ops: 56 */
 static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -499,8 +679,8 @@ static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/6.0F)*sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6);
-    const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6)/(x - 27);
+    const float c_H_inverse_0 = (1.0F/6.0F)*sqrtf(36 - x);
+    const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(36 - x)/(x - 27);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -524,15 +704,15 @@ static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m6_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H = 2*(x - 27)**2/(243*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * ops: 22 */
+ * det_H = -2*sqrt(36 - x)*(x - 27)**2/(243*(x - 36)) (algebraic in x)
+ * ops: 17 */
 static inline float symrot_sine_m6_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 27.0F)) {
         return NAN;
     }
-    const float c_det_H = (2.0F/243.0F)*powf(x - 27, 2)/(sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6));
+    const float c_det_H = -2.0F/243.0F*sqrtf(36 - x)*powf(x - 27, 2)/(x - 36);
     return c_det_H;
 }
 
@@ -588,10 +768,10 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
 
 /* symrot_sine_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
+ * K_0 = 3/sqrt(36 - x) (algebraic in x)
  * K_1: Horner degree 3 in x below x = 0.779432, else sin(phi/4)**2/(18*sin(phi/6)**2)
- * K_2: Horner degree 2 in x below x = 0.110607, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(216*(1 - 2*sin(phi/12)**2)*sin(phi/6)**2)
- * ops: 91 */
+ * K_2: Horner degree 7 in x below x = 5.28621, else (-2*cos(phi/6) - cos(phi/2) + 3)/(216*sin(phi/6)**2*cos(phi/6))
+ * ops: 88 */
 static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -607,18 +787,18 @@ static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 3/(sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6));
+    const float c_K_0 = 3/sqrtf(36 - x);
     float c_K_1, c_K_2;
-    if (x < 0.11060687F) {
+    if (x < 0.77943236F) {
         c_K_1 = x*(x*((-1.0F/7962624.0F)*x - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
-        c_K_2 = x*((5.0F/1492992.0F)*x + 1.0F/6912.0F) + 11.0F/432.0F;
+        c_K_2 = x*(x*(x*(x*(x*(x*((3.480556e-14F)*x + 1.3365334e-12F) + 5.1816374e-11F) + 2.0349704e-09F) + 8.139882e-08F) + 5.0F/1492992.0F) + 1.0F/6912.0F) + 11.0F/432.0F;
     } else {
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
-        const float w0 = powf(sinf((1.0F/6.0F)*phi), -2);
-        const float w1 = powf(sinf((1.0F/4.0F)*phi), 2);
-        const float w2 = powf(sinf((1.0F/12.0F)*phi), 2);
-        c_K_1 = x < 0.77943236F ? x*(x*((-1.0F/7962624.0F)*x - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F : (1.0F/18.0F)*w0*w1;
-        c_K_2 = (1.0F/216.0F)*w0*(2*w1 + 4*w2)/(1 - 2*w2);
+        const float w0 = (1.0F/6.0F)*phi;
+        const float w1 = powf(sinf(w0), -2);
+        const float w2 = cosf(w0);
+        c_K_1 = (1.0F/18.0F)*w1*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = x < 5.2862067F ? x*(x*(x*(x*(x*(x*((3.480556e-14F)*x + 1.3365334e-12F) + 5.1816374e-11F) + 2.0349704e-09F) + 8.139882e-08F) + 5.0F/1492992.0F) + 1.0F/6912.0F) + 11.0F/432.0F : (1.0F/216.0F)*w1*(-2*w2 - cosf((1.0F/2.0F)*phi) + 3)/w2;
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -643,10 +823,10 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
 
 /* symrot_sine_m6_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/6 (algebraic in x)
+ * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = -sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)/(3*(x - 27)) (algebraic in x)
- * ops: 66 */
+ * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
+ * ops: 50 */
 static inline void symrot_sine_m6_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -656,8 +836,8 @@ static inline void symrot_sine_m6_pdot_f(const float p[3], const float omega[3],
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/6.0F)*sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6);
-    const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6)/(x - 27);
+    const float c_H_inverse_0 = (1.0F/6.0F)*sqrtf(36 - x);
+    const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(36 - x)/(x - 27);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -668,10 +848,10 @@ static inline void symrot_sine_m6_pdot_f(const float p[3], const float omega[3],
 
 /* symrot_sine_m6_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/(sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * H_1 = (x - 27)**2/1458 (algebraic in x)
- * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(6 - sqrt(x))*sqrt(sqrt(x) + 6)) (algebraic in x)
- * ops: 71 */
+ * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
+ * ops: 65 */
 static inline void symrot_sine_m6_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -681,15 +861,167 @@ static inline void symrot_sine_m6_omega_f(const float p[3], const float pdot[3],
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 6/(sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6));
-    const float c_H_1 = (1.0F/1458.0F)*powf(x - 27, 2);
-    const float c_H_2 = (1.0F/1458.0F)*((x*x) - 72*x + 1539)/(sqrtf(6 - sqrtf(x))*sqrtf(sqrtf(x) + 6));
+    const float c_H_0 = 6/sqrtf(36 - x);
+    const float c_H_2 = (1.0F/1458.0F)*((x*x) - 72*x + 1539)/sqrtf(36 - x);
+    float c_H_1;
+    if (x < 5.2862067F) {
+        c_H_1 = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
+    } else {
+        const float phi = symrot_sine_m6__phi_f(sqrtf(x));
+        c_H_1 = (1.0F/18.0F)*powf(4*powf(sinf((1.0F/6.0F)*phi), 2) - 3, 2);
+    }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_sine_m6_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(36 - x)*(x - 9)/54 (algebraic in x)
+ * nu = -(x - 27)/27 (algebraic in x)
+ * ops: 19 */
+static inline void symrot_sine_m6_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 27.0F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_e_0 = -1.0F/54.0F*sqrtf(36 - x)*(x - 9);
+    const float c_nu = 1 - 1.0F/27.0F*x;
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_sine_m6__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 1 in t = phi^2 below 3.48198e-05, else 6*sin(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
+static inline int symrot_sine_m6__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float phi = 2*atan2f(e_norm, c0);
+    const float t = (phi*phi);
+    float sigma;
+    if (t < 3.4819823e-05F) {
+        sigma = (2.0F/27.0F)*t + 2;
+    } else {
+        sigma = 6*sinf((1.0F/6.0F)*phi)/sinf((1.0F/2.0F)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 27.0F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_sine_m6_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_sine_m6_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_sine_m6__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_sine_m6_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_sine_m6_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_sine_m6__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_sine_m6__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_sine_m6__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_sine_m6__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_sine_m6_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_sine_m6_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_sine_m6_to_quaternion_f(p1, a);
+    symrot_sine_m6_to_quaternion_f(p2, b);
+    return symrot_sine_m6__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_sine_m6_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_sine_m6_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_sine_m6_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_sine_m6__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

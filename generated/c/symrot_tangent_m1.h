@@ -10,8 +10,13 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
+ *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
  *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
@@ -35,13 +40,13 @@ static inline double symrot_tangent_m1__phi(double s)
 }
 
 /* symrot_tangent_m1_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * phi = atan(s) (closed inverse of p(phi))
  * ops: 19 */
 static inline double symrot_tangent_m1_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         return NAN;
     }
     double s;
@@ -57,15 +62,15 @@ static inline double symrot_tangent_m1_angle(const double p[3])
 }
 
 /* symrot_tangent_m1_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 1/sqrt(x + 1) (algebraic in x)
- * R_2: Horner degree 1 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**2/(2 - 2*sin(phi/2)**2)
- * ops: 61 */
+ * R_2 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
+ * ops: 55 */
 static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -78,14 +83,7 @@ static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R
         return;
     }
     const double c_R_1 = 1.0/sqrt(x + 1);
-    double c_R_2;
-    if (x < 1.0000000000000066e-14) {
-        c_R_2 = 1.0/2.0 + (-3.0/8.0)*x;
-    } else {
-        const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/2.0)*phi), 2);
-        c_R_2 = pow(1 - w0, 2)/(2 - w0);
-    }
+    const double c_R_2 = 1.0/(x + sqrt(x + 1) + 1);
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -108,15 +106,15 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m1_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**2/(2 - 2*sin(phi/2)**2)
- * H_2: Horner degree 1 in x below x = 1e-14, else -(1 - 2*sin(phi/2)**2)**3/(2 - 2*sin(phi/2)**2)
- * ops: 63 */
+ * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
+ * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 61 */
 static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -129,18 +127,8 @@ static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
         return;
     }
     const double c_H_0 = 1.0/(x + 1);
-    double c_H_1, c_H_2;
-    if (x < 1.0000000000000066e-14) {
-        c_H_1 = 1.0/2.0 + (-3.0/8.0)*x;
-        c_H_2 = (5.0/8.0)*x - 1.0/2.0;
-    } else {
-        const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/2.0)*phi), 2);
-        const double w1 = 1 - w0;
-        const double w2 = 1.0/(2 - w0);
-        c_H_1 = (w1*w1)*w2;
-        c_H_2 = -(w1*w1*w1)*w2;
-    }
+    const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
+    const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -163,15 +151,15 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
 }
 
 /* symrot_tangent_m1_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 1 in x below x = 1e-14, else (3 - 2*sin(phi/2)**2)/(2*(2 - 2*sin(phi/2)**2))
- * ops: 58 */
+ * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 57 */
 static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -184,14 +172,7 @@ static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double H
         return;
     }
     const double c_H_inverse_0 = x + 1;
-    double c_H_inverse_2;
-    if (x < 1.0000000000000066e-14) {
-        c_H_inverse_2 = (1.0/16.0)*x + 3.0/4.0;
-    } else {
-        const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/2.0)*phi), 2);
-        c_H_inverse_2 = (1.0/2.0)*(3 - w0)/(2 - w0);
-    }
+    const double c_H_inverse_2 = (1.0/2.0)*(2*sqrt(x + 1) + 1)/(sqrt(x + 1) + 1);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -214,35 +195,29 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m1_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
- * det_H: Horner degree 1 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**4/(1 - 2*sin(phi/4)**2)**2
- * ops: 23 */
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * det_H = 2/((x + 1)*(x + sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 14 */
 static inline double symrot_tangent_m1_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         return NAN;
     }
-    double c_det_H;
-    if (x < 1.0000000000000066e-14) {
-        c_det_H = 1 + (-7.0/4.0)*x;
-    } else {
-        const double phi = symrot_tangent_m1__phi(sqrt(x));
-        c_det_H = pow(1 - 2*pow(sin((1.0/2.0)*phi), 2), 4)/pow(1 - 2*pow(sin((1.0/4.0)*phi), 2), 2);
-    }
+    const double c_det_H = 2/((x + 1)*(x + sqrt(x + 1) + 1));
     return c_det_H;
 }
 
 /* symrot_tangent_m1_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)/(2*(1 - 2*sin(phi/4)**2))
- * G_2: Horner degree 1 in x below x = 1e-14, else 2*sin(phi/4)**2/tan(phi)**2
- * ops: 64 */
+ * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
+ * G_2: Horner degree 3 in x below x = 7.88901e-06, else 2*sin(phi/4)**2/s**2
+ * ops: 71 */
 static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -254,15 +229,14 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
         G[8] = NAN;
         return;
     }
-    double c_G_1, c_G_2;
-    if (x < 1.0000000000000066e-14) {
-        c_G_1 = 1.0/2.0 + (-3.0/16.0)*x;
-        c_G_2 = 1.0/8.0 + (-11.0/128.0)*x;
+    const double c_G_1 = (1.0/2.0)*sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
+    double c_G_2;
+    if (x < 7.889013259849932e-06) {
+        c_G_2 = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/4.0)*phi), 2);
-        c_G_1 = (1.0/2.0)*(1 - 2*pow(sin((1.0/2.0)*phi), 2))/(1 - w0);
-        c_G_2 = w0/pow(tan(phi), 2);
+        const double s = sqrt(x);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -286,15 +260,15 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
 }
 
 /* symrot_tangent_m1_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 1/(2*(x + 1)) (algebraic in x)
- * K_1: Horner degree 1 in x below x = 1e-14, else 2*sin(phi/4)**2/tan(phi)**2
- * K_2: Horner degree 14 in x below x = 0.0694553, else ((1 - 2*sin(phi/2)**2)**2/2 - sin(phi/2)/tan(phi))/tan(phi)**2
- * ops: 107 */
+ * K_1: Horner degree 3 in x below x = 7.88901e-06, else 2*sin(phi/4)**2/s**2
+ * K_2: Horner degree 18 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
+ * ops: 118 */
 static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -308,16 +282,15 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (1.0/2.0)/(x + 1);
     double c_K_1, c_K_2;
-    if (x < 1.0000000000000066e-14) {
-        c_K_1 = 1.0/8.0 + (-11.0/128.0)*x;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.4712032458464977 + (-0.47268778690839536)*x) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
+    if (x < 7.889013259849932e-06) {
+        c_K_1 = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
     } else {
         const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double w0 = tan(phi);
-        const double w1 = 1.0/(w0*w0);
-        const double w2 = sin((1.0/2.0)*phi);
-        c_K_1 = 2*w1*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 0.06945526078799306 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.4712032458464977 + (-0.47268778690839536)*x) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w1*((1.0/2.0)*pow(1 - 2*(w2*w2), 2) - w2/w0);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 0.1318263071600862 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*((1.0/2.0)/(x + 1) - sin((1.0/2.0)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -341,29 +314,22 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
 }
 
 /* symrot_tangent_m1_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 1 in x below x = 1e-14, else (3 - 2*sin(phi/2)**2)/(2*(2 - 2*sin(phi/2)**2))
- * ops: 52 */
+ * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 51 */
 static inline void symrot_tangent_m1_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
     const double c_H_inverse_0 = x + 1;
-    double c_H_inverse_2;
-    if (x < 1.0000000000000066e-14) {
-        c_H_inverse_2 = (1.0/16.0)*x + 3.0/4.0;
-    } else {
-        const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/2.0)*phi), 2);
-        c_H_inverse_2 = (1.0/2.0)*(3 - w0)/(2 - w0);
-    }
+    const double c_H_inverse_2 = (1.0/2.0)*(2*sqrt(x + 1) + 1)/(sqrt(x + 1) + 1);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -373,39 +339,174 @@ static inline void symrot_tangent_m1_pdot(const double p[3], const double omega[
 }
 
 /* symrot_tangent_m1_omega: omega = H pdot (eq 20).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**2/(2 - 2*sin(phi/2)**2)
- * H_2: Horner degree 1 in x below x = 1e-14, else -(1 - 2*sin(phi/2)**2)**3/(2 - 2*sin(phi/2)**2)
- * ops: 57 */
+ * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
+ * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 55 */
 static inline void symrot_tangent_m1_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
     const double c_H_0 = 1.0/(x + 1);
-    double c_H_1, c_H_2;
-    if (x < 1.0000000000000066e-14) {
-        c_H_1 = 1.0/2.0 + (-3.0/8.0)*x;
-        c_H_2 = (5.0/8.0)*x - 1.0/2.0;
-    } else {
-        const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double w0 = 2*pow(sin((1.0/2.0)*phi), 2);
-        const double w1 = 1 - w0;
-        const double w2 = 1.0/(2 - w0);
-        c_H_1 = (w1*w1)*w2;
-        c_H_2 = -(w1*w1*w1)*w2;
-    }
+    const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
+    const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m1_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 1 in x below x = 1e-14, else cos(phi/2)
+ * nu = sqrt(2)/((x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 29 */
+static inline void symrot_tangent_m1_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.149515568880993e+180)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_nu = sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
+    double c_e_0;
+    if (x < 1.0000000000000066e-14) {
+        c_e_0 = 1 + (-1.0/8.0)*x;
+    } else {
+        const double phi = symrot_tangent_m1__phi(sqrt(x));
+        c_e_0 = cos((1.0/2.0)*phi);
+    }
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m1__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 2*e0/(2*e0**2 - 1) (trig-free in e0)
+ * ops: 54 */
+static inline int symrot_tangent_m1__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    if (!(c0 > 0.7071067811865476)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    e_norm = e_norm / n;
+    const double sigma = 2*c0/(2*(c0*c0) - 1);
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    return 0;
+}
+
+/* symrot_tangent_m1_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 0 */
+static inline int symrot_tangent_m1_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_tangent_m1__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m1_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m1_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m1__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m1__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m1__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m1__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m1_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 28 */
+static inline int symrot_tangent_m1_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_tangent_m1_to_quaternion(p1, a);
+    symrot_tangent_m1_to_quaternion(p2, b);
+    return symrot_tangent_m1__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m1_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m1_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_tangent_m1_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m1__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 /* symrot_tangent_m1__phi_f: internal: phi from s = |p| (eq 11).
@@ -417,13 +518,13 @@ static inline float symrot_tangent_m1__phi_f(float s)
 }
 
 /* symrot_tangent_m1_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * phi = atan(s) (closed inverse of p(phi))
  * ops: 19 */
 static inline float symrot_tangent_m1_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         return NAN;
     }
     float s;
@@ -439,15 +540,15 @@ static inline float symrot_tangent_m1_angle_f(const float p[3])
 }
 
 /* symrot_tangent_m1_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 1/sqrt(x + 1) (algebraic in x)
- * R_2: Horner degree 0 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**2/(2 - 2*sin(phi/2)**2)
- * ops: 61 */
+ * R_2 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
+ * ops: 55 */
 static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -460,14 +561,7 @@ static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R
         return;
     }
     const float c_R_1 = 1.0F/sqrtf(x + 1);
-    float c_R_2;
-    if (x < 1e-14F) {
-        c_R_2 = 1.0F/2.0F;
-    } else {
-        const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float w0 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_R_2 = powf(1 - w0, 2)/(2 - w0);
-    }
+    const float c_R_2 = 1.0F/(x + sqrtf(x + 1) + 1);
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -490,15 +584,15 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m1_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
- * H_1: Horner degree 0 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**2/(2 - 2*sin(phi/2)**2)
- * H_2: Horner degree 0 in x below x = 1e-14, else -(1 - 2*sin(phi/2)**2)**3/(2 - 2*sin(phi/2)**2)
- * ops: 63 */
+ * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
+ * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 61 */
 static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -511,18 +605,8 @@ static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
         return;
     }
     const float c_H_0 = 1.0F/(x + 1);
-    float c_H_1, c_H_2;
-    if (x < 1e-14F) {
-        c_H_1 = 1.0F/2.0F;
-        c_H_2 = -1.0F/2.0F;
-    } else {
-        const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float w0 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w1 = 1 - w0;
-        const float w2 = 1.0F/(2 - w0);
-        c_H_1 = (w1*w1)*w2;
-        c_H_2 = -(w1*w1*w1)*w2;
-    }
+    const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
+    const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -545,15 +629,15 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
 }
 
 /* symrot_tangent_m1_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1e-14, else (cos(phi) + 2)/(2*(cos(phi) + 1))
- * ops: 55 */
+ * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 57 */
 static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -566,14 +650,7 @@ static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float H
         return;
     }
     const float c_H_inverse_0 = x + 1;
-    float c_H_inverse_2;
-    if (x < 1e-14F) {
-        c_H_inverse_2 = 3.0F/4.0F;
-    } else {
-        const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float w0 = cosf(phi);
-        c_H_inverse_2 = (1.0F/2.0F)*(w0 + 2)/(w0 + 1);
-    }
+    const float c_H_inverse_2 = (1.0F/2.0F)*(2*sqrtf(x + 1) + 1)/(sqrtf(x + 1) + 1);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -596,35 +673,29 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m1_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
- * det_H: Horner degree 0 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**4/(1 - 2*sin(phi/4)**2)**2
- * ops: 23 */
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * det_H = 2/((x + 1)*(x + sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 14 */
 static inline float symrot_tangent_m1_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         return NAN;
     }
-    float c_det_H;
-    if (x < 1e-14F) {
-        c_det_H = 1;
-    } else {
-        const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        c_det_H = powf(1 - 2*powf(sinf((1.0F/2.0F)*phi), 2), 4)/powf(1 - 2*powf(sinf((1.0F/4.0F)*phi), 2), 2);
-    }
+    const float c_det_H = 2/((x + 1)*(x + sqrtf(x + 1) + 1));
     return c_det_H;
 }
 
 /* symrot_tangent_m1_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)/(2*(1 - 2*sin(phi/4)**2))
- * G_2: Horner degree 2 in x below x = 0.00178909, else 2*sin(phi/4)**2/tan(phi)**2
- * ops: 69 */
+ * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
+ * G_2: Horner degree 4 in x below x = 0.0372489, else 2*sin(phi/4)**2/s**2
+ * ops: 73 */
 static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -636,15 +707,14 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
         G[8] = NAN;
         return;
     }
-    float c_G_1, c_G_2;
-    if (x < 1e-14F) {
-        c_G_1 = 1.0F/2.0F;
-        c_G_2 = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
+    const float c_G_1 = (1.0F/2.0F)*sqrtf(2)/(powf(x + 1, 1.0F/4.0F)*sqrtf(sqrtf(x + 1) + 1));
+    float c_G_2;
+    if (x < 0.03724894F) {
+        c_G_2 = x*(x*(x*((12767.0F/262144.0F)*x - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float w0 = 2*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_G_1 = (1.0F/2.0F)*(1 - 2*powf(sinf((1.0F/2.0F)*phi), 2))/(1 - w0);
-        c_G_2 = x < 0.0017890878F ? x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F : w0/powf(tanf(phi), 2);
+        const float s = sqrtf(x);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -668,15 +738,15 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
 }
 
 /* symrot_tangent_m1_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 1/(2*(x + 1)) (algebraic in x)
- * K_1: Horner degree 2 in x below x = 0.00178909, else 2*sin(phi/4)**2/tan(phi)**2
- * K_2: Horner degree 13 in x below x = 0.258954, else ((1 - 2*sin(phi/2)**2)**2/2 - sin(phi/2)/tan(phi))/tan(phi)**2
- * ops: 103 */
+ * K_1: Horner degree 4 in x below x = 0.0372489, else 2*sin(phi/4)**2/s**2
+ * K_2: Horner degree 8 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
+ * ops: 88 */
 static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -690,16 +760,15 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
     }
     const float c_K_0 = (1.0F/2.0F)/(x + 1);
     float c_K_1, c_K_2;
-    if (x < 0.0017890878F) {
-        c_K_1 = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
+    if (x < 0.03724894F) {
+        c_K_1 = x*(x*(x*((12767.0F/262144.0F)*x - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(0.45584974F + (-0.4596311F)*x) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
     } else {
         const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float w0 = tanf(phi);
-        const float w1 = 1.0F/(w0*w0);
-        const float w2 = sinf((1.0F/2.0F)*phi);
-        c_K_1 = 2*w1*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 0.2589544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F : w1*((1.0F/2.0F)*powf(1 - 2*(w2*w2), 2) - w2/w0);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = x < 0.13182631F ? x*(x*(x*(x*(x*(x*(x*(0.45584974F + (-0.4596311F)*x) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F : w0*((1.0F/2.0F)/(x + 1) - sinf((1.0F/2.0F)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -723,29 +792,22 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
 }
 
 /* symrot_tangent_m1_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1e-14, else (cos(phi) + 2)/(2*(cos(phi) + 1))
- * ops: 49 */
+ * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 51 */
 static inline void symrot_tangent_m1_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
     const float c_H_inverse_0 = x + 1;
-    float c_H_inverse_2;
-    if (x < 1e-14F) {
-        c_H_inverse_2 = 3.0F/4.0F;
-    } else {
-        const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float w0 = cosf(phi);
-        c_H_inverse_2 = (1.0F/2.0F)*(w0 + 2)/(w0 + 1);
-    }
+    const float c_H_inverse_2 = (1.0F/2.0F)*(2*sqrtf(x + 1) + 1)/(sqrtf(x + 1) + 1);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -755,39 +817,174 @@ static inline void symrot_tangent_m1_pdot_f(const float p[3], const float omega[
 }
 
 /* symrot_tangent_m1_omega_f: omega = H pdot (eq 20).
- * Valid for every finite p (|phi| < 1.5707963267948966) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
- * H_1: Horner degree 0 in x below x = 1e-14, else (1 - 2*sin(phi/2)**2)**2/(2 - 2*sin(phi/2)**2)
- * H_2: Horner degree 0 in x below x = 1e-14, else -(1 - 2*sin(phi/2)**2)**3/(2 - 2*sin(phi/2)**2)
- * ops: 57 */
+ * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
+ * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 55 */
 static inline void symrot_tangent_m1_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
     const float c_H_0 = 1.0F/(x + 1);
-    float c_H_1, c_H_2;
-    if (x < 1e-14F) {
-        c_H_1 = 1.0F/2.0F;
-        c_H_2 = -1.0F/2.0F;
-    } else {
-        const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float w0 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w1 = 1 - w0;
-        const float w2 = 1.0F/(2 - w0);
-        c_H_1 = (w1*w1)*w2;
-        c_H_2 = -(w1*w1*w1)*w2;
-    }
+    const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
+    const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m1_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * e_0: Horner degree 0 in x below x = 1e-14, else cos(phi/2)
+ * nu = sqrt(2)/((x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
+ * ops: 29 */
+static inline void symrot_tangent_m1_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 1.2676506e+30F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_nu = sqrtf(2)/(powf(x + 1, 1.0F/4.0F)*sqrtf(sqrtf(x + 1) + 1));
+    float c_e_0;
+    if (x < 1e-14F) {
+        c_e_0 = 1;
+    } else {
+        const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
+        c_e_0 = cosf((1.0F/2.0F)*phi);
+    }
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m1__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 2*e0/(2*e0**2 - 1) (trig-free in e0)
+ * ops: 54 */
+static inline int symrot_tangent_m1__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    if (!(c0 > 0.70710677F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    e_norm = e_norm / n;
+    const float sigma = 2*c0/(2*(c0*c0) - 1);
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    return 0;
+}
+
+/* symrot_tangent_m1_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 0 */
+static inline int symrot_tangent_m1_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_tangent_m1__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m1_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m1_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m1__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m1__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m1__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m1__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m1_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * needs |phi| < 1.5707963267948966, i.e. e0 > 0.70710678118654757).
+ * ops: 28 */
+static inline int symrot_tangent_m1_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_tangent_m1_to_quaternion_f(p1, a);
+    symrot_tangent_m1_to_quaternion_f(p2, b);
+    return symrot_tangent_m1__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m1_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m1_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_tangent_m1_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m1__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

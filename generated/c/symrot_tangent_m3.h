@@ -10,8 +10,13 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
+ *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
  *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
@@ -35,13 +40,13 @@ static inline double symrot_tangent_m3__phi(double s)
 }
 
 /* symrot_tangent_m3_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * phi = 3*atan(s/3) (closed inverse of p(phi))
  * ops: 21 */
 static inline double symrot_tangent_m3_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         return NAN;
     }
     double s;
@@ -57,15 +62,15 @@ static inline double symrot_tangent_m3_angle(const double p[3])
 }
 
 /* symrot_tangent_m3_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
- * R_2: Horner degree 6 in x below x = 0.0360887, else 2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * ops: 71 */
+ * R_1: Horner degree 1 in x below x = 1e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 13 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * ops: 101 */
 static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -77,13 +82,16 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
         R[8] = NAN;
         return;
     }
-    const double c_R_1 = -(x - 27)/pow(x + 9, 3.0/2.0);
-    double c_R_2;
-    if (x < 0.03608868100976054) {
-        c_R_2 = x*(x*(x*(x*(x*((2717.0/1088391168.0)*x - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    double c_R_1, c_R_2;
+    if (x < 1.0000000000000006e-14) {
+        c_R_1 = 1 + (-11.0/54.0)*x;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        c_R_2 = (2.0/9.0)*pow(sin((1.0/2.0)*phi), 2)/pow(tan((1.0/3.0)*phi), 2);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        c_R_1 = 2*sin(w0)*cos(w0)/s;
+        c_R_2 = x < 0.4871184501507491 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : (1 - cos(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -107,15 +115,15 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 0.0360887, else 2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * H_2: Horner degree 1 in x below x = 1e-14, else (1 - 2*sin(phi/6)**2)**3*(5 - 8*sin(phi/6)**2)/(27*(2 - 2*sin(phi/6)**2))
- * ops: 85 */
+ * H_1: Horner degree 13 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 102 */
 static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -128,16 +136,14 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
         return;
     }
     const double c_H_0 = 9/(x + 9);
-    double c_H_1, c_H_2;
-    if (x < 1.0000000000000006e-14) {
-        c_H_1 = x*(x*(x*(x*(x*((2717.0/1088391168.0)*x - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
-        c_H_2 = 5.0/54.0 + (-11.0/648.0)*x;
+    const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
+    double c_H_1;
+    if (x < 0.4871184501507491) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/6.0)*phi), 2);
-        const double w1 = 2*w0;
-        c_H_1 = x < 0.03608868100976054 ? x*(x*(x*(x*(x*((2717.0/1088391168.0)*x - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : (2.0/9.0)*pow(sin((1.0/2.0)*phi), 2)/pow(tan((1.0/3.0)*phi), 2);
-        c_H_2 = (1.0/27.0)*pow(1 - w1, 3)*(5 - 8*w0)/(2 - w1);
+        const double s = sqrt(x);
+        c_H_1 = (1 - cos(phi))/(s*s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -161,15 +167,15 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
 }
 
 /* symrot_tangent_m3_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 3 in x below x = 0.0004009, else (9*cos(phi/3) + 3*cos(2*phi/3) + 5)/(18*(cos(phi/3) + 1)*(2*cos(phi/3) + 1))
- * ops: 68 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * ops: 74 */
 static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -182,14 +188,7 @@ static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double H
         return;
     }
     const double c_H_inverse_0 = (1.0/9.0)*x + 1;
-    double c_H_inverse_2;
-    if (x < 0.0004009003227728036) {
-        c_H_inverse_2 = x*(x*(13.0/629856.0 + (-139.0/136048896.0)*x) - 7.0/11664.0) + 17.0/108.0;
-    } else {
-        const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double w0 = cos((1.0/3.0)*phi);
-        c_H_inverse_2 = (1.0/18.0)*(9*w0 + 3*cos((2.0/3.0)*phi) + 5)/((w0 + 1)*(2*w0 + 1));
-    }
+    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -212,35 +211,36 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m3_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
- * det_H: Horner degree 7 in x below x = 0.0360887, else 4*(1 - 2*sin(phi/6)**2)**2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * ops: 29 */
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * det_H: Horner degree 11 in x below x = 0.251942, else 36*sin(phi/2)**2/(s**2*(x + 9))
+ * ops: 41 */
 static inline double symrot_tangent_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         return NAN;
     }
     double c_det_H;
-    if (x < 0.03608868100976054) {
-        c_det_H = x*(x*(x*(x*(x*(x*(124507.0/4897760256.0 + (-2410387.0/705277476864.0)*x) - 50027.0/272097792.0) + 9677.0/7558272.0) - 3547.0/419904.0) + 299.0/5832.0) - 29.0/108.0) + 1;
+    if (x < 0.2519423440547372) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(60995261.0/8226356490141696.0 + (-9.345602752961522e-10)*x) - 26573665.0/457019805007872.0) + 5708089.0/12694994583552.0) - 2410387.0/705277476864.0) + 124507.0/4897760256.0) - 50027.0/272097792.0) + 9677.0/7558272.0) - 3547.0/419904.0) + 299.0/5832.0) - 29.0/108.0) + 1;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        c_det_H = (4.0/9.0)*pow(1 - 2*pow(sin((1.0/6.0)*phi), 2), 2)*pow(sin((1.0/2.0)*phi), 2)/pow(tan((1.0/3.0)*phi), 2);
+        const double s = sqrt(x);
+        c_det_H = 36*pow(sin((1.0/2.0)*phi), 2)/((s*s)*(x + 9));
     }
     return c_det_H;
 }
 
 /* symrot_tangent_m3_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 1.9012e-14, else sin(phi/2)/(3*tan(phi/3))
- * G_2: Horner degree 2 in x below x = 9.45526e-08, else 2*sin(phi/4)**2/(9*tan(phi/3)**2)
- * ops: 65 */
+ * G_1: Horner degree 1 in x below x = 1.9012e-14, else sin(phi/2)/s
+ * G_2: Horner degree 5 in x below x = 0.0189581, else 2*sin(phi/4)**2/s**2
+ * ops: 74 */
 static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -255,12 +255,12 @@ static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
     double c_G_1, c_G_2;
     if (x < 1.9011961863057328e-14) {
         c_G_1 = 1.0/2.0 + (-17.0/432.0)*x;
-        c_G_2 = x*((893.0/746496.0)*x - 41.0/3456.0) + 1.0/8.0;
+        c_G_2 = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double w0 = tan((1.0/3.0)*phi);
-        c_G_1 = (1.0/3.0)*sin((1.0/2.0)*phi)/w0;
-        c_G_2 = x < 9.455257579519528e-08 ? x*((893.0/746496.0)*x - 41.0/3456.0) + 1.0/8.0 : (2.0/9.0)*pow(sin((1.0/4.0)*phi), 2)/(w0*w0);
+        const double s = sqrt(x);
+        c_G_1 = sin((1.0/2.0)*phi)/s;
+        c_G_2 = x < 0.018958083893503733 ? x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -284,15 +284,15 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
 }
 
 /* symrot_tangent_m3_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 2 in x below x = 9.45526e-08, else 2*sin(phi/4)**2/(9*tan(phi/3)**2)
- * K_2: Horner degree 17 in x below x = 0.956738, else (3*(1 - 2*sin(phi/6)**2)**2 - 2*sin(phi/2)/tan(phi/3))/(54*tan(phi/3)**2)
- * ops: 117 */
+ * K_1: Horner degree 5 in x below x = 0.0189581, else 2*sin(phi/4)**2/s**2
+ * K_2: Horner degree 21 in x below x = 1.93909, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
+ * ops: 130 */
 static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -306,15 +306,15 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (9.0/2.0)/(x + 9);
     double c_K_1, c_K_2;
-    if (x < 9.455257579519528e-08) {
-        c_K_1 = x*((893.0/746496.0)*x - 41.0/3456.0) + 1.0/8.0;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.09491161556633e-18)*x - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
+    if (x < 0.018958083893503733) {
+        c_K_1 = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double w0 = tan((1.0/3.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_K_1 = (2.0/9.0)*w1*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 0.9567381777096989 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.09491161556633e-18)*x - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0 : (1.0/54.0)*w1*(3*pow(1 - 2*pow(sin((1.0/6.0)*phi), 2), 2) - 2*sin((1.0/2.0)*phi)/w0);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 1.9390924142768224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0 : (1.0/6.0)*w0*(27/(x + 9) - 6*sin((1.0/2.0)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -338,29 +338,22 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
 }
 
 /* symrot_tangent_m3_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 3 in x below x = 0.0004009, else (9*cos(phi/3) + 3*cos(2*phi/3) + 5)/(18*(cos(phi/3) + 1)*(2*cos(phi/3) + 1))
- * ops: 62 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * ops: 68 */
 static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/9.0)*x + 1;
-    double c_H_inverse_2;
-    if (x < 0.0004009003227728036) {
-        c_H_inverse_2 = x*(x*(13.0/629856.0 + (-139.0/136048896.0)*x) - 7.0/11664.0) + 17.0/108.0;
-    } else {
-        const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double w0 = cos((1.0/3.0)*phi);
-        c_H_inverse_2 = (1.0/18.0)*(9*w0 + 3*cos((2.0/3.0)*phi) + 5)/((w0 + 1)*(2*w0 + 1));
-    }
+    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -370,31 +363,29 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
 }
 
 /* symrot_tangent_m3_omega: omega = H pdot (eq 20).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 0.0360887, else 2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * H_2: Horner degree 1 in x below x = 1e-14, else (1 - 2*sin(phi/6)**2)**3*(5 - 8*sin(phi/6)**2)/(27*(2 - 2*sin(phi/6)**2))
- * ops: 79 */
+ * H_1: Horner degree 13 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 96 */
 static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
     const double c_H_0 = 9/(x + 9);
-    double c_H_1, c_H_2;
-    if (x < 1.0000000000000006e-14) {
-        c_H_1 = x*(x*(x*(x*(x*((2717.0/1088391168.0)*x - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
-        c_H_2 = 5.0/54.0 + (-11.0/648.0)*x;
+    const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
+    double c_H_1;
+    if (x < 0.4871184501507491) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/6.0)*phi), 2);
-        const double w1 = 2*w0;
-        c_H_1 = x < 0.03608868100976054 ? x*(x*(x*(x*(x*((2717.0/1088391168.0)*x - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : (2.0/9.0)*pow(sin((1.0/2.0)*phi), 2)/pow(tan((1.0/3.0)*phi), 2);
-        c_H_2 = (1.0/27.0)*pow(1 - w1, 3)*(5 - 8*w0)/(2 - w1);
+        const double s = sqrt(x);
+        c_H_1 = (1 - cos(phi))/(s*s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -402,6 +393,153 @@ static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/(2*(x + 9)**(3/4)) (algebraic in x)
+ * nu: Horner degree 1 in x below x = 1e-14, else 2*sin(phi/2)/s
+ * ops: 42 */
+static inline void symrot_tangent_m3_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.149515568880993e+180)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_e_0 = -1.0/2.0*sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/pow(x + 9, 3.0/4.0);
+    double c_nu;
+    if (x < 1.0000000000000006e-14) {
+        c_nu = 1 + (-17.0/216.0)*x;
+    } else {
+        const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_nu = 2*sin((1.0/2.0)*phi)/s;
+    }
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m3__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 5 in t = phi^2 below 0.0347285, else 3*tan(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 67 */
+static inline int symrot_tangent_m3__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double phi = 2*atan2(e_norm, c0);
+    const double t = (phi*phi);
+    double sigma;
+    if (t < 0.034728524608297284) {
+        sigma = t*(t*(t*(t*((105958219.0/109709829734400.0)*t + 6354073.0/304749527040.0) + 7379.0/16796160.0) + 137.0/15552.0) + 17.0/108.0) + 2;
+    } else {
+        sigma = 3*tan((1.0/3.0)*phi)/sin((1.0/2.0)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    return 0;
+}
+
+/* symrot_tangent_m3_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_tangent_m3_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_tangent_m3__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m3_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m3_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m3__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m3__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m3__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m3__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m3_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_tangent_m3_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_tangent_m3_to_quaternion(p1, a);
+    symrot_tangent_m3_to_quaternion(p2, b);
+    return symrot_tangent_m3__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m3_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m3_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_tangent_m3_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m3__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 /* symrot_tangent_m3__phi_f: internal: phi from s = |p| (eq 11).
@@ -413,13 +551,13 @@ static inline float symrot_tangent_m3__phi_f(float s)
 }
 
 /* symrot_tangent_m3_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * phi = 3*atan(s/3) (closed inverse of p(phi))
  * ops: 21 */
 static inline float symrot_tangent_m3_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         return NAN;
     }
     float s;
@@ -435,15 +573,15 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
 }
 
 /* symrot_tangent_m3_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
- * R_2: Horner degree 3 in x below x = 0.0360887, else 2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * ops: 66 */
+ * R_1: Horner degree 0 in x below x = 1e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 12 in x below x = 1.93909, else 2*sin(phi/2)**2/s**2
+ * ops: 97 */
 static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -455,13 +593,17 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
         R[8] = NAN;
         return;
     }
-    const float c_R_1 = -(x - 27)/powf(x + 9, 3.0F/2.0F);
-    float c_R_2;
-    if (x < 0.036088683F) {
-        c_R_2 = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
+    float c_R_1, c_R_2;
+    if (x < 1e-14F) {
+        c_R_1 = 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        c_R_2 = (2.0F/9.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(tanf((1.0F/3.0F)*phi), 2);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_1 = 2*w1*cosf(w0)/s;
+        c_R_2 = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F : 2*(w1*w1)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -485,15 +627,15 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 3 in x below x = 0.0360887, else 2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * H_2: Horner degree 0 in x below x = 1e-14, else (4*cos(phi/3) + 1)*cos(phi/3)**3/(27*(cos(phi/3) + 1))
- * ops: 74 */
+ * H_1: Horner degree 12 in x below x = 1.93909, else 2*sin(phi/2)**2/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 98 */
 static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -506,16 +648,14 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
         return;
     }
     const float c_H_0 = 9/(x + 9);
-    float c_H_1, c_H_2;
-    if (x < 1e-14F) {
-        c_H_1 = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = 5.0F/54.0F;
+    const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
+    float c_H_1;
+    if (x < 1.9390924F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float w0 = (1.0F/3.0F)*phi;
-        const float w1 = cosf(w0);
-        c_H_1 = x < 0.036088683F ? x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F : (2.0F/9.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(tanf(w0), 2);
-        c_H_2 = (1.0F/27.0F)*(w1*w1*w1)*(4*w1 + 1)/(w1 + 1);
+        const float s = sqrtf(x);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -539,15 +679,15 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
 }
 
 /* symrot_tangent_m3_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1.9012e-14, else (-18*sin(phi/6)**2 - 6*sin(phi/3)**2 + 17)/(18*(2 - 2*sin(phi/6)**2)*(3 - 4*sin(phi/6)**2))
- * ops: 70 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * ops: 74 */
 static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -560,14 +700,7 @@ static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float H
         return;
     }
     const float c_H_inverse_0 = (1.0F/9.0F)*x + 1;
-    float c_H_inverse_2;
-    if (x < 1.9011963e-14F) {
-        c_H_inverse_2 = 17.0F/108.0F;
-    } else {
-        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float w0 = powf(sinf((1.0F/6.0F)*phi), 2);
-        c_H_inverse_2 = (1.0F/18.0F)*(-18*w0 - 6*powf(sinf((1.0F/3.0F)*phi), 2) + 17)/((2 - 2*w0)*(3 - 4*w0));
-    }
+    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -590,35 +723,36 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m3_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
- * det_H: Horner degree 2 in x below x = 0.00996503, else 4*(1 - 2*sin(phi/6)**2)**2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * ops: 28 */
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * det_H: Horner degree 13 in x below x = 1.93909, else 36*sin(phi/2)**2/(s**2*(x + 9))
+ * ops: 47 */
 static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         return NAN;
     }
     float c_det_H;
-    if (x < 0.00996503F) {
-        c_det_H = x*((299.0F/5832.0F)*x - 29.0F/108.0F) + 1;
+    if (x < 1.9390924F) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.1664401e-10F + (-1.4436824e-11F)*x) - 9.345603e-10F) + 7.4146143e-09F) - 5.8145545e-08F) + 4.4963303e-07F) - 3.4176435e-06F) + 2.5421212e-05F) - 0.0001838567F) + 9677.0F/7558272.0F) - 3547.0F/419904.0F) + 299.0F/5832.0F) - 29.0F/108.0F) + 1;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        c_det_H = (4.0F/9.0F)*powf(1 - 2*powf(sinf((1.0F/6.0F)*phi), 2), 2)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(tanf((1.0F/3.0F)*phi), 2);
+        const float s = sqrtf(x);
+        c_det_H = 36*powf(sinf((1.0F/2.0F)*phi), 2)/((s*s)*(x + 9));
     }
     return c_det_H;
 }
 
 /* symrot_tangent_m3_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 1.9012e-14, else sin(phi/2)/(3*tan(phi/3))
- * G_2: Horner degree 0 in x below x = 1.05314e-09, else 2*sin(phi/4)**2/(9*tan(phi/3)**2)
- * ops: 65 */
+ * G_1: Horner degree 3 in x below x = 0.131361, else sin(phi/2)/s
+ * G_2: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/s**2
+ * ops: 92 */
 static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -631,14 +765,15 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
         return;
     }
     float c_G_1, c_G_2;
-    if (x < 1.9011963e-14F) {
-        c_G_1 = 1.0F/2.0F;
-        c_G_2 = 1.0F/8.0F;
+    if (x < 0.13136065F) {
+        c_G_1 = x*(x*(79.0F/20736.0F + (-193.0F/497664.0F)*x) - 17.0F/432.0F) + 1.0F/2.0F;
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/3.0F)*phi);
-        c_G_1 = (1.0F/3.0F)*sinf((1.0F/2.0F)*phi)/w0;
-        c_G_2 = x < 1.0531368e-09F ? 1.0F/8.0F : (2.0F/9.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/(w0*w0);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_G_1 = sinf(w0)/s;
+        c_G_2 = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F : (1 - cosf(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -662,15 +797,15 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
 }
 
 /* symrot_tangent_m3_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 0 in x below x = 1.05314e-09, else 2*sin(phi/4)**2/(9*tan(phi/3)**2)
- * K_2: Horner degree 21 in x below x = 4.19813, else (3*(1 - 2*sin(phi/6)**2)**2 - 2*sin(phi/2)/tan(phi/3))/(54*tan(phi/3)**2)
- * ops: 129 */
+ * K_1: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/s**2
+ * K_2: Horner degree 21 in x below x = 4.19813, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
+ * ops: 148 */
 static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -684,15 +819,16 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
     }
     const float c_K_0 = (9.0F/2.0F)/(x + 9);
     float c_K_1, c_K_2;
-    if (x < 1.0531368e-09F) {
-        c_K_1 = 1.0F/8.0F;
+    if (x < 1.9390924F) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/3.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_K_1 = (2.0F/9.0F)*w1*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/54.0F)*w1*(3*powf(1 - 2*powf(sinf((1.0F/6.0F)*phi), 2), 2) - 2*sinf((1.0F/2.0F)*phi)/w0);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_K_1 = w0*(1 - cosf(w1));
+        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w0*(27/(x + 9) - 6*sinf(w1)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -716,29 +852,22 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
 }
 
 /* symrot_tangent_m3_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 0 in x below x = 1.9012e-14, else (-18*sin(phi/6)**2 - 6*sin(phi/3)**2 + 17)/(18*(2 - 2*sin(phi/6)**2)*(3 - 4*sin(phi/6)**2))
- * ops: 64 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * ops: 68 */
 static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
         return;
     }
     const float c_H_inverse_0 = (1.0F/9.0F)*x + 1;
-    float c_H_inverse_2;
-    if (x < 1.9011963e-14F) {
-        c_H_inverse_2 = 17.0F/108.0F;
-    } else {
-        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float w0 = powf(sinf((1.0F/6.0F)*phi), 2);
-        c_H_inverse_2 = (1.0F/18.0F)*(-18*w0 - 6*powf(sinf((1.0F/3.0F)*phi), 2) + 17)/((2 - 2*w0)*(3 - 4*w0));
-    }
+    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -748,31 +877,29 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
 }
 
 /* symrot_tangent_m3_omega_f: omega = H pdot (eq 20).
- * Valid for every finite p (|phi| < 4.7123889803846897) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 3 in x below x = 0.0360887, else 2*sin(phi/2)**2/(9*tan(phi/3)**2)
- * H_2: Horner degree 0 in x below x = 1e-14, else (4*cos(phi/3) + 1)*cos(phi/3)**3/(27*(cos(phi/3) + 1))
- * ops: 68 */
+ * H_1: Horner degree 12 in x below x = 1.93909, else 2*sin(phi/2)**2/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 92 */
 static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
     const float c_H_0 = 9/(x + 9);
-    float c_H_1, c_H_2;
-    if (x < 1e-14F) {
-        c_H_1 = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = 5.0F/54.0F;
+    const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
+    float c_H_1;
+    if (x < 1.9390924F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float w0 = (1.0F/3.0F)*phi;
-        const float w1 = cosf(w0);
-        c_H_1 = x < 0.036088683F ? x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F : (2.0F/9.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(tanf(w0), 2);
-        c_H_2 = (1.0F/27.0F)*(w1*w1*w1)*(4*w1 + 1)/(w1 + 1);
+        const float s = sqrtf(x);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -780,6 +907,153 @@ static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/(2*(x + 9)**(3/4)) (algebraic in x)
+ * nu: Horner degree 3 in x below x = 0.131361, else 2*sin(phi/2)/s
+ * ops: 42 */
+static inline void symrot_tangent_m3_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 1.2676506e+30F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_e_0 = -1.0F/2.0F*sqrtf(2)*(sqrtf(x + 9) - 6)*sqrtf(sqrtf(x + 9) + 3)/powf(x + 9, 3.0F/4.0F);
+    float c_nu;
+    if (x < 0.13136065F) {
+        c_nu = x*(x*(79.0F/10368.0F + (-193.0F/248832.0F)*x) - 17.0F/216.0F) + 1;
+    } else {
+        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        c_nu = 2*sinf((1.0F/2.0F)*phi)/s;
+    }
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m3__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 0 in t = phi^2 below 3.50952e-14, else 3*tan(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 58 */
+static inline int symrot_tangent_m3__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float phi = 2*atan2f(e_norm, c0);
+    const float t = (phi*phi);
+    float sigma;
+    if (t < 3.509516e-14F) {
+        sigma = 2;
+    } else {
+        sigma = 3*tanf((1.0F/3.0F)*phi)/sinf((1.0F/2.0F)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    return 0;
+}
+
+/* symrot_tangent_m3_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_tangent_m3_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_tangent_m3__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m3_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m3_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m3__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m3__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m3__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m3__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m3_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_tangent_m3_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_tangent_m3_to_quaternion_f(p1, a);
+    symrot_tangent_m3_to_quaternion_f(p2, b);
+    return symrot_tangent_m3__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m3_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m3_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_tangent_m3_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m3__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

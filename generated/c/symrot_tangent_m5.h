@@ -13,6 +13,11 @@
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -59,9 +64,9 @@ static inline double symrot_tangent_m5_angle(const double p[3])
 /* symrot_tangent_m5_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
- * R_2: Horner degree 1 in x below x = 6.39269e-08, else 2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * ops: 68 */
+ * R_1: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 9 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * ops: 89 */
 static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -77,13 +82,16 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
         R[8] = NAN;
         return;
     }
-    const double c_R_1 = ((x*x) - 250*x + 3125)/pow(x + 25, 5.0/2.0);
-    double c_R_2;
-    if (x < 6.392693322499042e-08) {
-        c_R_2 = 1.0/2.0 + (-11.0/200.0)*x;
+    double c_R_1, c_R_2;
+    if (x < 3.690968361342381e-14) {
+        c_R_1 = 1 + (-9.0/50.0)*x;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        c_R_2 = (2.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/pow(tan((1.0/5.0)*phi), 2);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        c_R_1 = 2*sin(w0)*cos(w0)/s;
+        c_R_2 = x < 0.41316041360625944 ? x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : (1 - cos(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -109,9 +117,9 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
 /* symrot_tangent_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 6.39269e-08, else 2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * H_2: Horner degree 14 in x below x = 1.57118, else ((1 - 2*sin(phi/10)**2)**2 - sin(phi)/(5*tan(phi/5)))/(25*tan(phi/5)**2)
- * ops: 107 */
+ * H_1: Horner degree 9 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * ops: 138 */
 static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -129,15 +137,16 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 25/(x + 25);
     double c_H_1, c_H_2;
-    if (x < 6.392693322499042e-08) {
-        c_H_1 = 1.0/2.0 + (-11.0/200.0)*x;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.56680776016e-19)*x - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
+    if (x < 0.41316041360625944) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double w0 = tan((1.0/5.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_H_1 = (2.0/25.0)*w1*pow(sin((1.0/2.0)*phi), 2);
-        c_H_2 = x < 1.5711836845444251 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.56680776016e-19)*x - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (1.0/25.0)*w1*(pow(1 - 2*pow(sin((1.0/10.0)*phi), 2), 2) - 1.0/5.0*sin(phi)/w0);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        const double w1 = (1.0/2.0)*phi;
+        c_H_1 = w0*(1 - cos(phi));
+        c_H_2 = x < 3.1374537386488224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*sin(w1)*cos(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -164,7 +173,7 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (tan(phi/5)**2 + 1 - 5*sin(phi)*tan(phi/5)/(4*sin(phi/2)**2))/(25*tan(phi/5)**2)
+ * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
  * ops: 104 */
 static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double Hinv[9])
 {
@@ -187,9 +196,10 @@ static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double H
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double w0 = tan((1.0/5.0)*phi);
-        const double w1 = (w0*w0);
-        c_H_inverse_2 = (1.0/25.0)*(-5.0/4.0*w0*sin(phi)/pow(sin((1.0/2.0)*phi), 2) + w1 + 1)/w1;
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (-1.0/2.0*s*cos(w1)/sin(w1) + (1.0/25.0)*w0 + 1)/w0;
     }
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -214,8 +224,8 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
 
 /* symrot_tangent_m5_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 6 in x below x = 0.0300217, else 4*(1 - 2*sin(phi/10)**2)**2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * ops: 28 */
+ * det_H: Horner degree 15 in x below x = 1.57118, else 100*sin(phi/2)**2/(s**2*(x + 25))
+ * ops: 53 */
 static inline double symrot_tangent_m5_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -223,11 +233,12 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 0.030021652939650968) {
-        c_det_H = x*(x*(x*(x*(x*((1517899.0/6250000000000.0)*x - 530507.0/125000000000.0) + 87293.0/1250000000.0) - 5279.0/5000000.0) + 351.0/25000.0) - 3.0/20.0) + 1;
+    if (x < 1.5711836845444251) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(9.778632622432e-18 + (-4.5732425583628e-19)*x) - 2.069196198448e-16) + 4.32659709712e-15) - 8.9230635128e-14) + 1.8109456592e-12) - 3.606187528e-11) + 7.01918024e-10) - 33216019.0/2500000000000000.0) + 1517899.0/6250000000000.0) - 530507.0/125000000000.0) + 87293.0/1250000000.0) - 5279.0/5000000.0) + 351.0/25000.0) - 3.0/20.0) + 1;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        c_det_H = (4.0/25.0)*pow(1 - 2*pow(sin((1.0/10.0)*phi), 2), 2)*pow(sin((1.0/2.0)*phi), 2)/pow(tan((1.0/5.0)*phi), 2);
+        const double s = sqrt(x);
+        c_det_H = 100*pow(sin((1.0/2.0)*phi), 2)/((s*s)*(x + 25));
     }
     return c_det_H;
 }
@@ -235,9 +246,9 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
 /* symrot_tangent_m5_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 3.69097e-14, else sin(phi/2)/(5*tan(phi/5))
- * G_2: Horner degree 2 in x below x = 2.35952e-07, else 2*sin(phi/4)**2/(25*tan(phi/5)**2)
- * ops: 65 */
+ * G_1: Horner degree 1 in x below x = 3.69097e-14, else sin(phi/2)/s
+ * G_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/4)**2/s**2
+ * ops: 80 */
 static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -256,12 +267,12 @@ static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
     double c_G_1, c_G_2;
     if (x < 3.690968361342381e-14) {
         c_G_1 = 1.0/2.0 + (-11.0/400.0)*x;
-        c_G_2 = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double w0 = tan((1.0/5.0)*phi);
-        c_G_1 = (1.0/5.0)*sin((1.0/2.0)*phi)/w0;
-        c_G_2 = x < 2.3595228905348048e-07 ? x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0 : (2.0/25.0)*pow(sin((1.0/4.0)*phi), 2)/(w0*w0);
+        const double s = sqrt(x);
+        c_G_1 = sin((1.0/2.0)*phi)/s;
+        c_G_2 = x < 0.1110480704185358 ? x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -287,9 +298,9 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
 /* symrot_tangent_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 2 in x below x = 2.35952e-07, else 2*sin(phi/4)**2/(25*tan(phi/5)**2)
- * K_2: Horner degree 18 in x below x = 3.13745, else (5*(1 - 2*sin(phi/10)**2)**2 - 2*sin(phi/2)/tan(phi/5))/(250*tan(phi/5)**2)
- * ops: 120 */
+ * K_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/4)**2/s**2
+ * K_2: Horner degree 18 in x below x = 3.13745, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
+ * ops: 127 */
 static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -307,15 +318,15 @@ static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (25.0/2.0)/(x + 25);
     double c_K_1, c_K_2;
-    if (x < 2.3595228905348048e-07) {
-        c_K_1 = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
+    if (x < 0.1110480704185358) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double w0 = tan((1.0/5.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_K_1 = (2.0/25.0)*w1*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 3.1374537386488224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0 : (1.0/250.0)*w1*(5*pow(1 - 2*pow(sin((1.0/10.0)*phi), 2), 2) - 2*sin((1.0/2.0)*phi)/w0);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 3.1374537386488224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0 : (1.0/10.0)*w0*(125/(x + 25) - 10*sin((1.0/2.0)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -342,7 +353,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (tan(phi/5)**2 + 1 - 5*sin(phi)*tan(phi/5)/(4*sin(phi/2)**2))/(25*tan(phi/5)**2)
+ * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
  * ops: 98 */
 static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[3], double pdot[3])
 {
@@ -359,9 +370,10 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double w0 = tan((1.0/5.0)*phi);
-        const double w1 = (w0*w0);
-        c_H_inverse_2 = (1.0/25.0)*(-5.0/4.0*w0*sin(phi)/pow(sin((1.0/2.0)*phi), 2) + w1 + 1)/w1;
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (-1.0/2.0*s*cos(w1)/sin(w1) + (1.0/25.0)*w0 + 1)/w0;
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -374,9 +386,9 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
 /* symrot_tangent_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 1 in x below x = 6.39269e-08, else 2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * H_2: Horner degree 14 in x below x = 1.57118, else ((1 - 2*sin(phi/10)**2)**2 - sin(phi)/(5*tan(phi/5)))/(25*tan(phi/5)**2)
- * ops: 101 */
+ * H_1: Horner degree 9 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * ops: 132 */
 static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -388,15 +400,16 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
     }
     const double c_H_0 = 25/(x + 25);
     double c_H_1, c_H_2;
-    if (x < 6.392693322499042e-08) {
-        c_H_1 = 1.0/2.0 + (-11.0/200.0)*x;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.56680776016e-19)*x - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
+    if (x < 0.41316041360625944) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double w0 = tan((1.0/5.0)*phi);
-        const double w1 = 1.0/(w0*w0);
-        c_H_1 = (2.0/25.0)*w1*pow(sin((1.0/2.0)*phi), 2);
-        c_H_2 = x < 1.5711836845444251 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.56680776016e-19)*x - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (1.0/25.0)*w1*(pow(1 - 2*pow(sin((1.0/10.0)*phi), 2), 2) - 1.0/5.0*sin(phi)/w0);
+        const double s = sqrt(x);
+        const double w0 = 1.0/(s*s);
+        const double w1 = (1.0/2.0)*phi;
+        c_H_1 = w0*(1 - cos(phi));
+        c_H_2 = x < 3.1374537386488224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*sin(w1)*cos(w1)/s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -404,6 +417,159 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m5_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(2)*sqrt(sqrt(x + 25) + 5)*(x + 10*sqrt(x + 25) - 75)/(2*(x + 25)**(5/4)) (algebraic in x)
+ * nu: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
+ * ops: 44 */
+static inline void symrot_tangent_m5_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.80339887498945)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_e_0 = -1.0/2.0*sqrt(2)*sqrt(sqrt(x + 25) + 5)*(x + 10*sqrt(x + 25) - 75)/pow(x + 25, 5.0/4.0);
+    double c_nu;
+    if (x < 3.690968361342381e-14) {
+        c_nu = 1 + (-11.0/200.0)*x;
+    } else {
+        const double phi = symrot_tangent_m5__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_nu = 2*sin((1.0/2.0)*phi)/s;
+    }
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m5__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 7 in t = phi^2 below 0.228327, else 5*tan(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 74 */
+static inline int symrot_tangent_m5__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double phi = 2*atan2(e_norm, c0);
+    const double t = (phi*phi);
+    double sigma;
+    if (t < 0.22832695303370756) {
+        sigma = t*(t*(t*(t*(t*(t*((6.28986084965754e-11)*t + 2.424361005796223e-09) + 9.208975986552029e-08) + 6880849.0/2016000000000.0) + 43619.0/360000000.0) + 2381.0/600000.0) + 11.0/100.0) + 2;
+    } else {
+        sigma = 5*tan((1.0/5.0)*phi)/sin((1.0/2.0)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 236.80339887498945)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_tangent_m5_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_tangent_m5_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_tangent_m5__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m5_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m5_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m5__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m5__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m5__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m5__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m5_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_tangent_m5_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_tangent_m5_to_quaternion(p1, a);
+    symrot_tangent_m5_to_quaternion(p2, b);
+    return symrot_tangent_m5__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m5_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m5_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_tangent_m5_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m5__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 /* symrot_tangent_m5__phi_f: internal: phi from s = |p| (eq 11).
@@ -439,9 +605,9 @@ static inline float symrot_tangent_m5_angle_f(const float p[3])
 /* symrot_tangent_m5_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 0.00423083, else 2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * ops: 68 */
+ * R_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi)/s
+ * R_2: Horner degree 4 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * ops: 69 */
 static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -457,13 +623,15 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
         R[8] = NAN;
         return;
     }
-    const float c_R_1 = ((x*x) - 250*x + 3125)/powf(x + 25, 5.0F/2.0F);
-    float c_R_2;
-    if (x < 0.00423083F) {
-        c_R_2 = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
+    float c_R_1, c_R_2;
+    if (x < 3.6909684e-14F) {
+        c_R_1 = 1;
+        c_R_2 = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        c_R_2 = (2.0F/25.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(tanf((1.0F/5.0F)*phi), 2);
+        const float s = sqrtf(x);
+        c_R_1 = sinf(phi)/s;
+        c_R_2 = x < 0.41316044F ? x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F : (1 - cosf(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -489,9 +657,9 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 2 in x below x = 0.00423083, else 2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * H_2: Horner degree 7 in x below x = 1.57118, else ((1 - 2*sin(phi/10)**2)**2 - sin(phi)/(5*tan(phi/5)))/(25*tan(phi/5)**2)
- * ops: 87 */
+ * H_1: Horner degree 4 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * ops: 109 */
 static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -509,15 +677,16 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
     }
     const float c_H_0 = 25/(x + 25);
     float c_H_1, c_H_2;
-    if (x < 0.00423083F) {
-        c_H_1 = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(7.942544e-09F + (-3.846086e-10F)*x) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+    if (x < 0.41316044F) {
+        c_H_1 = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/5.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_H_1 = (2.0F/25.0F)*w1*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_H_2 = x < 1.5711837F ? x*(x*(x*(x*(x*(x*(7.942544e-09F + (-3.846086e-10F)*x) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : (1.0F/25.0F)*w1*(powf(1 - 2*powf(sinf((1.0F/10.0F)*phi), 2), 2) - 1.0F/5.0F*sinf(phi)/w0);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_H_1 = w0*(1 - cosf(phi));
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -544,7 +713,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 3 in x below x = 0.801859, else (tan(phi/5)**2 + 1 - 5*sin(phi)*tan(phi/5)/(4*sin(phi/2)**2))/(25*tan(phi/5)**2)
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
  * ops: 68 */
 static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float Hinv[9])
 {
@@ -563,13 +732,14 @@ static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float H
     }
     const float c_H_inverse_0 = (1.0F/25.0F)*x + 1;
     float c_H_inverse_2;
-    if (x < 0.80185854F) {
-        c_H_inverse_2 = x*(x*((1.16e-08F)*x + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
+    if (x < 6.5117908F) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/5.0F)*phi);
-        const float w1 = (w0*w0);
-        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/4.0F*w0*sinf(phi)/powf(sinf((1.0F/2.0F)*phi), 2) + w1 + 1)/w1;
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w1)/sinf(w1) + (1.0F/25.0F)*w0 + 1)/w0;
     }
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -594,8 +764,8 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
 
 /* symrot_tangent_m5_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 2 in x below x = 0.00423083, else 4*(1 - 2*sin(phi/10)**2)**2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * ops: 28 */
+ * det_H: Horner degree 6 in x below x = 0.801859, else 100*sin(phi/2)**2/(s**2*(x + 25))
+ * ops: 25 */
 static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -603,11 +773,12 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 0.00423083F) {
-        c_det_H = x*((351.0F/25000.0F)*x - 3.0F/20.0F) + 1;
+    if (x < 0.80185854F) {
+        c_det_H = x*(x*(x*(x*(x*((2.4286385e-07F)*x - 4.244056e-06F) + 6.98344e-05F) - 5279.0F/5000000.0F) + 351.0F/25000.0F) - 3.0F/20.0F) + 1;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        c_det_H = (4.0F/25.0F)*powf(1 - 2*powf(sinf((1.0F/10.0F)*phi), 2), 2)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(tanf((1.0F/5.0F)*phi), 2);
+        const float s = sqrtf(x);
+        c_det_H = 100*powf(sinf((1.0F/2.0F)*phi), 2)/((s*s)*(x + 25));
     }
     return c_det_H;
 }
@@ -615,9 +786,9 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
 /* symrot_tangent_m5_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi/2)/(5*tan(phi/5))
- * G_2: Horner degree 8 in x below x = 3.13745, else 2*sin(phi/4)**2/(25*tan(phi/5)**2)
- * ops: 83 */
+ * G_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi/2)/s
+ * G_2: Horner degree 8 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
+ * ops: 82 */
 static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -639,9 +810,10 @@ static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
         c_G_2 = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/5.0F)*phi);
-        c_G_1 = (1.0F/5.0F)*sinf((1.0F/2.0F)*phi)/w0;
-        c_G_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F : (2.0F/25.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/(w0*w0);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_G_1 = sinf(w0)/s;
+        c_G_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F : (1 - cosf(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -667,9 +839,9 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
 /* symrot_tangent_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 8 in x below x = 3.13745, else 2*sin(phi/4)**2/(25*tan(phi/5)**2)
- * K_2: Horner degree 8 in x below x = 3.13745, else (5*(1 - 2*sin(phi/10)**2)**2 - 2*sin(phi/2)/tan(phi/5))/(250*tan(phi/5)**2)
- * ops: 99 */
+ * K_1: Horner degree 8 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
+ * K_2: Horner degree 14 in x below x = 6.51179, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
+ * ops: 117 */
 static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -689,13 +861,14 @@ static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9]
     float c_K_1, c_K_2;
     if (x < 3.1374536F) {
         c_K_1 = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*((1.5613167e-13F)*x - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/5.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_K_1 = (2.0F/25.0F)*w1*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = (1.0F/250.0F)*w1*(5*powf(1 - 2*powf(sinf((1.0F/10.0F)*phi), 2), 2) - 2*sinf((1.0F/2.0F)*phi)/w0);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_K_1 = w0*(1 - cosf(w1));
+        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*w0*(125/(x + 25) - 10*sinf(w1)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -722,7 +895,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 3 in x below x = 0.801859, else (tan(phi/5)**2 + 1 - 5*sin(phi)*tan(phi/5)/(4*sin(phi/2)**2))/(25*tan(phi/5)**2)
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
  * ops: 62 */
 static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
@@ -735,13 +908,14 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
     }
     const float c_H_inverse_0 = (1.0F/25.0F)*x + 1;
     float c_H_inverse_2;
-    if (x < 0.80185854F) {
-        c_H_inverse_2 = x*(x*((1.16e-08F)*x + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
+    if (x < 6.5117908F) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/5.0F)*phi);
-        const float w1 = (w0*w0);
-        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/4.0F*w0*sinf(phi)/powf(sinf((1.0F/2.0F)*phi), 2) + w1 + 1)/w1;
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w1)/sinf(w1) + (1.0F/25.0F)*w0 + 1)/w0;
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -754,9 +928,9 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 2 in x below x = 0.00423083, else 2*sin(phi/2)**2/(25*tan(phi/5)**2)
- * H_2: Horner degree 7 in x below x = 1.57118, else ((1 - 2*sin(phi/10)**2)**2 - sin(phi)/(5*tan(phi/5)))/(25*tan(phi/5)**2)
- * ops: 81 */
+ * H_1: Horner degree 4 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * ops: 103 */
 static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -768,15 +942,16 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
     }
     const float c_H_0 = 25/(x + 25);
     float c_H_1, c_H_2;
-    if (x < 0.00423083F) {
-        c_H_1 = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(7.942544e-09F + (-3.846086e-10F)*x) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+    if (x < 0.41316044F) {
+        c_H_1 = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float w0 = tanf((1.0F/5.0F)*phi);
-        const float w1 = 1.0F/(w0*w0);
-        c_H_1 = (2.0F/25.0F)*w1*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_H_2 = x < 1.5711837F ? x*(x*(x*(x*(x*(x*(7.942544e-09F + (-3.846086e-10F)*x) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : (1.0F/25.0F)*w1*(powf(1 - 2*powf(sinf((1.0F/10.0F)*phi), 2), 2) - 1.0F/5.0F*sinf(phi)/w0);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/(s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_H_1 = w0*(1 - cosf(phi));
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -784,6 +959,159 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m5_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -sqrt(2)*sqrt(sqrt(x + 25) + 5)*(x + 10*sqrt(x + 25) - 75)/(2*(x + 25)**(5/4)) (algebraic in x)
+ * nu: Horner degree 0 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
+ * ops: 44 */
+static inline void symrot_tangent_m5_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.8034F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_e_0 = -1.0F/2.0F*sqrtf(2)*sqrtf(sqrtf(x + 25) + 5)*(x + 10*sqrtf(x + 25) - 75)/powf(x + 25, 5.0F/4.0F);
+    float c_nu;
+    if (x < 3.6909684e-14F) {
+        c_nu = 1;
+    } else {
+        const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        c_nu = 2*sinf((1.0F/2.0F)*phi)/s;
+    }
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m5__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 3 in t = phi^2 below 0.228327, else 5*tan(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 62 */
+static inline int symrot_tangent_m5__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float phi = 2*atan2f(e_norm, c0);
+    const float t = (phi*phi);
+    float sigma;
+    if (t < 0.22832695F) {
+        sigma = t*(t*((0.00012116389F)*t + 2381.0F/600000.0F) + 11.0F/100.0F) + 2;
+    } else {
+        sigma = 5*tanf((1.0F/5.0F)*phi)/sinf((1.0F/2.0F)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 236.8034F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_tangent_m5_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_tangent_m5_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_tangent_m5__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m5_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m5_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m5__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m5__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m5__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m5__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m5_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_tangent_m5_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_tangent_m5_to_quaternion_f(p1, a);
+    symrot_tangent_m5_to_quaternion_f(p2, b);
+    return symrot_tangent_m5__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m5_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m5_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_tangent_m5_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m5__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

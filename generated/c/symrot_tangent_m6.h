@@ -13,6 +13,11 @@
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
  *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -59,9 +64,9 @@ static inline double symrot_tangent_m6_angle(const double p[3])
 /* symrot_tangent_m6_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
- * R_2 = 2*(x - 108)**2/(x + 36)**3 (algebraic in x)
- * ops: 58 */
+ * R_1: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 8 in x below x = 0.213555, else 2*sin(phi/2)**2/s**2
+ * ops: 85 */
 static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -77,8 +82,18 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
         R[8] = NAN;
         return;
     }
-    const double c_R_1 = 36*(x - 108)*(x - 12)/pow(x + 36, 3);
-    const double c_R_2 = 2*pow(x - 108, 2)/pow(x + 36, 3);
+    double c_R_1, c_R_2;
+    if (x < 3.69096836134238e-14) {
+        c_R_1 = 1 + (-19.0/108.0)*x;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
+    } else {
+        const double phi = symrot_tangent_m6__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        c_R_1 = 2*w1*cos(w0)/s;
+        c_R_2 = x < 0.21355546857295157 ? x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0 : 2*(w1*w1)/(s*s);
+    }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -103,9 +118,9 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
 /* symrot_tangent_m6_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1 = 2*(x - 108)**2/(x + 36)**3 (algebraic in x)
+ * H_1: Horner degree 8 in x below x = 0.213555, else 2*sin(phi/2)**2/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 56 */
+ * ops: 76 */
 static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -122,8 +137,15 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
         return;
     }
     const double c_H_0 = 36/(x + 36);
-    const double c_H_1 = 2*pow(x - 108, 2)/pow(x + 36, 3);
     const double c_H_2 = 6912/pow(x + 36, 3);
+    double c_H_1;
+    if (x < 0.21355546857295157) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
+    } else {
+        const double phi = symrot_tangent_m6__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+    }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -206,9 +228,9 @@ static inline double symrot_tangent_m6_tangent_det(const double p[3])
 /* symrot_tangent_m6_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1 = -(x - 108)/(x + 36)**(3/2) (algebraic in x)
- * G_2: Horner degree 3 in x below x = 0.00220203, else sin(phi/4)**2/(18*tan(phi/6)**2)
- * ops: 65 */
+ * G_1: Horner degree 1 in x below x = 3.69097e-14, else sin(phi/2)/s
+ * G_2: Horner degree 12 in x below x = 1.55153, else (1 - cos(phi/2))/s**2
+ * ops: 94 */
 static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -224,13 +246,16 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
         G[8] = NAN;
         return;
     }
-    const double c_G_1 = -(x - 108)/pow(x + 36, 3.0/2.0);
-    double c_G_2;
-    if (x < 0.002202034702797594) {
-        c_G_2 = x*(x*(125.0/746496.0 + (-385.0/71663616.0)*x) - 17.0/3456.0) + 1.0/8.0;
+    double c_G_1, c_G_2;
+    if (x < 3.69096836134238e-14) {
+        c_G_1 = 1.0/2.0 + (-11.0/432.0)*x;
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        c_G_2 = (1.0/18.0)*pow(sin((1.0/4.0)*phi), 2)/pow(tan((1.0/6.0)*phi), 2);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        c_G_1 = sin(w0)/s;
+        c_G_2 = x < 1.5515262672070247 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0 : (1 - cos(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -256,9 +281,9 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
 /* symrot_tangent_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 18/(x + 36) (algebraic in x)
- * K_1: Horner degree 3 in x below x = 0.00220203, else sin(phi/4)**2/(18*tan(phi/6)**2)
- * K_2: Horner degree 1 in x below x = 7.09105e-14, else (1 - 2*sin(phi/12)**2)**3*(5 - 8*sin(phi/12)**2)/(216*(2 - 2*sin(phi/12)**2))
- * ops: 77 */
+ * K_1: Horner degree 12 in x below x = 1.55153, else (1 - cos(phi/2))/s**2
+ * K_2 = (sqrt(x + 36) + 24)/((x + 36)**(3/2)*(sqrt(x + 36) + 6)) (algebraic in x)
+ * ops: 98 */
 static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -275,16 +300,14 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
         return;
     }
     const double c_K_0 = 18/(x + 36);
-    double c_K_1, c_K_2;
-    if (x < 7.091048955981849e-14) {
-        c_K_1 = x*(x*(125.0/746496.0 + (-385.0/71663616.0)*x) - 17.0/3456.0) + 1.0/8.0;
-        c_K_2 = 5.0/432.0 + (-11.0/20736.0)*x;
+    const double c_K_2 = (sqrt(x + 36) + 24)/(pow(x + 36, 3.0/2.0)*(sqrt(x + 36) + 6));
+    double c_K_1;
+    if (x < 1.5515262672070247) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/12.0)*phi), 2);
-        const double w1 = 2*w0;
-        c_K_1 = x < 0.002202034702797594 ? x*(x*(125.0/746496.0 + (-385.0/71663616.0)*x) - 17.0/3456.0) + 1.0/8.0 : (1.0/18.0)*pow(sin((1.0/4.0)*phi), 2)/pow(tan((1.0/6.0)*phi), 2);
-        c_K_2 = (1.0/216.0)*pow(1 - w1, 3)*(5 - 8*w0)/(2 - w1);
+        const double s = sqrt(x);
+        c_K_1 = (1 - cos((1.0/2.0)*phi))/(s*s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -335,9 +358,9 @@ static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[
 /* symrot_tangent_m6_omega: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1 = 2*(x - 108)**2/(x + 36)**3 (algebraic in x)
+ * H_1: Horner degree 8 in x below x = 0.213555, else 2*sin(phi/2)**2/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 50 */
+ * ops: 70 */
 static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -348,14 +371,174 @@ static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[
         return;
     }
     const double c_H_0 = 36/(x + 36);
-    const double c_H_1 = 2*pow(x - 108, 2)/pow(x + 36, 3);
     const double c_H_2 = 6912/pow(x + 36, 3);
+    double c_H_1;
+    if (x < 0.21355546857295157) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
+    } else {
+        const double phi = symrot_tangent_m6__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+    }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m6_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -18*(x - 12)/(x + 36)**(3/2) (algebraic in x)
+ * nu: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
+ * ops: 29 */
+static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 108.0)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_e_0 = -18*(x - 12)/pow(x + 36, 3.0/2.0);
+    double c_nu;
+    if (x < 3.69096836134238e-14) {
+        c_nu = 1 + (-11.0/216.0)*x;
+    } else {
+        const double phi = symrot_tangent_m6__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_nu = 2*sin((1.0/2.0)*phi)/s;
+    }
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m6__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 2 in t = phi^2 below 2.82704e-06, else 6*tan(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
+static inline int symrot_tangent_m6__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double phi = 2*atan2(e_norm, c0);
+    const double t = (phi*phi);
+    double sigma;
+    if (t < 2.8270409165227273e-06) {
+        sigma = t*((53.0/15552.0)*t + 11.0/108.0) + 2;
+    } else {
+        sigma = 6*tan((1.0/6.0)*phi)/sin((1.0/2.0)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 108.0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_tangent_m6_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_tangent_m6_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_tangent_m6__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m6_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m6_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m6__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m6__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m6__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m6__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m6_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_tangent_m6_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_tangent_m6_to_quaternion(p1, a);
+    symrot_tangent_m6_to_quaternion(p2, b);
+    return symrot_tangent_m6__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m6_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m6_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_tangent_m6_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m6__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 /* symrot_tangent_m6__phi_f: internal: phi from s = |p| (eq 11).
@@ -391,9 +574,9 @@ static inline float symrot_tangent_m6_angle_f(const float p[3])
 /* symrot_tangent_m6_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
- * R_2 = 2*(x - 108)**2/(x + 36)**3 (algebraic in x)
- * ops: 58 */
+ * R_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi)/s
+ * R_2: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
+ * ops: 93 */
 static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -409,8 +592,16 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
         R[8] = NAN;
         return;
     }
-    const float c_R_1 = 36*(x - 108)*(x - 12)/powf(x + 36, 3);
-    const float c_R_2 = 2*powf(x - 108, 2)/powf(x + 36, 3);
+    float c_R_1, c_R_2;
+    if (x < 3.6909684e-14F) {
+        c_R_1 = 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+    } else {
+        const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        c_R_1 = sinf(phi)/s;
+        c_R_2 = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F : 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+    }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
@@ -435,9 +626,9 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m6_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1 = 2*(x - 108)**2/(x + 36)**3 (algebraic in x)
+ * H_1: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 56 */
+ * ops: 88 */
 static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -454,8 +645,15 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
         return;
     }
     const float c_H_0 = 36/(x + 36);
-    const float c_H_1 = 2*powf(x - 108, 2)/powf(x + 36, 3);
     const float c_H_2 = 6912/powf(x + 36, 3);
+    float c_H_1;
+    if (x < 6.1960254F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+    } else {
+        const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+    }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -538,9 +736,9 @@ static inline float symrot_tangent_m6_tangent_det_f(const float p[3])
 /* symrot_tangent_m6_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1 = -(x - 108)/(x + 36)**(3/2) (algebraic in x)
- * G_2: Horner degree 3 in x below x = 0.213555, else sin(phi/4)**2/(18*tan(phi/6)**2)
- * ops: 65 */
+ * G_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi/2)/s
+ * G_2: Horner degree 10 in x below x = 6.19603, else (1 - cos(phi/2))/s**2
+ * ops: 88 */
 static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -556,13 +754,16 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
         G[8] = NAN;
         return;
     }
-    const float c_G_1 = -(x - 108)/powf(x + 36, 3.0F/2.0F);
-    float c_G_2;
-    if (x < 0.21355546F) {
-        c_G_2 = x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F;
+    float c_G_1, c_G_2;
+    if (x < 3.6909684e-14F) {
+        c_G_1 = 1.0F/2.0F;
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1372548e-16F)*x - 3.9035403e-15F) + 1.3331388e-13F) - 4.5247226e-12F) + 1.5236482e-10F) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        c_G_2 = (1.0F/18.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/powf(tanf((1.0F/6.0F)*phi), 2);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_G_1 = sinf(w0)/s;
+        c_G_2 = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1372548e-16F)*x - 3.9035403e-15F) + 1.3331388e-13F) - 4.5247226e-12F) + 1.5236482e-10F) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F : (1 - cosf(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -588,9 +789,9 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
 /* symrot_tangent_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 18/(x + 36) (algebraic in x)
- * K_1: Horner degree 3 in x below x = 0.213555, else sin(phi/4)**2/(18*tan(phi/6)**2)
- * K_2: Horner degree 0 in x below x = 7.09105e-14, else (1 - 2*sin(phi/12)**2)**3*(5 - 8*sin(phi/12)**2)/(216*(2 - 2*sin(phi/12)**2))
- * ops: 77 */
+ * K_1: Horner degree 10 in x below x = 6.19603, else (1 - cos(phi/2))/s**2
+ * K_2 = (sqrt(x + 36) + 24)/((x + 36)**(3/2)*(sqrt(x + 36) + 6)) (algebraic in x)
+ * ops: 92 */
 static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -607,16 +808,14 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
         return;
     }
     const float c_K_0 = 18/(x + 36);
-    float c_K_1, c_K_2;
-    if (x < 7.0910495e-14F) {
-        c_K_1 = x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F;
-        c_K_2 = 5.0F/432.0F;
+    const float c_K_2 = (sqrtf(x + 36) + 24)/(powf(x + 36, 3.0F/2.0F)*(sqrtf(x + 36) + 6));
+    float c_K_1;
+    if (x < 6.1960254F) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1372548e-16F)*x - 3.9035403e-15F) + 1.3331388e-13F) - 4.5247226e-12F) + 1.5236482e-10F) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        const float w0 = powf(sinf((1.0F/12.0F)*phi), 2);
-        const float w1 = 2*w0;
-        c_K_1 = x < 0.21355546F ? x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F : (1.0F/18.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/powf(tanf((1.0F/6.0F)*phi), 2);
-        c_K_2 = (1.0F/216.0F)*powf(1 - w1, 3)*(5 - 8*w0)/(2 - w1);
+        const float s = sqrtf(x);
+        c_K_1 = (1 - cosf((1.0F/2.0F)*phi))/(s*s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -667,9 +866,9 @@ static inline void symrot_tangent_m6_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m6_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1 = 2*(x - 108)**2/(x + 36)**3 (algebraic in x)
+ * H_1: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 50 */
+ * ops: 82 */
 static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -680,14 +879,174 @@ static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[
         return;
     }
     const float c_H_0 = 36/(x + 36);
-    const float c_H_1 = 2*powf(x - 108, 2)/powf(x + 36, 3);
     const float c_H_2 = 6912/powf(x + 36, 3);
+    float c_H_1;
+    if (x < 6.1960254F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+    } else {
+        const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+    }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_tangent_m6_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * e_0 = -18*(x - 12)/(x + 36)**(3/2) (algebraic in x)
+ * nu: Horner degree 0 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
+ * ops: 29 */
+static inline void symrot_tangent_m6_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 108.0F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_e_0 = -18*(x - 12)/powf(x + 36, 3.0F/2.0F);
+    float c_nu;
+    if (x < 3.6909684e-14F) {
+        c_nu = 1;
+    } else {
+        const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        c_nu = 2*sinf((1.0F/2.0F)*phi)/s;
+    }
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_tangent_m6__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma: Horner degree 0 in t = phi^2 below 6.57462e-14, else 6*tan(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
+static inline int symrot_tangent_m6__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float phi = 2*atan2f(e_norm, c0);
+    const float t = (phi*phi);
+    float sigma;
+    if (t < 6.5746237e-14F) {
+        sigma = 2;
+    } else {
+        sigma = 6*tanf((1.0F/6.0F)*phi)/sinf((1.0F/2.0F)*phi);
+    }
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 108.0F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    return 0;
+}
+
+/* symrot_tangent_m6_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_tangent_m6_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_tangent_m6__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_tangent_m6_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_tangent_m6_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_tangent_m6__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_tangent_m6__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_tangent_m6__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_tangent_m6__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_tangent_m6_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_tangent_m6_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_tangent_m6_to_quaternion_f(p1, a);
+    symrot_tangent_m6_to_quaternion_f(p2, b);
+    return symrot_tangent_m6__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_tangent_m6_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_tangent_m6_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_tangent_m6_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_tangent_m6__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

@@ -10,8 +10,13 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * Never a silently wrong value: NaN in every output instead.
+ *
+ * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
+ * (R(p3) = R(p2) R(p1): p1 applied first) and rescale (|phi| <= pi) work through Euler-Rodrigues
+ * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
+ * the output is NaN (input out of range or not finite, or rotation not representable).
  *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
@@ -35,13 +40,13 @@ static inline double symrot_wiener_milenkovic__phi(double s)
 }
 
 /* symrot_wiener_milenkovic_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * phi = 4*atan(s/4) (closed inverse of p(phi))
  * ops: 21 */
 static inline double symrot_wiener_milenkovic_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         return NAN;
     }
     double s;
@@ -57,15 +62,15 @@ static inline double symrot_wiener_milenkovic_angle(const double p[3])
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -16*(sqrt(x) - 4)*(sqrt(x) + 4)/(x + 16)**2 (algebraic in x)
+ * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * R_2 = 128/(x + 16)**2 (algebraic in x)
- * ops: 60 */
+ * ops: 54 */
 static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -77,7 +82,7 @@ static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], d
         R[8] = NAN;
         return;
     }
-    const double c_R_1 = -16*(sqrt(x) - 4)*(sqrt(x) + 4)/pow(x + 16, 2);
+    const double c_R_1 = -16*(x - 16)/pow(x + 16, 2);
     const double c_R_2 = 128/pow(x + 16, 2);
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -101,7 +106,7 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
 }
 
 /* symrot_wiener_milenkovic_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -109,7 +114,7 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
 static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -146,7 +151,7 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -154,7 +159,7 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
 static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -189,13 +194,13 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, cons
 }
 
 /* symrot_wiener_milenkovic_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * det_H = 4096/(x + 16)**3 (algebraic in x)
  * ops: 9 */
 static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         return NAN;
     }
     const double c_det_H = 4096/pow(x + 16, 3);
@@ -203,7 +208,7 @@ static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
 }
 
 /* symrot_wiener_milenkovic_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = 8/(x + 16) (algebraic in x)
  * G_2 = 2/(x + 16) (algebraic in x)
@@ -211,7 +216,7 @@ static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
 static inline void symrot_wiener_milenkovic_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -247,7 +252,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
 }
 
 /* symrot_wiener_milenkovic_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 8/(x + 16) (algebraic in x)
  * K_1 = 2/(x + 16) (algebraic in x)
  * K_2 = 0 (constant)
@@ -255,7 +260,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
 static inline void symrot_wiener_milenkovic_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -291,7 +296,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
 }
 
 /* symrot_wiener_milenkovic_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -299,7 +304,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
 static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -315,7 +320,7 @@ static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double
 }
 
 /* symrot_wiener_milenkovic_omega: omega = H pdot (eq 20).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -323,7 +328,7 @@ static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double
 static inline void symrot_wiener_milenkovic_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 1.7976931348623157e+308)) {
+    if (!(x < 4.149515568880993e+180)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -340,6 +345,139 @@ static inline void symrot_wiener_milenkovic_omega(const double p[3], const doubl
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
 }
 
+/* symrot_wiener_milenkovic_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * e_0 = -(x - 16)/(x + 16) (algebraic in x)
+ * nu = 16/(x + 16) (algebraic in x)
+ * ops: 16 */
+static inline void symrot_wiener_milenkovic_to_quaternion(const double p[3], double e[4])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.149515568880993e+180)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const double c_e_0 = -(x - 16)/(x + 16);
+    const double c_nu = 16/(x + 16);
+    const double half_nu = (1.0/2.0)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_wiener_milenkovic__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 4/(e0 + 1) (trig-free in e0)
+ * ops: 50 */
+static inline int symrot_wiener_milenkovic__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
+    const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
+    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+        int k;
+        (void)frexp(big, &k);
+        e0 = ldexp(e0, -k);
+        e1 = ldexp(e1, -k);
+        e2 = ldexp(e2, -k);
+        e3 = ldexp(e3, -k);
+    }
+    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
+    const double y = (e1*e1) + (e2*e2) + (e3*e3);
+    double e_norm;
+    if (y < 2.409919865102884e-181 && m > 0) {
+        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrt(y);
+    }
+    const double n = hypot(e0, e_norm);
+    if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const double f = (e0 < 0 ? -1 : 1) / n;
+    const double c0 = fabs(e0)/n;
+    e_norm = e_norm / n;
+    const double sigma = 4/(c0 + 1);
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    return 0;
+}
+
+/* symrot_wiener_milenkovic_from_quaternion: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_wiener_milenkovic_from_quaternion(const double e[4], double p[3])
+{
+    return symrot_wiener_milenkovic__from_quaternion(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_wiener_milenkovic_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_wiener_milenkovic_from_rotation_matrix(const double R[9], double p[3])
+{
+    const double tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_wiener_milenkovic__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_wiener_milenkovic__from_quaternion(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_wiener_milenkovic__from_quaternion(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_wiener_milenkovic__from_quaternion(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_wiener_milenkovic_compose: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_wiener_milenkovic_compose(const double p1[3], const double p2[3], double p3[3])
+{
+    double a[4], b[4];
+    symrot_wiener_milenkovic_to_quaternion(p1, a);
+    symrot_wiener_milenkovic_to_quaternion(p2, b);
+    return symrot_wiener_milenkovic__from_quaternion(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_wiener_milenkovic_rescale: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_wiener_milenkovic_rescale(const double p[3], double q[3])
+{
+    double e[4];
+    symrot_wiener_milenkovic_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_wiener_milenkovic__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
+}
+
 /* symrot_wiener_milenkovic__phi_f: internal: phi from s = |p| (eq 11).
  * phi = 4*atan(s/4) (closed inverse of p(phi))
  * ops: 3 */
@@ -349,13 +487,13 @@ static inline float symrot_wiener_milenkovic__phi_f(float s)
 }
 
 /* symrot_wiener_milenkovic_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * phi = 4*atan(s/4) (closed inverse of p(phi))
  * ops: 21 */
 static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         return NAN;
     }
     float s;
@@ -371,15 +509,15 @@ static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -16*(sqrt(x) - 4)*(sqrt(x) + 4)/(x + 16)**2 (algebraic in x)
+ * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * R_2 = 128/(x + 16)**2 (algebraic in x)
- * ops: 60 */
+ * ops: 54 */
 static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -391,7 +529,7 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], 
         R[8] = NAN;
         return;
     }
-    const float c_R_1 = -16*(sqrtf(x) - 4)*(sqrtf(x) + 4)/powf(x + 16, 2);
+    const float c_R_1 = -16*(x - 16)/powf(x + 16, 2);
     const float c_R_2 = 128/powf(x + 16, 2);
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -415,7 +553,7 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
 }
 
 /* symrot_wiener_milenkovic_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -423,7 +561,7 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
 static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -460,7 +598,7 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -468,7 +606,7 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
 static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -503,13 +641,13 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, co
 }
 
 /* symrot_wiener_milenkovic_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * det_H = 4096/(x + 16)**3 (algebraic in x)
  * ops: 9 */
 static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         return NAN;
     }
     const float c_det_H = 4096/powf(x + 16, 3);
@@ -517,7 +655,7 @@ static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 }
 
 /* symrot_wiener_milenkovic_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = 8/(x + 16) (algebraic in x)
  * G_2 = 2/(x + 16) (algebraic in x)
@@ -525,7 +663,7 @@ static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 static inline void symrot_wiener_milenkovic_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -561,7 +699,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
 }
 
 /* symrot_wiener_milenkovic_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 8/(x + 16) (algebraic in x)
  * K_1 = 2/(x + 16) (algebraic in x)
  * K_2 = 0 (constant)
@@ -569,7 +707,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
 static inline void symrot_wiener_milenkovic_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -605,7 +743,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
 }
 
 /* symrot_wiener_milenkovic_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -613,7 +751,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
 static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -629,7 +767,7 @@ static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float
 }
 
 /* symrot_wiener_milenkovic_omega_f: omega = H pdot (eq 20).
- * Valid for every finite p (|phi| < 6.2831853071795862) whose |p|^2 does not overflow; otherwise every output is NaN.
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -637,7 +775,7 @@ static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float
 static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 3.4028235e+38F)) {
+    if (!(x < 1.2676506e+30F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -652,6 +790,139 @@ static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const floa
     omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
     omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
     omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+}
+
+/* symrot_wiener_milenkovic_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
+ * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * e_0 = -(x - 16)/(x + 16) (algebraic in x)
+ * nu = 16/(x + 16) (algebraic in x)
+ * ops: 16 */
+static inline void symrot_wiener_milenkovic_to_quaternion_f(const float p[3], float e[4])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 1.2676506e+30F)) {
+        e[0] = NAN;
+        e[1] = NAN;
+        e[2] = NAN;
+        e[3] = NAN;
+        return;
+    }
+    const float c_e_0 = -(x - 16)/(x + 16);
+    const float c_nu = 16/(x + 16);
+    const float half_nu = (1.0F/2.0F)*c_nu;
+    e[0] = c_e_0;
+    e[1] = half_nu*p[0];
+    e[2] = half_nu*p[1];
+    e[3] = half_nu*p[2];
+}
+
+/* symrot_wiener_milenkovic__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
+ * sigma = 4/(e0 + 1) (trig-free in e0)
+ * ops: 50 */
+static inline int symrot_wiener_milenkovic__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
+{
+    /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
+    const float big = fmaxf(fmaxf(fabsf(e0), fabsf(e1)), fmaxf(fabsf(e2), fabsf(e3)));
+    if (big > 0 && big < INFINITY && (big < 8.6736174e-19F || big > 1.1529215e+18F)) {
+        int k;
+        (void)frexpf(big, &k);
+        e0 = ldexpf(e0, -k);
+        e1 = ldexpf(e1, -k);
+        e2 = ldexpf(e2, -k);
+        e3 = ldexpf(e3, -k);
+    }
+    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
+    const float y = (e1*e1) + (e2*e2) + (e3*e3);
+    float e_norm;
+    if (y < 7.888609e-31F && m > 0) {
+        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
+    } else {
+        e_norm = sqrtf(y);
+    }
+    const float n = hypotf(e0, e_norm);
+    if (!(n > 0) || !(n <= 3.4028235e+38F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
+    const float f = (e0 < 0 ? -1 : 1) / n;
+    const float c0 = fabsf(e0)/n;
+    e_norm = e_norm / n;
+    const float sigma = 4/(c0 + 1);
+    p[0] = e1*f*sigma;
+    p[1] = e2*f*sigma;
+    p[2] = e3*f*sigma;
+    return 0;
+}
+
+/* symrot_wiener_milenkovic_from_quaternion_f: parameter vector from Euler-Rodrigues parameters (scalar first) (eq 75).
+ * e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),
+ * which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or
+ * zero, or the rotation is not representable (every rotation is, for this parameterization).
+ * ops: 0 */
+static inline int symrot_wiener_milenkovic_from_quaternion_f(const float e[4], float p[3])
+{
+    return symrot_wiener_milenkovic__from_quaternion_f(e[0], e[1], e[2], e[3], p);
+}
+
+/* symrot_wiener_milenkovic_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
+ * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
+ * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
+ * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
+ * non-finite R gives status 1 and NaN.
+ * ops: 27 */
+static inline int symrot_wiener_milenkovic_from_rotation_matrix_f(const float R[9], float p[3])
+{
+    const float tr = R[0] + R[4] + R[8];
+    if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
+        return symrot_wiener_milenkovic__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
+    }
+    if (R[0] >= R[4] && R[0] >= R[8]) {
+        return symrot_wiener_milenkovic__from_quaternion_f(R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6], p);
+    }
+    if (R[4] >= R[8]) {
+        return symrot_wiener_milenkovic__from_quaternion_f(R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7], p);
+    }
+    return symrot_wiener_milenkovic__from_quaternion_f(R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8], p);
+}
+
+/* symrot_wiener_milenkovic_compose_f: composition of two rotations (eq 18-19).
+ * Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);
+ * quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1
+ * with p3 = NaN when p1 or p2 is out of range or the result is not representable (
+ * every rotation is, for this parameterization).
+ * ops: 28 */
+static inline int symrot_wiener_milenkovic_compose_f(const float p1[3], const float p2[3], float p3[3])
+{
+    float a[4], b[4];
+    symrot_wiener_milenkovic_to_quaternion_f(p1, a);
+    symrot_wiener_milenkovic_to_quaternion_f(p2, b);
+    return symrot_wiener_milenkovic__from_quaternion_f(a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1]), p3);
+}
+
+/* symrot_wiener_milenkovic_rescale_f: rescaling to |phi| <= pi (eq 40-47).
+ * The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,
+ * otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out
+ * of range.
+ * ops: 2 */
+static inline int symrot_wiener_milenkovic_rescale_f(const float p[3], float q[3])
+{
+    float e[4];
+    symrot_wiener_milenkovic_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        q[0] = NAN;
+        q[1] = NAN;
+        q[2] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        q[0] = p[0];
+        q[1] = p[1];
+        q[2] = p[2];
+        return 0;
+    }
+    return symrot_wiener_milenkovic__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
 #ifdef __cplusplus

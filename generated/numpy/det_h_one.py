@@ -9,398 +9,597 @@ every output is NaN.
 angle(p) -> phi; rotation_matrix(p) -> R (eq 16); tangent(p) -> H, omega = H pdot (eq 20);
 tangent_inverse(p) -> H^-1 (eq 26); tangent_det(p) -> det H (eq 24); root_matrix(p) -> G (eq 81);
 root_tangent(p) -> K (eq 83); pdot(p, omega) -> H^-1 omega (eq 25); omega(p, pdot) -> H pdot.
-"""
+
+Rotations of any size (Euler-Rodrigues parameters e = (e0, e1, e2, e3), scalar first, eqs 74-75):
+to_quaternion(p) -> e (..., 4); from_quaternion(e) -> p (normalizes e, takes the hemisphere
+e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65);
+compose(p1, p2) -> p3 with R(p3) = R(p2) R(p1), p1 applied first (eqs 18-19, 67);
+rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).  Every rotation has
+such a representation, so these results are NaN only for non-finite input."""
 
 import numpy
 
 P_MAX = 3.3530783864394875
 
 
-def _p_prime_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -3.3160977010058107e-12
-    series = -4.569666554548725e-11 + t * series
-    series = -6.473542653639692e-10 + t * series
-    series = -9.50993765619616e-09 + t * series
-    series = -1.4686206650492366e-07 + t * series
-    series = -2.440218511647083e-06 + t * series
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
-    closed = 4*numpy.sin((0.5)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
-
-
-def _nu_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -5.1339188726594446e-12
-    series = -6.740882557422226e-11 + t * series
-    series = -9.035261398610608e-10 + t * series
-    series = -1.244209181073502e-08 + t * series
-    series = -1.7778215165910478e-07 + t * series
-    series = -2.680413429576376e-06 + t * series
-    series = -4.402281746031746e-05 + t * series
-    series = -0.0008482142857142857 + t * series
-    series = -0.025 + t * series
-    series = 1.0 + t * series
-    closed = 2*numpy.sin((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    return numpy.where(small, series, closed)
-
-
-def _epsilon_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 4.0027973542176834e-11
-    series = 2.8351938089872594e-10 + t * series
-    series = 2.0082446735268566e-09 + t * series
-    series = 1.4225834946840515e-08 + t * series
-    series = 1.0078371181814193e-07 + t * series
-    series = 7.141710355470859e-07 + t * series
-    series = 5.063042332919034e-06 + t * series
-    series = 3.592768342768343e-05 + t * series
-    series = 0.0002554692331478046 + t * series
-    series = 0.0018253968253968255 + t * series
-    series = 0.013214285714285715 + t * series
-    series = 0.1 + t * series
-    series = 1.0 + t * series
-    closed = 2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    return numpy.where(small, series, closed)
-
-
-def _mu_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 8.157249203307483e-12
-    series = 9.503025504854477e-11 + t * series
-    series = 1.111738558870201e-09 + t * series
-    series = 1.3075291305333323e-08 + t * series
-    series = 1.548516833380779e-07 + t * series
-    series = 1.8513431013431014e-06 + t * series
-    series = 2.2437384044526902e-05 + t * series
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
-    closed = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/numpy.sin((0.5)*phi)**2
-    return numpy.where(small, series, closed)
-
-
-def _det_H_64(x, phi):
-    return numpy.full_like(x, 1.0)
-
-
-def _R_0_64(x, phi):
-    return numpy.full_like(x, 1.0)
-
-
-def _R_1_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 5.001592370976041e-12
-    series = 6.539638581589419e-11 + t * series
-    series = 8.716860870222215e-10 + t * series
-    series = 1.1911667949082915e-08 + t * series
-    series = 1.683039183039183e-07 + t * series
-    series = 2.4930426716141e-06 + t * series
-    series = 3.968253968253968e-05 + t * series
-    series = 0.0007142857142857143 + t * series
-    series = -0.15 + t * series
-    series = 1.0 + t * series
-    w0 = numpy.sin(phi)
-    closed = w0/numpy.cbrt(6*phi - 6*w0)
-    return numpy.where(small, series, closed)
-
-
-def _R_2_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -1.6580488505029053e-12
-    series = -2.2848332772743624e-11 + t * series
-    series = -3.236771326819846e-10 + t * series
-    series = -4.75496882809808e-09 + t * series
-    series = -7.343103325246183e-08 + t * series
-    series = -1.2201092558235415e-06 + t * series
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
-    closed = 2*numpy.sin((0.5)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
-
-
-def _H_0_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 8.157249203307483e-12
-    series = 9.503025504854477e-11 + t * series
-    series = 1.111738558870201e-09 + t * series
-    series = 1.3075291305333323e-08 + t * series
-    series = 1.548516833380779e-07 + t * series
-    series = 1.8513431013431014e-06 + t * series
-    series = 2.2437384044526902e-05 + t * series
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
-    closed = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/numpy.sin((0.5)*phi)**2
-    return numpy.where(small, series, closed)
-
-
-def _H_1_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -1.6580488505029053e-12
-    series = -2.2848332772743624e-11 + t * series
-    series = -3.236771326819846e-10 + t * series
-    series = -4.75496882809808e-09 + t * series
-    series = -7.343103325246183e-08 + t * series
-    series = -1.2201092558235415e-06 + t * series
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
-    closed = 2*numpy.sin((0.5)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
-
-
-def _H_2_64(x, phi):
+def _p_prime_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812090283314
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 1.22815740465074, phi).astype(x.dtype)
-    series = 2.5501224371929e-20
-    series = 2.918170543767923e-19 + t * series
-    series = 3.3425985887827363e-18 + t * series
-    series = 3.8329294257465515e-17 + t * series
-    series = 4.4005658265072545e-16 + t * series
-    series = 5.0592551808267075e-15 + t * series
-    series = 5.825704915999495e-14 + t * series
-    series = 6.720412596247862e-13 + t * series
-    series = 7.768808765054745e-12 + t * series
-    series = 9.002866267756873e-11 + t * series
-    series = 1.046342173054307e-09 + t * series
-    series = 1.22036052183111e-08 + t * series
-    series = 1.42940015388995e-07 + t * series
-    series = 1.683039183039183e-06 + t * series
-    series = 1.99443413729128e-05 + t * series
-    series = 0.0002380952380952381 + t * series
-    series = 0.002857142857142857 + t * series
-    series = 0.2 + t * series
-    w0 = numpy.sin(phi)
-    closed = (0.08333333333333333)*(3*phi - 4*w0 + (0.5)*numpy.sin(2*phi))/((phi - w0)*numpy.sin((0.5)*phi)**2)
-    return numpy.where(small, series, closed)
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -6.816125240403192e-19
+        series = -8.626941850237128e-18 + t * series
+        series = -1.1016217975387359e-16 + t * series
+        series = -1.4213047418173123e-15 + t * series
+        series = -1.8561269939266666e-14 + t * series
+        series = -2.4592808133854967e-13 + t * series
+        series = -3.3160977010058107e-12 + t * series
+        series = -4.569666554548725e-11 + t * series
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
 
 
-def _H_inverse_0_64(x, phi):
+def _nu_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -3.3160977010058107e-12
-    series = -4.569666554548725e-11 + t * series
-    series = -6.473542653639692e-10 + t * series
-    series = -9.50993765619616e-09 + t * series
-    series = -1.4686206650492366e-07 + t * series
-    series = -2.440218511647083e-06 + t * series
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
-    closed = 4*numpy.sin((0.5)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -5.1339188726594446e-12
+        series = -6.740882557422226e-11 + t * series
+        series = -9.035261398610608e-10 + t * series
+        series = -1.244209181073502e-08 + t * series
+        series = -1.7778215165910478e-07 + t * series
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = 2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+    return out
 
 
-def _H_inverse_1_64(x, phi):
+def _epsilon_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.4031334653787326
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 4.0027973542176834e-11
+        series = 2.8351938089872594e-10 + t * series
+        series = 2.0082446735268566e-09 + t * series
+        series = 1.4225834946840515e-08 + t * series
+        series = 1.0078371181814193e-07 + t * series
+        series = 7.141710355470859e-07 + t * series
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+    return out
+
+
+def _mu_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283314
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 3.0039990891728625e-19
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
+    return out
+
+
+def _det_H_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 1.0)
+
+
+def _R_0_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 1.0)
+
+
+def _R_1_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.4031334653787326
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 5.001592370976041e-12
+        series = 6.539638581589419e-11 + t * series
+        series = 8.716860870222215e-10 + t * series
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        w0 = numpy.sin(phi)
+        out[big] = w0/numpy.cbrt(6*phi - 6*w0)
+    return out
+
+
+def _R_2_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283314
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -3.408062620201596e-19
+        series = -4.313470925118564e-18 + t * series
+        series = -5.5081089876936793e-17 + t * series
+        series = -7.106523709086561e-16 + t * series
+        series = -9.280634969633333e-15 + t * series
+        series = -1.2296404066927484e-13 + t * series
+        series = -1.6580488505029053e-12 + t * series
+        series = -2.2848332772743624e-11 + t * series
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
+
+
+def _H_0_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283314
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 3.0039990891728625e-19
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
+    return out
+
+
+def _H_1_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283314
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -3.408062620201596e-19
+        series = -4.313470925118564e-18 + t * series
+        series = -5.5081089876936793e-17 + t * series
+        series = -7.106523709086561e-16 + t * series
+        series = -9.280634969633333e-15 + t * series
+        series = -1.2296404066927484e-13 + t * series
+        series = -1.6580488505029053e-12 + t * series
+        series = -2.2848332772743624e-11 + t * series
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
+
+
+def _H_2_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.630222724141611
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.499151775319712e-24
+        series = 1.7102707948061374e-23 + t * series
+        series = 1.9524132761456664e-22 + t * series
+        series = 2.230454684338051e-21 + t * series
+        series = 2.5501224371929e-20 + t * series
+        series = 2.918170543767923e-19 + t * series
+        series = 3.3425985887827363e-18 + t * series
+        series = 3.8329294257465515e-17 + t * series
+        series = 4.4005658265072545e-16 + t * series
+        series = 5.0592551808267075e-15 + t * series
+        series = 5.825704915999495e-14 + t * series
+        series = 6.720412596247862e-13 + t * series
+        series = 7.768808765054745e-12 + t * series
+        series = 9.002866267756873e-11 + t * series
+        series = 1.046342173054307e-09 + t * series
+        series = 1.22036052183111e-08 + t * series
+        series = 1.42940015388995e-07 + t * series
+        series = 1.683039183039183e-06 + t * series
+        series = 1.99443413729128e-05 + t * series
+        series = 0.0002380952380952381 + t * series
+        series = 0.002857142857142857 + t * series
+        series = 0.2 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        out[big] = (0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0))
+    return out
+
+
+def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283314
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -6.816125240403192e-19
+        series = -8.626941850237128e-18 + t * series
+        series = -1.1016217975387359e-16 + t * series
+        series = -1.4213047418173123e-15 + t * series
+        series = -1.8561269939266666e-14 + t * series
+        series = -2.4592808133854967e-13 + t * series
+        series = -3.3160977010058107e-12 + t * series
+        series = -4.569666554548725e-11 + t * series
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
+
+
+def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_64(x, phi):
+def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 2.630222724141611
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 1.702311807871781, phi).astype(x.dtype)
-    series = 3.42701592796967e-25
-    series = 3.982335375612905e-24 + t * series
-    series = 4.6352839539983977e-23 + t * series
-    series = 5.40513214847762e-22 + t * series
-    series = 6.315600653020195e-21 + t * series
-    series = 7.396110286959959e-20 + t * series
-    series = 8.683469103988305e-19 + t * series
-    series = 1.0224187860604788e-17 + t * series
-    series = 1.207771859033198e-16 + t * series
-    series = 1.4321083368003567e-15 + t * series
-    series = 1.7055656901807745e-14 + t * series
-    series = 2.0417396933193335e-13 + t * series
-    series = 2.4592808133854965e-12 + t * series
-    series = 2.9844879309052296e-11 + t * series
-    series = 3.65573324363898e-10 + t * series
-    series = 4.531479857547785e-09 + t * series
-    series = 5.705962593717696e-08 + t * series
-    series = 7.343103325246182e-07 + t * series
-    series = 9.760874046588332e-06 + t * series
-    series = 0.0001369047619047619 + t * series
-    series = 0.002142857142857143 + t * series
-    series = 0.05 + t * series
-    w0 = numpy.sin((0.5)*phi)**2
-    w1 = numpy.sin(phi)
-    closed = -0.5*(3*phi*w1 - 8*w0 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(6*phi - 6*w1)**4)
-    return numpy.where(small, series, closed)
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 3.42701592796967e-25
+        series = 3.982335375612905e-24 + t * series
+        series = 4.6352839539983977e-23 + t * series
+        series = 5.40513214847762e-22 + t * series
+        series = 6.315600653020195e-21 + t * series
+        series = 7.396110286959959e-20 + t * series
+        series = 8.683469103988305e-19 + t * series
+        series = 1.0224187860604788e-17 + t * series
+        series = 1.207771859033198e-16 + t * series
+        series = 1.4321083368003567e-15 + t * series
+        series = 1.7055656901807745e-14 + t * series
+        series = 2.0417396933193335e-13 + t * series
+        series = 2.4592808133854965e-12 + t * series
+        series = 2.9844879309052296e-11 + t * series
+        series = 3.65573324363898e-10 + t * series
+        series = 4.531479857547785e-09 + t * series
+        series = 5.705962593717696e-08 + t * series
+        series = 7.343103325246182e-07 + t * series
+        series = 9.760874046588332e-06 + t * series
+        series = 0.0001369047619047619 + t * series
+        series = 0.002142857142857143 + t * series
+        series = 0.05 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = sin_half**2
+        w1 = 6*phi
+        w2 = cos_half*sin_half
+        out[big] = -0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4)
+    return out
 
 
-def _G_0_64(x, phi):
+def _G_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_64(x, phi):
+def _G_1_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -2.5669594363297223e-12
-    series = -3.370441278711113e-11 + t * series
-    series = -4.517630699305304e-10 + t * series
-    series = -6.22104590536751e-09 + t * series
-    series = -8.889107582955239e-08 + t * series
-    series = -1.340206714788188e-06 + t * series
-    series = -2.201140873015873e-05 + t * series
-    series = -0.00042410714285714285 + t * series
-    series = -0.0125 + t * series
-    series = 0.5 + t * series
-    closed = numpy.sin((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    return numpy.where(small, series, closed)
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -2.5669594363297223e-12
+        series = -3.370441278711113e-11 + t * series
+        series = -4.517630699305304e-10 + t * series
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+    return out
 
 
-def _G_2_64(x, phi):
+def _G_2_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.630222724141611
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 2.0267443963482225e-26
+        series = 2.464306843655364e-25 + t * series
+        series = 3.0079808258545666e-24 + t * series
+        series = 3.687361714465075e-23 + t * series
+        series = 4.541735732543677e-22 + t * series
+        series = 5.623858631914075e-21 + t * series
+        series = 7.005500832060205e-20 + t * series
+        series = 8.78575012329886e-19 + t * series
+        series = 1.1103729250660078e-17 + t * series
+        series = 1.415858727786663e-16 + t * series
+        series = 1.8241874371141333e-15 + t * series
+        series = 2.3791812685232493e-14 + t * series
+        series = 3.1488034564609846e-13 + t * series
+        series = 4.242513271852192e-12 + t * series
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+    return out
+
+
+def _K_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812090283314
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 1.22815740465074, phi).astype(x.dtype)
-    series = 7.005500832060205e-20
-    series = 8.78575012329886e-19 + t * series
-    series = 1.1103729250660078e-17 + t * series
-    series = 1.415858727786663e-16 + t * series
-    series = 1.8241874371141333e-15 + t * series
-    series = 2.3791812685232493e-14 + t * series
-    series = 3.1488034564609846e-13 + t * series
-    series = 4.242513271852192e-12 + t * series
-    series = 5.844969408074523e-11 + t * series
-    series = 8.286380574805527e-10 + t * series
-    series = 1.2203463534465907e-08 + t * series
-    series = 1.8955121406990826e-07 + t * series
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
-    closed = (1 - numpy.cos((0.5)*phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.5019995445864313e-19
+        series = 1.7235273973410984e-18 + t * series
+        series = 1.9803468699690516e-17 + t * series
+        series = 2.2788644458698284e-16 + t * series
+        series = 2.626920959275406e-15 + t * series
+        series = 3.034221310416404e-14 + t * series
+        series = 3.512942948038655e-13 + t * series
+        series = 4.078624601653741e-12 + t * series
+        series = 4.7515127524272383e-11 + t * series
+        series = 5.558692794351005e-10 + t * series
+        series = 6.5376456526666615e-09 + t * series
+        series = 7.742584166903895e-08 + t * series
+        series = 9.256715506715507e-07 + t * series
+        series = 1.1218692022263451e-05 + t * series
+        series = 0.0001388888888888889 + t * series
+        series = 0.0017857142857142857 + t * series
+        series = 0.025 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = (0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
+    return out
 
 
-def _K_0_64(x, phi):
-    small = x < 0.4031334653787326
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 4.078624601653741e-12
-    series = 4.7515127524272383e-11 + t * series
-    series = 5.558692794351005e-10 + t * series
-    series = 6.5376456526666615e-09 + t * series
-    series = 7.742584166903895e-08 + t * series
-    series = 9.256715506715507e-07 + t * series
-    series = 1.1218692022263451e-05 + t * series
-    series = 0.0001388888888888889 + t * series
-    series = 0.0017857142857142857 + t * series
-    series = 0.025 + t * series
-    series = 0.5 + t * series
-    closed = (0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/numpy.sin((0.5)*phi)**2
-    return numpy.where(small, series, closed)
+def _K_1_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.630222724141611
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 2.0267443963482225e-26
+        series = 2.464306843655364e-25 + t * series
+        series = 3.0079808258545666e-24 + t * series
+        series = 3.687361714465075e-23 + t * series
+        series = 4.541735732543677e-22 + t * series
+        series = 5.623858631914075e-21 + t * series
+        series = 7.005500832060205e-20 + t * series
+        series = 8.78575012329886e-19 + t * series
+        series = 1.1103729250660078e-17 + t * series
+        series = 1.415858727786663e-16 + t * series
+        series = 1.8241874371141333e-15 + t * series
+        series = 2.3791812685232493e-14 + t * series
+        series = 3.1488034564609846e-13 + t * series
+        series = 4.242513271852192e-12 + t * series
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+    return out
 
 
-def _K_1_64(x, phi):
-    small = x < 1.4342812090283314
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 1.22815740465074, phi).astype(x.dtype)
-    series = 7.005500832060205e-20
-    series = 8.78575012329886e-19 + t * series
-    series = 1.1103729250660078e-17 + t * series
-    series = 1.415858727786663e-16 + t * series
-    series = 1.8241874371141333e-15 + t * series
-    series = 2.3791812685232493e-14 + t * series
-    series = 3.1488034564609846e-13 + t * series
-    series = 4.242513271852192e-12 + t * series
-    series = 5.844969408074523e-11 + t * series
-    series = 8.286380574805527e-10 + t * series
-    series = 1.2203463534465907e-08 + t * series
-    series = 1.8955121406990826e-07 + t * series
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
-    closed = (1 - numpy.cos((0.5)*phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+def _K_2_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.630222724141611
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 7.837904569910299e-25
+        series = 8.960375161004176e-24 + t * series
+        series = 1.0252484904999445e-22 + t * series
+        series = 1.1742209353136828e-21 + t * series
+        series = 1.3462827495637501e-20 + t * series
+        series = 1.5454156215361094e-19 + t * series
+        series = 1.7764157194142527e-18 + t * series
+        series = 2.0451064003372294e-17 + t * series
+        series = 2.3586252560910385e-16 + t * series
+        series = 2.725820183855303e-15 + t * series
+        series = 3.157810155130715e-14 + t * series
+        series = 3.6688033619582197e-13 + t * series
+        series = 4.277333653830018e-12 + t * series
+        series = 5.008208696060211e-11 + t * series
+        series = 5.895736922222117e-10 + t * series
+        series = 6.9894087225971915e-09 + t * series
+        series = 8.364688757440645e-08 + t * series
+        series = 1.0145626265011032e-06 + t * series
+        series = 1.2558898737051639e-05 + t * series
+        series = 0.0001609002976190476 + t * series
+        series = 0.0022098214285714286 + t * series
+        series = 0.0375 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
+        w1 = w0**2
+        out[big] = (sin_half/w0 + (0.125)*w1/sin_half**2)/w1
+    return out
 
 
-def _K_2_64(x, phi):
-    small = x < 0.7648242352443012
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.8860718721584834, phi).astype(x.dtype)
-    series = 2.3586252560910385e-16
-    series = 2.725820183855303e-15 + t * series
-    series = 3.157810155130715e-14 + t * series
-    series = 3.6688033619582197e-13 + t * series
-    series = 4.277333653830018e-12 + t * series
-    series = 5.008208696060211e-11 + t * series
-    series = 5.895736922222117e-10 + t * series
-    series = 6.9894087225971915e-09 + t * series
-    series = 8.364688757440645e-08 + t * series
-    series = 1.0145626265011032e-06 + t * series
-    series = 1.2558898737051639e-05 + t * series
-    series = 0.0001609002976190476 + t * series
-    series = 0.0022098214285714286 + t * series
-    series = 0.0375 + t * series
-    w0 = numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    w1 = w0**2
-    w2 = numpy.sin((0.5)*phi)
-    closed = ((0.125)*w1/w2**2 - w2/w0)/w1
-    return numpy.where(small, series, closed)
+def _e_0_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.9211893090849666e-14
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -0.125
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        cos_half = cos_half[big]
+        out[big] = cos_half
+    return out
 
 
 def _ratio_64(t, phi):
-    small = t < 0.4086652777619201
-    t = numpy.where(small, t, 0.0).astype(t.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(t.dtype)
-    series = -1.6124590954522927e-13
-    series = 1.0461319985129509e-11 + t * series
-    series = 2.863098101193339e-09 + t * series
-    series = t * series
-    series = 0.00011904761904761905 + t * series
-    series = -0.016666666666666666 + t * series
-    series = 1.0 + t * series
-    closed = numpy.cbrt(6*phi - 6*numpy.sin(phi))/phi
-    return numpy.where(small, series, closed)
+    small = t < 0.7851233626304397
+    out = numpy.empty_like(t)
+    if small.any():
+        t = t[small]
+        series = -5.032990449379227e-15
+        series = -1.6124590954522927e-13 + t * series
+        series = 1.0461319985129509e-11 + t * series
+        series = 2.863098101193339e-09 + t * series
+        series = t * series
+        series = 0.00011904761904761905 + t * series
+        series = -0.016666666666666666 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        w0 = (0.5)*phi
+        out[big] = numpy.cbrt(6*phi - 12*numpy.sin(w0)*numpy.cos(w0))/phi
+    return out
 
 
 def _slope_64(t, phi):
-    small = t < 0.4086652777619201
-    t = numpy.where(small, t, 0.0).astype(t.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(t.dtype)
-    series = -7.549485674068841e-14
-    series = -2.0961968240879805e-12 + t * series
-    series = 1.150745198364246e-10 + t * series
-    series = 2.5767882910740054e-08 + t * series
-    series = t * series
-    series = 0.0005952380952380953 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
-    closed = 4*numpy.sin((0.5)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+    small = t < 1.5083706105984414
+    out = numpy.empty_like(t)
+    if small.any():
+        t = t[small]
+        series = -1.2684836118177708e-17
+        series = -1.2818613276093299e-15 + t * series
+        series = -7.549485674068841e-14 + t * series
+        series = -2.0961968240879805e-12 + t * series
+        series = 1.150745198364246e-10 + t * series
+        series = 2.5767882910740054e-08 + t * series
+        series = t * series
+        series = 0.0005952380952380953 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
 
 
-def _angle_64(s):
+def _angle_64(s, d):
     s2 = s * s
     start = 8.716860870222215e-10
     start = 1.1911667949082915e-08 + s2 * start
@@ -410,7 +609,35 @@ def _angle_64(s):
     start = 0.0007142857142857143 + s2 * start
     start = 0.016666666666666666 + s2 * start
     start = 1.0 + s2 * start
-    phi = numpy.clip(s * start, 0.0, 6.283185307179586).astype(s.dtype)
+    v = 1.0 - numpy.cbrt(numpy.maximum(1.0 - s / 3.3530783864394875, 0.0))
+    y = 2.0 * v - 1.0
+    far = -1.9799649845617596e-05
+    far = 3.845712059591823e-05 + y * far
+    far = 6.944290860171888e-05 + y * far
+    far = -0.0001466954306176658 + y * far
+    far = -0.00014373224275280463 + y * far
+    far = 0.0003115313529609402 + y * far
+    far = 0.00012868823229833358 + y * far
+    far = -0.00030993305996142973 + y * far
+    far = -0.00016808026446555073 + y * far
+    far = 0.0003578223364733247 + y * far
+    far = -0.00011488832383323612 + y * far
+    far = 0.00015591438323289667 + y * far
+    far = -0.0004915899408385197 + y * far
+    far = 0.0008726139854363284 + y * far
+    far = -0.0014078691985324407 + y * far
+    far = 0.002564052915767814 + y * far
+    far = -0.00441490398383476 + y * far
+    far = 0.008868914251229019 + y * far
+    far = -0.01410305605515404 + y * far
+    far = 0.0374013021897593 + y * far
+    far = -0.05443155201399025 + y * far
+    far = 0.17235578974251842 + y * far
+    far = -0.4721849231422934 + y * far
+    far = 2.919122883842764 + y * far
+    far = 3.688874917307175 + y * far
+    phi = numpy.where(s < 0.6986294588918617, s * start, far)
+    phi = numpy.clip(phi, 0.0, 6.283185307179586).astype(s.dtype)
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
     for _ in range(6):
@@ -425,300 +652,460 @@ def _angle_64(s):
     return phi
 
 
-def _p_prime_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -2.440218511647083e-06
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
-    closed = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+def _scale_64(e0, e_norm):
+    phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
+    t = phi * phi
+    small = t < 0.8013171044383103
+    out = numpy.empty_like(t)
+    if small.any():
+        t = t[small]
+        series = 9.165622812957786e-15
+        series = 3.620429902548073e-13 + t * series
+        series = 1.430275196509799e-11 + t * series
+        series = 5.645976592827012e-10 + t * series
+        series = 2.2216922909817254e-08 + t * series
+        series = 8.677535881776953e-07 + t * series
+        series = 3.348214285714286e-05 + t * series
+        series = 0.0012797619047619049 + t * series
+        series = 0.05 + t * series
+        series = 2.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/numpy.sin((0.5)*phi)
+    return out
 
 
-def _nu_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -2.680413429576376e-06
-    series = -4.402281746031746e-05 + t * series
-    series = -0.0008482142857142857 + t * series
-    series = -0.025 + t * series
-    series = 1.0 + t * series
-    closed = 2*numpy.sin((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    return numpy.where(small, series, closed)
+def _p_prime_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -9.50993765619616e-09
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
 
 
-def _epsilon_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 3.592768342768343e-05
-    series = 0.0002554692331478046 + t * series
-    series = 0.0018253968253968255 + t * series
-    series = 0.013214285714285715 + t * series
-    series = 0.1 + t * series
-    series = 1.0 + t * series
-    closed = 2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    return numpy.where(small, series, closed)
+def _nu_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -1.7778215165910478e-07
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = 2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+    return out
 
 
-def _mu_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 2.2437384044526902e-05
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
-    closed = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/numpy.sin((0.5)*phi)**2
-    return numpy.where(small, series, closed)
+def _epsilon_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 7.141710355470859e-07
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+    return out
 
 
-def _det_H_32(x, phi):
+def _mu_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.548516833380779e-07
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
+    return out
+
+
+def _det_H_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _R_0_32(x, phi):
+def _R_0_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _R_1_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 2.4930426716141e-06
-    series = 3.968253968253968e-05 + t * series
-    series = 0.0007142857142857143 + t * series
-    series = -0.15 + t * series
-    series = 1.0 + t * series
-    w0 = numpy.sin(phi)
-    closed = w0/numpy.cbrt(6*phi - 6*w0)
-    return numpy.where(small, series, closed)
+def _R_1_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.1911667949082915e-08
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        out[big] = 2*w0/numpy.cbrt(6*phi - 12*w0)
+    return out
 
 
-def _R_2_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -1.2201092558235415e-06
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
-    closed = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+def _R_2_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -4.75496882809808e-09
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
 
 
-def _H_0_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 2.2437384044526902e-05
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
-    closed = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/numpy.sin((0.5)*phi)**2
-    return numpy.where(small, series, closed)
+def _H_0_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.548516833380779e-07
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
+    return out
 
 
-def _H_1_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -1.2201092558235415e-06
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
-    closed = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+def _H_1_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -4.75496882809808e-09
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
 
 
-def _H_2_32(x, phi):
+def _H_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 2.3595228756885427, phi).astype(x.dtype)
-    series = 2.5501224371929e-20
-    series = 2.918170543767923e-19 + t * series
-    series = 3.3425985887827363e-18 + t * series
-    series = 3.8329294257465515e-17 + t * series
-    series = 4.4005658265072545e-16 + t * series
-    series = 5.0592551808267075e-15 + t * series
-    series = 5.825704915999495e-14 + t * series
-    series = 6.720412596247862e-13 + t * series
-    series = 7.768808765054745e-12 + t * series
-    series = 9.002866267756873e-11 + t * series
-    series = 1.046342173054307e-09 + t * series
-    series = 1.22036052183111e-08 + t * series
-    series = 1.42940015388995e-07 + t * series
-    series = 1.683039183039183e-06 + t * series
-    series = 1.99443413729128e-05 + t * series
-    series = 0.0002380952380952381 + t * series
-    series = 0.002857142857142857 + t * series
-    series = 0.2 + t * series
-    w0 = numpy.sin(phi)
-    closed = (0.08333333333333333)*(3*phi - 4*w0 + (0.5)*numpy.sin(2*phi))/((phi - w0)*numpy.sin((0.5)*phi)**2)
-    return numpy.where(small, series, closed)
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 2.5501224371929e-20
+        series = 2.918170543767923e-19 + t * series
+        series = 3.3425985887827363e-18 + t * series
+        series = 3.8329294257465515e-17 + t * series
+        series = 4.4005658265072545e-16 + t * series
+        series = 5.0592551808267075e-15 + t * series
+        series = 5.825704915999495e-14 + t * series
+        series = 6.720412596247862e-13 + t * series
+        series = 7.768808765054745e-12 + t * series
+        series = 9.002866267756873e-11 + t * series
+        series = 1.046342173054307e-09 + t * series
+        series = 1.22036052183111e-08 + t * series
+        series = 1.42940015388995e-07 + t * series
+        series = 1.683039183039183e-06 + t * series
+        series = 1.99443413729128e-05 + t * series
+        series = 0.0002380952380952381 + t * series
+        series = 0.002857142857142857 + t * series
+        series = 0.2 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        out[big] = (0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0))
+    return out
 
 
-def _H_inverse_0_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -2.440218511647083e-06
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
-    closed = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -9.50993765619616e-09
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
 
 
-def _H_inverse_1_32(x, phi):
+def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_32(x, phi):
+def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 2.3595228756885427, phi).astype(x.dtype)
-    series = 6.315600653020195e-21
-    series = 7.396110286959959e-20 + t * series
-    series = 8.683469103988305e-19 + t * series
-    series = 1.0224187860604788e-17 + t * series
-    series = 1.207771859033198e-16 + t * series
-    series = 1.4321083368003567e-15 + t * series
-    series = 1.7055656901807745e-14 + t * series
-    series = 2.0417396933193335e-13 + t * series
-    series = 2.4592808133854965e-12 + t * series
-    series = 2.9844879309052296e-11 + t * series
-    series = 3.65573324363898e-10 + t * series
-    series = 4.531479857547785e-09 + t * series
-    series = 5.705962593717696e-08 + t * series
-    series = 7.343103325246182e-07 + t * series
-    series = 9.760874046588332e-06 + t * series
-    series = 0.0001369047619047619 + t * series
-    series = 0.002142857142857143 + t * series
-    series = 0.05 + t * series
-    w0 = numpy.cos(phi)
-    w1 = numpy.sin(phi)
-    closed = (3*phi*w1 + w0**2 + 4*w0 - 5)/((w0 - 1)*numpy.cbrt(6*phi - 6*w1)**4)
-    return numpy.where(small, series, closed)
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 6.315600653020195e-21
+        series = 7.396110286959959e-20 + t * series
+        series = 8.683469103988305e-19 + t * series
+        series = 1.0224187860604788e-17 + t * series
+        series = 1.207771859033198e-16 + t * series
+        series = 1.4321083368003567e-15 + t * series
+        series = 1.7055656901807745e-14 + t * series
+        series = 2.0417396933193335e-13 + t * series
+        series = 2.4592808133854965e-12 + t * series
+        series = 2.9844879309052296e-11 + t * series
+        series = 3.65573324363898e-10 + t * series
+        series = 4.531479857547785e-09 + t * series
+        series = 5.705962593717696e-08 + t * series
+        series = 7.343103325246182e-07 + t * series
+        series = 9.760874046588332e-06 + t * series
+        series = 0.0001369047619047619 + t * series
+        series = 0.002142857142857143 + t * series
+        series = 0.05 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = sin_half**2
+        w1 = 6*phi
+        w2 = cos_half*sin_half
+        out[big] = -0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4)
+    return out
 
 
-def _G_0_32(x, phi):
+def _G_0_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = -1.340206714788188e-06
-    series = -2.201140873015873e-05 + t * series
-    series = -0.00042410714285714285 + t * series
-    series = -0.0125 + t * series
-    series = 0.5 + t * series
-    closed = numpy.sin((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    return numpy.where(small, series, closed)
+def _G_1_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -8.889107582955239e-08
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+    return out
 
 
-def _G_2_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 1.8955121406990826e-07
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
-    closed = 2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+def _G_2_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.8955121406990826e-07
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+    return out
 
 
-def _K_0_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 1.1218692022263451e-05
-    series = 0.0001388888888888889 + t * series
-    series = 0.0017857142857142857 + t * series
-    series = 0.025 + t * series
-    series = 0.5 + t * series
-    closed = (0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/numpy.sin((0.5)*phi)**2
-    return numpy.where(small, series, closed)
+def _K_0_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 7.742584166903895e-08
+        series = 9.256715506715507e-07 + t * series
+        series = 1.1218692022263451e-05 + t * series
+        series = 0.0001388888888888889 + t * series
+        series = 0.0017857142857142857 + t * series
+        series = 0.025 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        out[big] = (0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
+    return out
 
 
-def _K_1_32(x, phi):
-    small = x < 0.40313349125353487
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(x.dtype)
-    series = 1.8955121406990826e-07
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
-    closed = 2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+def _K_1_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7648242161335777
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.8955121406990826e-07
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+    return out
 
 
-def _K_2_32(x, phi):
-    small = x < 4.619481091176478
-    t = numpy.where(small, x, 0.0).astype(x.dtype)
-    phi = numpy.where(small, 2.3595228756885427, phi).astype(x.dtype)
-    series = 1.1742209353136828e-21
-    series = 1.3462827495637501e-20 + t * series
-    series = 1.5454156215361094e-19 + t * series
-    series = 1.7764157194142527e-18 + t * series
-    series = 2.0451064003372294e-17 + t * series
-    series = 2.3586252560910385e-16 + t * series
-    series = 2.725820183855303e-15 + t * series
-    series = 3.157810155130715e-14 + t * series
-    series = 3.6688033619582197e-13 + t * series
-    series = 4.277333653830018e-12 + t * series
-    series = 5.008208696060211e-11 + t * series
-    series = 5.895736922222117e-10 + t * series
-    series = 6.9894087225971915e-09 + t * series
-    series = 8.364688757440645e-08 + t * series
-    series = 1.0145626265011032e-06 + t * series
-    series = 1.2558898737051639e-05 + t * series
-    series = 0.0001609002976190476 + t * series
-    series = 0.0022098214285714286 + t * series
-    series = 0.0375 + t * series
-    w0 = numpy.cbrt(6*phi - 6*numpy.sin(phi))
-    w1 = w0**2
-    closed = ((0.25)*w1/(1 - numpy.cos(phi)) - numpy.sin((0.5)*phi)/w0)/w1
-    return numpy.where(small, series, closed)
+def _K_2_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.630222574480542
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 3.157810155130715e-14
+        series = 3.6688033619582197e-13 + t * series
+        series = 4.277333653830018e-12 + t * series
+        series = 5.008208696060211e-11 + t * series
+        series = 5.895736922222117e-10 + t * series
+        series = 6.9894087225971915e-09 + t * series
+        series = 8.364688757440645e-08 + t * series
+        series = 1.0145626265011032e-06 + t * series
+        series = 1.2558898737051639e-05 + t * series
+        series = 0.0001609002976190476 + t * series
+        series = 0.0022098214285714286 + t * series
+        series = 0.0375 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        w0 = numpy.cbrt(6*phi - 6*numpy.sin(phi))
+        w1 = w0**2
+        out[big] = (-sin_half/w0 + (0.125)*w1/sin_half**2)/w1
+    return out
+
+
+def _e_0_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.921189444436213e-14
+    out = numpy.empty_like(x)
+    if small.any():
+        series = 1.0
+        out[small] = series
+    if not small.all():
+        big = ~small
+        cos_half = cos_half[big]
+        out[big] = cos_half
+    return out
 
 
 def _ratio_32(t, phi):
-    small = t < 0.408665304354372
-    t = numpy.where(small, t, 0.0).astype(t.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(t.dtype)
-    series = 0.00011904761904761905
-    series = -0.016666666666666666 + t * series
-    series = 1.0 + t * series
-    closed = numpy.cbrt(6*phi - 6*numpy.sin(phi))/phi
-    return numpy.where(small, series, closed)
+    small = t < 1.5083706018396157
+    out = numpy.empty_like(t)
+    if small.any():
+        t = t[small]
+        series = 0.00011904761904761905
+        series = -0.016666666666666666 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/phi
+    return out
 
 
 def _slope_32(t, phi):
-    small = t < 0.408665304354372
-    t = numpy.where(small, t, 0.0).astype(t.dtype)
-    phi = numpy.where(small, 0.6392693311601301, phi).astype(t.dtype)
-    series = 0.0005952380952380953
-    series = -0.05 + t * series
-    series = 1.0 + t * series
-    closed = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
-    return numpy.where(small, series, closed)
+    small = t < 1.5083706018396157
+    out = numpy.empty_like(t)
+    if small.any():
+        t = t[small]
+        series = 2.5767882910740054e-08
+        series = t * series
+        series = 0.0005952380952380953 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+    return out
 
 
-def _angle_32(s):
+def _angle_32(s, d):
     s2 = s * s
     start = 8.716860870222215e-10
     start = 1.1911667949082915e-08 + s2 * start
@@ -728,7 +1115,35 @@ def _angle_32(s):
     start = 0.0007142857142857143 + s2 * start
     start = 0.016666666666666666 + s2 * start
     start = 1.0 + s2 * start
-    phi = numpy.clip(s * start, 0.0, 6.283185307179586).astype(s.dtype)
+    v = 1.0 - numpy.cbrt(numpy.maximum(1.0 - s / 3.3530783864394875, 0.0))
+    y = 2.0 * v - 1.0
+    far = -1.9799649845617596e-05
+    far = 3.845712059591823e-05 + y * far
+    far = 6.944290860171888e-05 + y * far
+    far = -0.0001466954306176658 + y * far
+    far = -0.00014373224275280463 + y * far
+    far = 0.0003115313529609402 + y * far
+    far = 0.00012868823229833358 + y * far
+    far = -0.00030993305996142973 + y * far
+    far = -0.00016808026446555073 + y * far
+    far = 0.0003578223364733247 + y * far
+    far = -0.00011488832383323612 + y * far
+    far = 0.00015591438323289667 + y * far
+    far = -0.0004915899408385197 + y * far
+    far = 0.0008726139854363284 + y * far
+    far = -0.0014078691985324407 + y * far
+    far = 0.002564052915767814 + y * far
+    far = -0.00441490398383476 + y * far
+    far = 0.008868914251229019 + y * far
+    far = -0.01410305605515404 + y * far
+    far = 0.0374013021897593 + y * far
+    far = -0.05443155201399025 + y * far
+    far = 0.17235578974251842 + y * far
+    far = -0.4721849231422934 + y * far
+    far = 2.919122883842764 + y * far
+    far = 3.688874917307175 + y * far
+    phi = numpy.where(s < 0.6986294588918617, s * start, far)
+    phi = numpy.clip(phi, 0.0, 6.283185307179586).astype(s.dtype)
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
     for _ in range(6):
@@ -741,6 +1156,29 @@ def _angle_32(s):
         inside = safe & (step >= low) & (step <= high)
         phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)
     return phi
+
+
+def _scale_32(e0, e_norm):
+    phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
+    t = phi * phi
+    small = t < 1.5011636704730478
+    out = numpy.empty_like(t)
+    if small.any():
+        t = t[small]
+        series = 2.2216922909817254e-08
+        series = 8.677535881776953e-07 + t * series
+        series = 3.348214285714286e-05 + t * series
+        series = 0.0012797619047619049 + t * series
+        series = 0.05 + t * series
+        series = 2.0 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        w0 = (0.5)*phi
+        w1 = numpy.sin(w0)
+        out[big] = numpy.cbrt(6*phi - 12*w1*numpy.cos(w0))/w1
+    return out
 
 
 _COEFFICIENTS = {
@@ -765,6 +1203,7 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "e_0": _e_0_64,
     },
     "32": {
         "p_prime": _p_prime_32,
@@ -787,67 +1226,123 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_SCALE = {"64": _scale_64, "32": _scale_32}
+_USES_PHI = {
+    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'e_0': True},
+    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'e_0': True},
+}
+_BLOCK = 16384
+_TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
+_HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
+E0_MIN = -numpy.inf
 
 
-def _prepare(p):
-    p = numpy.asarray(p)
-    if p.dtype != numpy.float32:
-        p = p.astype(numpy.float64)
-    if p.ndim < 1 or p.shape[-1] != 3:
-        raise ValueError(f"p must have shape (..., 3), got {p.shape}")
+def _as_float(value, name, shape):
+    value = numpy.asarray(value)
+    if value.dtype != numpy.float32:
+        value = value.astype(numpy.float64)
+    if value.ndim < len(shape) or value.shape[value.ndim - len(shape):] != shape:
+        raise ValueError(f"{name} must have shape (..., {', '.join(map(str, shape))}), got {value.shape}")
+    return value
+
+
+def _norm(v):
+    """|v| over the last axis without underflow or overflow (inf for infinite, NaN for NaN input)."""
+    scale = numpy.max(numpy.abs(v), axis=-1)
+    scale = numpy.where((scale > 0) & (scale < numpy.inf), scale, 1.0).astype(v.dtype)
+    unit = v / scale[..., None]
+    return scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))
+
+
+def _length(p, suffix):
+    """(|p|^2, |p|): the one definition of |p| used by every validity test."""
+    x = numpy.asarray(numpy.einsum("...i,...i->...", p, p))
+    s = numpy.asarray(numpy.sqrt(x))
+    extreme = ~((x >= _TINY[suffix]) & (x <= _HUGE[suffix]))
+    if extreme.any():  # |p| without underflow or overflow
+        s[extreme] = _norm(p[extreme])
+    return x, s
+
+
+def _prepare(p, names):
+    """p, (x, phi, s, d, sin(phi/2), cos(phi/2)), valid, suffix: the arguments of the coefficient
+    functions ``names`` (the half-angle sine and cosine computed once for all of them).
+
+    phi is computed only when one of them needs it (None otherwise)."""
+    p = _as_float(p, "p", (3,))
     suffix = "32" if p.dtype == numpy.float32 else "64"
-    scale = numpy.max(numpy.abs(p), axis=-1)
-    scale = numpy.where(scale > 0, scale, 1.0).astype(p.dtype)
-    unit = p / scale[..., None]
-    s = scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))  # |p| without underflow
-    valid = s < P_MAX
-    p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
-    s = numpy.where(valid, s, 0.0).astype(p.dtype)
-    x = s * s
-    phi = _ANGLE[suffix](s)
-    return p, x, phi, valid, suffix
+    x, s = _length(p, suffix)
+    valid = (s < P_MAX) & (x < _HUGE[suffix])  # |p|^2 >= 2^600 (2^100 in float32): out of range
+    if not valid.all():
+        p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
+        s = numpy.where(valid, s, 0.0).astype(p.dtype)
+        x = s * s
+    d = None
+    table = _USES_PHI[suffix]
+    if any(table[name] for name in names):
+        phi = _ANGLE[suffix](s, d)
+        half = 0.5 * phi
+        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half)), valid, suffix
+    return p, (x, None, s, d, None, None), valid, suffix
 
 
 def _scalar(p, name):
-    p, x, phi, valid, suffix = _prepare(p)
-    value = _COEFFICIENTS[suffix][name](x, phi)
+    p, state, valid, suffix = _prepare(p, [name])
+    value = _COEFFICIENTS[suffix][name](*state)
     return numpy.where(valid, value, numpy.nan).astype(p.dtype)
 
 
 def _tensor(p, name):
-    p, x, phi, valid, suffix = _prepare(p)
+    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3), computed in cache-sized blocks."""
+    p = _as_float(p, "p", (3,))
+    shape = p.shape[:-1]
+    flat = p.reshape(-1, 3)
+    out = numpy.empty((flat.shape[0], 9), dtype=p.dtype)
+    for start in range(0, flat.shape[0], _BLOCK):
+        _tensor_block(flat[start:start + _BLOCK], name, out[start:start + _BLOCK])
+    return out.reshape(*shape, 3, 3)
+
+
+def _tensor_block(p, name, out):
+    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
     table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](x, phi)
-    b = table[name + "_1"](x, phi)
-    c = table[name + "_2"](x, phi)
-    diagonal = a - c * x
-    p0, p1, p2 = p[..., 0], p[..., 1], p[..., 2]
-    c0, c1, c2 = c * p0, c * p1, c * p2
+    a = table[name + "_0"](*state)
+    b = table[name + "_1"](*state)
+    c = table[name + "_2"](*state)
+    p0, p1, p2 = p.T
+    c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
-    matrix = numpy.empty((*p.shape, 3), dtype=p.dtype)
-    matrix[..., 0, 0] = diagonal + c0 * p0
-    matrix[..., 1, 1] = diagonal + c1 * p1
-    matrix[..., 2, 2] = diagonal + c2 * p2
-    matrix[..., 0, 1] = c0 * p1 - b2
-    matrix[..., 1, 0] = c0 * p1 + b2
-    matrix[..., 0, 2] = c0 * p2 + b1
-    matrix[..., 2, 0] = c0 * p2 - b1
-    matrix[..., 1, 2] = c1 * p2 - b0
-    matrix[..., 2, 1] = c1 * p2 + b0
-    matrix[~valid] = numpy.nan
-    return matrix
+    s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
+    m = numpy.empty((9, p.shape[0]), dtype=p.dtype)  # entry-major: contiguous writes
+    m[0] = a - c * (s1 + s2)  # T_ii = c0 - c2 (p_j^2 + p_k^2): no cancellation against |p|^2
+    m[4] = a - c * (s0 + s2)
+    m[8] = a - c * (s0 + s1)
+    q = c0 * p1
+    m[1] = q - b2
+    m[3] = q + b2
+    q = c0 * p2
+    m[2] = q + b1
+    m[6] = q - b1
+    q = c1 * p2
+    m[5] = q - b0
+    m[7] = q + b0
+    out[:] = m.T
+    if not valid.all():
+        out[~valid] = numpy.nan
 
 
 def _apply(p, v, name):
-    p, x, phi, valid, suffix = _prepare(p)
+    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
     v = numpy.asarray(v, dtype=p.dtype)
     table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](x, phi)[..., None]
-    b = table[name + "_1"](x, phi)[..., None]
-    c = table[name + "_2"](x, phi)[..., None]
+    x = state[0]
+    a = table[name + "_0"](*state)[..., None]
+    b = table[name + "_1"](*state)[..., None]
+    c = table[name + "_2"](*state)[..., None]
     p_cross_v = numpy.cross(p, v)
     p_dot_v = numpy.einsum("...i,...i->...", p, v)[..., None]
     result = a * v + b * p_cross_v + c * (p * p_dot_v - x[..., None] * v)
@@ -856,7 +1351,8 @@ def _apply(p, v, name):
 
 def angle(p):
     """phi = |phi| from p (..., 3); NaN outside the validity range."""
-    p, _x, phi, valid, _suffix = _prepare(p)
+    p, state, valid, suffix = _prepare(p, [])
+    phi = _ANGLE[suffix](state[2], state[3])
     return numpy.where(valid, phi, numpy.nan).astype(p.dtype)
 
 
@@ -898,3 +1394,112 @@ def pdot(p, omega):
 def omega(p, pdot):
     """omega = H pdot (eq 20)."""
     return _apply(p, pdot, "H")
+
+
+def _quaternion(p):
+    p, state, valid, suffix = _prepare(p, ["e_0", "nu"])
+    table = _COEFFICIENTS[suffix]
+    e0 = table["e_0"](*state)
+    e = (0.5 * table["nu"](*state))[..., None] * p
+    return e0, e, valid, suffix
+
+
+def _from_quaternion(e0, e, valid, suffix):
+    """p = sigma e on the hemisphere e0 >= 0 after normalization; NaN where not representable."""
+    dtype = e.dtype
+    # exact power-of-two scaling: subnormal or huge quaternions normalize without under/overflow
+    biggest = numpy.maximum(numpy.abs(e0), numpy.max(numpy.abs(e), axis=-1))
+    exponent = numpy.frexp(numpy.where(valid & (biggest > 0) & (biggest < numpy.inf), biggest, 1.0))[1]
+    e0 = numpy.ldexp(e0, -exponent).astype(dtype)
+    e = numpy.ldexp(e, -exponent[..., None]).astype(dtype)
+    e_norm = _norm(e)
+    n = numpy.hypot(e0, e_norm)
+    valid = valid & (n > 0) & numpy.isfinite(n)
+    n = numpy.where(valid, n, 1.0).astype(dtype)
+    sign = numpy.where(e0 < 0, -1.0, 1.0).astype(dtype)
+    e0 = numpy.abs(e0) / n
+    e = e * (sign / n)[..., None]
+    e_norm = e_norm / n
+    valid = valid & (e0 > E0_MIN)
+    e0 = numpy.where(valid, e0, 1.0).astype(dtype)
+    e_norm = numpy.where(valid, e_norm, 0.0).astype(dtype)
+    p = _SCALE[suffix](e0, e_norm)[..., None] * e
+    x, s = _length(p, suffix)
+    valid = valid & (s < P_MAX) & (x < _HUGE[suffix])
+    return numpy.where(valid[..., None], p, numpy.nan).astype(dtype)
+
+
+def to_quaternion(p):
+    """e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon (eq 74), (e1, e2, e3) = (nu/2) p (eq 75)."""
+    e0, e, valid, _suffix = _quaternion(p)
+    q = numpy.concatenate([e0[..., None], e], axis=-1)
+    return numpy.where(valid[..., None], q, numpy.nan).astype(e.dtype)
+
+
+def from_quaternion(e):
+    """p from e = (e0, e1, e2, e3) (scalar first; normalized here; e and -e give the same p).
+
+    phi = 2 atan2(|e|, |e0|) <= pi and p = (p(phi) / sin(phi/2)) e (inverse of eq 75), with the
+    sign of e chosen so that e0 >= 0 (rescaling, eqs 40-47).  NaN where not representable.
+    """
+    e = _as_float(e, "e", (4,))
+    suffix = "32" if e.dtype == numpy.float32 else "64"
+    finite = numpy.all(numpy.isfinite(e), axis=-1)
+    e = numpy.where(finite[..., None], e, 0.0).astype(e.dtype)
+    return _from_quaternion(e[..., 0], e[..., 1:], finite, suffix)
+
+
+def from_rotation_matrix(R):
+    """p from a rotation matrix (..., 3, 3): Shepperd's largest pivot (eqs 61-65), then from_quaternion.
+
+    No orthogonalization: for R = Q + D with Q a rotation the result differs from Q's parameter
+    vector by O(|D|); non-finite R gives NaN.
+    """
+    r = _as_float(R, "R", (3, 3))
+    suffix = "32" if r.dtype == numpy.float32 else "64"
+    finite = numpy.all(numpy.isfinite(r), axis=(-2, -1))
+    r = numpy.where(finite[..., None, None], r, 0.0).astype(r.dtype)
+    r00, r01, r02 = r[..., 0, 0], r[..., 0, 1], r[..., 0, 2]
+    r10, r11, r12 = r[..., 1, 0], r[..., 1, 1], r[..., 1, 2]
+    r20, r21, r22 = r[..., 2, 0], r[..., 2, 1], r[..., 2, 2]
+    one = numpy.ones_like(r00)
+    # row k is 4 e_k e for the pivot k in (e0, e1, e2, e3): eqs 62-65
+    rows = numpy.stack([
+        numpy.stack([one + r00 + r11 + r22, r21 - r12, r02 - r20, r10 - r01], axis=-1),
+        numpy.stack([r21 - r12, one + r00 - r11 - r22, r01 + r10, r02 + r20], axis=-1),
+        numpy.stack([r02 - r20, r01 + r10, one - r00 + r11 - r22, r12 + r21], axis=-1),
+        numpy.stack([r10 - r01, r02 + r20, r12 + r21, one - r00 - r11 + r22], axis=-1),
+    ], axis=-2)
+    pivot = numpy.argmax(numpy.stack([r00 + r11 + r22, r00, r11, r22], axis=-1), axis=-1)
+    q = numpy.take_along_axis(rows, pivot[..., None, None], axis=-2)[..., 0, :]
+    return _from_quaternion(q[..., 0], q[..., 1:], finite, suffix)
+
+
+def compose(p1, p2):
+    """p3 with R(p3) = R(p2) R(p1): p1 applied first, then p2 (eqs 18-19; e3 = e2 o e1, eq 67).
+
+    The result is rescaled (|phi3| <= pi); NaN where an input is out of range or the result
+    is not representable.
+    """
+    a0, a, valid1, suffix = _quaternion(p1)
+    b0, b, valid2, _suffix = _quaternion(p2)
+    if a.dtype != b.dtype:
+        raise ValueError("compose: p1 and p2 must have the same dtype")
+    e0 = a0 * b0 - numpy.einsum("...i,...i->...", a, b)
+    e = a0[..., None] * b + b0[..., None] * a + numpy.cross(b, a)
+    valid = valid1 & valid2
+    e0 = numpy.where(valid, e0, 1.0).astype(a.dtype)
+    e = numpy.where(valid[..., None], e, 0.0).astype(a.dtype)
+    return _from_quaternion(e0, e, valid, suffix)
+
+
+def rescale(p):
+    """The equivalent parameter vector with |phi| <= pi (eqs 40-47); p itself when |phi| <= pi."""
+    p = _as_float(p, "p", (3,))
+    e0, e, valid, suffix = _quaternion(p)
+    flip = valid & (e0 < 0)
+    e0 = numpy.where(valid, e0, 1.0).astype(p.dtype)
+    e = numpy.where(valid[..., None], e, 0.0).astype(p.dtype)
+    rescaled = _from_quaternion(e0, e, valid, suffix)
+    kept = numpy.where(valid[..., None], p, numpy.nan).astype(p.dtype)
+    return numpy.where(flip[..., None], rescaled, kept)

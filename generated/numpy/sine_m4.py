@@ -9,209 +9,234 @@ every output is NaN.
 angle(p) -> phi; rotation_matrix(p) -> R (eq 16); tangent(p) -> H, omega = H pdot (eq 20);
 tangent_inverse(p) -> H^-1 (eq 26); tangent_det(p) -> det H (eq 24); root_matrix(p) -> G (eq 81);
 root_tangent(p) -> K (eq 83); pdot(p, omega) -> H^-1 omega (eq 25); omega(p, pdot) -> H pdot.
-"""
+
+Rotations of any size (Euler-Rodrigues parameters e = (e0, e1, e2, e3), scalar first, eqs 74-75):
+to_quaternion(p) -> e (..., 4); from_quaternion(e) -> p (normalizes e, takes the hemisphere
+e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65);
+compose(p1, p2) -> p3 with R(p3) = R(p2) R(p1), p1 applied first (eqs 18-19, 67);
+rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).  Every rotation has
+such a representation, so these results are NaN only for non-finite input."""
 
 import numpy
 
 P_MAX = 4.0
 
 
-def _p_prime_64(x, phi):
-    x = numpy.asarray(x)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float64)
+def _p_prime_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _nu_64(x, phi):
-    x = numpy.asarray(x)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float64)
+def _nu_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _epsilon_64(x, phi):
-    x = numpy.asarray(x)
-    return ((-2*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)/(x - 8)) + 0.0 * x).astype(numpy.float64)
+def _epsilon_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-2*numpy.sqrt(d)/(x - 8)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _mu_64(x, phi):
-    x = numpy.asarray(x)
-    return ((4/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float64)
+def _mu_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _det_H_64(x, phi):
-    x = numpy.asarray(x)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float64)
+def _det_H_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _R_0_64(x, phi):
+def _R_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _R_1_64(x, phi):
-    x = numpy.asarray(x)
-    return ((-0.03125*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)*(x - 8)) + 0.0 * x).astype(numpy.float64)
+def _R_1_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-0.03125*numpy.sqrt(d)*(x - 8)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _R_2_64(x, phi):
-    x = numpy.asarray(x)
-    return ((-0.03125*(numpy.sqrt(x) - 4)*(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float64)
+def _R_2_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_0_64(x, phi):
-    x = numpy.asarray(x)
-    return ((4/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float64)
+def _H_0_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_1_64(x, phi):
-    x = numpy.asarray(x)
-    return ((-0.03125*(numpy.sqrt(x) - 4)*(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float64)
+def _H_1_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_2_64(x, phi):
-    x = numpy.asarray(x)
-    return ((-0.03125*(x - 24)/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float64)
+def _H_2_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-0.03125*(x - 24)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_inverse_0_64(x, phi):
-    x = numpy.asarray(x)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float64)
+def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_inverse_1_64(x, phi):
+def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_64(x, phi):
-    x = numpy.asarray(x)
-    return (((0.25)/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float64)
+def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _G_0_64(x, phi):
+def _G_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_64(x, phi):
-    x = numpy.asarray(x)
-    return (((0.125)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float64)
+def _G_1_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.125)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _G_2_64(x, phi):
+def _G_2_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_0_64(x, phi):
-    x = numpy.asarray(x)
-    return ((2/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float64)
+def _K_0_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _K_1_64(x, phi):
+def _K_1_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_2_64(x, phi):
-    x = numpy.asarray(x)
-    return (((0.125)/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float64)
+def _K_2_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.125)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _angle_64(s):
-    return 4*numpy.arcsin((0.25)*s) + 0.0 * s
+def _e_0_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((1 - 0.125*x) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _p_prime_32(x, phi):
+def _angle_64(s, d):
+    return 4*numpy.arctan2(s, numpy.sqrt(d)) + 0.0 * s
+
+
+def _scale_64(e0, e_norm):
+    e0 = e0.astype(numpy.float64)
+    return ((2*numpy.sqrt(2)/numpy.sqrt(e0 + 1)) + 0.0 * e0).astype(numpy.float64)
+
+
+def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _nu_32(x, phi):
+def _nu_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _epsilon_32(x, phi):
+def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((-2*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)/(x - 8)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-2*numpy.sqrt(d)/(x - 8)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _mu_32(x, phi):
+def _mu_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((4/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _det_H_32(x, phi):
+def _det_H_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _R_0_32(x, phi):
+def _R_0_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _R_1_32(x, phi):
+def _R_1_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((-0.03125*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)*(x - 8)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-0.03125*numpy.sqrt(d)*(x - 8)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _R_2_32(x, phi):
+def _R_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((-0.03125*(numpy.sqrt(x) - 4)*(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_0_32(x, phi):
+def _H_0_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((4/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_1_32(x, phi):
+def _H_1_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((-0.03125*(numpy.sqrt(x) - 4)*(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_2_32(x, phi):
+def _H_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((-0.03125*(x - 24)/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-0.03125*(x - 24)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_0_32(x, phi):
+def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return (((0.25)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_1_32(x, phi):
+def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_32(x, phi):
+def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return (((0.25)/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _G_0_32(x, phi):
+def _G_0_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_32(x, phi):
+def _G_1_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return (((0.125)*numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4)) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.125)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _G_2_32(x, phi):
+def _G_2_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_0_32(x, phi):
+def _K_0_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return ((2/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _K_1_32(x, phi):
+def _K_1_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_2_32(x, phi):
+def _K_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return (((0.125)/(numpy.sqrt(4 - numpy.sqrt(x))*numpy.sqrt(numpy.sqrt(x) + 4))) + 0.0 * x).astype(numpy.float32)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.125)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _angle_32(s):
-    return 4*numpy.arcsin((0.25)*s) + 0.0 * s
+def _e_0_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    return numpy.asarray((1 - 0.125*x) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _angle_32(s, d):
+    return 4*numpy.arctan2(s, numpy.sqrt(d)) + 0.0 * s
+
+
+def _scale_32(e0, e_norm):
+    e0 = e0.astype(numpy.float64)
+    return ((2*numpy.sqrt(2)/numpy.sqrt(e0 + 1)) + 0.0 * e0).astype(numpy.float32)
 
 
 _COEFFICIENTS = {
@@ -236,6 +261,7 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "e_0": _e_0_64,
     },
     "32": {
         "p_prime": _p_prime_32,
@@ -258,67 +284,148 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_SCALE = {"64": _scale_64, "32": _scale_32}
+_USES_PHI = {
+    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
+    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
+}
+_BLOCK = 16384
+_TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
+_HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
+E0_MIN = -numpy.inf
 
 
-def _prepare(p):
-    p = numpy.asarray(p)
-    if p.dtype != numpy.float32:
-        p = p.astype(numpy.float64)
-    if p.ndim < 1 or p.shape[-1] != 3:
-        raise ValueError(f"p must have shape (..., 3), got {p.shape}")
+def _as_float(value, name, shape):
+    value = numpy.asarray(value)
+    if value.dtype != numpy.float32:
+        value = value.astype(numpy.float64)
+    if value.ndim < len(shape) or value.shape[value.ndim - len(shape):] != shape:
+        raise ValueError(f"{name} must have shape (..., {', '.join(map(str, shape))}), got {value.shape}")
+    return value
+
+
+def _norm(v):
+    """|v| over the last axis without underflow or overflow (inf for infinite, NaN for NaN input)."""
+    scale = numpy.max(numpy.abs(v), axis=-1)
+    scale = numpy.where((scale > 0) & (scale < numpy.inf), scale, 1.0).astype(v.dtype)
+    unit = v / scale[..., None]
+    return scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))
+
+
+def _two_square(a):
+    """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
+    c = 134217729.0 * a
+    high = c - (c - a)
+    low = a - high
+    square = a * a
+    return square, ((high * high - square) + 2.0 * high * low) + low * low
+
+
+def _complement(p):
+    """d = 16 - |p|^2 accurate to a few ulp of d (compensated products and sums), float64."""
+    if p.dtype == numpy.float32:
+        q = p.astype(numpy.float64)
+        return 16.0 - numpy.einsum("...i,...i->...", q, q)
+    high = numpy.full(p.shape[:-1], 16.0)
+    low = numpy.zeros(p.shape[:-1])
+    for i in range(3):
+        square, error = _two_square(p[..., i])
+        total = high - square
+        virtual = total - high
+        low = low + ((high - (total - virtual)) + (-square - virtual)) - error
+        high = total
+    return high + low
+
+
+def _length(p, suffix):
+    """(|p|^2, |p|): the one definition of |p| used by every validity test."""
+    x = numpy.asarray(numpy.einsum("...i,...i->...", p, p))
+    s = numpy.asarray(numpy.sqrt(x))
+    extreme = ~((x >= _TINY[suffix]) & (x <= _HUGE[suffix]))
+    if extreme.any():  # |p| without underflow or overflow
+        s[extreme] = _norm(p[extreme])
+    return x, s
+
+
+def _prepare(p, names):
+    """p, (x, phi, s, d, sin(phi/2), cos(phi/2)), valid, suffix: the arguments of the coefficient
+    functions ``names`` (the half-angle sine and cosine computed once for all of them).
+
+    phi is computed only when one of them needs it (None otherwise)."""
+    p = _as_float(p, "p", (3,))
     suffix = "32" if p.dtype == numpy.float32 else "64"
-    scale = numpy.max(numpy.abs(p), axis=-1)
-    scale = numpy.where(scale > 0, scale, 1.0).astype(p.dtype)
-    unit = p / scale[..., None]
-    s = scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))  # |p| without underflow
-    valid = s < P_MAX
-    p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
-    s = numpy.where(valid, s, 0.0).astype(p.dtype)
-    x = s * s
-    phi = _ANGLE[suffix](s)
-    return p, x, phi, valid, suffix
+    x, s = _length(p, suffix)
+    valid = (s < P_MAX) & (x < _HUGE[suffix])  # |p|^2 >= 2^600 (2^100 in float32): out of range
+    if not valid.all():
+        p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
+        s = numpy.where(valid, s, 0.0).astype(p.dtype)
+        x = s * s
+    d = numpy.where(valid, _complement(p), 1.0).astype(p.dtype)
+    table = _USES_PHI[suffix]
+    if any(table[name] for name in names):
+        phi = _ANGLE[suffix](s, d)
+        half = 0.5 * phi
+        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half)), valid, suffix
+    return p, (x, None, s, d, None, None), valid, suffix
 
 
 def _scalar(p, name):
-    p, x, phi, valid, suffix = _prepare(p)
-    value = _COEFFICIENTS[suffix][name](x, phi)
+    p, state, valid, suffix = _prepare(p, [name])
+    value = _COEFFICIENTS[suffix][name](*state)
     return numpy.where(valid, value, numpy.nan).astype(p.dtype)
 
 
 def _tensor(p, name):
-    p, x, phi, valid, suffix = _prepare(p)
+    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3), computed in cache-sized blocks."""
+    p = _as_float(p, "p", (3,))
+    shape = p.shape[:-1]
+    flat = p.reshape(-1, 3)
+    out = numpy.empty((flat.shape[0], 9), dtype=p.dtype)
+    for start in range(0, flat.shape[0], _BLOCK):
+        _tensor_block(flat[start:start + _BLOCK], name, out[start:start + _BLOCK])
+    return out.reshape(*shape, 3, 3)
+
+
+def _tensor_block(p, name, out):
+    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
     table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](x, phi)
-    b = table[name + "_1"](x, phi)
-    c = table[name + "_2"](x, phi)
-    diagonal = a - c * x
-    p0, p1, p2 = p[..., 0], p[..., 1], p[..., 2]
-    c0, c1, c2 = c * p0, c * p1, c * p2
+    a = table[name + "_0"](*state)
+    b = table[name + "_1"](*state)
+    c = table[name + "_2"](*state)
+    p0, p1, p2 = p.T
+    c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
-    matrix = numpy.empty((*p.shape, 3), dtype=p.dtype)
-    matrix[..., 0, 0] = diagonal + c0 * p0
-    matrix[..., 1, 1] = diagonal + c1 * p1
-    matrix[..., 2, 2] = diagonal + c2 * p2
-    matrix[..., 0, 1] = c0 * p1 - b2
-    matrix[..., 1, 0] = c0 * p1 + b2
-    matrix[..., 0, 2] = c0 * p2 + b1
-    matrix[..., 2, 0] = c0 * p2 - b1
-    matrix[..., 1, 2] = c1 * p2 - b0
-    matrix[..., 2, 1] = c1 * p2 + b0
-    matrix[~valid] = numpy.nan
-    return matrix
+    s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
+    m = numpy.empty((9, p.shape[0]), dtype=p.dtype)  # entry-major: contiguous writes
+    m[0] = a - c * (s1 + s2)  # T_ii = c0 - c2 (p_j^2 + p_k^2): no cancellation against |p|^2
+    m[4] = a - c * (s0 + s2)
+    m[8] = a - c * (s0 + s1)
+    q = c0 * p1
+    m[1] = q - b2
+    m[3] = q + b2
+    q = c0 * p2
+    m[2] = q + b1
+    m[6] = q - b1
+    q = c1 * p2
+    m[5] = q - b0
+    m[7] = q + b0
+    out[:] = m.T
+    if not valid.all():
+        out[~valid] = numpy.nan
 
 
 def _apply(p, v, name):
-    p, x, phi, valid, suffix = _prepare(p)
+    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
     v = numpy.asarray(v, dtype=p.dtype)
     table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](x, phi)[..., None]
-    b = table[name + "_1"](x, phi)[..., None]
-    c = table[name + "_2"](x, phi)[..., None]
+    x = state[0]
+    a = table[name + "_0"](*state)[..., None]
+    b = table[name + "_1"](*state)[..., None]
+    c = table[name + "_2"](*state)[..., None]
     p_cross_v = numpy.cross(p, v)
     p_dot_v = numpy.einsum("...i,...i->...", p, v)[..., None]
     result = a * v + b * p_cross_v + c * (p * p_dot_v - x[..., None] * v)
@@ -327,7 +434,8 @@ def _apply(p, v, name):
 
 def angle(p):
     """phi = |phi| from p (..., 3); NaN outside the validity range."""
-    p, _x, phi, valid, _suffix = _prepare(p)
+    p, state, valid, suffix = _prepare(p, [])
+    phi = _ANGLE[suffix](state[2], state[3])
     return numpy.where(valid, phi, numpy.nan).astype(p.dtype)
 
 
@@ -369,3 +477,112 @@ def pdot(p, omega):
 def omega(p, pdot):
     """omega = H pdot (eq 20)."""
     return _apply(p, pdot, "H")
+
+
+def _quaternion(p):
+    p, state, valid, suffix = _prepare(p, ["e_0", "nu"])
+    table = _COEFFICIENTS[suffix]
+    e0 = table["e_0"](*state)
+    e = (0.5 * table["nu"](*state))[..., None] * p
+    return e0, e, valid, suffix
+
+
+def _from_quaternion(e0, e, valid, suffix):
+    """p = sigma e on the hemisphere e0 >= 0 after normalization; NaN where not representable."""
+    dtype = e.dtype
+    # exact power-of-two scaling: subnormal or huge quaternions normalize without under/overflow
+    biggest = numpy.maximum(numpy.abs(e0), numpy.max(numpy.abs(e), axis=-1))
+    exponent = numpy.frexp(numpy.where(valid & (biggest > 0) & (biggest < numpy.inf), biggest, 1.0))[1]
+    e0 = numpy.ldexp(e0, -exponent).astype(dtype)
+    e = numpy.ldexp(e, -exponent[..., None]).astype(dtype)
+    e_norm = _norm(e)
+    n = numpy.hypot(e0, e_norm)
+    valid = valid & (n > 0) & numpy.isfinite(n)
+    n = numpy.where(valid, n, 1.0).astype(dtype)
+    sign = numpy.where(e0 < 0, -1.0, 1.0).astype(dtype)
+    e0 = numpy.abs(e0) / n
+    e = e * (sign / n)[..., None]
+    e_norm = e_norm / n
+    valid = valid & (e0 > E0_MIN)
+    e0 = numpy.where(valid, e0, 1.0).astype(dtype)
+    e_norm = numpy.where(valid, e_norm, 0.0).astype(dtype)
+    p = _SCALE[suffix](e0, e_norm)[..., None] * e
+    x, s = _length(p, suffix)
+    valid = valid & (s < P_MAX) & (x < _HUGE[suffix])
+    return numpy.where(valid[..., None], p, numpy.nan).astype(dtype)
+
+
+def to_quaternion(p):
+    """e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon (eq 74), (e1, e2, e3) = (nu/2) p (eq 75)."""
+    e0, e, valid, _suffix = _quaternion(p)
+    q = numpy.concatenate([e0[..., None], e], axis=-1)
+    return numpy.where(valid[..., None], q, numpy.nan).astype(e.dtype)
+
+
+def from_quaternion(e):
+    """p from e = (e0, e1, e2, e3) (scalar first; normalized here; e and -e give the same p).
+
+    phi = 2 atan2(|e|, |e0|) <= pi and p = (p(phi) / sin(phi/2)) e (inverse of eq 75), with the
+    sign of e chosen so that e0 >= 0 (rescaling, eqs 40-47).  NaN where not representable.
+    """
+    e = _as_float(e, "e", (4,))
+    suffix = "32" if e.dtype == numpy.float32 else "64"
+    finite = numpy.all(numpy.isfinite(e), axis=-1)
+    e = numpy.where(finite[..., None], e, 0.0).astype(e.dtype)
+    return _from_quaternion(e[..., 0], e[..., 1:], finite, suffix)
+
+
+def from_rotation_matrix(R):
+    """p from a rotation matrix (..., 3, 3): Shepperd's largest pivot (eqs 61-65), then from_quaternion.
+
+    No orthogonalization: for R = Q + D with Q a rotation the result differs from Q's parameter
+    vector by O(|D|); non-finite R gives NaN.
+    """
+    r = _as_float(R, "R", (3, 3))
+    suffix = "32" if r.dtype == numpy.float32 else "64"
+    finite = numpy.all(numpy.isfinite(r), axis=(-2, -1))
+    r = numpy.where(finite[..., None, None], r, 0.0).astype(r.dtype)
+    r00, r01, r02 = r[..., 0, 0], r[..., 0, 1], r[..., 0, 2]
+    r10, r11, r12 = r[..., 1, 0], r[..., 1, 1], r[..., 1, 2]
+    r20, r21, r22 = r[..., 2, 0], r[..., 2, 1], r[..., 2, 2]
+    one = numpy.ones_like(r00)
+    # row k is 4 e_k e for the pivot k in (e0, e1, e2, e3): eqs 62-65
+    rows = numpy.stack([
+        numpy.stack([one + r00 + r11 + r22, r21 - r12, r02 - r20, r10 - r01], axis=-1),
+        numpy.stack([r21 - r12, one + r00 - r11 - r22, r01 + r10, r02 + r20], axis=-1),
+        numpy.stack([r02 - r20, r01 + r10, one - r00 + r11 - r22, r12 + r21], axis=-1),
+        numpy.stack([r10 - r01, r02 + r20, r12 + r21, one - r00 - r11 + r22], axis=-1),
+    ], axis=-2)
+    pivot = numpy.argmax(numpy.stack([r00 + r11 + r22, r00, r11, r22], axis=-1), axis=-1)
+    q = numpy.take_along_axis(rows, pivot[..., None, None], axis=-2)[..., 0, :]
+    return _from_quaternion(q[..., 0], q[..., 1:], finite, suffix)
+
+
+def compose(p1, p2):
+    """p3 with R(p3) = R(p2) R(p1): p1 applied first, then p2 (eqs 18-19; e3 = e2 o e1, eq 67).
+
+    The result is rescaled (|phi3| <= pi); NaN where an input is out of range or the result
+    is not representable.
+    """
+    a0, a, valid1, suffix = _quaternion(p1)
+    b0, b, valid2, _suffix = _quaternion(p2)
+    if a.dtype != b.dtype:
+        raise ValueError("compose: p1 and p2 must have the same dtype")
+    e0 = a0 * b0 - numpy.einsum("...i,...i->...", a, b)
+    e = a0[..., None] * b + b0[..., None] * a + numpy.cross(b, a)
+    valid = valid1 & valid2
+    e0 = numpy.where(valid, e0, 1.0).astype(a.dtype)
+    e = numpy.where(valid[..., None], e, 0.0).astype(a.dtype)
+    return _from_quaternion(e0, e, valid, suffix)
+
+
+def rescale(p):
+    """The equivalent parameter vector with |phi| <= pi (eqs 40-47); p itself when |phi| <= pi."""
+    p = _as_float(p, "p", (3,))
+    e0, e, valid, suffix = _quaternion(p)
+    flip = valid & (e0 < 0)
+    e0 = numpy.where(valid, e0, 1.0).astype(p.dtype)
+    e = numpy.where(valid[..., None], e, 0.0).astype(p.dtype)
+    rescaled = _from_quaternion(e0, e, valid, suffix)
+    kept = numpy.where(valid[..., None], p, numpy.nan).astype(p.dtype)
+    return numpy.where(flip[..., None], rescaled, kept)

@@ -6,8 +6,10 @@ no plan of its own. For each function of :data:`FUNCTIONS` the header has a doub
 float version (suffix ``_f``, float math functions, the float32 plan), and matrix functions also a
 ``_batch`` kernel. How a plan becomes C:
 
-* x = |p|² once; outside the validity range (``!(x < p_max²)``, which also catches inf and NaN)
-  every output is NaN;
+* x = |p|² once; outside the validity range (``!(x < p_max²)``, or ``!(x < 2^600)`` (2^100 in
+  float) when p is unbounded, which also catches inf and NaN) every output is NaN; for the sine
+  family also d = p_max² − x with fma-exact products and TwoSum (``__complement``), which the plan's
+  expressions use instead of k² − x;
 * coefficients: a :class:`~symrot.plan.Constant` is folded into the output expressions, an
   :class:`~symrot.plan.Algebraic` one is a single expression in x (no branch, no trig); the
   :class:`~symrot.plan.Branch` ones of a function share one ``if (x < smallest threshold)``:
@@ -35,9 +37,11 @@ from typing import Any, Literal
 
 import sympy as sp
 
+from ..algebraic import X
 from ..api import derive
 from ..core import Derivation
 from ..errors import SymrotError
+from ..newton_start import FarStart
 from ..parsing import PHI
 from ..plan import (
     Algebraic,
@@ -48,7 +52,6 @@ from ..plan import (
     NewtonAngle,
     PrecisionPlan,
     S,
-    X,
     evaluation_plan,
 )
 from ..registry import NAMED, find_by_expression
@@ -188,12 +191,54 @@ class FunctionWriter:
     def squared_norm(self) -> Statement:
         return self.let("x", P[0] ** 2 + P[1] ** 2 + P[2] ** 2)
 
+    def prologue(self) -> list[Statement]:
+        """x = |p|², and d = p_max² − x (compensated) when the plan uses the fold complement."""
+        statements = [self.squared_norm()]
+        if self.plan.complement is not None:
+            statements.append({"kind": "let", "type": self.ctype, "name": "d",
+                               "value": f"{self.complement_helper}(p)", "ops": 20})
+        return statements
+
+    @property
+    def complement_helper(self) -> str:
+        return f"symrot_{self.header}__complement{self.suffix}"
+
+    def angle_call(self, s_text: str) -> str:
+        extra = ", d" if self.plan.complement is not None else ""
+        return f"{self.angle_helper}({s_text}{extra})"
+
+    def complement_function(self) -> dict[str, Any]:
+        """d = p_max² − |p|²: exact products (fma) and error-free sums (TwoSum), then one rounding."""
+        t = self.ctype
+        fma = "fma" if t == "double" else "fmaf"
+        k2 = self.printer.literal(sp.Integer(self.plan.complement) if self.plan.complement is not None else 0)
+        statements: list[Statement] = [{"kind": "declare", "type": t, "names": [f"high = {k2}", "low = 0"]},
+                                       {"kind": "declare", "type": "int", "names": ["i"]}]
+        body: list[Statement] = [
+            {"kind": "let", "type": t, "name": "square", "value": "p[i] * p[i]", "ops": 1},
+            {"kind": "let", "type": t, "name": "error", "value": f"{fma}(p[i], p[i], -square)", "ops": 1},
+            {"kind": "let", "type": t, "name": "total", "value": "high - square", "ops": 1},
+            {"kind": "let", "type": t, "name": "virtual_", "value": "total - high", "ops": 1},
+            {"kind": "set", "name": "low",
+             "value": "low + (((high - (total - virtual_)) + (-square - virtual_)) - error)", "ops": 6},
+            {"kind": "set", "name": "high", "value": "total", "ops": 0},
+        ]
+        statements.append({"kind": "loop", "header": "i = 0; i < 3; ++i", "body": body, "times": 3})
+        statements.append({"kind": "return", "value": "high + low", "ops": 1})
+        return {"c_name": self.complement_helper, "summary": "internal: d = p_max^2 - |p|^2, compensated",
+                "equation": "31-32, 36", "ops": ops_of(statements),
+                "notes": ["Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2",
+                          "rounded would leave no correct digit of p_max^2 - x (error-free products by",
+                          "fma, TwoSum)."],
+                "signature": f"{t} {self.complement_helper}(const {t} p[3])", "statements": statements,
+                "batch_signature": None, "output": None}
+
     def out_of_range(self) -> sp.Expr:
         """The C condition (as text) under which every output is NaN."""
         if math.isfinite(self.plan.p_max):
             bound = sp.Float(self.plan.p_max, 30) ** 2
             return f"!(x < {self.printer.literal(bound)})"
-        return f"!(x <= {self.printer.literal(LARGEST[self.precision])})"
+        return f"!(x < {self.printer.literal(TINY_X[self.precision][1])})"
 
     # -- φ ---------------------------------------------------------------------------------------
     def branch_value(self, branch: Branch, variable: sp.Symbol, target: str) -> Statement:
@@ -208,7 +253,8 @@ class FunctionWriter:
     def angle_function(self) -> dict[str, Any]:
         """The helper φ(s), s = |p| ≥ 0: the closed inverse or the safeguarded Newton iteration."""
         angle = self.precision_plan.angle
-        signature = f"{self.ctype} {self.angle_helper}({self.ctype} s)"
+        extra = f", {self.ctype} d" if self.plan.complement is not None else ""
+        signature = f"{self.ctype} {self.angle_helper}({self.ctype} s{extra})"
         if isinstance(angle, ClosedAngle):
             expression = angle.expression.subs(S, S_SYMBOL)
             statements: list[Statement] = [{"kind": "return", "value": self.c(expression),
@@ -239,10 +285,18 @@ class FunctionWriter:
              "otherwise": [self.set("phi", (sp.Symbol("low") + sp.Symbol("high")) / 2)]},
         ]
         phi_max = self.printer.literal(angle.phi_max)
+        far = angle.far
+        y = sp.Symbol("y", real=True)
+        far_value = horner(tuple(sp.Float(c, 17) for c in far.coefficients), y)
         return [
             self.let("s2", S_SYMBOL**2),
-            {"kind": "declare", "type": self.ctype, "names": [f"phi = {self.c(start)}", "low = 0",
-                                                            f"high = {phi_max}"], "ops": sp.count_ops(start)},
+            {"kind": "let", "type": self.ctype, "name": "v", "value": self.far_variable(far), "ops": 4},
+            self.let("y", 2 * sp.Symbol("v", real=True) - 1),
+            {"kind": "declare", "type": self.ctype,
+             "names": [f"phi = s < {self.printer.literal(far.switch)} ? {self.c(start)} : "
+                       f"{self.c(far_value)}",
+                       "low = 0", f"high = {phi_max}"],
+             "ops": 1 + max(sp.count_ops(start), sp.count_ops(far_value))},
             {"kind": "declare", "type": "int", "names": ["k"]},
             {"kind": "if", "condition": f"phi > {phi_max}", "then": [self.set("phi", "high")],
              "otherwise": []},
@@ -250,6 +304,19 @@ class FunctionWriter:
              "times": angle.iterations},
             {"kind": "return", "value": "phi"},
         ]
+
+    def far_variable(self, far: FarStart) -> str:
+        """v(s) of the far-field Newton start (symrot.newton_start), as C."""
+        f = "" if self.precision == "double" else "f"
+        ratio = f"s / {self.printer.literal(far.scale)}"
+        if far.kind == "fold":
+            inner = f"fmax{f}(1 - {ratio}, 0)"
+            root = {2: f"sqrt{f}({inner})", 3: f"cbrt{f}({inner})"}.get(
+                far.order, f"pow{f}({inner}, {self.printer.literal(sp.Rational(1, far.order))})")
+            return f"1 - {root}"
+        if far.kind == "linear":
+            return f"fmin{f}({ratio}, 1)"
+        return f"s / (s + {self.printer.literal(far.scale)})"
 
     def norm(self) -> list[Statement]:
         """s = |p| without underflow (x = |p|² is already computed)."""
@@ -284,11 +351,13 @@ class FunctionWriter:
         below = [self.set(f"c_{n}", horner(b.horner, X_SYMBOL)) for n, b in branches.items()]  # type: ignore[union-attr]
         closed = [b.closed.subs(PHI, PHI_SYMBOL) for b in branches.values()]  # type: ignore[union-attr]
         replacements, reduced = sp.cse(closed, symbols=sp.numbered_symbols("w"))
-        above: list[Statement] = [
-            {"kind": "let", "type": self.ctype, "name": "phi",
-             "value": f"{self.angle_helper}({self.c(sp.sqrt(X_SYMBOL))})",
-             "ops": 2 + ops_of(self.angle_function()["statements"])},
-        ]
+        above: list[Statement] = []
+        if any(b.closed.has(PHI) for b in branches.values()):  # type: ignore[union-attr]
+            above.append({"kind": "let", "type": self.ctype, "name": "phi",
+                          "value": self.angle_call(self.c(sp.sqrt(X_SYMBOL))),
+                          "ops": 2 + ops_of(self.angle_function()["statements"])})
+        if any(b.closed.has(S) for b in branches.values()):  # type: ignore[union-attr]
+            above.append(self.let("s", sp.sqrt(X_SYMBOL)))
         above += [self.let(str(symbol), value) for symbol, value in replacements]
         for (name, branch), value in zip(branches.items(), reduced, strict=True):
             assert isinstance(branch, Branch)
@@ -310,8 +379,9 @@ class FunctionWriter:
         if math.isfinite(plan.p_max):
             return [f"Valid for |p| < {plan.p_max:.17g} (|phi| < {plan.phi_max:.17g}); outside it, and for "
                     "non-finite p, every output is NaN."]
-        return [f"Valid for every finite p (|phi| < {plan.phi_max:.17g}) whose |p|^2 does not overflow; "
-                "otherwise every output is NaN."]
+        bound = "2^600" if self.precision == "double" else "2^100"
+        return [f"Valid for every p with |p|^2 < {bound} (|phi| < {plan.phi_max:.17g}); otherwise, and for "
+                "non-finite p, every output is NaN."]
 
     def coefficient_notes(self, names: list[str]) -> list[str]:
         notes = []
@@ -329,7 +399,7 @@ class FunctionWriter:
     def function(self, spec: CFunction) -> dict[str, Any]:
         name = f"symrot_{self.header}_{spec.name}{self.suffix}"
         t = self.ctype
-        statements: list[Statement] = [self.squared_norm()]
+        statements: list[Statement] = self.prologue()
         notes = self.validity_notes()
         if spec.kind == "scalar":
             signature = f"{t} {name}(const {t} p[3])"
@@ -337,7 +407,7 @@ class FunctionWriter:
                                "then": [{"kind": "return", "value": "NAN"}], "otherwise": []})
             if spec.name == "angle":
                 statements += self.norm()
-                statements.append({"kind": "return", "value": f"{self.angle_helper}(s)",
+                statements.append({"kind": "return", "value": self.angle_call("s"),
                                    "ops": ops_of(self.angle_function()["statements"])})
                 notes.append(self.angle_function()["notes"][0])
             else:
@@ -392,13 +462,18 @@ class InvalidHeaderName(SymrotError):
 
 def header_source(plan: EvaluationPlan, name: str, expression: str | None = None) -> str:
     """The text of ``symrot_NAME.h`` for ``plan``."""
+    from .c_operations import OperationWriter  # it builds on FunctionWriter
+
     if not HEADER_NAME.fullmatch(name):
         raise InvalidHeaderName(f"--name {name[:40]!r} is not a C identifier")
     functions = []
     for precision in PRECISIONS:
         writer = FunctionWriter(plan, name, precision)
+        if plan.complement is not None:
+            functions.append(writer.complement_function())
         functions.append(writer.angle_function())
         functions += [writer.function(spec) for spec in FUNCTIONS]
+        functions += OperationWriter(plan, name, precision).all()
     identifier = registry_title(plan.p)
     text = expression or sp.sstr(plan.p)
     return render(

@@ -3,8 +3,13 @@
 The module (NumPy only) exposes, for p of shape (..., 3): ``angle`` (φ), ``rotation_matrix`` (R,
 eq 16), ``tangent`` (H, ω = H ṗ, eq 20), ``tangent_inverse`` (H⁻¹, eq 26), ``tangent_det`` (det H,
 eq 24), ``root_matrix`` (G, eq 81), ``root_tangent`` (K, eq 83), ``pdot`` (ṗ = H⁻¹ ω, eq 25) and
-``omega`` (ω = H ṗ).  float32 input is evaluated with the float32 plan, anything else as float64.
-Outside the validity range |p| < p_max every output is NaN.
+``omega`` (ω = H ṗ), and the operations on rotations of any size ``to_quaternion``,
+``from_quaternion``, ``from_rotation_matrix``, ``compose`` (R(p3) = R(p2) R(p1)) and ``rescale``
+(eqs 18–19, 40–47, 61–65, 74–75).  float32 input is evaluated with the float32 plan, anything else
+as float64.  Outside the validity range |p| < p_max (|p|² < 2⁶⁰⁰ when p is unbounded) every output
+is NaN.  Tensors are evaluated in blocks of 16384 vectors (entry-major, then transposed), each
+coefficient's Horner polynomial and closed form only on the lanes where it applies, and
+sin(φ/2), cos(φ/2) once per block for all the coefficients that need them.
 """
 
 from __future__ import annotations
@@ -17,6 +22,8 @@ import numpy as np
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
+from ..algebraic import D, X
+from ..newton_start import FarStart
 from ..parsing import PHI
 from ..plan import (
     Algebraic,
@@ -26,9 +33,9 @@ from ..plan import (
     EvaluationPlan,
     NewtonAngle,
     S,
-    X,
     evaluation_plan,
 )
+from ..quaternion_plan import E0, QuaternionScale
 from .templating import render
 
 TENSORS = ("R", "H", "H_inverse", "G", "K")
@@ -68,22 +75,37 @@ def _literal(value: sp.Expr) -> str:
     return repr(float(value))
 
 
-def _branch_lines(branch: Branch, variable: str, phi: str) -> list[str]:
-    """Statements computing ``result`` from ``variable`` (t) and ``phi`` for one Branch."""
-    lines = [f"small = {variable} < {branch.threshold!r}"]
+SIN_HALF = sp.Symbol("sin_half")
+COS_HALF = sp.Symbol("cos_half")
+
+
+def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = False) -> list[str]:
+    """Statements returning the Branch value from ``variable`` (t) and ``phi``: the Horner
+    polynomial on the lanes with t < threshold, the closed form on the others (each computed on
+    its own lanes only, so neither can divide by zero and no work is wasted)."""
+    lines = [f"small = {variable} < {branch.threshold!r}", f"out = numpy.empty_like({variable})",
+             "if small.any():"]
     if len(branch.horner) > 1:
-        lines.append(f"t = numpy.where(small, {variable}, 0.0).astype({variable}.dtype)")
-    lines.append(f"phi = numpy.where(small, {branch.safe_phi!r}, {phi}).astype({variable}.dtype)")
-    lines.append(f"series = {_literal(branch.horner[-1])}")
+        lines.append(f"    t = {variable}[small]")
+    lines.append(f"    series = {_literal(branch.horner[-1])}")
     for c in reversed(branch.horner[:-1]):
-        lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
-    horner = "series"
-    closed = branch.closed.subs(PHI, sp.Symbol("phi"))
+        lines.append(f"    series = {_literal(c)} + t * series" if c != 0 else "    series = t * series")
+    lines.append("    out[small] = series")
+    lines += ["if not small.all():", "    big = ~small"]
+    closed = branch.closed
+    if half_angles:  # sin(φ/2), cos(φ/2) come precomputed, shared by the coefficients of a tensor
+        closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
+    if closed.has(PHI):
+        lines.append(f"    phi = {phi}[big]")
+    for symbol in (S, D, SIN_HALF, COS_HALF):
+        if closed.has(symbol):
+            lines.append(f"    {symbol} = {symbol}[big]")
+    closed = closed.subs(PHI, sp.Symbol("phi"))
     replacements, (reduced,) = sp.cse([closed], symbols=sp.numbered_symbols("w"))
     for symbol, value in replacements:
-        lines.append(f"{symbol} = {print_expression(value)}")
-    lines.append(f"closed = {print_expression(reduced)}")
-    lines.append(f"return numpy.where(small, {horner}, closed)")
+        lines.append(f"    {symbol} = {print_expression(value)}")
+    lines.append(f"    out[big] = {print_expression(reduced)}")
+    lines.append("return out")
     return lines
 
 
@@ -93,10 +115,15 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
         return [f"return {print_expression(expression)} + 0.0 * s"]
     start_lines = [f"start = {_literal(angle.start[-1])}"]
     start_lines += [f"start = {_literal(c)} + s2 * start" for c in reversed(angle.start[:-1])]
+    far = angle.far
+    far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", f"far = {far.coefficients[-1]!r}"]
+    far_lines += [f"far = {c!r} + y * far" for c in reversed(far.coefficients[:-1])]
     return [
         "s2 = s * s",
         *start_lines,
-        f"phi = numpy.clip(s * start, 0.0, {angle.phi_max!r}).astype(s.dtype)",
+        *far_lines,
+        f"phi = numpy.where(s < {far.switch!r}, s * start, far)",
+        f"phi = numpy.clip(phi, 0.0, {angle.phi_max!r}).astype(s.dtype)",
         "low = numpy.zeros_like(s)",
         f"high = numpy.full_like(s, {angle.phi_max!r})",
         f"for _ in range({angle.iterations}):",
@@ -112,14 +139,34 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
     ]
 
 
+def _far_variable(far: FarStart) -> str:
+    """v(s) of the far-field Newton start (symrot.newton_start)."""
+    if far.kind == "fold":
+        power = f"numpy.power({{}}, {1 / far.order!r})"
+        root = {2: "numpy.sqrt({})", 3: "numpy.cbrt({})"}.get(far.order, power)
+        return "1.0 - " + root.format(f"numpy.maximum(1.0 - s / {far.scale!r}, 0.0)")
+    if far.kind == "linear":
+        return f"numpy.minimum(s / {far.scale!r}, 1.0)"
+    return f"s / (s + {far.scale!r})"
+
+
 def module_context(plan: EvaluationPlan) -> dict[str, Any]:
     functions: list[dict[str, Any]] = []
     for label, precision in plan.precisions.items():
         functions.extend(module_context_functions(precision, SUFFIX[label]))
     p_max = plan.p_max
-    return {"name": plan.name, "p_text": str(plan.p), "functions": functions,
+    e0_min = repr(plan.e0_min) if plan.e0_min is not None else None
+    return {"name": plan.name, "p_text": str(plan.p), "functions": functions, "e0_min": e0_min,
             "names": list(plan.precisions["float64"].coefficients),
-            "p_max": repr(p_max) if np.isfinite(p_max) else None, "phi_max": repr(plan.phi_max)}
+            "p_max": repr(p_max) if np.isfinite(p_max) else None, "phi_max": repr(plan.phi_max),
+            "complement": str(plan.complement) if plan.complement is not None else None,
+            "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
+                         for label, precision in plan.precisions.items()}}
+
+
+def uses_phi(coefficient: Any) -> bool:
+    """Whether the coefficient's code needs the angle φ (a Branch whose closed form has φ)."""
+    return isinstance(coefficient, Branch) and coefficient.closed.has(PHI)
 
 
 def module_context_functions(precision: Any, suffix: str) -> list[dict[str, Any]]:
@@ -130,12 +177,17 @@ def module_context_functions(precision: Any, suffix: str) -> list[dict[str, Any]
         elif isinstance(coefficient, Algebraic):
             expression = coefficient.expression.subs(X, sp.Symbol("x"))
             # float64 intermediates: powers such as (x + 16)**4 must not overflow float32
-            body = ["x = x.astype(numpy.float64)" if suffix == "32" else "x = numpy.asarray(x)",
-                    f"return (({print_expression(expression)}) + 0.0 * x).astype("
-                    f"numpy.float{suffix})"]
+            body = ["x = x.astype(numpy.float64)"] if suffix == "32" else []
+            if expression.has(D) and suffix == "32":
+                body.append("d = d.astype(numpy.float64)")
+            value = print_expression(expression)
+            if not expression.has(X):
+                value = f"({value}) + 0.0 * x"
+            body.append(f"return numpy.asarray({value}).astype(numpy.float{suffix}, copy=False)")
         else:
-            body = _branch_lines(coefficient, "x", "phi")
-        functions.append({"name": f"_{name}_{suffix}", "args": "x, phi", "body": body})
+            body = _branch_lines(coefficient, "x", "phi", half_angles=True)
+        functions.append({"name": f"_{name}_{suffix}", "args": "x, phi, s, d, sin_half, cos_half",
+                          "body": body})
     angle = precision.angle
     if isinstance(angle, NewtonAngle):
         for helper, branch in (("_ratio", angle.ratio), ("_slope", angle.slope)):
@@ -143,8 +195,21 @@ def module_context_functions(precision: Any, suffix: str) -> list[dict[str, Any]
                               "body": _branch_lines(branch, "t", "phi")})
     angle_body = [line.replace("_ratio(phi * phi)", f"_ratio_{suffix}(phi * phi, phi)")
                   .replace("_slope(", f"_slope_{suffix}(") for line in _angle_lines(angle)]
-    functions.append({"name": f"_angle_{suffix}", "args": "s", "body": angle_body})
+    functions.append({"name": f"_angle_{suffix}", "args": "s, d", "body": angle_body})
+    functions.append({"name": f"_scale_{suffix}", "args": "e0, e_norm",
+                      "body": _scale_lines(precision.quaternion_scale, suffix)})
     return functions
+
+
+def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
+    """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.quaternion_plan)."""
+    if scale.algebraic is not None:
+        expression = scale.algebraic.subs(E0, sp.Symbol("e0"))
+        return ["e0 = e0.astype(numpy.float64)",
+                f"return (({print_expression(expression)}) + 0.0 * e0).astype(numpy.float{suffix})"]
+    assert isinstance(scale.branch, Branch)
+    return ["phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)", "t = phi * phi",
+            *_branch_lines(scale.branch, "t", "phi")]
 
 
 def module_source(plan: EvaluationPlan) -> str:

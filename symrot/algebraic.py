@@ -1,0 +1,212 @@
+"""Coefficients that are algebraic in x = |p|²: the branch-free entries of an evaluation plan.
+
+When p(φ) has a closed inverse φ = c·F(s/k) (F ∈ {asin, atan, acos}, e.g. 4 atan(s/4)), a
+coefficient c(φ) of eqs 16–26, 81–83 often becomes an algebraic function of x: for 4 tan(φ/4),
+ν²/ε = 16(16 − x)/(16 + x)² (eq 34). The reduction works on the base angle θ = F(s/k): multiple
+angles are expanded (``expand_trig``), half angles of θ replaced by their radicals (θ ∈ [0, π/2)
+on the validity range, so the positive roots), products of radicals combined and their radicands
+expanded (√(4 − √x)·√(4 + √x) → √(16 − x)).
+
+An algebraic form is only *accepted* when it is accurate in floating point: it is evaluated by
+the NumPy printer in float64 on a log grid of x from 10⁻³⁰⁰ to the edge of the range and compared
+with the closed form at 30 digits. Forms whose radicals cancel (1 − √(1 − x) near x = 0) are
+rationalized (``radsimp`` of the form or of its reciprocal) and re-checked; a form that still
+fails is rejected and the coefficient gets a Taylor/closed-form branch instead.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from .functions import mpmath_namespace
+from .parsing import PHI
+from .timeouts import bounded
+
+S = sp.Symbol("s", nonnegative=True)
+X = sp.Symbol("x", nonnegative=True)
+THETA = sp.Symbol("theta", positive=True)
+ACCEPT_ULP = 3.0
+"""Worst float64 error (ulp of max(|c|, |c(0)|)) for an algebraic form to be accepted."""
+CHECK_POINTS = 48
+UNBOUNDED_TOP = 1e40
+"""Largest x checked when p is unbounded (p → ∞ at φ_max): |φ_max − φ| down to ~1e-18 for m tan(φ/m)."""
+INVERSE_FUNCTIONS = (sp.asin, sp.atan, sp.acos)
+
+
+def base_angle(inverse: sp.Expr) -> tuple[sp.Expr, sp.Expr] | None:
+    """(c, F(arg)) with φ(s) = c·F(arg), c rational, F an inverse trigonometric function."""
+    coefficient, rest = inverse.as_coeff_Mul()
+    if isinstance(rest, INVERSE_FUNCTIONS) and coefficient.is_Rational:
+        return coefficient, rest
+    return None
+
+
+def _half_angle_radicals(expr: sp.Expr, half: sp.Expr) -> sp.Expr:
+    rules = {sp.sin: sp.sqrt((1 - sp.cos(THETA)) / 2), sp.cos: sp.sqrt((1 + sp.cos(THETA)) / 2),
+             sp.tan: sp.sin(THETA) / (1 + sp.cos(THETA))}
+    return expr.replace(lambda z: type(z) in rules and z.args[0] == half, lambda z: rules[type(z)])
+
+
+def tidy_radicals(expr: sp.Expr) -> sp.Expr:
+    """Combine products of radicals and expand their radicands; factor the result."""
+    combined = sp.powsimp(expr, force=True)
+    combined = combined.replace(
+        lambda z: isinstance(z, sp.Pow) and z.exp.is_Rational and not z.exp.is_Integer,
+        lambda z: sp.Pow(sp.factor(sp.expand(z.base)), z.exp))
+    return sp.factor(combined)
+
+
+def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
+    """c(φ(√x)) with trigonometry removed, or None (time-bounded)."""
+    base = base_angle(inverse)
+
+    def reduce() -> sp.Expr:
+        if base is None:
+            e = sp.expand_trig(closed.subs(PHI, inverse))
+        else:
+            factor, function = base
+            # φ = factor·θ; write θ = 2η so that half angles of θ are whole angles of η
+            eta = sp.Symbol("eta", positive=True)
+            e = sp.expand_trig(closed.subs(PHI, 2 * factor * eta))
+            e = _half_angle_radicals(e.subs(eta, THETA / 2), THETA / 2)
+            e = sp.expand_trig(e).subs(THETA, function)
+        e = sp.simplify(e)
+        return tidy_radicals(e.subs(S, sp.sqrt(X)))
+
+    reduced: sp.Expr | None = bounded(6, None, reduce)
+    if reduced is None or reduced.free_symbols - {X}:
+        return None
+    if any(isinstance(a, sp.Function) for a in sp.preorder_traversal(reduced)):
+        return None
+    if reduced.has(sp.sqrt(X)):
+        return None
+    at_zero = reduced.subs(X, 0)
+    if not at_zero.is_finite:
+        return None
+    return reduced
+
+
+def _check_grid(p_max: float) -> np.ndarray:
+    top = (p_max * (1 - 1e-9)) ** 2 if math.isfinite(p_max) else UNBOUNDED_TOP
+    return np.concatenate([[0.0], np.geomspace(1e-300, top, CHECK_POINTS)])
+
+
+def worst_ulp(candidate: sp.Expr, closed: sp.Expr, inverse: sp.Expr, p_max: float) -> float:
+    """Worst float64 error of ``candidate`` (NumPy printer) against ``closed`` at φ(√x), 30 digits."""
+    from .backends.numpy_backend import print_expression
+
+    source = f"def f(x):\n    return {print_expression(candidate)}\n"
+    namespace: dict[str, object] = {"numpy": np}
+    exec(compile(source, "<symrot algebraic>", "exec"), namespace)
+    function = namespace["f"]
+    reference = sp.lambdify(PHI, closed, modules=[mpmath_namespace(), "mpmath"])
+    angle = sp.lambdify(S, inverse, modules=[mpmath_namespace(), "mpmath"])
+    value_at_zero = candidate.subs(X, 0)
+    if not (value_at_zero.is_number and value_at_zero.is_finite):
+        return math.inf
+    at_zero = abs(float(value_at_zero))
+    worst = 0.0
+    grid = _check_grid(p_max)
+    digits = 30 + int(math.log10(grid[-1])) // 2 + 10  # φ is within ~1/√x of a pole
+    with mpmath.workdps(digits), np.errstate(all="ignore"):
+        for x in grid:
+            value = float(function(np.float64(x)))  # type: ignore[operator]
+            phi = angle(mpmath.sqrt(mpmath.mpf(x)))
+            try:
+                exact = mpmath.mpf(value_at_zero) if x == 0 else reference(phi)
+            except ZeroDivisionError:  # a removable singularity of the closed form on the grid
+                continue
+            scale = max(abs(float(exact)), at_zero, 1e-300)
+            if not math.isfinite(value) or (x == 0 and value != float(value_at_zero)):
+                return math.inf  # p = 0 must give exactly the identity's coefficients
+            worst = max(worst, float(abs(mpmath.mpf(value) - exact)) / (scale * np.finfo(float).eps))
+    return worst
+
+
+@lru_cache(maxsize=1024)
+def algebraic_in_x(closed: sp.Expr, inverse: sp.Expr, p_max: float) -> sp.Expr | None:
+    """An accurate algebraic form of c(φ) in x, or None (see the module docstring)."""
+    reduced = reduce_to_x(closed, inverse)
+    if reduced is None:
+        return None
+    candidates = [reduced]
+    for make in (lambda e: sp.factor(sp.radsimp(e)), lambda e: sp.factor(1 / sp.radsimp(1 / e))):
+        alternative = bounded(4, None, make, reduced)
+        if alternative is not None and alternative not in candidates and not alternative.has(sp.I):
+            candidates.append(alternative)
+    for candidate in candidates:
+        if worst_ulp(candidate, closed, inverse, p_max) <= ACCEPT_ULP:
+            return candidate
+    return None
+
+
+D = sp.Symbol("d", nonnegative=True)
+"""The complement d = p_max² − x, computed by the backends with compensated arithmetic."""
+
+
+def fold_complement(inverse: sp.Expr | None, p_max: float) -> sp.Rational | None:
+    """p_max² when φ(s) = c·asin(s/k) with k² = p_max² rational (the sine family, eqs 31, 32, 36).
+
+    There p′ → 0 at |p| = k (a fold): every quantity that vanishes or blows up there is a power of
+    √(k² − x) = k cos(φ/c), and k² − x loses all its digits when computed from a rounded x. With
+    d = k² − x accurate, those quantities keep their relative accuracy up to the edge of the range.
+    """
+    base = base_angle(inverse) if inverse is not None else None
+    if base is None or not isinstance(base[1], sp.asin) or not math.isfinite(p_max):
+        return None
+    argument = base[1].args[0]
+    k = sp.simplify(S / argument)
+    if not (k.is_Rational and k > 0) or abs(float(k) - p_max) > 1e-12 * p_max:
+        return None
+    return sp.Rational(k) ** 2
+
+
+def with_complement(expr: sp.Expr, complement: sp.Rational) -> sp.Expr:
+    """Replace every factor a·x + b with root x = complement by −a·d."""
+    def is_linear_factor(e: sp.Expr) -> bool:
+        if not (e.is_Add and e.free_symbols == {X}):
+            return False
+        poly = sp.Poly(e, X)
+        return poly.degree() == 1 and -poly.all_coeffs()[1] / poly.all_coeffs()[0] == complement
+
+    return expr.replace(is_linear_factor, lambda e: -sp.Poly(e, X).all_coeffs()[0] * D)
+
+
+def closed_with_complement(closed: sp.Expr, inverse: sp.Expr, complement: sp.Rational) -> sp.Expr:
+    """A closed form in φ with sin, cos, tan of the base angle φ/c replaced by s/k, √d/k, s/√d."""
+    base = base_angle(inverse)
+    assert base is not None
+    k = sp.sqrt(complement)
+    return _replace_base_trig(closed, PHI / base[0], S / k, sp.sqrt(D) / k)
+
+
+def closed_with_base_angle(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr:
+    """For φ = c·atan(s/k) (the tangent family, eqs 33, 34, 36): tan(φ/c) = s/k, sin(φ/c) =
+    s/√(k² + x), cos(φ/c) = k/√(k² + x), exactly. Near the pole φ/c → π/2, tan(φ/c) computed from
+    a rounded φ loses ~1/δ of its digits; these forms lose none. Unchanged for other inverses."""
+    base = base_angle(inverse)
+    if base is None or not isinstance(base[1], sp.atan):
+        return closed
+    k = sp.simplify(S / base[1].args[0])
+    if not (k.is_Rational and k > 0):
+        return closed
+    radius = sp.sqrt(k**2 + X)
+    return _replace_base_trig(closed, PHI / base[0], S / radius, k / radius)
+
+
+def _replace_base_trig(closed: sp.Expr, angle: sp.Expr, sine: sp.Expr, cosine: sp.Expr) -> sp.Expr:
+    rules = {sp.sin(angle): sine, sp.cos(angle): cosine, sp.tan(angle): sine / cosine,
+             1 - 2 * sp.sin(angle / 2) ** 2: cosine}  # the half-angle form of cos
+    return closed.xreplace(rules)
+
+
+def angle_with_complement(inverse: sp.Expr) -> sp.Expr:
+    """c·asin(s/k) as c·atan2(s, √d): accurate up to the fold s = k."""
+    base = base_angle(inverse)
+    assert base is not None
+    return base[0] * sp.atan2(S, sp.sqrt(D))

@@ -1,0 +1,238 @@
+"""C functions for rotations of any size (issue 6): quaternion conversion, composition, rescaling.
+
+Printed from the same evaluation plan as the rest of the header (:mod:`symrot.plan`, with the
+quaternion entries of :mod:`symrot.quaternion_plan`); quaternions are scalar first, matrices
+row-major. Every function that can fail returns an ``int`` status: 0 on success, 1 when an input
+is outside the validity range or not finite, or when the resulting rotation cannot be represented
+by this parameterization (|φ| ≥ φ_max with φ_max ≤ π); the output is then NaN.
+
+* ``to_quaternion`` (eqs 74–75): e₀ = cos(φ/2) (the plan coefficient ``e_0``), **e** = (ν/2) **p**;
+* ``from_quaternion``: normalizes e (``hypot``), takes the hemisphere e₀ ≥ 0 (|φ| ≤ π: this is
+  rescaling, eqs 40–47) and returns **p** = σ **e** with σ = p(φ)/sin(φ/2) from the plan (trig-free
+  in e₀ when possible, otherwise φ = 2 atan2(|**e**|, e₀) and a Taylor-safe branch in φ²);
+* ``from_rotation_matrix``: Shepperd's largest pivot (eqs 61–65); the selected row is 4 e_k e, so
+  no square root is needed before the normalization of ``from_quaternion``;
+* ``compose`` (eqs 18–19, 67): p₃ with R(p₃) = R(p₂) R(p₁), p₁ applied first: e₃ = e₂ ∘ e₁;
+* ``rescale``: **p** itself when e₀ ≥ 0, otherwise ``from_quaternion`` of −e.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import sympy as sp
+
+from ..parsing import PHI
+from ..plan import Branch
+from ..quaternion_plan import E0
+from .c_backend import LARGEST, PHI_SYMBOL, T_SYMBOL, FunctionWriter, Statement, ops_of
+
+E_SYMBOL = sp.Symbol("c0", real=True)
+NAN = "NAN"
+
+
+class OperationWriter(FunctionWriter):
+    """The operation functions of one plan in one precision."""
+
+    @property
+    def helper(self) -> str:
+        return f"symrot_{self.header}__from_quaternion{self.suffix}"
+
+    def name(self, operation: str) -> str:
+        return f"symrot_{self.header}_{operation}{self.suffix}"
+
+    def nan_out(self, output: str, count: int, status: bool = True) -> list[Statement]:
+        statements: list[Statement] = [self.set(f"{output}[{i}]", NAN) for i in range(count)]
+        statements.append({"kind": "return", "value": "1" if status else ""})
+        return statements
+
+    def entry(self, name: str, summary: str, equation: str, signature: str, statements: list[Statement],
+              notes: list[str]) -> dict[str, Any]:
+        return {"c_name": name, "summary": summary, "equation": equation, "notes": notes,
+                "ops": ops_of(statements), "signature": signature, "statements": statements,
+                "batch_signature": None, "output": None}
+
+    # -- to_quaternion ---------------------------------------------------------------------------
+    def to_quaternion(self) -> dict[str, Any]:
+        t = self.ctype
+        statements: list[Statement] = [*self.prologue(),
+                                       {"kind": "if", "condition": self.out_of_range(),
+                                        "then": self.nan_out("e", 4, status=False), "otherwise": []}]
+        body, values = self.coefficients(["e_0", "nu"])
+        statements += body
+        half_nu = values["nu"] / 2
+        statements.append(self.let("half_nu", half_nu))
+        statements.append(self.set("e[0]", values["e_0"]))
+        statements += [self.set(f"e[{i + 1}]", sp.Symbol("half_nu") * sp.Symbol(f"p[{i}]")) for i in range(3)]
+        notes = self.validity_notes() + self.coefficient_notes(["e_0", "nu"])
+        return self.entry(self.name("to_quaternion"), "Euler-Rodrigues parameters e = (e0, e1, e2, e3), "
+                          "e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p", "74-75",
+                          f"void {self.name('to_quaternion')}(const {t} p[3], {t} e[4])", statements, notes)
+
+    # -- from_quaternion (internal helper and public function) -----------------------------------
+    def scale_statements(self) -> tuple[list[Statement], str]:
+        """Statements leaving σ in ``sigma`` from ``c0`` (= e₀ ≥ 0) and ``e_norm`` (unit quaternion)."""
+        scale = self.precision_plan.quaternion_scale
+        if scale.algebraic is not None:
+            expression = scale.algebraic.subs(E0, E_SYMBOL)
+            return [self.let("sigma", expression)], f"sigma = {sp.sstr(scale.algebraic)} (trig-free in e0)"
+        branch = scale.branch
+        assert isinstance(branch, Branch)
+        statements: list[Statement] = [
+            self.let("phi", 2 * sp.atan2(sp.Symbol("e_norm", real=True), E_SYMBOL)),
+            self.let("t", PHI_SYMBOL ** 2),
+            {"kind": "declare", "type": self.ctype, "names": ["sigma"]},
+            self.branch_value(branch, T_SYMBOL, "sigma"),
+        ]
+        note = (f"sigma: Horner degree {len(branch.horner) - 1} in t = phi^2 below {branch.threshold:.6g}, "
+                f"else {sp.sstr(branch.closed.subs(PHI, sp.Symbol('phi')))}, phi = 2 atan2(|e|, e0)")
+        return statements, note
+
+    def from_quaternion_helper(self) -> dict[str, Any]:
+        t = self.ctype
+        p_lit = self.printer.literal
+        y = sp.Symbol("y", real=True)
+        sqrt = "sqrt" if t == "double" else "sqrtf"
+        e_norm_statements: list[Statement] = [
+            self.let("m", sp.Max(sp.Abs(sp.Symbol("e1")), sp.Abs(sp.Symbol("e2")), sp.Abs(sp.Symbol("e3")))),
+            self.let("y", sp.Symbol("e1") ** 2 + sp.Symbol("e2") ** 2 + sp.Symbol("e3") ** 2),
+            {"kind": "declare", "type": t, "names": ["e_norm"]},
+            {"kind": "if", "condition": f"y < {p_lit(sp.Integer(2) ** (-600 if t == 'double' else -100))}"
+             " && m > 0",
+             "then": [self.set("e_norm", f"m * {sqrt}((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + "
+                                         "(e3 / m) * (e3 / m))", ops=12)],
+             "otherwise": [self.set("e_norm", sp.sqrt(y))]},
+        ]
+        hypot = "hypot" if t == "double" else "hypotf"
+        f = "" if t == "double" else "f"
+        low, high = (("2^-500", "2^500") if t == "double" else ("2^-60", "2^60"))
+        low_lit = p_lit(sp.Integer(2) ** (-500 if t == "double" else -60))
+        high_lit = p_lit(sp.Integer(2) ** (500 if t == "double" else 60))
+        scaling: list[Statement] = [
+            {"kind": "comment", "text": f"exact power-of-two scaling when max |e_i| is outside "
+                                        f"[{low}, {high}]"},
+            {"kind": "let", "type": t, "name": "big",
+             "value": f"fmax{f}(fmax{f}(fabs{f}(e0), fabs{f}(e1)), fmax{f}(fabs{f}(e2), fabs{f}(e3)))",
+             "ops": 7},
+            {"kind": "if", "condition": f"big > 0 && big < INFINITY && (big < {low_lit} || big > {high_lit})",
+             "then": [{"kind": "declare", "type": "int", "names": ["k"]},
+                      {"kind": "call", "value": f"(void)frexp{f}(big, &k)"}]
+             + [{"kind": "set", "name": v, "value": f"ldexp{f}({v}, -k)", "ops": 1}
+                for v in ("e0", "e1", "e2", "e3")],
+             "otherwise": []},
+        ]
+        statements: list[Statement] = scaling + e_norm_statements + [
+            {"kind": "let", "type": t, "name": "n", "value": f"{hypot}(e0, e_norm)", "ops": 1},
+            {"kind": "if", "condition": f"!(n > 0) || !(n <= {p_lit(LARGEST[self.precision])})",
+             "then": self.nan_out("p", 3), "otherwise": []},
+            {"kind": "let", "type": t, "name": "f", "value": "(e0 < 0 ? -1 : 1) / n", "ops": 2},
+            {"kind": "let", "type": t, "name": "c0",
+             "value": self.c(sp.Abs(sp.Symbol("e0")) / sp.Symbol("n")), "ops": 2},
+        ]
+        if self.plan.e0_min is not None:
+            statements.append({"kind": "if", "condition": f"!(c0 > {p_lit(self.plan.e0_min)})",
+                               "then": self.nan_out("p", 3), "otherwise": []})
+        statements.append({"kind": "set", "name": "e_norm", "value": "e_norm / n", "ops": 1})
+        scale, note = self.scale_statements()
+        statements += scale
+        statements += [self.set(f"p[{i}]", sp.Symbol("sigma") * (sp.Symbol(f"e{i + 1}") * sp.Symbol("f")))
+                       for i in range(3)]
+        if math.isfinite(self.plan.p_max):
+            bound = self.printer.literal(sp.Float(self.plan.p_max, 30) ** 2)
+            statements.append({"kind": "if",
+                               "condition": f"!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < {bound})",
+                               "then": self.nan_out("p", 3), "otherwise": []})
+        statements.append({"kind": "return", "value": "0"})
+        signature = f"int {self.helper}({t} e0, {t} e1, {t} e2, {t} e3, {t} p[3])"
+        return self.entry(self.helper, "internal: p from a quaternion of any norm and sign",
+                          "75", signature, statements, [note])
+
+    def from_quaternion(self) -> dict[str, Any]:
+        t = self.ctype
+        call = f"{self.helper}(e[0], e[1], e[2], e[3], p)"
+        statements: list[Statement] = [{"kind": "return", "value": call}]
+        notes = ["e is normalized; e and -e give the same p: the hemisphere e0 >= 0 is taken (|phi| <= pi),",
+                 "which is the rescaling of eqs 40-47. Returns 0, or 1 with p = NaN when e is not finite or",
+                 "zero, or the rotation is not representable (" + self.representable_note() + ")."]
+        return self.entry(self.name("from_quaternion"), "parameter vector from Euler-Rodrigues parameters "
+                          "(scalar first)", "75",
+                          f"int {self.name('from_quaternion')}(const {t} e[4], {t} p[3])",
+                          statements, notes)
+
+    def representable_note(self) -> str:
+        if self.plan.e0_min is None:
+            return "every rotation is, for this parameterization"
+        return f"needs |phi| < {self.plan.phi_max:.17g}, i.e. e0 > {self.plan.e0_min:.17g}"
+
+    # -- from_rotation_matrix --------------------------------------------------------------------
+    def from_rotation_matrix(self) -> dict[str, Any]:
+        t = self.ctype
+        h = self.helper
+        rows = [
+            "1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1]",
+            "R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6]",
+            "R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7]",
+            "R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8]",
+        ]
+        statements: list[Statement] = [
+            {"kind": "let", "type": t, "name": "tr", "value": "R[0] + R[4] + R[8]", "ops": 2},
+            {"kind": "if", "condition": "tr >= R[0] && tr >= R[4] && tr >= R[8]",
+             "then": [{"kind": "return", "value": f"{h}({rows[0]}, p)", "ops": 4}], "otherwise": []},
+            {"kind": "if", "condition": "R[0] >= R[4] && R[0] >= R[8]",
+             "then": [{"kind": "return", "value": f"{h}({rows[1]}, p)", "ops": 6}], "otherwise": []},
+            {"kind": "if", "condition": "R[4] >= R[8]",
+             "then": [{"kind": "return", "value": f"{h}({rows[2]}, p)", "ops": 6}], "otherwise": []},
+            {"kind": "return", "value": f"{h}({rows[3]}, p)", "ops": 6},
+        ]
+        notes = ["Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the",
+                 "quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for",
+                 "R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a",
+                 "non-finite R gives status 1 and NaN."]
+        return self.entry(self.name("from_rotation_matrix"), "parameter vector from a rotation matrix",
+                          "61-65", f"int {self.name('from_rotation_matrix')}(const {t} R[9], {t} p[3])",
+                          statements, notes)
+
+    # -- compose and rescale ---------------------------------------------------------------------
+    def compose(self) -> dict[str, Any]:
+        t = self.ctype
+        to_q = self.name("to_quaternion")
+        product = ("a[0] * b[0] - (a[1] * b[1] + a[2] * b[2] + a[3] * b[3]), "
+                   "a[0] * b[1] + b[0] * a[1] + (b[2] * a[3] - b[3] * a[2]), "
+                   "a[0] * b[2] + b[0] * a[2] + (b[3] * a[1] - b[1] * a[3]), "
+                   "a[0] * b[3] + b[0] * a[3] + (b[1] * a[2] - b[2] * a[1])")
+        statements: list[Statement] = [
+            {"kind": "declare", "type": t, "names": ["a[4]", "b[4]"]},
+            {"kind": "call", "value": f"{to_q}(p1, a)"},
+            {"kind": "call", "value": f"{to_q}(p2, b)"},
+            {"kind": "return", "value": f"{self.helper}({product}, p3)", "ops": 28},
+        ]
+        notes = ["Convention: R(p3) = R(p2) R(p1), i.e. p1 is applied first, then p2 (eqs 18-19);",
+                 "quaternions: e3 = e2 o e1 (eq 67). The result is rescaled (|phi3| <= pi). Returns 0, or 1",
+                 "with p3 = NaN when p1 or p2 is out of range or the result is not representable (",
+                 self.representable_note() + ")."]
+        return self.entry(self.name("compose"), "composition of two rotations", "18-19",
+                          f"int {self.name('compose')}(const {t} p1[3], const {t} p2[3], {t} p3[3])",
+                          statements, notes)
+
+    def rescale(self) -> dict[str, Any]:
+        t = self.ctype
+        statements: list[Statement] = [
+            {"kind": "declare", "type": t, "names": ["e[4]"]},
+            {"kind": "call", "value": f"{self.name('to_quaternion')}(p, e)"},
+            {"kind": "if", "condition": "isnan(e[0])", "then": self.nan_out("q", 3), "otherwise": []},
+            {"kind": "if", "condition": "e[0] >= 0",
+             "then": [self.set(f"q[{i}]", f"p[{i}]") for i in range(3)] + [{"kind": "return", "value": "0"}],
+             "otherwise": []},
+            {"kind": "return", "value": f"{self.helper}(-e[0], -e[1], -e[2], -e[3], q)"},
+        ]
+        notes = ["The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,",
+                 "otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out",
+                 "of range."]
+        return self.entry(self.name("rescale"), "rescaling to |phi| <= pi", "40-47",
+                          f"int {self.name('rescale')}(const {t} p[3], {t} q[3])", statements, notes)
+
+    def all(self) -> list[dict[str, Any]]:
+        """Helper first, then the public functions (C needs declaration before use)."""
+        return [self.to_quaternion(), self.from_quaternion_helper(), self.from_quaternion(),
+                self.from_rotation_matrix(), self.compose(), self.rescale()]

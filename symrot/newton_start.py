@@ -1,0 +1,145 @@
+"""Starting values for the Newton iteration φ(s), s = |p|, when p(φ) has no closed inverse.
+
+The reverted series φ ≈ Σ b_k s^(2k+1) (exact, from the series engine) is an excellent start near
+s = 0 but useless far from it, and a fixed small number of Newton steps cannot repair a poor
+start: near a fold of p (p′(φ_max) = 0, e.g. eq 35 at 2π, where p_max − p ∝ (φ_max − φ)³) Newton
+converges only linearly. So beyond a switch s₀ the start is a polynomial in a variable in which
+φ is analytic up to the edge of the range:
+
+* ``fold`` (p_max finite, p′(φ_max) = 0 with a zero of order k − 1):
+  v = 1 − (1 − s/p_max)^(1/k), since φ_max − φ is analytic in (p_max − s)^(1/k);
+* ``linear`` (p_max finite, no fold): v = s/p_max;
+* ``ratio`` (p unbounded): v = s/(s + c), c = p(φ_max/2).
+
+φ(v) is interpolated at Chebyshev nodes (values from a 30-digit bisection) by a polynomial in
+y = 2v − 1, stored in monomial (Horner) form; the degree is the smallest whose start is within
+``START_TOLERANCE`` (relative to φ_max) at the midpoints. s₀ is where the reverted series' own
+relative error reaches ``SERIES_TOLERANCE``. Plan-time numerics only (mpmath, NumPy); no SymPy
+call that can hang.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from .functions import mpmath_namespace
+from .parsing import PHI
+
+START_TOLERANCE = 1e-9
+SERIES_TOLERANCE = 1e-12
+DEGREES = (8, 12, 16, 24, 32, 40)
+DIGITS = 30
+FOLD_DERIVATIVE = mpmath.mpf(10) ** -12
+
+
+@dataclass(frozen=True)
+class FarStart:
+    """φ ≈ Σ coefficients[j] y^j, y = 2v(s) − 1, used for s ≥ switch (see the module docstring)."""
+
+    kind: Literal["fold", "linear", "ratio"]
+    scale: float
+    """p_max for ``fold`` and ``linear``, c for ``ratio``."""
+    order: int
+    """k for ``fold`` (v = 1 − (1 − s/p_max)^(1/k)); 1 otherwise."""
+    coefficients: tuple[float, ...]
+    switch: float
+    measured: float
+    """Worst relative start error (of φ_max) at the check points."""
+
+
+def _p_function(p: sp.Expr) -> object:
+    return sp.lambdify(PHI, p, modules=[mpmath_namespace(), "mpmath"])
+
+
+def fold_order(p: sp.Expr, phi_max: float) -> int:
+    """1 if p′(φ_max) ≠ 0, else 1 + the order of the zero of p′ at φ_max (at most 4)."""
+    f = _p_function(p)
+    with mpmath.workdps(DIGITS):
+        at = mpmath.mpf(phi_max)
+        scale = max(abs(f(at)), 1)  # type: ignore[operator]
+        for k in range(1, 5):
+            if abs(mpmath.diff(f, at, k)) > FOLD_DERIVATIVE * scale:
+                return k
+    return 4
+
+
+def v_of_s(kind: str, scale: float, order: int, s: np.ndarray | float) -> np.ndarray:
+    """The interpolation variable v ∈ [0, 1] (float64)."""
+    s = np.asarray(s, dtype=np.float64)
+    if kind == "fold":
+        return np.asarray(1.0 - np.power(np.maximum(1.0 - s / scale, 0.0), 1.0 / order))
+    if kind == "linear":
+        return np.asarray(np.minimum(s / scale, 1.0))
+    return np.asarray(s / (s + scale))
+
+
+def _s_of_v(kind: str, scale: float, order: int, v: mpmath.mpf) -> mpmath.mpf:
+    if kind == "fold":
+        return scale * (1 - (1 - v) ** order)
+    if kind == "linear":
+        return scale * v
+    return scale * v / (1 - v)
+
+
+def _phi_of_s(f: object, s: mpmath.mpf, phi_max: mpmath.mpf) -> mpmath.mpf:
+    low, high = mpmath.mpf(0), phi_max
+    for _ in range(110):
+        middle = (low + high) / 2
+        low, high = (middle, high) if f(middle) < s else (low, middle)  # type: ignore[operator]
+    return (low + high) / 2
+
+
+def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, ...]) -> FarStart:
+    """The far-field start for p(φ) on 0 ≤ φ < φ_max (|p| < p_max)."""
+    f = _p_function(p)
+    if math.isfinite(p_max):
+        order = fold_order(p, phi_max)
+        kind: Literal["fold", "linear", "ratio"] = "fold" if order > 1 else "linear"
+        scale = p_max
+    else:
+        kind, order = "ratio", 1
+        with mpmath.workdps(DIGITS):
+            scale = float(f(mpmath.mpf(phi_max) / 2))  # type: ignore[operator]
+    with mpmath.workdps(DIGITS):
+        top = mpmath.mpf(phi_max)
+
+        def phi_at_v(v: float) -> float:
+            if v >= 1:
+                return phi_max
+            return float(_phi_of_s(f, _s_of_v(kind, scale, order, mpmath.mpf(v)), top))
+
+        checks = np.linspace(0.0, 1.0, 97)[1:-1]
+        check_values = np.array([phi_at_v(v) for v in checks])
+        best: tuple[float, tuple[float, ...]] = (math.inf, ())
+        for degree in DEGREES:
+            nodes = np.cos(np.pi * (np.arange(degree + 1) + 0.5) / (degree + 1))
+            values = np.array([phi_at_v((y + 1) / 2) for y in nodes])
+            chebyshev = np.polynomial.chebyshev.Chebyshev.fit(nodes, values, degree, domain=[-1, 1])
+            monomial = chebyshev.convert(kind=np.polynomial.Polynomial).coef
+            estimate = np.polynomial.polynomial.polyval(2 * checks - 1, monomial)
+            error = float(np.max(np.abs(estimate - check_values))) / phi_max
+            if error < best[0]:
+                best = (error, tuple(float(c) for c in monomial))
+            if error <= START_TOLERANCE:
+                break
+        switch = _series_switch(f, series, phi_max)
+    return FarStart(kind, float(scale), order, best[1], switch, best[0])
+
+
+def _series_switch(f: object, series: tuple[sp.Expr, ...], phi_max: float) -> float:
+    """Largest s on a log grid below which the reverted series is within SERIES_TOLERANCE."""
+    coefficients = [mpmath.mpf(sp.N(c, DIGITS)) for c in series]
+    switch = 0.0
+    for angle in np.geomspace(1e-6, phi_max * 0.99, 80):
+        s = f(mpmath.mpf(angle))  # type: ignore[operator]
+        estimate = s * mpmath.polyval(coefficients[::-1], s * s)
+        if abs(estimate - angle) > SERIES_TOLERANCE * angle:
+            break
+        switch = float(s)
+    return switch
