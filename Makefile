@@ -2,9 +2,10 @@
 PYTHON ?= python3
 PIP ?= $(PYTHON) -m pip
 PYTEST_ARGS ?=
+SYMFORCE_VENV ?= /tmp/symforce_venv
 
 .DEFAULT_GOAL := help
-.PHONY: audit help setup setup-system setup-python test lint typecheck pytest generate check-generated bench clean
+.PHONY: audit help setup setup-bench setup-system setup-python test lint typecheck pytest generate check-generated bench clean
 
 help: ## List the targets with what they do
 	@grep -E '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-16s %s\n", $$1, $$2}'
@@ -28,6 +29,10 @@ setup-system: ## Install gcc, clang (+ sanitizer runtime), Eigen (bench peer), a
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
 	fi
 
+setup-bench: ## Install the benchmark peer SymForce in $(SYMFORCE_VENV) (bench/c_speed.py; not needed by the tests)
+	test -x $(SYMFORCE_VENV)/bin/python || $(PYTHON) -m venv $(SYMFORCE_VENV)
+	$(SYMFORCE_VENV)/bin/pip install -q symforce
+
 setup-python: ## pip install symrot in editable mode with its dev extras
 	$(PIP) install -q -e '.[dev]'
 
@@ -50,7 +55,9 @@ check-generated: ## Fail with a diff when generated/ is stale
 
 bench: ## Benchmarks (accuracy and speed); writes docs/*.md
 	$(PYTHON) -m symrot.generate --list >/dev/null
-	@for script in bench/*.py; do echo "== $$script"; $(PYTHON) $$script || exit 1; done
+	@for script in bench/*.py; do echo "== $$script"; \
+	  SYMROT_SYMFORCE_PYTHON=$$(test -x $(SYMFORCE_VENV)/bin/python && echo $(SYMFORCE_VENV)/bin/python || echo $(PYTHON)) \
+	  $(PYTHON) $$script || exit 1; done
 
 clean: ## Remove build and cache files
 	rm -rf build dist *.egg-info .pytest_cache .mypy_cache .ruff_cache .hypothesis

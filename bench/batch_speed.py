@@ -71,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
              "ratio against from_rotvec, or from_mrp for Wiener-Milenkovic = 4 x MRP).", "",
              "| kernel | seconds | ratio to scipy |", "|---|---|---|"]
     lines += [f"| {label} | {seconds:.4f} | {ratio:.2f} |" for label, seconds, ratio in rows]
-    section = "\n".join(lines) + "\n"
+    section = "\n".join(lines) + "\n\n"
     print(section)
     out = Path(args.out)
     text = out.read_text(encoding="utf-8") if out.exists() else "# Performance\n\n"

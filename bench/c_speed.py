@@ -11,7 +11,7 @@ Measured in one run, side by side, on the same random parameter vectors:
 
 SymForce pins its own tool versions, so it is looked for in the Python named by
 ``$SYMROT_SYMFORCE_PYTHON`` (default: this one); set up with
-``python -m venv /tmp/symforce_venv && /tmp/symforce_venv/bin/pip install symforce``.
+``make setup-bench`` (a venv in /tmp/symforce_venv).
 
 Run: ``python bench/c_speed.py`` (writes the "C backend" section of docs/performance.md).
 """

@@ -160,6 +160,20 @@ class EvaluationPlan:
     complement: sp.Rational | None = None
     """p_max² when expressions use the symbol ``D`` = p_max² − x, which backends must compute with
     compensated arithmetic (:func:`symrot.algebraic.fold_complement`)."""
+    p_max_squared_exact: sp.Float | None = None
+    """p_max² at 50 digits (None when p is unbounded): see :meth:`boundary`."""
+
+    def boundary(self, mantissa_bits: int) -> tuple[float, bool]:
+        """(B, inclusive) for a binary type with that many mantissa bits: B = p_max² rounded to the
+        type; inclusive when B lies below the exact p_max², so that x = |p|² ≤ B is inside the range
+        (e.g. p = fl(2π) u for the rotation vector); otherwise inside means x < B."""
+        if self.p_max_squared_exact is None:
+            return float("inf"), False
+        with mpmath.workprec(200):
+            exact = mpmath.mpf(self.p_max_squared_exact._to_mpmath(200))
+            with mpmath.workprec(mantissa_bits):
+                rounded = +exact
+            return float(rounded), bool(rounded < exact)
 
 
 def well_conditioned(expr: sp.Expr) -> sp.Expr:
@@ -324,7 +338,16 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
                             if isinstance(c, Branch) else c for n, c in coefficients.items()}
         precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale)
-    return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement)
+    return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
+                          _p_max_squared(p, limits.phi_max, p_max))
+
+
+def _p_max_squared(p: sp.Expr, phi_max: sp.Expr, p_max: float) -> sp.Float | None:
+    """p(φ_max)² at 50 digits, or None when p is unbounded."""
+    if not np.isfinite(p_max):
+        return None
+    exact = sp.N(p.subs(PHI, phi_max) ** 2, 50)
+    return exact if exact.is_real and exact.is_finite else sp.Float(p_max * p_max, 50)
 
 
 def _use_complement(coefficient: Coefficient, inverse: sp.Expr, complement: sp.Rational) -> Coefficient:

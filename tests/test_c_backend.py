@@ -252,6 +252,26 @@ def test_outside_the_validity_range_every_output_is_nan(name: str, builds: dict)
             assert np.all(np.isnan(values)), (name, precision, function.name, values)
 
 
+@pytest.mark.parametrize("precision, dtype", [("double", np.float64), ("float", np.float32)])
+def test_the_boundary_is_decided_on_the_exact_range(precision: str, dtype: type, builds: dict) -> None:
+    """p = fl(2π) u lies inside |φ| < 2π in double (fl(2π) < 2π) but outside in float
+    (fl₃₂(2π) > 2π): C and NumPy agree, and inside means a finite result."""
+    library = builds["gcc-O2-nofma"].load()
+    module = numpy_module("rotation_vector")
+    p = np.array([[2 * np.pi, 0, 0], [0, 0, -2 * np.pi]], dtype=dtype)
+    inside = precision == "double"
+    for function in FUNCTIONS:
+        c_values = library.call("rotation_vector", function, precision, p, np.ones_like(p))
+        args = (p, np.ones_like(p)) if function.kind == "vector" else (p,)
+        np_values = np.asarray(getattr(module, function.name)(*args))
+        if function.name in ("tangent_inverse", "pdot", "tangent_det"):  # singular there (cot φ/2)
+            continue
+        assert np.isfinite(c_values).all() == inside and np.isfinite(np_values).all() == inside, function.name
+    rotation = module.rotation_matrix(p)
+    if inside:
+        np.testing.assert_allclose(rotation, np.broadcast_to(np.eye(3), rotation.shape), atol=1e-14)
+
+
 # -- the header text ------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", COVERED)
 def test_header_text_follows_the_contract(name: str) -> None:

@@ -81,7 +81,7 @@ static inline double symrot_det_h_one__phi(double s)
 static inline double symrot_det_h_one_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         return NAN;
     }
     double s;
@@ -105,7 +105,7 @@ static inline double symrot_det_h_one_angle(const double p[3])
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -158,7 +158,7 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -216,7 +216,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -270,7 +270,7 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
 static inline double symrot_det_h_one_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         return NAN;
     }
     return 1;
@@ -285,7 +285,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -339,7 +339,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -399,7 +399,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -436,7 +436,7 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -474,7 +474,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.243134665607638)) {
+    if (!(x <= 11.243134665607636)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;
@@ -542,7 +542,7 @@ static inline int symrot_det_h_one__from_quaternion(double e0, double e1, double
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 11.243134665607638)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) <= 11.243134665607636)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;
@@ -669,7 +669,7 @@ static inline float symrot_det_h_one__phi_f(float s)
 static inline float symrot_det_h_one_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         return NAN;
     }
     float s;
@@ -693,7 +693,7 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -746,7 +746,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -804,7 +804,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -858,7 +858,7 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
 static inline float symrot_det_h_one_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         return NAN;
     }
     return 1;
@@ -873,7 +873,7 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -927,7 +927,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -986,7 +986,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -1023,7 +1023,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -1061,7 +1061,7 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 11.2431345F)) {
+    if (!(x <= 11.2431345F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;
@@ -1131,7 +1131,7 @@ static inline int symrot_det_h_one__from_quaternion_f(float e0, float e1, float 
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 11.2431345F)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) <= 11.2431345F)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;

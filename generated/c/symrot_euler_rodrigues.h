@@ -444,7 +444,7 @@ static inline int symrot_euler_rodrigues__from_quaternion(double e0, double e1, 
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 4.0)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 4.0)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;
@@ -935,7 +935,7 @@ static inline int symrot_euler_rodrigues__from_quaternion_f(float e0, float e1, 
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 4.0F)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 4.0F)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;

@@ -484,7 +484,7 @@ static inline int symrot_linear__from_quaternion(double e0, double e1, double e2
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 1.0)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 1.0)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;
@@ -1015,7 +1015,7 @@ static inline int symrot_linear__from_quaternion_f(float e0, float e1, float e2,
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 1.0F)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 1.0F)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;

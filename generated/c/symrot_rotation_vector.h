@@ -46,7 +46,7 @@ static inline double symrot_rotation_vector__phi(double s)
 static inline double symrot_rotation_vector_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         return NAN;
     }
     double s;
@@ -70,7 +70,7 @@ static inline double symrot_rotation_vector_angle(const double p[3])
 static inline void symrot_rotation_vector_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -123,7 +123,7 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
 static inline void symrot_rotation_vector_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -174,7 +174,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
 static inline void symrot_rotation_vector_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -222,7 +222,7 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
 static inline double symrot_rotation_vector_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         return NAN;
     }
     double c_det_H;
@@ -244,7 +244,7 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
 static inline void symrot_rotation_vector_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -295,7 +295,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
 static inline void symrot_rotation_vector_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -346,7 +346,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
 static inline void symrot_rotation_vector_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -377,7 +377,7 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
 static inline void symrot_rotation_vector_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -408,7 +408,7 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
 static inline void symrot_rotation_vector_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.47841760435743)) {
+    if (!(x <= 39.47841760435743)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;
@@ -476,7 +476,7 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 39.47841760435743)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) <= 39.47841760435743)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;
@@ -569,7 +569,7 @@ static inline float symrot_rotation_vector__phi_f(float s)
 static inline float symrot_rotation_vector_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         return NAN;
     }
     float s;
@@ -593,7 +593,7 @@ static inline float symrot_rotation_vector_angle_f(const float p[3])
 static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -646,7 +646,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
 static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -697,7 +697,7 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
 static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -745,7 +745,7 @@ static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, cons
 static inline float symrot_rotation_vector_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         return NAN;
     }
     float c_det_H;
@@ -767,7 +767,7 @@ static inline float symrot_rotation_vector_tangent_det_f(const float p[3])
 static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -818,7 +818,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
 static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -869,7 +869,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
 static inline void symrot_rotation_vector_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -900,7 +900,7 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
 static inline void symrot_rotation_vector_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -931,7 +931,7 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
 static inline void symrot_rotation_vector_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 39.478416F)) {
+    if (!(x <= 39.478416F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;
@@ -999,7 +999,7 @@ static inline int symrot_rotation_vector__from_quaternion_f(float e0, float e1, 
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 39.478416F)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) <= 39.478416F)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;

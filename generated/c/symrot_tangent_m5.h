@@ -46,7 +46,7 @@ static inline double symrot_tangent_m5__phi(double s)
 static inline double symrot_tangent_m5_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         return NAN;
     }
     double s;
@@ -70,7 +70,7 @@ static inline double symrot_tangent_m5_angle(const double p[3])
 static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -123,7 +123,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
 static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -178,7 +178,7 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
 static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -229,7 +229,7 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
 static inline double symrot_tangent_m5_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         return NAN;
     }
     double c_det_H;
@@ -252,7 +252,7 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
 static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -304,7 +304,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
 static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -358,7 +358,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
 static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -392,7 +392,7 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
 static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -427,7 +427,7 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
 static inline void symrot_tangent_m5_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 236.80339887498945)) {
+    if (!(x <= 236.80339887498948)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;
@@ -494,7 +494,7 @@ static inline int symrot_tangent_m5__from_quaternion(double e0, double e1, doubl
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 236.80339887498945)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) <= 236.80339887498948)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;
@@ -1036,7 +1036,7 @@ static inline int symrot_tangent_m5__from_quaternion_f(float e0, float e1, float
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < 236.8034F)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 236.8034F)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;

@@ -20,6 +20,7 @@ such a representation, so these results are NaN only for non-finite input."""
 import numpy
 
 P_MAX = numpy.inf
+P_MAX_SQUARED = numpy.inf  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
@@ -311,6 +312,12 @@ def _length(p, suffix):
     return x, s
 
 
+def _inside(x, suffix):
+    """The validity test on x = |p|^2 (as in the C header); |p|^2 >= 2^600 (2^100 in float32) is
+    outside even when p is unbounded."""
+    return (x < P_MAX_SQUARED) & (x < _HUGE[suffix])
+
+
 def _prepare(p, names):
     """p, (x, phi, s, d, sin(phi/2), cos(phi/2)), valid, suffix: the arguments of the coefficient
     functions ``names`` (the half-angle sine and cosine computed once for all of them).
@@ -319,7 +326,7 @@ def _prepare(p, names):
     p = _as_float(p, "p", (3,))
     suffix = "32" if p.dtype == numpy.float32 else "64"
     x, s = _length(p, suffix)
-    valid = (s < P_MAX) & (x < _HUGE[suffix])  # |p|^2 >= 2^600 (2^100 in float32): out of range
+    valid = _inside(x, suffix)
     if not valid.all():
         p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
         s = numpy.where(valid, s, 0.0).astype(p.dtype)
@@ -467,8 +474,7 @@ def _from_quaternion(e0, e, valid, suffix):
     e0 = numpy.where(valid, e0, 1.0).astype(dtype)
     e_norm = numpy.where(valid, e_norm, 0.0).astype(dtype)
     p = _SCALE[suffix](e0, e_norm)[..., None] * e
-    x, s = _length(p, suffix)
-    valid = valid & (s < P_MAX) & (x < _HUGE[suffix])
+    valid = valid & _inside(_length(p, suffix)[0], suffix)
     return numpy.where(valid[..., None], p, numpy.nan).astype(dtype)
 
 

@@ -132,6 +132,7 @@ TINY_X = {"double": (sp.Integer(2) ** -600, sp.Integer(2) ** 600),
 |p|² < first, down to the smallest subnormal, q² is a normal number and cannot overflow."""
 LARGEST = {"double": sp.Float("1.7976931348623157e308", 20), "float": sp.Float("3.4028234663852886e38", 20)}
 PLAN_LABEL = {"double": "float64", "float": "float32"}
+MANTISSA = {"double": 53, "float": 24}
 X_SYMBOL = sp.Symbol("x", real=True)
 S_SYMBOL = sp.Symbol("s", real=True)
 PHI_SYMBOL = sp.Symbol("phi", real=True)
@@ -191,6 +192,16 @@ class FunctionWriter:
     def squared_norm(self) -> Statement:
         return self.let("x", P[0] ** 2 + P[1] ** 2 + P[2] ** 2)
 
+    @property
+    def bound(self) -> float:
+        """p_max² rounded to this precision (see ``EvaluationPlan.boundary``)."""
+        return self.plan.boundary(MANTISSA[self.precision])[0]
+
+    @property
+    def inside_operator(self) -> str:
+        """``<=`` when the rounded p_max² lies below the exact one (x equal to it is inside), else ``<``."""
+        return "<=" if self.plan.boundary(MANTISSA[self.precision])[1] else "<"
+
     def prologue(self) -> list[Statement]:
         """x = |p|², and d = p_max² − x (compensated) when the plan uses the fold complement."""
         statements = [self.squared_norm()]
@@ -236,8 +247,7 @@ class FunctionWriter:
     def out_of_range(self) -> sp.Expr:
         """The C condition (as text) under which every output is NaN."""
         if math.isfinite(self.plan.p_max):
-            bound = sp.Float(self.plan.p_max, 30) ** 2
-            return f"!(x < {self.printer.literal(bound)})"
+            return f"!(x {self.inside_operator} {self.printer.literal(self.bound)})"
         return f"!(x < {self.printer.literal(TINY_X[self.precision][1])})"
 
     # -- φ ---------------------------------------------------------------------------------------

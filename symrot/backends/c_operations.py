@@ -139,9 +139,10 @@ class OperationWriter(FunctionWriter):
         statements += [self.set(f"p[{i}]", sp.Symbol("sigma") * (sp.Symbol(f"e{i + 1}") * sp.Symbol("f")))
                        for i in range(3)]
         if math.isfinite(self.plan.p_max):
-            bound = self.printer.literal(sp.Float(self.plan.p_max, 30) ** 2)
+            bound = self.printer.literal(self.bound)
+            squared = "(p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2])"  # as x in every function
             statements.append({"kind": "if",
-                               "condition": f"!(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] < {bound})",
+                               "condition": f"!({squared} {self.inside_operator} {bound})",
                                "then": self.nan_out("p", 3), "otherwise": []})
         statements.append({"kind": "return", "value": "0"})
         signature = f"int {self.helper}({t} e0, {t} e1, {t} e2, {t} e3, {t} p[3])"

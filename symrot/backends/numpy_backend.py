@@ -156,10 +156,13 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
         functions.extend(module_context_functions(precision, SUFFIX[label]))
     p_max = plan.p_max
     e0_min = repr(plan.e0_min) if plan.e0_min is not None else None
+    squared, inclusive = plan.boundary(53)  # float32 x compares exactly against the double bound
     return {"name": plan.name, "p_text": str(plan.p), "functions": functions, "e0_min": e0_min,
             "names": list(plan.precisions["float64"].coefficients),
             "p_max": repr(p_max) if np.isfinite(p_max) else None, "phi_max": repr(plan.phi_max),
             "complement": str(plan.complement) if plan.complement is not None else None,
+            "p_max_squared": repr(squared) if np.isfinite(squared) else "numpy.inf",
+            "inclusive": inclusive,
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()}}
 
