@@ -53,6 +53,7 @@ polynomial, then the fewest distinct trigonometric arguments (sin a and cos a: o
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
@@ -92,6 +93,7 @@ GRID_POINTS = 56
 EDGE_POINTS = 12
 JITTER = 0.0137
 JITTER_SAMPLES = 6
+ALGEBRAIC_BUDGET_SECONDS = 20.0
 PRECISIONS: dict[str, type[np.floating]] = {"float64": np.float64, "float32": np.float32}
 CLOSED_TOLERANCE_ULP = 1.5
 NEWTON_ITERATIONS = 6
@@ -308,6 +310,10 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     x_of_phi = p ** 2
     p_max = float(limits.p_max_float)
     complement = fold_complement(inverse, p_max)
+    # the algebraic search of one plan is capped (a few seconds for every named parameterization;
+    # expressions whose forms never simplify would otherwise spend minutes): past it, branches
+    algebraic_deadline = time.monotonic() + ALGEBRAIC_BUDGET_SECONDS
+    algebraic_forms: dict[str, sp.Expr | None] = {}
     precisions = {}
     for label, dtype in PRECISIONS.items():
         coefficients: dict[str, Coefficient] = {}
@@ -317,9 +323,14 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                 coefficients[coefficient] = Constant(constant)
                 continue
             if inverse is not None:
-                simplest_form = derivation.simplified_coefficients()[coefficient]
-                algebraic = (algebraic_in_x(simplest_form, inverse, p_max)
-                             or algebraic_in_x(closed, inverse, p_max))
+                if coefficient not in algebraic_forms:  # the first precision searches, both use it
+                    simplest_form = derivation.simplified_coefficients()[coefficient]
+                    found = None
+                    if time.monotonic() < algebraic_deadline:
+                        found = (algebraic_in_x(simplest_form, inverse, p_max)
+                                 or algebraic_in_x(closed, inverse, p_max))
+                    algebraic_forms[coefficient] = found
+                algebraic = algebraic_forms[coefficient]
                 if algebraic is not None:
                     coefficients[coefficient] = Algebraic(algebraic)
                     continue
