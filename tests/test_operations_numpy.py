@@ -53,7 +53,7 @@ USER_EXPRESSION = "cbrt(6*(phi-sin(phi)))"
 C_P = 8.0
 C_R = 8.0
 EXAMPLES = 25
-SETTINGS = settings(max_examples=EXAMPLES, deadline=None,
+SETTINGS = settings(max_examples=EXAMPLES, deadline=None, derandomize=True, database=None,  # same in CI
                     phases=[Phase.explicit, Phase.reuse, Phase.generate],  # no minutes-long shrinking
                     suppress_health_check=[HealthCheck.function_scoped_fixture])
 EPS = {np.dtype(np.float64): float(np.finfo(np.float64).eps),
@@ -565,7 +565,10 @@ def test_out_of_range_compose_is_nan(module_dir: Path, name: str, first: Rotatio
     nan = np.isnan(p3).any(-1)
     assert np.array_equal(nan, np.isnan(p3).all(-1))
     margin = 1e-9  # the rounded inputs are these rotations to ~1e-16; 1e-9 is far outside rounding
-    assert not nan[phi3 < param.phi_max - margin].any(), (phi3[nan], p3[nan])
+    # inside: for sin φ the range ends at a fold (p′(π/2) = 0): φ within √(8ε) ≈ 4e-8 of π/2 has
+    # |p| within 4ε of 1, where the rounding of |p|² decides; the quaternion test beyond is sharp
+    inside_margin = 1e-7 if name == "linear" else margin
+    assert not nan[phi3 < param.phi_max - inside_margin].any(), (phi3[nan], p3[nan])
     if name == "linear":
         assert nan[phi3 > param.phi_max + margin].all(), (phi3, p3)
     finite = ~nan

@@ -370,7 +370,7 @@ static inline void symrot_cayley_gibbs_rodrigues_to_quaternion(const double p[3]
 
 /* symrot_cayley_gibbs_rodrigues__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma = 2/e0 (trig-free in e0)
- * ops: 50 */
+ * ops: 34 */
 static inline int symrot_cayley_gibbs_rodrigues__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -383,15 +383,8 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion(double e0, doub
         e2 = ldexp(e2, -k);
         e3 = ldexp(e3, -k);
     }
-    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
     const double y = (e1*e1) + (e2*e2) + (e3*e3);
-    double e_norm;
-    if (y < 2.409919865102884e-181 && m > 0) {
-        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
-    } else {
-        e_norm = sqrt(y);
-    }
-    const double n = hypot(e0, e_norm);
+    const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
         p[0] = NAN;
         p[1] = NAN;
@@ -406,7 +399,6 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion(double e0, doub
         p[2] = NAN;
         return 1;
     }
-    e_norm = e_norm / n;
     const double sigma = 2/c0;
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
@@ -822,7 +814,7 @@ static inline void symrot_cayley_gibbs_rodrigues_to_quaternion_f(const float p[3
 
 /* symrot_cayley_gibbs_rodrigues__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma = 2/e0 (trig-free in e0)
- * ops: 50 */
+ * ops: 34 */
 static inline int symrot_cayley_gibbs_rodrigues__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -835,15 +827,8 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion_f(float e0, flo
         e2 = ldexpf(e2, -k);
         e3 = ldexpf(e3, -k);
     }
-    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
     const float y = (e1*e1) + (e2*e2) + (e3*e3);
-    float e_norm;
-    if (y < 7.888609e-31F && m > 0) {
-        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
-    } else {
-        e_norm = sqrtf(y);
-    }
-    const float n = hypotf(e0, e_norm);
+    const float n = sqrtf((e0*e0) + y);
     if (!(n > 0) || !(n <= 3.4028235e+38F)) {
         p[0] = NAN;
         p[1] = NAN;
@@ -858,7 +843,6 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion_f(float e0, flo
         p[2] = NAN;
         return 1;
     }
-    e_norm = e_norm / n;
     const float sigma = 2/c0;
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;

@@ -434,7 +434,7 @@ static inline void symrot_rotation_vector_to_quaternion(const double p[3], doubl
 
 /* symrot_rotation_vector__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma: Horner degree 1 in t = phi^2 below 6.57462e-14, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 56 */
+ * ops: 41 */
 static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -447,15 +447,9 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
         e2 = ldexp(e2, -k);
         e3 = ldexp(e3, -k);
     }
-    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
     const double y = (e1*e1) + (e2*e2) + (e3*e3);
-    double e_norm;
-    if (y < 2.409919865102884e-181 && m > 0) {
-        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
-    } else {
-        e_norm = sqrt(y);
-    }
-    const double n = hypot(e0, e_norm);
+    const double e_norm = sqrt(y);
+    const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
         p[0] = NAN;
         p[1] = NAN;
@@ -463,9 +457,7 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
-    const double c0 = fabs(e0)/n;
-    e_norm = e_norm / n;
-    const double phi = 2*atan2(e_norm, c0);
+    const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
     if (t < 6.574622895991269e-14) {
@@ -957,7 +949,7 @@ static inline void symrot_rotation_vector_to_quaternion_f(const float p[3], floa
 
 /* symrot_rotation_vector__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma: Horner degree 0 in t = phi^2 below 6.57462e-14, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 56 */
+ * ops: 41 */
 static inline int symrot_rotation_vector__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -970,15 +962,9 @@ static inline int symrot_rotation_vector__from_quaternion_f(float e0, float e1, 
         e2 = ldexpf(e2, -k);
         e3 = ldexpf(e3, -k);
     }
-    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
     const float y = (e1*e1) + (e2*e2) + (e3*e3);
-    float e_norm;
-    if (y < 7.888609e-31F && m > 0) {
-        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
-    } else {
-        e_norm = sqrtf(y);
-    }
-    const float n = hypotf(e0, e_norm);
+    const float e_norm = sqrtf(y);
+    const float n = sqrtf((e0*e0) + y);
     if (!(n > 0) || !(n <= 3.4028235e+38F)) {
         p[0] = NAN;
         p[1] = NAN;
@@ -986,9 +972,7 @@ static inline int symrot_rotation_vector__from_quaternion_f(float e0, float e1, 
         return 1;
     }
     const float f = (e0 < 0 ? -1 : 1) / n;
-    const float c0 = fabsf(e0)/n;
-    e_norm = e_norm / n;
-    const float phi = 2*atan2f(e_norm, c0);
+    const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
     if (t < 6.5746237e-14F) {

@@ -466,7 +466,7 @@ static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
 
 /* symrot_sine_m3__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma: Horner degree 3 in t = phi^2 below 0.00281963, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 62 */
+ * ops: 47 */
 static inline int symrot_sine_m3__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -479,15 +479,9 @@ static inline int symrot_sine_m3__from_quaternion(double e0, double e1, double e
         e2 = ldexp(e2, -k);
         e3 = ldexp(e3, -k);
     }
-    const double m = fmax(fabs(e1), fmax(fabs(e2), fabs(e3)));
     const double y = (e1*e1) + (e2*e2) + (e3*e3);
-    double e_norm;
-    if (y < 2.409919865102884e-181 && m > 0) {
-        e_norm = m * sqrt((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
-    } else {
-        e_norm = sqrt(y);
-    }
-    const double n = hypot(e0, e_norm);
+    const double e_norm = sqrt(y);
+    const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
         p[0] = NAN;
         p[1] = NAN;
@@ -495,9 +489,7 @@ static inline int symrot_sine_m3__from_quaternion(double e0, double e1, double e
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
-    const double c0 = fabs(e0)/n;
-    e_norm = e_norm / n;
-    const double phi = 2*atan2(e_norm, c0);
+    const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
     if (t < 0.002819628356600472) {
@@ -1021,7 +1013,7 @@ static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
 
 /* symrot_sine_m3__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma: Horner degree 1 in t = phi^2 below 3.48198e-05, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 59 */
+ * ops: 44 */
 static inline int symrot_sine_m3__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1034,15 +1026,9 @@ static inline int symrot_sine_m3__from_quaternion_f(float e0, float e1, float e2
         e2 = ldexpf(e2, -k);
         e3 = ldexpf(e3, -k);
     }
-    const float m = fmaxf(fabsf(e1), fmaxf(fabsf(e2), fabsf(e3)));
     const float y = (e1*e1) + (e2*e2) + (e3*e3);
-    float e_norm;
-    if (y < 7.888609e-31F && m > 0) {
-        e_norm = m * sqrtf((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + (e3 / m) * (e3 / m));
-    } else {
-        e_norm = sqrtf(y);
-    }
-    const float n = hypotf(e0, e_norm);
+    const float e_norm = sqrtf(y);
+    const float n = sqrtf((e0*e0) + y);
     if (!(n > 0) || !(n <= 3.4028235e+38F)) {
         p[0] = NAN;
         p[1] = NAN;
@@ -1050,9 +1036,7 @@ static inline int symrot_sine_m3__from_quaternion_f(float e0, float e1, float e2
         return 1;
     }
     const float f = (e0 < 0 ? -1 : 1) / n;
-    const float c0 = fabsf(e0)/n;
-    e_norm = e_norm / n;
-    const float phi = 2*atan2f(e_norm, c0);
+    const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
     if (t < 3.4819823e-05F) {

@@ -72,7 +72,8 @@ class OperationWriter(FunctionWriter):
 
     # -- from_quaternion (internal helper and public function) -----------------------------------
     def scale_statements(self) -> tuple[list[Statement], str]:
-        """Statements leaving σ in ``sigma`` from ``c0`` (= e₀ ≥ 0) and ``e_norm`` (unit quaternion)."""
+        """Statements leaving σ in ``sigma`` from ``c0`` = |e₀|/|e| (normalized) or, for the branch in
+        φ², from φ = 2 atan2(|**e**|, |e₀|) (scale-free)."""
         scale = self.precision_plan.quaternion_scale
         if scale.algebraic is not None:
             expression = scale.algebraic.subs(E0, E_SYMBOL)
@@ -80,7 +81,8 @@ class OperationWriter(FunctionWriter):
         branch = scale.branch
         assert isinstance(branch, Branch)
         statements: list[Statement] = [
-            self.let("phi", 2 * sp.atan2(sp.Symbol("e_norm", real=True), E_SYMBOL)),
+            # atan2 does not need the quaternion normalized
+            self.let("phi", 2 * sp.atan2(sp.Symbol("e_norm", real=True), sp.Abs(sp.Symbol("e0", real=True)))),
             self.let("t", PHI_SYMBOL ** 2),
             {"kind": "declare", "type": self.ctype, "names": ["sigma"]},
             self.branch_value(branch, T_SYMBOL, "sigma"),
@@ -92,19 +94,12 @@ class OperationWriter(FunctionWriter):
     def from_quaternion_helper(self) -> dict[str, Any]:
         t = self.ctype
         p_lit = self.printer.literal
-        y = sp.Symbol("y", real=True)
-        sqrt = "sqrt" if t == "double" else "sqrtf"
-        e_norm_statements: list[Statement] = [
-            self.let("m", sp.Max(sp.Abs(sp.Symbol("e1")), sp.Abs(sp.Symbol("e2")), sp.Abs(sp.Symbol("e3")))),
-            self.let("y", sp.Symbol("e1") ** 2 + sp.Symbol("e2") ** 2 + sp.Symbol("e3") ** 2),
-            {"kind": "declare", "type": t, "names": ["e_norm"]},
-            {"kind": "if", "condition": f"y < {p_lit(sp.Integer(2) ** (-600 if t == 'double' else -100))}"
-             " && m > 0",
-             "then": [self.set("e_norm", f"m * {sqrt}((e1 / m) * (e1 / m) + (e2 / m) * (e2 / m) + "
-                                         "(e3 / m) * (e3 / m))", ops=12)],
-             "otherwise": [self.set("e_norm", sp.sqrt(y))]},
-        ]
-        hypot = "hypot" if t == "double" else "hypotf"
+        e1, e2, e3 = (sp.Symbol(f"e{i}", real=True) for i in (1, 2, 3))
+        # after the scaling below, max |e_i| lies in [2^-500, 2^500] ([2^-60, 2^60] in float): no
+        # square that matters can underflow or overflow, so plain sums of squares are safe
+        e_norm_statements: list[Statement] = [self.let("y", e1**2 + e2**2 + e3**2)]
+        if self.precision_plan.quaternion_scale.algebraic is None:  # the branch in φ² needs |e|
+            e_norm_statements.append(self.let("e_norm", sp.sqrt(sp.Symbol("y", real=True))))
         f = "" if t == "double" else "f"
         low, high = (("2^-500", "2^500") if t == "double" else ("2^-60", "2^60"))
         low_lit = p_lit(sp.Integer(2) ** (-500 if t == "double" else -60))
@@ -123,17 +118,17 @@ class OperationWriter(FunctionWriter):
              "otherwise": []},
         ]
         statements: list[Statement] = scaling + e_norm_statements + [
-            {"kind": "let", "type": t, "name": "n", "value": f"{hypot}(e0, e_norm)", "ops": 1},
+            self.let("n", sp.sqrt(sp.Symbol("e0", real=True) ** 2 + sp.Symbol("y", real=True))),
             {"kind": "if", "condition": f"!(n > 0) || !(n <= {p_lit(LARGEST[self.precision])})",
              "then": self.nan_out("p", 3), "otherwise": []},
             {"kind": "let", "type": t, "name": "f", "value": "(e0 < 0 ? -1 : 1) / n", "ops": 2},
-            {"kind": "let", "type": t, "name": "c0",
-             "value": self.c(sp.Abs(sp.Symbol("e0")) / sp.Symbol("n")), "ops": 2},
         ]
+        if self.plan.e0_min is not None or self.precision_plan.quaternion_scale.algebraic is not None:
+            statements.append({"kind": "let", "type": t, "name": "c0",
+                               "value": self.c(sp.Abs(sp.Symbol("e0")) / sp.Symbol("n")), "ops": 2})
         if self.plan.e0_min is not None:
             statements.append({"kind": "if", "condition": f"!(c0 > {p_lit(self.plan.e0_min)})",
                                "then": self.nan_out("p", 3), "otherwise": []})
-        statements.append({"kind": "set", "name": "e_norm", "value": "e_norm / n", "ops": 1})
         scale, note = self.scale_statements()
         statements += scale
         statements += [self.set(f"p[{i}]", sp.Symbol("sigma") * (sp.Symbol(f"e{i + 1}") * sp.Symbol("f")))
