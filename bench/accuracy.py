@@ -195,11 +195,15 @@ def sweep(phi_max: float, points: int, edge: float = 1e-6) -> np.ndarray:
         phi_max - np.geomspace(0.1, edge, 6)]))
 
 
+def subject(name: str) -> tuple[Derivation, EvaluationPlan, Reference]:
+    """The derivation, plan and 50-digit reference of one parameterization (shared by both sweeps)."""
+    derivation = derive(name).derivation
+    return derivation, evaluation_plan(derivation, name), Reference(derivation)
+
+
 def measure(name: str, points: int, seed: int = 1, edge: float = 1e-6) -> dict[tuple[str, str, str], Worst]:
     """{(function, precision, kind): Worst} with kind 'plan' or 'naive'."""
-    derivation = derive(name).derivation
-    plan = evaluation_plan(derivation, name)
-    reference = Reference(derivation)
+    derivation, plan, reference = subject(name)
     naive = {n: numpy_function(e) for n, e in derivation.simplified_coefficients().items()}
     angles = sweep(plan.phi_max, points, edge)
     rng = np.random.default_rng(seed)

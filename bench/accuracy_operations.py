@@ -29,10 +29,7 @@ from typing import Any
 
 import mpmath
 import numpy as np
-from accuracy import DIGITS, DTYPES, Reference, Worst, condition, load_module, sweep
-
-from symrot.api import derive
-from symrot.plan import evaluation_plan
+from accuracy import DIGITS, DTYPES, Reference, Worst, condition, load_module, subject, sweep
 
 OPERATIONS = ("to_quaternion", "from_quaternion", "from_rotation_matrix", "compose", "rescale")
 
@@ -121,9 +118,7 @@ def _error(value: np.ndarray, reference: list[Any], epsilon: float, tiny: float)
 def measure_operations(name: str, points: int, seed: int = 2, edge: float = 1e-6
                        ) -> dict[tuple[str, str, str], Worst]:
     """{(operation, precision, 'plan'): Worst} over the sweep."""
-    derivation = derive(name).derivation
-    plan = evaluation_plan(derivation, name)
-    reference = Reference(derivation)
+    _derivation, plan, reference = subject(name)
     ops = OperationReference(reference)
     angles = sweep(plan.phi_max, points, edge)
     rng = np.random.default_rng(seed)

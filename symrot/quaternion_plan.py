@@ -20,6 +20,7 @@ Pure planning (SymPy + the plan's error model); backends print it.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import sympy as sp
 
@@ -28,6 +29,9 @@ from .functions import RealCbrt
 from .parsing import PHI
 from .series import coefficient_list, compose_even_in_x, taylor_series
 from .timeouts import bounded
+
+if TYPE_CHECKING:  # symrot.plan imports this module
+    from .plan import Branch
 
 E0 = sp.Symbol("e0", positive=True)
 """The scalar part e₀ of the unit quaternion on the hemisphere e₀ ≥ 0."""
@@ -40,7 +44,7 @@ class QuaternionScale:
     """σ = p(φ)/sin(φ/2), **p** = σ **e**: ``algebraic`` in :data:`E0` or ``branch`` in t = φ²."""
 
     algebraic: sp.Expr | None
-    branch: object | None  # a symrot.plan.Branch (typed loosely: plan imports this module)
+    branch: Branch | None
 
 
 def quaternion_scalar() -> sp.Expr:
