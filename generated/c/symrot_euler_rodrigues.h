@@ -27,6 +27,12 @@
 #include <math.h>
 #include <stddef.h>
 
+#ifndef SYMROT_BATCH_BLOCK
+/* Vectors per block of the _batch kernels, a compile-time constant so that their coefficient loop
+ * vectorizes; each kernel keeps about 8 arrays of this many numbers on the stack. */
+#define SYMROT_BATCH_BLOCK 32
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -117,12 +123,59 @@ static inline void symrot_euler_rodrigues_rotation_matrix(const double p[3], dou
 }
 
 /* symrot_euler_rodrigues_rotation_matrix_batch: symrot_euler_rodrigues_rotation_matrix for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_rotation_matrix(p + 3 * k, R + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0)) {
+                u0_lanes[k] = 0;
+            } else {
+                const double d = symrot_euler_rodrigues__complement(pk);
+                const double u0 = sqrt(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double u0 = u0_lanes[k];
+            c_R_1_lanes[k] = (1.0/2.0)*u0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 4.0) ? NAN : 1;
+            const double closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 4.0) ? NAN : closed_R_1;
+            c_R_2_lanes[k] = !(x < 4.0) ? NAN : 1.0/2.0;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -162,12 +215,61 @@ static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9]
 }
 
 /* symrot_euler_rodrigues_tangent_batch: symrot_euler_rodrigues_tangent for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = 1/sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *p, double *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_tangent(p + 3 * k, H + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0)) {
+                u0_lanes[k] = 0;
+            } else {
+                const double d = symrot_euler_rodrigues__complement(pk);
+                const double u0 = 1.0/sqrt(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double u0 = u0_lanes[k];
+            c_H_0_lanes[k] = 2*u0;
+            c_H_2_lanes[k] = (1.0/2.0)*u0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 4.0) ? NAN : closed_H_0;
+            c_H_1_lanes[k] = !(x < 4.0) ? NAN : 1.0/2.0;
+            const double closed_H_2 = c_H_2_lanes[k];
+            c_H_2_lanes[k] = !(x < 4.0) ? NAN : closed_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -206,12 +308,59 @@ static inline void symrot_euler_rodrigues_tangent_inverse(const double p[3], dou
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_batch: symrot_euler_rodrigues_tangent_inverse for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_tangent_inverse(p + 3 * k, Hinv + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0)) {
+                u0_lanes[k] = 0;
+            } else {
+                const double d = symrot_euler_rodrigues__complement(pk);
+                const double u0 = sqrt(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double u0 = u0_lanes[k];
+            c_H_inverse_0_lanes[k] = (1.0/2.0)*u0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 4.0) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 4.0) ? NAN : -1.0/2.0;
+            c_H_inverse_2_lanes[k] = !(x < 4.0) ? NAN : 0;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -265,12 +414,59 @@ static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double 
 }
 
 /* symrot_euler_rodrigues_root_matrix_batch: symrot_euler_rodrigues_root_matrix for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_root_matrix(p + 3 * k, G + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0)) {
+                u0_lanes[k] = 0;
+            } else {
+                const double d = symrot_euler_rodrigues__complement(pk);
+                const double u0 = sqrt(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double u0 = u0_lanes[k];
+            c_G_2_lanes[k] = (1.0/2.0)/(u0 + 2);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 4.0) ? NAN : 1;
+            c_G_1_lanes[k] = !(x < 4.0) ? NAN : 1.0/2.0;
+            const double closed_G_2 = c_G_2_lanes[k];
+            c_G_2_lanes[k] = !(x < 4.0) ? NAN : closed_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -317,12 +513,72 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
 }
 
 /* symrot_euler_rodrigues_root_tangent_batch: symrot_euler_rodrigues_root_tangent for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = 1/sqrt(d), u1 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_root_tangent(p + 3 * k, K + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0)) {
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const double d = symrot_euler_rodrigues__complement(pk);
+                const double u0 = 1.0/sqrt(d);
+                const double u1 = sqrt(d);
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
+            c_K_0_lanes[k] = u0;
+            c_K_1_lanes[k] = (1.0/2.0)/(u1 + 2);
+            c_K_2_lanes[k] = (1.0/4.0)*u0/((1.0/2.0)*u1 + 1);
+            poly_K_2_lanes[k] = (3.0/256.0)*x + 1.0/16.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 4.0) ? NAN : closed_K_0;
+            const double closed_K_1 = c_K_1_lanes[k];
+            c_K_1_lanes[k] = !(x < 4.0) ? NAN : closed_K_1;
+            const double closed_K_2 = c_K_2_lanes[k];
+            const double poly_K_2 = poly_K_2_lanes[k];
+            const double v_K_2 = x < 9.99999999999999e-15 ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 4.0) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -600,12 +856,59 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f(const float p[3], fl
 }
 
 /* symrot_euler_rodrigues_rotation_matrix_f_batch: symrot_euler_rodrigues_rotation_matrix_f for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_rotation_matrix_f(p + 3 * k, R + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0F)) {
+                u0_lanes[k] = 0;
+            } else {
+                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float u0 = sqrtf(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float u0 = u0_lanes[k];
+            c_R_1_lanes[k] = (1.0F/2.0F)*u0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 4.0F) ? NAN : 1;
+            const float closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 4.0F) ? NAN : closed_R_1;
+            c_R_2_lanes[k] = !(x < 4.0F) ? NAN : 1.0F/2.0F;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -645,12 +948,61 @@ static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9]
 }
 
 /* symrot_euler_rodrigues_tangent_f_batch: symrot_euler_rodrigues_tangent_f for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = 1/sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_tangent_f(p + 3 * k, H + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0F)) {
+                u0_lanes[k] = 0;
+            } else {
+                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float u0 = 1.0F/sqrtf(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float u0 = u0_lanes[k];
+            c_H_0_lanes[k] = 2*u0;
+            c_H_2_lanes[k] = (1.0F/2.0F)*u0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 4.0F) ? NAN : closed_H_0;
+            c_H_1_lanes[k] = !(x < 4.0F) ? NAN : 1.0F/2.0F;
+            const float closed_H_2 = c_H_2_lanes[k];
+            c_H_2_lanes[k] = !(x < 4.0F) ? NAN : closed_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -689,12 +1041,59 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f(const float p[3], fl
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_f_batch: symrot_euler_rodrigues_tangent_inverse_f for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_tangent_inverse_f(p + 3 * k, Hinv + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0F)) {
+                u0_lanes[k] = 0;
+            } else {
+                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float u0 = sqrtf(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float u0 = u0_lanes[k];
+            c_H_inverse_0_lanes[k] = (1.0F/2.0F)*u0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 4.0F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 4.0F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_2_lanes[k] = !(x < 4.0F) ? NAN : 0;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -748,12 +1147,59 @@ static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float 
 }
 
 /* symrot_euler_rodrigues_root_matrix_f_batch: symrot_euler_rodrigues_root_matrix_f for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_root_matrix_f(p + 3 * k, G + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0F)) {
+                u0_lanes[k] = 0;
+            } else {
+                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float u0 = sqrtf(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float u0 = u0_lanes[k];
+            c_G_2_lanes[k] = (1.0F/2.0F)/(u0 + 2);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 4.0F) ? NAN : 1;
+            c_G_1_lanes[k] = !(x < 4.0F) ? NAN : 1.0F/2.0F;
+            const float closed_G_2 = c_G_2_lanes[k];
+            c_G_2_lanes[k] = !(x < 4.0F) ? NAN : closed_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -800,12 +1246,71 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
 }
 
 /* symrot_euler_rodrigues_root_tangent_f_batch: symrot_euler_rodrigues_root_tangent_f for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = 1/sqrt(d), u1 = sqrt(d).
+ */
 static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_euler_rodrigues_root_tangent_f(p + 3 * k, K + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.0F)) {
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float u0 = 1.0F/sqrtf(d);
+                const float u1 = sqrtf(d);
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
+            c_K_0_lanes[k] = u0;
+            c_K_1_lanes[k] = (1.0F/2.0F)/(u1 + 2);
+            c_K_2_lanes[k] = (1.0F/4.0F)*u0/((1.0F/2.0F)*u1 + 1);
+            poly_K_2_lanes[k] = 1.0F/16.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 4.0F) ? NAN : closed_K_0;
+            const float closed_K_1 = c_K_1_lanes[k];
+            c_K_1_lanes[k] = !(x < 4.0F) ? NAN : closed_K_1;
+            const float closed_K_2 = c_K_2_lanes[k];
+            const float poly_K_2 = poly_K_2_lanes[k];
+            const float v_K_2 = x < 1e-14F ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 4.0F) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 

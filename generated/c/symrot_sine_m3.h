@@ -27,6 +27,12 @@
 #include <math.h>
 #include <stddef.h>
 
+#ifndef SYMROT_BATCH_BLOCK
+/* Vectors per block of the _batch kernels, a compile-time constant so that their coefficient loop
+ * vectorizes; each kernel keeps about 8 arrays of this many numbers on the stack. */
+#define SYMROT_BATCH_BLOCK 32
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -125,12 +131,81 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
 }
 
 /* symrot_sine_m3_rotation_matrix_batch: symrot_sine_m3_rotation_matrix for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_rotation_matrix(p + 3 * k, R + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0) || x < 0.018918233509283077) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+            } else {
+                const double d = symrot_sine_m3__complement(pk);
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m3__phi(s, d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double s = s_lanes[k];
+            const double phi = phi_lanes[k];
+            const double a0_a = (1.0/2.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            c_R_1_lanes[k] = 1 - 4.0/27.0*x;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 9.0) ? NAN : 1;
+            const double closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 9.0) ? NAN : closed_R_1;
+            const double closed_R_2 = c_R_2_lanes[k];
+            const double poly_R_2 = poly_R_2_lanes[k];
+            const double v_R_2 = x < 0.018918233509283077 ? poly_R_2 : closed_R_2;
+            c_R_2_lanes[k] = !(x < 9.0) ? NAN : v_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -182,12 +257,98 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 }
 
 /* symrot_sine_m3_tangent_batch: symrot_sine_m3_tangent for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi, u0 = 1/sqrt(d), u1 = sqrt(d).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_tangent(p + 3 * k, H + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0)) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const double d = symrot_sine_m3__complement(pk);
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m3__phi(s, d);
+                const double u0 = 1.0/sqrt(d);
+                const double u1 = sqrt(d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double s = s_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
+            const double a0_a = (1.0/2.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double w0 = 1.0/(s*s);
+            const double w1 = 2*(sin0*sin0);
+            c_H_0_lanes[k] = 3*u0;
+            c_H_1_lanes[k] = w0*w1;
+            poly_H_1_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            c_H_2_lanes[k] = u0*w0*(-2.0/3.0*u1 + w1 + 2);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 9.0) ? NAN : closed_H_0;
+            const double closed_H_1 = c_H_1_lanes[k];
+            const double poly_H_1 = poly_H_1_lanes[k];
+            const double v_H_1 = x < 0.018918233509283077 ? poly_H_1 : closed_H_1;
+            c_H_1_lanes[k] = !(x < 9.0) ? NAN : v_H_1;
+            const double closed_H_2 = c_H_2_lanes[k];
+            const double poly_H_2 = poly_H_2_lanes[k];
+            const double v_H_2 = x < 0.8648056668462036 ? poly_H_2 : closed_H_2;
+            c_H_2_lanes[k] = !(x < 9.0) ? NAN : v_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -227,12 +388,62 @@ static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv
 }
 
 /* symrot_sine_m3_tangent_inverse_batch: symrot_sine_m3_tangent_inverse for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_tangent_inverse(p + 3 * k, Hinv + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0)) {
+                u0_lanes[k] = 0;
+            } else {
+                const double d = symrot_sine_m3__complement(pk);
+                const double u0 = sqrt(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double u0 = u0_lanes[k];
+            c_H_inverse_0_lanes[k] = (1.0/3.0)*u0;
+            c_H_inverse_2_lanes[k] = -1.0/6.0*(2*u0 + 9)/(-9*u0 + 2*x - 27);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 9.0) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 9.0) ? NAN : -1.0/2.0;
+            const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
+            c_H_inverse_2_lanes[k] = !(x < 9.0) ? NAN : closed_H_inverse_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -302,12 +513,94 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
 }
 
 /* symrot_sine_m3_root_matrix_batch: symrot_sine_m3_root_matrix for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_root_matrix(p + 3 * k, G + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0) || x < 1.9011961863057287e-14) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+            } else {
+                const double d = symrot_sine_m3__complement(pk);
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m3__phi(s, d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double s = s_lanes[k];
+            const double phi = phi_lanes[k];
+            const double a0_a = (1.0/2.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_G_1_lanes[k] = sin0/s;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-5.0/432.0)*x;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 9.0) ? NAN : 1;
+            const double closed_G_1 = c_G_1_lanes[k];
+            const double poly_G_1 = poly_G_1_lanes[k];
+            const double v_G_1 = x < 1.9011961863057287e-14 ? poly_G_1 : closed_G_1;
+            c_G_1_lanes[k] = !(x < 9.0) ? NAN : v_G_1;
+            const double closed_G_2 = c_G_2_lanes[k];
+            const double poly_G_2 = poly_G_2_lanes[k];
+            const double v_G_2 = x < 0.8648056668462036 ? poly_G_2 : closed_G_2;
+            c_G_2_lanes[k] = !(x < 9.0) ? NAN : v_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -357,12 +650,102 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
 }
 
 /* symrot_sine_m3_root_tangent_batch: symrot_sine_m3_root_tangent for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi, u0 = 1/sqrt(d).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_root_tangent(p + 3 * k, K + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0)) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const double d = symrot_sine_m3__complement(pk);
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m3__phi(s, d);
+                const double u0 = 1.0/sqrt(d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double s = s_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double a0_a = (1.0/4.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double w0 = 1.0/(s*s);
+            c_K_0_lanes[k] = (3.0/2.0)*u0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/6.0)*w0*(9*u0 - 6*sin1/s);
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 9.0) ? NAN : closed_K_0;
+            const double closed_K_1 = c_K_1_lanes[k];
+            const double poly_K_1 = poly_K_1_lanes[k];
+            const double v_K_1 = x < 0.8648056668462036 ? poly_K_1 : closed_K_1;
+            c_K_1_lanes[k] = !(x < 9.0) ? NAN : v_K_1;
+            const double closed_K_2 = c_K_2_lanes[k];
+            const double poly_K_2 = poly_K_2_lanes[k];
+            const double v_K_2 = x < 1.5953637712864257 ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 9.0) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -672,12 +1055,81 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
 }
 
 /* symrot_sine_m3_rotation_matrix_f_batch: symrot_sine_m3_rotation_matrix_f for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_rotation_matrix_f(p + 3 * k, R + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0F) || x < 2.8627653F) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+            } else {
+                const float d = symrot_sine_m3__complement_f(pk);
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m3__phi_f(s, d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float s = s_lanes[k];
+            const float phi = phi_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            c_R_1_lanes[k] = 1 - 4.0F/27.0F*x;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 9.0F) ? NAN : 1;
+            const float closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 9.0F) ? NAN : closed_R_1;
+            const float closed_R_2 = c_R_2_lanes[k];
+            const float poly_R_2 = poly_R_2_lanes[k];
+            const float v_R_2 = x < 2.8627653F ? poly_R_2 : closed_R_2;
+            c_R_2_lanes[k] = !(x < 9.0F) ? NAN : v_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -728,12 +1180,103 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 }
 
 /* symrot_sine_m3_tangent_f_batch: symrot_sine_m3_tangent_f for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi, u0 = 1/sqrt(d).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_tangent_f(p + 3 * k, H + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0F)) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const float d = symrot_sine_m3__complement_f(pk);
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m3__phi_f(s, d);
+                const float u0 = 1.0F/sqrtf(d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float s = s_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a1_a = (1.0F/6.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float w0 = 1.0F/(s*s);
+            const float w1 = 2*(sin0*sin0);
+            c_H_0_lanes[k] = 3*u0;
+            c_H_1_lanes[k] = w0*w1;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + w1);
+            poly_H_2_lanes[k] = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 9.0F) ? NAN : closed_H_0;
+            const float closed_H_1 = c_H_1_lanes[k];
+            const float poly_H_1 = poly_H_1_lanes[k];
+            const float v_H_1 = x < 2.8627653F ? poly_H_1 : closed_H_1;
+            c_H_1_lanes[k] = !(x < 9.0F) ? NAN : v_H_1;
+            const float closed_H_2 = c_H_2_lanes[k];
+            const float poly_H_2 = poly_H_2_lanes[k];
+            const float v_H_2 = x < 0.46210724F ? poly_H_2 : closed_H_2;
+            c_H_2_lanes[k] = !(x < 9.0F) ? NAN : v_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -773,12 +1316,62 @@ static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv
 }
 
 /* symrot_sine_m3_tangent_inverse_f_batch: symrot_sine_m3_tangent_inverse_f for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(d).
+ */
 static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_tangent_inverse_f(p + 3 * k, Hinv + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0F)) {
+                u0_lanes[k] = 0;
+            } else {
+                const float d = symrot_sine_m3__complement_f(pk);
+                const float u0 = sqrtf(d);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float u0 = u0_lanes[k];
+            c_H_inverse_0_lanes[k] = (1.0F/3.0F)*u0;
+            c_H_inverse_2_lanes[k] = -1.0F/6.0F*(2*u0 + 9)/(-9*u0 + 2*x - 27);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 9.0F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 9.0F) ? NAN : -1.0F/2.0F;
+            const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
+            c_H_inverse_2_lanes[k] = !(x < 9.0F) ? NAN : closed_H_inverse_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -849,12 +1442,86 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
 }
 
 /* symrot_sine_m3_root_matrix_f_batch: symrot_sine_m3_root_matrix_f for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_root_matrix_f(p + 3 * k, G + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0F) || x < 1.9011963e-14F) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+            } else {
+                const float d = symrot_sine_m3__complement_f(pk);
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m3__phi_f(s, d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float s = s_lanes[k];
+            const float phi = phi_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_G_1_lanes[k] = sin0/s;
+            poly_G_1_lanes[k] = 1.0F/2.0F;
+            c_G_2_lanes[k] = (1 - cos0)/(s*s);
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 9.0F) ? NAN : 1;
+            const float closed_G_1 = c_G_1_lanes[k];
+            const float poly_G_1 = poly_G_1_lanes[k];
+            const float v_G_1 = x < 1.9011963e-14F ? poly_G_1 : closed_G_1;
+            c_G_1_lanes[k] = !(x < 9.0F) ? NAN : v_G_1;
+            const float closed_G_2 = c_G_2_lanes[k];
+            const float poly_G_2 = poly_G_2_lanes[k];
+            const float v_G_2 = x < 1.5953637F ? poly_G_2 : closed_G_2;
+            c_G_2_lanes[k] = !(x < 9.0F) ? NAN : v_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -905,12 +1572,94 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
 }
 
 /* symrot_sine_m3_root_tangent_f_batch: symrot_sine_m3_root_tangent_f for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi, u0 = 1/sqrt(d).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m3_root_tangent_f(p + 3 * k, K + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 9.0F)) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const float d = symrot_sine_m3__complement_f(pk);
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m3__phi_f(s, d);
+                const float u0 = 1.0F/sqrtf(d);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float s = s_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float w0 = 1.0F/(s*s);
+            c_K_0_lanes[k] = (3.0F/2.0F)*u0;
+            c_K_1_lanes[k] = w0*(1 - cos0);
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/6.0F)*w0*(9*u0 - 6*sin0/s);
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 9.0F) ? NAN : closed_K_0;
+            const float closed_K_1 = c_K_1_lanes[k];
+            const float poly_K_1 = poly_K_1_lanes[k];
+            const float v_K_1 = x < 1.5953637F ? poly_K_1 : closed_K_1;
+            c_K_1_lanes[k] = !(x < 9.0F) ? NAN : v_K_1;
+            const float closed_K_2 = c_K_2_lanes[k];
+            const float poly_K_2 = poly_K_2_lanes[k];
+            const float v_K_2 = x < 2.8627653F ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 9.0F) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 

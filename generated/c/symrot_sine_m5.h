@@ -27,6 +27,12 @@
 #include <math.h>
 #include <stddef.h>
 
+#ifndef SYMROT_BATCH_BLOCK
+/* Vectors per block of the _batch kernels, a compile-time constant so that their coefficient loop
+ * vectorizes; each kernel keeps about 8 arrays of this many numbers on the stack. */
+#define SYMROT_BATCH_BLOCK 32
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -102,12 +108,86 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
 }
 
 /* symrot_sine_m5_rotation_matrix_batch: symrot_sine_m5_rotation_matrix for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_rotation_matrix(p + 3 * k, R + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612712429686844) || x < 0.00423011441675066) {
+                phi_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m5__phi(s);
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double phi = phi_lanes[k];
+            const double a0_a = (1.0/5.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_R_1_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
+            c_R_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
+            poly_R_2_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 22.612712429686844) ? NAN : 1;
+            const double closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_R_1;
+            const double closed_R_2 = c_R_2_lanes[k];
+            const double poly_R_2 = poly_R_2_lanes[k];
+            const double v_R_2 = x < 0.00423011441675066 ? poly_R_2 : closed_R_2;
+            c_R_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -159,12 +239,101 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
 }
 
 /* symrot_sine_m5_tangent_batch: symrot_sine_m5_tangent for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, double *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_tangent(p + 3 * k, H + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612712429686844)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m5__phi(s);
+                const double u0 = 1.0/sqrt(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double a0_a = (1.0/5.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const double w0 = 1.0/(sin0*sin0);
+            c_H_0_lanes[k] = 5*u0;
+            c_H_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
+            poly_H_1_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            c_H_2_lanes[k] = (1.0/25.0)*w0*(-2.0/5.0*cos1*sin1/sin0 + 1.0/cos0);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_H_0;
+            const double closed_H_1 = c_H_1_lanes[k];
+            const double poly_H_1 = poly_H_1_lanes[k];
+            const double v_H_1 = x < 0.00423011441675066 ? poly_H_1 : closed_H_1;
+            c_H_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_1;
+            const double closed_H_2 = c_H_2_lanes[k];
+            const double poly_H_2 = poly_H_2_lanes[k];
+            const double v_H_2 = x < 2.7876134135933768 ? poly_H_2 : closed_H_2;
+            c_H_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -212,12 +381,95 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
 }
 
 /* symrot_sine_m5_tangent_inverse_batch: symrot_sine_m5_tangent_inverse for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_tangent_inverse(p + 3 * k, Hinv + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612712429686844)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m5__phi(s);
+                const double u0 = sqrt(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double a0_a = (1.0/5.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            c_H_inverse_0_lanes[k] = (1.0/5.0)*u0;
+            c_H_inverse_2_lanes[k] = (1.0/25.0)*(cos0 - 5.0/2.0*cos1*sin0/sin1)/(sin0*sin0);
+            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 22.612712429686844) ? NAN : -1.0/2.0;
+            const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
+            const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
+            const double v_H_inverse_2 = x < 2.7876134135933768 ? poly_H_inverse_2 : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_inverse_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -283,12 +535,96 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
 }
 
 /* symrot_sine_m5_root_matrix_batch: symrot_sine_m5_root_matrix for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_root_matrix(p + 3 * k, G + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612712429686844)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m5__phi(s);
+                const double u0 = 1.0/sqrt(sqrt(25 - x) + 5);
+                const double u1 = sqrt(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
+            const double a0_a = (1.0/5.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_G_1_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
+            c_G_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
+            poly_G_2_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 22.612712429686844) ? NAN : 1;
+            const double closed_G_1 = c_G_1_lanes[k];
+            c_G_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_G_1;
+            const double closed_G_2 = c_G_2_lanes[k];
+            const double poly_G_2 = poly_G_2_lanes[k];
+            const double v_G_2 = x < 0.00423011441675066 ? poly_G_2 : closed_G_2;
+            c_G_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -338,12 +674,109 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
 }
 
 /* symrot_sine_m5_root_tangent_batch: symrot_sine_m5_root_tangent for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_root_tangent(p + 3 * k, K + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612712429686844)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_sine_m5__phi(s);
+                const double u0 = 1.0/sqrt(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double a0_a = (1.0/5.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a2_a = (1.0/2.0)*phi;
+            const double a2_q = rint(a2_a*0.6366197723675814);
+            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
+            const double a2_z = a2_r*a2_r;
+            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
+            const double a2_h = rint(0.5*a2_j - 0.25);
+            const double a2_odd = a2_j - 2*a2_h;
+            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const double w0 = 1.0/(sin0*sin0);
+            c_K_0_lanes[k] = (5.0/2.0)*u0;
+            c_K_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
+            poly_K_1_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/250.0)*w0*(-2*sin2/sin0 + 5/cos0);
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_K_0;
+            const double closed_K_1 = c_K_1_lanes[k];
+            const double poly_K_1 = poly_K_1_lanes[k];
+            const double v_K_1 = x < 0.00423011441675066 ? poly_K_1 : closed_K_1;
+            c_K_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_K_1;
+            const double closed_K_2 = c_K_2_lanes[k];
+            const double poly_K_2 = poly_K_2_lanes[k];
+            const double v_K_2 = x < 5.166154456090218 ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -628,12 +1061,86 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
 }
 
 /* symrot_sine_m5_rotation_matrix_f_batch: symrot_sine_m5_rotation_matrix_f for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_rotation_matrix_f(p + 3 * k, R + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612713F) || x < 2.7876132F) {
+                phi_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m5__phi_f(s);
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float phi = phi_lanes[k];
+            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_R_1_lanes[k] = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
+            c_R_2_lanes[k] = (2.0F/25.0F)*(sin1*sin1)/(sin0*sin0);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 22.612713F) ? NAN : 1;
+            const float closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 22.612713F) ? NAN : closed_R_1;
+            const float closed_R_2 = c_R_2_lanes[k];
+            const float poly_R_2 = poly_R_2_lanes[k];
+            const float v_R_2 = x < 2.7876132F ? poly_R_2 : closed_R_2;
+            c_R_2_lanes[k] = !(x < 22.612713F) ? NAN : v_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -685,12 +1192,101 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
 }
 
 /* symrot_sine_m5_tangent_f_batch: symrot_sine_m5_tangent_f for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_tangent_f(p + 3 * k, H + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612713F)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m5__phi_f(s);
+                const float u0 = 1.0F/sqrtf(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const float w0 = 1.0F/(sin0*sin0);
+            c_H_0_lanes[k] = 5*u0;
+            c_H_1_lanes[k] = (2.0F/25.0F)*(sin1*sin1)*w0;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = (1.0F/25.0F)*w0*(-2.0F/5.0F*cos1*sin1/sin0 + 1.0F/cos0);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_H_0;
+            const float closed_H_1 = c_H_1_lanes[k];
+            const float poly_H_1 = poly_H_1_lanes[k];
+            const float v_H_1 = x < 2.7876132F ? poly_H_1 : closed_H_1;
+            c_H_1_lanes[k] = !(x < 22.612713F) ? NAN : v_H_1;
+            const float closed_H_2 = c_H_2_lanes[k];
+            const float poly_H_2 = poly_H_2_lanes[k];
+            const float v_H_2 = x < 5.1661544F ? poly_H_2 : closed_H_2;
+            c_H_2_lanes[k] = !(x < 22.612713F) ? NAN : v_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -738,12 +1334,95 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
 }
 
 /* symrot_sine_m5_tangent_inverse_f_batch: symrot_sine_m5_tangent_inverse_f for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_tangent_inverse_f(p + 3 * k, Hinv + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612713F)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m5__phi_f(s);
+                const float u0 = sqrtf(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            c_H_inverse_0_lanes[k] = (1.0F/5.0F)*u0;
+            c_H_inverse_2_lanes[k] = (1.0F/25.0F)*(cos0 - 5.0F/2.0F*cos1*sin0/sin1)/(sin0*sin0);
+            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 22.612713F) ? NAN : -1.0F/2.0F;
+            const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
+            const float poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
+            const float v_H_inverse_2 = x < 5.1661544F ? poly_H_inverse_2 : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 22.612713F) ? NAN : v_H_inverse_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -809,12 +1488,96 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
 }
 
 /* symrot_sine_m5_root_matrix_f_batch: symrot_sine_m5_root_matrix_f for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_root_matrix_f(p + 3 * k, G + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612713F)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m5__phi_f(s);
+                const float u0 = 1.0F/sqrtf(sqrtf(25 - x) + 5);
+                const float u1 = sqrtf(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
+            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_G_1_lanes[k] = -0.0126491105F*u0*(-10*u1 + 4*x - 75);
+            c_G_2_lanes[k] = (2.0F/25.0F)*(sin1*sin1)/(sin0*sin0);
+            poly_G_2_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 22.612713F) ? NAN : 1;
+            const float closed_G_1 = c_G_1_lanes[k];
+            c_G_1_lanes[k] = !(x < 22.612713F) ? NAN : closed_G_1;
+            const float closed_G_2 = c_G_2_lanes[k];
+            const float poly_G_2 = poly_G_2_lanes[k];
+            const float v_G_2 = x < 0.21211211F ? poly_G_2 : closed_G_2;
+            c_G_2_lanes[k] = !(x < 22.612713F) ? NAN : v_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -864,12 +1627,109 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
 }
 
 /* symrot_sine_m5_root_tangent_f_batch: symrot_sine_m5_root_tangent_f for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_sine_m5_root_tangent_f(p + 3 * k, K + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 22.612713F)) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_sine_m5__phi_f(s);
+                const float u0 = 1.0F/sqrtf(25 - x);
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a2_a = (1.0F/2.0F)*phi;
+            const float a2_q = rintf(a2_a*0.63661975F);
+            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
+            const float a2_z = a2_r*a2_r;
+            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
+            const float a2_h = rintf(0.5F*a2_j - 0.25F);
+            const float a2_odd = a2_j - 2*a2_h;
+            const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const float w0 = 1.0F/(sin0*sin0);
+            c_K_0_lanes[k] = (5.0F/2.0F)*u0;
+            c_K_1_lanes[k] = (2.0F/25.0F)*(sin1*sin1)*w0;
+            poly_K_1_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/250.0F)*w0*(-2*sin2/sin0 + 5/cos0);
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_K_0;
+            const float closed_K_1 = c_K_1_lanes[k];
+            const float poly_K_1 = poly_K_1_lanes[k];
+            const float v_K_1 = x < 0.21211211F ? poly_K_1 : closed_K_1;
+            c_K_1_lanes[k] = !(x < 22.612713F) ? NAN : v_K_1;
+            const float closed_K_2 = c_K_2_lanes[k];
+            const float poly_K_2 = poly_K_2_lanes[k];
+            const float v_K_2 = x < 5.1661544F ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 22.612713F) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 

@@ -27,6 +27,12 @@
 #include <math.h>
 #include <stddef.h>
 
+#ifndef SYMROT_BATCH_BLOCK
+/* Vectors per block of the _batch kernels, a compile-time constant so that their coefficient loop
+ * vectorizes; each kernel keeps about 8 arrays of this many numbers on the stack. */
+#define SYMROT_BATCH_BLOCK 32
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -96,12 +102,66 @@ static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R
 }
 
 /* symrot_tangent_m1_rotation_matrix_batch: symrot_tangent_m1_rotation_matrix for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = 1/sqrt(x + 1), u1 = sqrt(x + 1).
+ */
 static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_rotation_matrix(p + 3 * k, R + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.149515568880993e+180)) {
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const double u0 = 1.0/sqrt(x + 1);
+                const double u1 = sqrt(x + 1);
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
+            c_R_1_lanes[k] = u0;
+            c_R_2_lanes[k] = 1.0/(u1 + x + 1);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            const double closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_1;
+            const double closed_R_2 = c_R_2_lanes[k];
+            c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -141,12 +201,65 @@ static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
 }
 
 /* symrot_tangent_m1_tangent_batch: symrot_tangent_m1_tangent for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(x + 1).
+ */
 static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, double *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_tangent(p + 3 * k, H + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.149515568880993e+180)) {
+                u0_lanes[k] = 0;
+            } else {
+                const double u0 = sqrt(x + 1);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double w0 = x + 1;
+            const double w1 = 1.0/w0;
+            c_H_0_lanes[k] = w1;
+            c_H_1_lanes[k] = 1.0/(u0 + w0);
+            c_H_2_lanes[k] = -w1/(u0 + 1);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_0;
+            const double closed_H_1 = c_H_1_lanes[k];
+            c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_1;
+            const double closed_H_2 = c_H_2_lanes[k];
+            c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -185,12 +298,61 @@ static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double H
 }
 
 /* symrot_tangent_m1_tangent_inverse_batch: symrot_tangent_m1_tangent_inverse for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(x + 1).
+ */
 static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_tangent_inverse(p + 3 * k, Hinv + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.149515568880993e+180)) {
+                u0_lanes[k] = 0;
+            } else {
+                const double u0 = sqrt(x + 1);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double u0 = u0_lanes[k];
+            c_H_inverse_0_lanes[k] = x + 1;
+            c_H_inverse_2_lanes[k] = (1.0/2.0)*(2*u0 + 1)/(u0 + 1);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : -1.0/2.0;
+            const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
+            c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -250,12 +412,90 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
 }
 
 /* symrot_tangent_m1_root_matrix_batch: symrot_tangent_m1_root_matrix for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_root_matrix(p + 3 * k, G + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.149515568880993e+180)) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_tangent_m1__phi(s);
+                const double u0 = pow(x + 1, -1.0/4.0);
+                const double u1 = 1.0/sqrt(sqrt(x + 1) + 1);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double s = s_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
+            const double a0_a = (1.0/4.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            c_G_1_lanes[k] = 0.7071067811865476*u0*u1;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            poly_G_2_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            const double closed_G_1 = c_G_1_lanes[k];
+            c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_1;
+            const double closed_G_2 = c_G_2_lanes[k];
+            const double poly_G_2 = poly_G_2_lanes[k];
+            const double v_G_2 = x < 7.889013259849932e-06 ? poly_G_2 : closed_G_2;
+            c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -304,12 +544,97 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
 }
 
 /* symrot_tangent_m1_root_tangent_batch: symrot_tangent_m1_root_tangent for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_root_tangent(p + 3 * k, K + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 4.149515568880993e+180) || x < 7.889013259849932e-06) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_tangent_m1__phi(s);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double s = s_lanes[k];
+            const double phi = phi_lanes[k];
+            const double a0_a = (1.0/4.0)*phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double w0 = (1.0/2.0)/(x + 1);
+            const double w1 = 1.0/(s*s);
+            c_K_0_lanes[k] = w0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
+            poly_K_1_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
+            c_K_2_lanes[k] = w1*(w0 - sin1/s);
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
+            const double closed_K_1 = c_K_1_lanes[k];
+            const double poly_K_1 = poly_K_1_lanes[k];
+            const double v_K_1 = x < 7.889013259849932e-06 ? poly_K_1 : closed_K_1;
+            c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_1;
+            const double closed_K_2 = c_K_2_lanes[k];
+            const double poly_K_2 = poly_K_2_lanes[k];
+            const double v_K_2 = x < 0.1318263071600862 ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -566,12 +891,66 @@ static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R
 }
 
 /* symrot_tangent_m1_rotation_matrix_f_batch: symrot_tangent_m1_rotation_matrix_f for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = 1/sqrt(x + 1), u1 = sqrt(x + 1).
+ */
 static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_rotation_matrix_f(p + 3 * k, R + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 1.2676506e+30F)) {
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const float u0 = 1.0F/sqrtf(x + 1);
+                const float u1 = sqrtf(x + 1);
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
+            c_R_1_lanes[k] = u0;
+            c_R_2_lanes[k] = 1.0F/(u1 + x + 1);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            const float closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_1;
+            const float closed_R_2 = c_R_2_lanes[k];
+            c_R_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -611,12 +990,65 @@ static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
 }
 
 /* symrot_tangent_m1_tangent_f_batch: symrot_tangent_m1_tangent_f for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(x + 1).
+ */
 static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_tangent_f(p + 3 * k, H + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 1.2676506e+30F)) {
+                u0_lanes[k] = 0;
+            } else {
+                const float u0 = sqrtf(x + 1);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float w0 = x + 1;
+            const float w1 = 1.0F/w0;
+            c_H_0_lanes[k] = w1;
+            c_H_1_lanes[k] = 1.0F/(u0 + w0);
+            c_H_2_lanes[k] = -w1/(u0 + 1);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_0;
+            const float closed_H_1 = c_H_1_lanes[k];
+            c_H_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_1;
+            const float closed_H_2 = c_H_2_lanes[k];
+            c_H_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -655,12 +1087,61 @@ static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float H
 }
 
 /* symrot_tangent_m1_tangent_inverse_f_batch: symrot_tangent_m1_tangent_inverse_f for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: u0 = sqrt(x + 1).
+ */
 static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_tangent_inverse_f(p + 3 * k, Hinv + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 1.2676506e+30F)) {
+                u0_lanes[k] = 0;
+            } else {
+                const float u0 = sqrtf(x + 1);
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float u0 = u0_lanes[k];
+            c_H_inverse_0_lanes[k] = x + 1;
+            c_H_inverse_2_lanes[k] = (1.0F/2.0F)*(2*u0 + 1)/(u0 + 1);
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : -1.0F/2.0F;
+            const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
+            c_H_inverse_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -720,12 +1201,90 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
 }
 
 /* symrot_tangent_m1_root_matrix_f_batch: symrot_tangent_m1_root_matrix_f for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_root_matrix_f(p + 3 * k, G + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 1.2676506e+30F)) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_tangent_m1__phi_f(s);
+                const float u0 = powf(x + 1, -1.0F/4.0F);
+                const float u1 = 1.0F/sqrtf(sqrtf(x + 1) + 1);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float s = s_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            c_G_1_lanes[k] = 0.70710677F*u0*u1;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            poly_G_2_lanes[k] = x*(x*(x*((12767.0F/262144.0F)*x - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            const float closed_G_1 = c_G_1_lanes[k];
+            c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_1;
+            const float closed_G_2 = c_G_2_lanes[k];
+            const float poly_G_2 = poly_G_2_lanes[k];
+            const float v_G_2 = x < 0.03724894F ? poly_G_2 : closed_G_2;
+            c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -774,12 +1333,97 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
 }
 
 /* symrot_tangent_m1_root_tangent_f_batch: symrot_tangent_m1_root_tangent_f for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: s, phi.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
 static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_tangent_m1_root_tangent_f(p + 3 * k, K + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x < 1.2676506e+30F) || x < 0.03724894F) {
+                s_lanes[k] = 0;
+                phi_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_tangent_m1__phi_f(s);
+                s_lanes[k] = s;
+                phi_lanes[k] = phi;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            s_lanes[k] = 0;
+            phi_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float s = s_lanes[k];
+            const float phi = phi_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float w0 = (1.0F/2.0F)/(x + 1);
+            const float w1 = 1.0F/(s*s);
+            c_K_0_lanes[k] = w0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
+            poly_K_1_lanes[k] = x*(x*(x*((12767.0F/262144.0F)*x - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = w1*(w0 - sin1/s);
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(0.45584974F + (-0.4596311F)*x) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
+            const float closed_K_1 = c_K_1_lanes[k];
+            const float poly_K_1 = poly_K_1_lanes[k];
+            const float v_K_1 = x < 0.03724894F ? poly_K_1 : closed_K_1;
+            c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_1;
+            const float closed_K_2 = c_K_2_lanes[k];
+            const float poly_K_2 = poly_K_2_lanes[k];
+            const float v_K_2 = x < 0.13182631F ? poly_K_2 : closed_K_2;
+            c_K_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 

@@ -27,6 +27,12 @@
 #include <math.h>
 #include <stddef.h>
 
+#ifndef SYMROT_BATCH_BLOCK
+/* Vectors per block of the _batch kernels, a compile-time constant so that their coefficient loop
+ * vectorizes; each kernel keeps about 8 arrays of this many numbers on the stack. */
+#define SYMROT_BATCH_BLOCK 32
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -96,12 +102,53 @@ static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], d
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix_batch: symrot_wiener_milenkovic_rotation_matrix for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_rotation_matrix(p + 3 * k, R + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double w0 = 1.0/((x + 16)*(x + 16));
+            c_R_1_lanes[k] = -16*w0*(x - 16);
+            c_R_2_lanes[k] = 128*w0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            const double closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_1;
+            const double closed_R_2 = c_R_2_lanes[k];
+            c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -141,12 +188,56 @@ static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[
 }
 
 /* symrot_wiener_milenkovic_tangent_batch: symrot_wiener_milenkovic_tangent for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double *p, double *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_tangent(p + 3 * k, H + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double w0 = x + 16;
+            const double w1 = 1.0/(w0*w0);
+            c_H_0_lanes[k] = 16/w0;
+            c_H_1_lanes[k] = 128*w1;
+            c_H_2_lanes[k] = 32*w1;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_0;
+            const double closed_H_1 = c_H_1_lanes[k];
+            c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_1;
+            const double closed_H_2 = c_H_2_lanes[k];
+            c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -184,12 +275,50 @@ static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], d
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse_batch: symrot_wiener_milenkovic_tangent_inverse for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_tangent_inverse(p + 3 * k, Hinv + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_H_inverse_0_lanes[k] = (1.0/16.0)*x + 1;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : -1.0/2.0;
+            c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1.0/8.0;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -242,12 +371,53 @@ static inline void symrot_wiener_milenkovic_root_matrix(const double p[3], doubl
 }
 
 /* symrot_wiener_milenkovic_root_matrix_batch: symrot_wiener_milenkovic_root_matrix for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_root_matrix(p + 3 * k, G + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double w0 = 1.0/(x + 16);
+            c_G_1_lanes[k] = 8*w0;
+            c_G_2_lanes[k] = 2*w0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            const double closed_G_1 = c_G_1_lanes[k];
+            c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_1;
+            const double closed_G_2 = c_G_2_lanes[k];
+            c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -286,12 +456,53 @@ static inline void symrot_wiener_milenkovic_root_tangent(const double p[3], doub
 }
 
 /* symrot_wiener_milenkovic_root_tangent_batch: symrot_wiener_milenkovic_root_tangent for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_root_tangent(p + 3 * k, K + 9 * k);
+    double x_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double w0 = 1.0/(x + 16);
+            c_K_0_lanes[k] = 8*w0;
+            c_K_1_lanes[k] = 2*w0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
+            const double closed_K_1 = c_K_1_lanes[k];
+            c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_1;
+            c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 0;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -535,12 +746,53 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], 
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix_f_batch: symrot_wiener_milenkovic_rotation_matrix_f for n vectors p[3*k..3*k+2] into
- * R[9*k..9*k+8], k < n. */
+ * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_rotation_matrix_f(p + 3 * k, R + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float w0 = 1.0F/((x + 16)*(x + 16));
+            c_R_1_lanes[k] = -16*w0*(x - 16);
+            c_R_2_lanes[k] = 128*w0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            const float closed_R_1 = c_R_1_lanes[k];
+            c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_1;
+            const float closed_R_2 = c_R_2_lanes[k];
+            c_R_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = R + 9 * (start + k);
+            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -580,12 +832,56 @@ static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[
 }
 
 /* symrot_wiener_milenkovic_tangent_f_batch: symrot_wiener_milenkovic_tangent_f for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n. */
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_tangent_f(p + 3 * k, H + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float w0 = x + 16;
+            const float w1 = 1.0F/(w0*w0);
+            c_H_0_lanes[k] = 16/w0;
+            c_H_1_lanes[k] = 128*w1;
+            c_H_2_lanes[k] = 32*w1;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_0 = c_H_0_lanes[k];
+            c_H_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_0;
+            const float closed_H_1 = c_H_1_lanes[k];
+            c_H_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_1;
+            const float closed_H_2 = c_H_2_lanes[k];
+            c_H_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = H + 9 * (start + k);
+            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -623,12 +919,50 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], 
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse_f_batch: symrot_wiener_milenkovic_tangent_inverse_f for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n. */
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_tangent_inverse_f(p + 3 * k, Hinv + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_H_inverse_0_lanes[k] = (1.0F/16.0F)*x + 1;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
+            c_H_inverse_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1.0F/8.0F;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = Hinv + 9 * (start + k);
+            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -681,12 +1015,53 @@ static inline void symrot_wiener_milenkovic_root_matrix_f(const float p[3], floa
 }
 
 /* symrot_wiener_milenkovic_root_matrix_f_batch: symrot_wiener_milenkovic_root_matrix_f for n vectors p[3*k..3*k+2] into
- * G[9*k..9*k+8], k < n. */
+ * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_root_matrix_f(p + 3 * k, G + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float w0 = 1.0F/(x + 16);
+            c_G_1_lanes[k] = 8*w0;
+            c_G_2_lanes[k] = 2*w0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            const float closed_G_1 = c_G_1_lanes[k];
+            c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_1;
+            const float closed_G_2 = c_G_2_lanes[k];
+            c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = G + 9 * (start + k);
+            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 
@@ -725,12 +1100,53 @@ static inline void symrot_wiener_milenkovic_root_tangent_f(const float p[3], flo
 }
 
 /* symrot_wiener_milenkovic_root_tangent_f_batch: symrot_wiener_milenkovic_root_tangent_f for n vectors p[3*k..3*k+2] into
- * K[9*k..9*k+8], k < n. */
+ * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ */
 static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    size_t k;
-    for (k = 0; k < n; ++k) {
-        symrot_wiener_milenkovic_root_tangent_f(p + 3 * k, K + 9 * k);
+    float x_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float w0 = 1.0F/(x + 16);
+            c_K_0_lanes[k] = 8*w0;
+            c_K_1_lanes[k] = 2*w0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float closed_K_0 = c_K_0_lanes[k];
+            c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
+            const float closed_K_1 = c_K_1_lanes[k];
+            c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_1;
+            c_K_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 0;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            float *const out = K + 9 * (start + k);
+            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+        }
     }
 }
 

@@ -472,17 +472,23 @@ class InvalidHeaderName(SymrotError):
 
 def header_source(plan: EvaluationPlan, name: str, expression: str | None = None) -> str:
     """The text of ``symrot_NAME.h`` for ``plan``."""
-    from .c_operations import OperationWriter  # it builds on FunctionWriter
+    from .c_batch import DEFAULT_BLOCK, BatchWriter  # they build on FunctionWriter
+    from .c_operations import OperationWriter
 
     if not HEADER_NAME.fullmatch(name):
         raise InvalidHeaderName(f"--name {name[:40]!r} is not a C identifier")
     functions = []
     for precision in PRECISIONS:
         writer = FunctionWriter(plan, name, precision)
+        batch = BatchWriter(writer)
         if plan.complement is not None:
             functions.append(writer.complement_function())
         functions.append(writer.angle_function())
-        functions += [writer.function(spec) for spec in FUNCTIONS]
+        public = [writer.function(spec) for spec in FUNCTIONS]
+        for spec, function in zip(FUNCTIONS, public, strict=True):
+            if function["batch_signature"]:
+                function["batch_statements"], function["batch_notes"] = batch.kernel(spec)
+        functions += public
         functions += OperationWriter(plan, name, precision).all()
     identifier = registry_title(plan.p)
     text = expression or sp.sstr(plan.p)
@@ -491,7 +497,7 @@ def header_source(plan: EvaluationPlan, name: str, expression: str | None = None
         command=f"symrot derive '{text}' --name {name} --emit c --out DIR",
         validity=FunctionWriter(plan, name, "double").validity_notes()[0],
         plan_note=f"the float64 and float32 plans of symrot.plan, {angle_kind(plan)} for phi",
-        guard=f"SYMROT_{name.upper()}_H", functions=functions,
+        guard=f"SYMROT_{name.upper()}_H", functions=functions, block=DEFAULT_BLOCK,
     )
 
 

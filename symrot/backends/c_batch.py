@@ -1,0 +1,338 @@
+"""The ``_batch`` kernels of the C backend, written so that compilers vectorize them.
+
+A kernel ``symrot_NAME_F_batch(n, p, T)`` evaluates the tensor function F (R, H, H⁻¹, G or K,
+eqs 14, 22, 26, 81, 83) for n vectors. It prints the same plan as the single call
+(:class:`~symrot.backends.c_backend.FunctionWriter`), in blocks of ``SYMROT_BATCH_BLOCK`` vectors
+and three passes, so that the expensive middle pass has no branch and no library call:
+
+1. **scalar pass** (k < block length, branches allowed): x = |p|², and for vectors inside the
+   validity range every operation a vectorizing compiler cannot handle: s = √x, d = p_max² − x
+   (``__complement``), φ (the plan's closed inverse or Newton iteration) and each *scalar atom* u
+   of the coefficient expressions, a maximal subexpression that is not arithmetic (√(x + 9),
+   ∛(6(φ − sin φ)), ...). Lanes past n get 0.
+2. **coefficient pass** (a loop of constant trip count over the block): every coefficient c(x),
+   both the Horner polynomial and the closed form of a :class:`~symrot.plan.Branch` selected by its
+   threshold, NaN outside the validity range. sin and cos of arguments c·φ with a bounded range
+   come from the branch-free kernel of :mod:`symrot.sincos_kernel` (one call gives both); any other
+   trig call is a scalar atom.
+3. **assembly** (k < block length): T = c0 I + c1 (p×) + c2 (p×)² entry by entry, as the single call.
+
+The values differ from the single call only by the rounding of the sin/cos kernel (≈ 1 ulp where
+libm is ≈ 0.5 ulp); both are tested against mpmath. Lanes whose result is discarded may raise
+floating-point exception flags (a 0/0 in the closed form below its threshold, for example); the
+result never depends on them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from ..algebraic import D, S, X
+from ..parsing import PHI
+from ..plan import Algebraic, Branch, Coefficient, Constant
+from ..sincos_kernel import SinCosKernel, sincos_kernel
+from .c_backend import (
+    MANTISSA,
+    OUTPUT_NAMES,
+    PHI_SYMBOL,
+    TENSOR_OF,
+    X_SYMBOL,
+    CFunction,
+    FunctionWriter,
+    P,
+    Statement,
+    horner,
+    tensor_entries,
+)
+from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter
+
+BLOCK = "SYMROT_BATCH_BLOCK"
+DEFAULT_BLOCK = 32
+"""Vectors per block: 8 to 16 vector iterations of AVX2/AVX-512, a few KB of stack."""
+TRIG = (sp.sin, sp.cos, sp.tan)
+LANE = sp.Symbol("pk[0]"), sp.Symbol("pk[1]"), sp.Symbol("pk[2]")
+
+
+@dataclass
+class Lanes:
+    """The scalar atoms (expression → u{i}) and the kernel's trig arguments (argument → i)."""
+
+    atoms: dict[sp.Expr, sp.Symbol] = field(default_factory=dict)
+    trig: dict[sp.Expr, int] = field(default_factory=dict)
+
+
+class VectorCPrinter(SymrotCPrinter):
+    """Prints every small integer power as a product: ``pow`` is a library call (gcc folds only
+    the square), and a call keeps the coefficient pass from being vectorized."""
+
+    def _print_Pow(self, expr: sp.Pow) -> str:
+        base, exponent = expr.base, expr.exp
+        if exponent.is_Integer and 2 <= abs(int(exponent)) <= MAX_EXPANDED_POWER and not base.is_Symbol:
+            product = "(" + "*".join([f"({self._print(base)})"] * abs(int(exponent))) + ")"
+            return product if exponent > 0 else f"{self._print_Float(sp.Float(1))}/{product}"
+        return super()._print_Pow(expr)
+
+
+class BatchWriter:
+    """Statements of the ``_batch`` kernels (and the sin/cos helper) of one plan in one precision."""
+
+    def __init__(self, writer: FunctionWriter) -> None:
+        self.writer = writer
+        self.trig_kernel: SinCosKernel = sincos_kernel(MANTISSA[writer.precision])
+        self.t = writer.ctype
+        self.f = "" if writer.precision == "double" else "f"
+        self.printer = VectorCPrinter(writer.precision)
+
+    def c(self, expr: sp.Expr) -> str:
+        return str(self.printer.doprint(expr))
+
+    # -- the sin/cos kernel ----------------------------------------------------------------------
+    def sincos_statements(self, argument: str, index: int, wanted: set[str]) -> list[Statement]:
+        """Statements setting ``sin{index}`` and/or ``cos{index}`` (those in ``wanted``) to sin and
+        cos of ``argument`` (C text).
+
+        The kernel of :mod:`symrot.sincos_kernel`, printed inline rather than as a helper
+        function: in a translation unit with many callers a compiler may decline to inline a
+        helper, and a loop with a call in it is not vectorized.
+        """
+        kernel, literal, t, f = self.trig_kernel, self.printer.literal, self.t, self.f
+        z = sp.Symbol(f"a{index}_z", real=True)
+        first, second, third = (literal(part) for part in kernel.pio2_parts)
+        sine = self.c(horner(kernel.sin_coefficients, z))
+        cosine = self.c(horner(kernel.cos_coefficients, z))
+
+        def let(name: str, value: str) -> Statement:
+            return {"kind": "let", "type": t, "name": f"a{index}_{name}",
+                    "value": value.replace("$", f"a{index}_")}
+
+        statements = [
+            let("a", argument),
+            let("q", f"rint{f}($a*{literal(kernel.two_over_pi)})"),
+            let("r", f"(($a - $q*{first}) - $q*{second}) - $q*{third}"),
+            let("z", "$r*$r"),
+            let("s", f"$r + ($r*$z)*({sine})"),
+            let("c", f"1 + $z*({cosine})"),
+            let("j", f"$q - 4*rint{f}({literal(0.25)}*$q - {literal(0.375)})"),
+            let("h", f"rint{f}({literal(0.5)}*$j - {literal(0.25)})"),
+            let("odd", "$j - 2*$h"),
+        ]
+        if f"sin{index}" in wanted:
+            statements.append({"kind": "let", "type": t, "name": f"sin{index}",
+                               "value": "(1 - 2*$h)*((1 - $odd)*$s + $odd*$c)".replace("$", f"a{index}_")})
+        if f"cos{index}" in wanted:
+            statements.append(let("up", f"fabs{f}($j - {literal(1.5)}) - {literal(0.5)}"))
+            statements.append({"kind": "let", "type": t, "name": f"cos{index}",
+                               "value": "(2*$up - 1)*((1 - $odd)*$c + $odd*$s)".replace("$", f"a{index}_")})
+        return statements
+
+    def sincos_note(self) -> str:
+        """One line for the header comment of a kernel that uses the sin/cos kernel."""
+        kernel = self.trig_kernel
+        degrees = (2 * len(kernel.sin_coefficients) + 1, 2 * len(kernel.cos_coefficients))
+        return (f"sin/cos: a - q pi/2 in three parts (exact for |a| < {kernel.max_argument:.4g}), Taylor "
+                f"degree {degrees[0]}/{degrees[1]} on |r| <= pi/4 (truncation < {kernel.truncation:.1e}), "
+                "quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.")
+
+    # -- analysis --------------------------------------------------------------------------------
+    def vector_trig(self, argument: sp.Expr) -> bool:
+        """sin/cos/tan of ``argument`` can use the kernel: c·φ with |c·φ| far inside its range."""
+        if argument.free_symbols != {PHI_SYMBOL}:
+            return False
+        ratio = sp.simplify(argument / PHI_SYMBOL)
+        phi_max = self.writer.plan.phi_max
+        return bool(ratio.is_Rational) and math.isfinite(phi_max) and \
+            abs(float(ratio)) * phi_max < self.trig_kernel.max_argument / 2
+
+    def split(self, expr: sp.Expr, lanes: Lanes) -> sp.Expr:
+        """``expr`` with each maximal non-arithmetic subexpression replaced by a scalar atom."""
+        if expr.is_Symbol or expr.is_Rational:
+            return expr
+        if expr.is_number:
+            return sp.Float(expr.evalf(40), 40)
+        if isinstance(expr, TRIG) and self.vector_trig(expr.args[0]):
+            return expr
+        if expr.is_Add or expr.is_Mul or (expr.is_Pow and expr.exp.is_Integer):
+            return expr.func(*(self.split(arg, lanes) for arg in expr.args))
+        if expr not in lanes.atoms:
+            lanes.atoms[expr] = sp.Symbol(f"u{len(lanes.atoms)}", real=True)
+        return lanes.atoms[expr]
+
+    def vectorize(self, expr: sp.Expr, lanes: Lanes) -> sp.Expr:
+        """Scalar atoms split off, kernel trig replaced by sin{i}/cos{i} symbols."""
+        split = self.split(expr, lanes)
+        replacements: dict[sp.Expr, sp.Expr] = {}
+        for call in sorted(split.atoms(*TRIG), key=sp.default_sort_key):
+            argument = call.args[0]
+            index = lanes.trig.setdefault(argument, len(lanes.trig))
+            sine, cosine = sp.Symbol(f"sin{index}", real=True), sp.Symbol(f"cos{index}", real=True)
+            replacements[call] = {sp.sin: sine, sp.cos: cosine, sp.tan: sine / cosine}[call.func]
+        return split.xreplace(replacements)
+
+    # -- the kernel ------------------------------------------------------------------------------
+    def kernel(self, spec: CFunction) -> tuple[list[Statement], list[str]]:
+        """Body of ``symrot_NAME_F_batch(size_t n, const T *p, T *OUT)`` for matrix function F, and
+        the lines of its header comment."""
+        writer = self.writer
+        names = [f"{TENSOR_OF[spec.name]}_{k}" for k in range(3)]
+        plan = {name: writer.precision_plan.coefficients[name] for name in names}
+        lanes = Lanes()
+        closed: dict[str, sp.Expr] = {}
+        for name, coefficient in plan.items():
+            if isinstance(coefficient, Algebraic):
+                closed[name] = self.vectorize(coefficient.expression.subs(X, X_SYMBOL), lanes)
+            elif isinstance(coefficient, Branch):
+                closed[name] = self.vectorize(coefficient.closed.subs({PHI: PHI_SYMBOL, X: X_SYMBOL}), lanes)
+        replacements, reduced = sp.cse(list(closed.values()), symbols=sp.numbered_symbols("w"))
+        used: set[sp.Basic] = set().union(*(e.free_symbols for e in closed.values()))
+        if lanes.trig:
+            used.add(PHI_SYMBOL)
+        inputs = [symbol for symbol in (S, D, PHI_SYMBOL, *lanes.atoms.values()) if symbol in used]
+        branches = [name for name in names if isinstance(plan[name], Branch)]
+        arrays = [f"{name}_lanes[{BLOCK}]" for name in ["x", *(str(s) for s in inputs)]]
+        arrays += [f"c_{name}_lanes[{BLOCK}]" for name in names]
+        arrays += [f"poly_{name}_lanes[{BLOCK}]" for name in branches]
+        notes = []
+        scalar = [str(symbol) for symbol in inputs if symbol not in lanes.atoms.values()]
+        scalar += [f"{symbol} = {sp.sstr(atom)}" for atom, symbol in lanes.atoms.items()]
+        if scalar:
+            notes.append("Scalar pass: " + ", ".join(scalar) + ".")
+        if lanes.trig:
+            notes.append(self.sincos_note())
+        return [
+            {"kind": "declare", "type": self.t, "names": arrays},
+            {"kind": "declare", "type": "size_t", "names": ["start", "k"]},
+            {"kind": "loop", "header": f"start = 0; start < n; start += {BLOCK}", "times": 1, "body": [
+                {"kind": "let", "type": "size_t", "name": "m",
+                 "value": f"n - start < {BLOCK} ? n - start : {BLOCK}"},
+                *self.scalar_pass(lanes, inputs, self.polynomial_below(plan, closed, inputs)),
+                {"kind": "comment", "text": "every candidate value, unconditionally"},
+                {"kind": "loop", "header": f"k = 0; k < {BLOCK}; ++k", "times": 1,
+                 "body": self.candidate_pass(plan, inputs, lanes, replacements,
+                                             dict(zip(closed, reduced, strict=True)))},
+                {"kind": "comment", "text": "select: polynomial below the threshold, NaN outside the range"},
+                {"kind": "loop", "header": f"k = 0; k < {BLOCK}; ++k", "times": 1,
+                 "body": self.select_pass(plan)},
+                {"kind": "loop", "header": "k = 0; k < m; ++k", "times": 1,
+                 "body": self.assembly(spec, names)},
+            ]},
+        ], notes
+
+    def candidate_pass(self, plan: dict[str, Coefficient], inputs: list[sp.Symbol], lanes: Lanes,
+                       replacements: list[tuple[sp.Symbol, sp.Expr]],
+                       reduced: dict[str, sp.Expr]) -> list[Statement]:
+        """Closed forms into c_*_lanes, polynomials into poly_*_lanes, for every lane of the block.
+
+        Nothing is conditional here: under the default -ftrapping-math a compiler will not
+        speculate an arithmetic operation that the source only performs on one side of a branch
+        (gcc sinks it there), and such a loop is not vectorized without masked instructions.
+        """
+        polynomials = [c.horner for c in plan.values() if isinstance(c, Branch)]
+        uses_x = any(len(h) > 1 for h in polynomials) or any(
+            X_SYMBOL in e.free_symbols for e in [*reduced.values(), *(value for _, value in replacements)])
+        body: list[Statement] = []
+        if uses_x:
+            body.append({"kind": "let", "type": self.t, "name": "x", "value": "x_lanes[k]"})
+        body += [{"kind": "let", "type": self.t, "name": str(symbol), "value": f"{symbol}_lanes[k]"}
+                 for symbol in inputs]
+        wanted = {str(symbol) for e in [*reduced.values(), *(value for _, value in replacements)]
+                  for symbol in e.free_symbols}
+        for argument, index in lanes.trig.items():
+            body += self.sincos_statements(self.c(argument), index, wanted)
+        body += [{"kind": "let", "type": self.t, "name": str(symbol), "value": self.c(value)}
+                 for symbol, value in replacements]
+        for name, coefficient in plan.items():
+            if isinstance(coefficient, (Algebraic, Branch)):
+                body.append({"kind": "set", "name": f"c_{name}_lanes[k]", "value": self.c(reduced[name])})
+            if isinstance(coefficient, Branch):
+                body.append({"kind": "set", "name": f"poly_{name}_lanes[k]",
+                             "value": self.c(horner(coefficient.horner, X_SYMBOL))})
+        return body
+
+    def select_pass(self, plan: dict[str, Coefficient]) -> list[Statement]:
+        """Selects between values already loaded (a blend; every load is unconditional, so that
+        no compiler has to prove a conditional load safe)."""
+        body: list[Statement] = [{"kind": "let", "type": self.t, "name": "x", "value": "x_lanes[k]"}]
+        outside = self.writer.out_of_range()
+        for name, coefficient in plan.items():
+            value = f"closed_{name}"
+            if isinstance(coefficient, Constant):
+                value = self.c(sp.sympify(coefficient.value))
+            else:
+                body.append({"kind": "let", "type": self.t, "name": value, "value": f"c_{name}_lanes[k]"})
+            if isinstance(coefficient, Branch):
+                threshold = self.printer.literal(coefficient.threshold)
+                body.append({"kind": "let", "type": self.t, "name": f"poly_{name}",
+                             "value": f"poly_{name}_lanes[k]"})
+                body.append({"kind": "let", "type": self.t, "name": f"v_{name}",
+                             "value": f"x < {threshold} ? poly_{name} : {value}"})
+                value = f"v_{name}"
+            body.append({"kind": "set", "name": f"c_{name}_lanes[k]", "value": f"{outside} ? NAN : {value}"})
+        return body
+
+    def assembly(self, spec: CFunction, names: list[str]) -> list[Statement]:
+        """T = c0 I + c1 (p×) + c2 (p×)² for the vectors of the block, as in the single call."""
+        a, b, c = (sp.Symbol(f"c_{name}_lanes[k]", real=True) for name in names)
+        entries = [entry.xreplace(dict(zip(P, LANE, strict=True))) for entry in tensor_entries(a, b, c)]
+        output = OUTPUT_NAMES[spec.name]
+        return [
+            {"kind": "let", "type": f"{self.t} *const", "name": "pk", "value": "p + 3 * (start + k)"},
+            {"kind": "declare", "type": f"{self.t} *const", "names": [f"out = {output} + 9 * (start + k)"]},
+            *({"kind": "set", "name": f"out[{i}]", "value": self.c(entry)}
+              for i, entry in enumerate(entries)),
+        ]
+
+    @staticmethod
+    def polynomial_below(plan: dict[str, Coefficient], closed: dict[str, sp.Expr],
+                         inputs: list[sp.Symbol]) -> float | None:
+        """The x below which every coefficient reading the scalar pass is its polynomial (so the
+        scalar pass can skip φ and the atoms there, as the single call does), or None."""
+        if any(isinstance(plan[name], Algebraic) and closed[name].free_symbols & set(inputs)
+               for name in closed):
+            return None
+        thresholds = [c.threshold for c in plan.values() if isinstance(c, Branch)]
+        return min(thresholds) if thresholds else None
+
+    def scalar_pass(self, lanes: Lanes, inputs: list[sp.Symbol], below: float | None) -> list[Statement]:
+        """x for every vector of the block, and the library calls for those inside the range
+        (and at or above ``below``, where a closed form is used)."""
+        writer = self.writer
+        needs = set(inputs) | set().union(*(atom.free_symbols for atom in lanes.atoms))
+        if lanes.trig:
+            needs.add(PHI_SYMBOL)
+        if PHI_SYMBOL in needs:
+            needs.add(S)
+            if writer.plan.complement is not None:
+                needs.add(D)
+        inside: list[Statement] = []
+        if D in needs:
+            inside.append({"kind": "let", "type": self.t, "name": "d",
+                           "value": f"{writer.complement_helper}(pk)"})
+        if S in needs:
+            inside.append({"kind": "let", "type": self.t, "name": "s", "value": f"sqrt{self.f}(x)"})
+        if PHI_SYMBOL in needs:
+            inside.append({"kind": "let", "type": self.t, "name": "phi", "value": writer.angle_call("s")})
+        inside += [writer.let(str(symbol), atom) for atom, symbol in lanes.atoms.items()]
+        inside += [{"kind": "set", "name": f"{symbol}_lanes[k]", "value": str(symbol)} for symbol in inputs]
+        zero = [{"kind": "set", "name": f"{symbol}_lanes[k]", "value": "0"} for symbol in inputs]
+        x = writer.c(LANE[0] ** 2 + LANE[1] ** 2 + LANE[2] ** 2)
+        body: list[Statement] = [
+            {"kind": "let", "type": f"{self.t} *const", "name": "pk", "value": "p + 3 * (start + k)"},
+            {"kind": "let", "type": self.t, "name": "x", "value": x},
+            {"kind": "set", "name": "x_lanes[k]", "value": "x"},
+        ]
+        if inputs:
+            condition = writer.out_of_range()
+            if below is not None:
+                condition += f" || x < {self.printer.literal(below)}"
+            body.append({"kind": "if", "condition": condition, "then": zero, "otherwise": inside})
+        tail: list[Statement] = [{"kind": "set", "name": "x_lanes[k]", "value": "0"}, *zero]
+        return [
+            {"kind": "loop", "header": "k = 0; k < m; ++k", "times": 1, "body": body},
+            {"kind": "loop", "header": f"; k < {BLOCK}; ++k", "times": 1, "body": tail},
+        ]
+
+
+__all__ = ["BLOCK", "DEFAULT_BLOCK", "BatchWriter"]
