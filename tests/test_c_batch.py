@@ -1,6 +1,6 @@
 """The vectorizable batch kernels of the C backend (symrot.backends.c_batch).
 
-* the branch-free sin/cos kernel (symrot.sincos_kernel), printed exactly as the headers print it,
+* the branch-free sin/cos kernel (symrot.sincos_kernel), printed exactly as the batch kernels print it,
   is within 1.5 ulp of 50-digit mpmath in double and float, with and without FMA contraction, on
   arguments from 0 and 1e-300 up to far beyond the 3π/2 the headers need, and right next to
   multiples of π/2 where the reduction cancels;
@@ -41,7 +41,7 @@ def kernel_source(precision: Precision) -> str:
     """A C function evaluating the kernel on n arguments, from the statements the headers print."""
     # the kernel does not depend on the plan; any plan gives a writer for the precision
     writer = FunctionWriter(plan_for(derive("rotation_vector").derivation, "rotation_vector"), "t", precision)
-    statements = BatchWriter(writer).sincos_statements("a[k]", 0, {"sin0", "cos0"})
+    statements = BatchWriter(writer).sincos.kernel_statements("a[k]", 0, {"sin0", "cos0"})
     body = environment().get_template("c/statements.j2").module.block(statements, "        ")  # type: ignore[attr-defined]
     t = precision
     return (f"#include <math.h>\n#include <stddef.h>\n"

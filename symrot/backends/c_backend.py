@@ -15,7 +15,9 @@ float version (suffix ``_f``, float math functions, the float32 plan), and matri
   :class:`~symrot.plan.Branch` ones of a function share one ``if (x < smallest threshold)``:
   below it every coefficient is its Horner polynomial, above it φ is computed once, the closed
   forms share common subexpressions (``sympy.cse``, inside that branch only, where x > 0) and a
-  coefficient whose own threshold is larger still takes its polynomial;
+  coefficient whose own threshold is larger still takes its polynomial (sin and cos are libm's
+  here, ≈ 0.5 ulp; the ``_batch`` kernels of :mod:`symrot.backends.c_batch` use the vectorizable
+  kernel of :mod:`symrot.backends.c_sincos` instead);
 * φ: the plan's closed inverse, or its safeguarded Newton iteration (a helper function with the
   plan's fixed iteration count, bracket and Taylor-safe ratio and slope branches). ``angle`` needs
   |p| itself, accurately down to the smallest subnormal: below x = 2⁻⁶⁰⁰ (2⁻¹⁰⁰ in float) the
@@ -55,7 +57,7 @@ from ..plan import (
     evaluation_plan,
 )
 from ..registry import NAMED, find_by_expression
-from .c_printer import PRECISIONS, Precision, SymrotCPrinter
+from .c_printer import PRECISIONS, Precision, SymrotCPrinter, horner
 from .templating import render
 
 FunctionKind = Literal["scalar", "matrix", "vector"]
@@ -149,15 +151,6 @@ def ops_of(statements: list[Statement]) -> int:
         elif statement["kind"] == "loop":
             total += int(statement["times"]) * ops_of(statement["body"])
     return total
-
-
-def horner(coefficients: tuple[sp.Expr, ...], variable: sp.Symbol) -> sp.Expr:
-    """Σ coefficients[j] variable^j in Horner order, unevaluated so that it prints as nested."""
-    result: sp.Expr = sp.sympify(coefficients[-1])
-    for c in reversed(coefficients[:-1]):
-        product = sp.Mul(variable, result, evaluate=False)
-        result = product if c == 0 else sp.Add(c, product, evaluate=False)
-    return result
 
 
 class FunctionWriter:

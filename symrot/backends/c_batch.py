@@ -25,7 +25,6 @@ result never depends on them.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import sympy as sp
@@ -33,9 +32,7 @@ import sympy as sp
 from ..algebraic import D, S, X
 from ..parsing import PHI
 from ..plan import Algebraic, Branch, Coefficient, Constant
-from ..sincos_kernel import SinCosKernel, sincos_kernel
 from .c_backend import (
-    MANTISSA,
     OUTPUT_NAMES,
     PHI_SYMBOL,
     TENSOR_OF,
@@ -48,11 +45,11 @@ from .c_backend import (
     tensor_entries,
 )
 from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter
+from .c_sincos import TRIG, SinCosWriter
 
 BLOCK = "SYMROT_BATCH_BLOCK"
 DEFAULT_BLOCK = 32
 """Vectors per block: 8 to 16 vector iterations of AVX2/AVX-512, a few KB of stack."""
-TRIG = (sp.sin, sp.cos, sp.tan)
 LANE = sp.Symbol("pk[0]"), sp.Symbol("pk[1]"), sp.Symbol("pk[2]")
 
 
@@ -77,82 +74,26 @@ class VectorCPrinter(SymrotCPrinter):
 
 
 class BatchWriter:
-    """Statements of the ``_batch`` kernels (and the sin/cos helper) of one plan in one precision."""
+    """Statements of the ``_batch`` kernels of one plan in one precision."""
 
     def __init__(self, writer: FunctionWriter) -> None:
         self.writer = writer
-        self.trig_kernel: SinCosKernel = sincos_kernel(MANTISSA[writer.precision])
         self.t = writer.ctype
         self.f = "" if writer.precision == "double" else "f"
         self.printer = VectorCPrinter(writer.precision)
+        self.sincos = SinCosWriter(writer.precision, self.printer, PHI_SYMBOL, writer.plan.phi_max)
 
     def c(self, expr: sp.Expr) -> str:
         return str(self.printer.doprint(expr))
 
-    # -- the sin/cos kernel ----------------------------------------------------------------------
-    def sincos_statements(self, argument: str, index: int, wanted: set[str]) -> list[Statement]:
-        """Statements setting ``sin{index}`` and/or ``cos{index}`` (those in ``wanted``) to sin and
-        cos of ``argument`` (C text).
-
-        The kernel of :mod:`symrot.sincos_kernel`, printed inline rather than as a helper
-        function: in a translation unit with many callers a compiler may decline to inline a
-        helper, and a loop with a call in it is not vectorized.
-        """
-        kernel, literal, t, f = self.trig_kernel, self.printer.literal, self.t, self.f
-        z = sp.Symbol(f"a{index}_z", real=True)
-        first, second, third = (literal(part) for part in kernel.pio2_parts)
-        sine = self.c(horner(kernel.sin_coefficients, z))
-        cosine = self.c(horner(kernel.cos_coefficients, z))
-
-        def let(name: str, value: str) -> Statement:
-            return {"kind": "let", "type": t, "name": f"a{index}_{name}",
-                    "value": value.replace("$", f"a{index}_")}
-
-        statements = [
-            let("a", argument),
-            let("q", f"rint{f}($a*{literal(kernel.two_over_pi)})"),
-            let("r", f"(($a - $q*{first}) - $q*{second}) - $q*{third}"),
-            let("z", "$r*$r"),
-            let("s", f"$r + ($r*$z)*({sine})"),
-            let("c", f"1 + $z*({cosine})"),
-            let("j", f"$q - 4*rint{f}({literal(0.25)}*$q - {literal(0.375)})"),
-            let("h", f"rint{f}({literal(0.5)}*$j - {literal(0.25)})"),
-            let("odd", "$j - 2*$h"),
-        ]
-        if f"sin{index}" in wanted:
-            statements.append({"kind": "let", "type": t, "name": f"sin{index}",
-                               "value": "(1 - 2*$h)*((1 - $odd)*$s + $odd*$c)".replace("$", f"a{index}_")})
-        if f"cos{index}" in wanted:
-            statements.append(let("up", f"fabs{f}($j - {literal(1.5)}) - {literal(0.5)}"))
-            statements.append({"kind": "let", "type": t, "name": f"cos{index}",
-                               "value": "(2*$up - 1)*((1 - $odd)*$c + $odd*$s)".replace("$", f"a{index}_")})
-        return statements
-
-    def sincos_note(self) -> str:
-        """One line for the header comment of a kernel that uses the sin/cos kernel."""
-        kernel = self.trig_kernel
-        degrees = (2 * len(kernel.sin_coefficients) + 1, 2 * len(kernel.cos_coefficients))
-        return (f"sin/cos: a - q pi/2 in three parts (exact for |a| < {kernel.max_argument:.4g}), Taylor "
-                f"degree {degrees[0]}/{degrees[1]} on |r| <= pi/4 (truncation < {kernel.truncation:.1e}), "
-                "quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.")
-
     # -- analysis --------------------------------------------------------------------------------
-    def vector_trig(self, argument: sp.Expr) -> bool:
-        """sin/cos/tan of ``argument`` can use the kernel: c·φ with |c·φ| far inside its range."""
-        if argument.free_symbols != {PHI_SYMBOL}:
-            return False
-        ratio = sp.simplify(argument / PHI_SYMBOL)
-        phi_max = self.writer.plan.phi_max
-        return bool(ratio.is_Rational) and math.isfinite(phi_max) and \
-            abs(float(ratio)) * phi_max < self.trig_kernel.max_argument / 2
-
     def split(self, expr: sp.Expr, lanes: Lanes) -> sp.Expr:
         """``expr`` with each maximal non-arithmetic subexpression replaced by a scalar atom."""
         if expr.is_Symbol or expr.is_Rational:
             return expr
         if expr.is_number:
             return sp.Float(expr.evalf(40), 40)
-        if isinstance(expr, TRIG) and self.vector_trig(expr.args[0]):
+        if isinstance(expr, TRIG) and self.sincos.applies(expr.args[0]):
             return expr
         if expr.is_Add or expr.is_Mul or (expr.is_Pow and expr.exp.is_Integer):
             return expr.func(*(self.split(arg, lanes) for arg in expr.args))
@@ -162,14 +103,7 @@ class BatchWriter:
 
     def vectorize(self, expr: sp.Expr, lanes: Lanes) -> sp.Expr:
         """Scalar atoms split off, kernel trig replaced by sin{i}/cos{i} symbols."""
-        split = self.split(expr, lanes)
-        replacements: dict[sp.Expr, sp.Expr] = {}
-        for call in sorted(split.atoms(*TRIG), key=sp.default_sort_key):
-            argument = call.args[0]
-            index = lanes.trig.setdefault(argument, len(lanes.trig))
-            sine, cosine = sp.Symbol(f"sin{index}", real=True), sp.Symbol(f"cos{index}", real=True)
-            replacements[call] = {sp.sin: sine, sp.cos: cosine, sp.tan: sine / cosine}[call.func]
-        return split.xreplace(replacements)
+        return self.sincos.replace(self.split(expr, lanes), lanes.trig)
 
     # -- the kernel ------------------------------------------------------------------------------
     def kernel(self, spec: CFunction) -> tuple[list[Statement], list[str]]:
@@ -200,7 +134,7 @@ class BatchWriter:
         if scalar:
             notes.append("Scalar pass: " + ", ".join(scalar) + ".")
         if lanes.trig:
-            notes.append(self.sincos_note())
+            notes.append(self.sincos.note())
         return [
             {"kind": "declare", "type": self.t, "names": arrays},
             {"kind": "declare", "type": "size_t", "names": ["start", "k"]},
@@ -239,8 +173,7 @@ class BatchWriter:
                  for symbol in inputs]
         wanted = {str(symbol) for e in [*reduced.values(), *(value for _, value in replacements)]
                   for symbol in e.free_symbols}
-        for argument, index in lanes.trig.items():
-            body += self.sincos_statements(self.c(argument), index, wanted)
+        body += self.sincos.statements(lanes.trig, wanted)
         body += [{"kind": "let", "type": self.t, "name": str(symbol), "value": self.c(value)}
                  for symbol, value in replacements]
         for name, coefficient in plan.items():

@@ -108,9 +108,18 @@ class SymrotCPrinter(C99CodePrinter):
         return str(super()._print_Pow(expr))
 
 
+def horner(coefficients: tuple[sp.Expr, ...], variable: sp.Symbol) -> sp.Expr:
+    """Σ coefficients[j] variable^j in Horner order, unevaluated so that it prints as nested."""
+    result: sp.Expr = sp.sympify(coefficients[-1])
+    for c in reversed(coefficients[:-1]):
+        product = sp.Mul(variable, result, evaluate=False)
+        result = product if c == 0 else sp.Add(c, product, evaluate=False)
+    return result
+
+
 def print_c(expr: sp.Expr, precision: Precision = "double") -> str:
     """``expr`` as a C99 expression in ``precision``."""
     return str(SymrotCPrinter(precision).doprint(expr))
 
 
-__all__ = ["PRECISIONS", "Precision", "SymrotCPrinter", "print_c"]
+__all__ = ["PRECISIONS", "Precision", "SymrotCPrinter", "horner", "print_c"]
