@@ -45,8 +45,9 @@ Thresholds and degrees come from an error model per precision: the closed form's
 measured against 30-digit mpmath on a log grid of φ plus points approaching φ_max, each point
 taking the worst of a few nearby arguments (a cancellation must not hide behind one lucky
 rounding); the Horner tail is bounded by its next two terms at the threshold.  The switch is
-the grid point minimising the worse of the two, and the degree is the smallest meeting the
-target.  Among equivalent closed forms (as derived, half-angle forms of cos φ, everything in
+the grid point minimising the worse of the two, moved up for speed as far as a polynomial of
+``CHEAP_TERMS`` terms still truncates below a quarter ulp, and the degree is the smallest meeting
+the target.  Among equivalent closed forms (as derived, half-angle forms of cos φ, everything in
 sin(φ/2), cos(φ/2)) the plan takes the one whose worst error is smallest, then the shortest
 polynomial, then the fewest distinct trigonometric arguments (sin a and cos a: one sincos).
 """
@@ -89,6 +90,10 @@ from .series import coefficient_list, taylor_series
 from .timeouts import bounded
 
 MAX_TERMS = 24
+CHEAP_TERMS = 8
+"""A Horner polynomial of up to this many terms (8 fused multiply-adds) is cheaper than a closed
+form with sin/cos (a libm call is 20–60 cycles) or a division: switches move up to where it stays
+accurate, so that small rotations, the common case in time stepping, never reach libm."""
 GRID_POINTS = 56
 EDGE_POINTS = 12
 JITTER = 0.0137
@@ -292,6 +297,13 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                 best, best_k = worst, k
         elif worst < best:
             best, best_k = worst, k
+    # speed: a polynomial of up to CHEAP_TERMS terms costs less than the closed form's library
+    # calls, so the switch moves up while such a polynomial still truncates below a quarter ulp
+    # (the closed form then serves a smaller range, where its error can only be smaller)
+    while best_k + 1 < near_zero and tail(t_values[best_k + 1], CHEAP_TERMS) <= 0.25:
+        best_k += 1
+    best = min(best, max(float(np.max(closed_error[best_k:near_zero])),
+                         tail(t_values[best_k], MAX_TERMS - 2)))
     threshold = float(t_values[best_k])
     target = max(0.25, tail(threshold, MAX_TERMS - 2))
     degree = next((n for n in range(1, MAX_TERMS - 1) if tail(threshold, n) <= target), MAX_TERMS - 2)

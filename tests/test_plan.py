@@ -67,3 +67,28 @@ def test_sine_family_inverse_is_closed_form() -> None:
     # 4 asin(s/4) rewritten as 4 atan2(s, sqrt(d)), d = 16 - |p|^2 computed with compensated sums
     assert isinstance(angle, ClosedAngle) and angle.expression.has(sp.atan2)
     assert plan.complement == 16
+
+
+@pytest.mark.parametrize("label, dtype", [("float64", np.float64), ("float32", np.float32)])
+def test_small_rotations_take_short_polynomials_not_library_calls(label: str, dtype: type) -> None:
+    """The switch moves up as far as CHEAP_TERMS terms stay accurate: for the rotation vector,
+    R's coefficients are polynomials up to |φ| > 0.5 (the accuracy alone would switch at
+    |φ| ~ 1e-6), and those polynomials match 50-digit mpmath at the switch to within an ulp."""
+    import mpmath
+
+    from symrot.plan import CHEAP_TERMS
+
+    derivation = derive("rotation_vector").derivation
+    plan = evaluation_plan(derivation, "rotation_vector")
+    epsilon = float(np.finfo(dtype).eps)
+    for name in ("R_1", "R_2", "H_1", "G_1"):
+        branch = plan.precisions[label].coefficients[name]
+        assert isinstance(branch, Branch)
+        assert branch.threshold > 0.25 and len(branch.horner) <= CHEAP_TERMS, (name, branch.threshold)
+        x = dtype(branch.threshold)
+        value = dtype(0)
+        for c in reversed(branch.horner):
+            value = dtype(value * x + dtype(float(c)))
+        with mpmath.workdps(60):
+            exact = derivation.evaluate(name, mpmath.sqrt(mpmath.mpf(float(x))), 50)
+        assert abs(float(value) - float(exact)) <= 1.0 * epsilon * abs(float(exact)), name

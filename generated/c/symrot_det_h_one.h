@@ -908,7 +908,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
 
 /* symrot_det_h_one_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 1 in x below x = 1.92119e-14, else cos(phi/2)
+ * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
  * nu: Horner degree 9 in x below x = 0.403133, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * ops: 449 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
@@ -922,8 +922,8 @@ static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4]
         return;
     }
     double c_e_0, c_nu;
-    if (x < 1.9211893090849666e-14) {
-        c_e_0 = 1 + (-1.0/8.0)*x;
+    if (x < 0.11031240806298934) {
+        c_e_0 = x*(x*(x*(x*(x*(x*((-8.286380574805527e-10)*x - 3362377.0/275526451200000.0) - 150653.0/794787840000.0) - 823.0/258048000.0) - 11.0/179200.0) - 1.0/640.0) - 1.0/8.0) + 1;
         c_nu = x*(x*(x*(x*(x*(x*(x*(x*((-5.1339188726594446e-12)*x - 6.740882557422226e-11) - 9.035261398610608e-10) - 1.244209181073502e-08) - 1312063.0/7380172800000.0) - 17753.0/6623232000.0) - 71.0/1612800.0) - 19.0/22400.0) - 1.0/40.0) + 1;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
@@ -1054,7 +1054,7 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
 
 /* symrot_det_h_one__phi_f: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 219 */
+ * ops: 309 */
 static inline float symrot_det_h_one__phi_f(float s)
 {
     const float s2 = (s*s);
@@ -1068,13 +1068,14 @@ static inline float symrot_det_h_one__phi_f(float s)
     for (k = 0; k < 6; ++k) {
         const float t = (phi*phi);
         float ratio, slope, residual, step;
-        if (t < 1.5083706F) {
-            ratio = t*((1.0F/8400.0F)*t - 1.0F/60.0F) + 1;
+        if (t < 5.567348F) {
+            ratio = t*(t*(t*(t*((1.046132e-11F)*t + 2.8630982e-09F)) + 1.0F/8400.0F) - 1.0F/60.0F) + 1;
         } else {
-            ratio = cbrtf(6*phi - 6*sinf(phi))/phi;
+            const float ratio_w0 = (1.0F/2.0F)*phi;
+            ratio = cbrtf(6*phi - 12*sinf(ratio_w0)*cosf(ratio_w0))/phi;
         }
-        if (t < 1.5083706F) {
-            slope = t*(t*(t*((2.5767882e-08F)*t) + 1.0F/1680.0F) - 1.0F/20.0F) + 1;
+        if (t < 5.567348F) {
+            slope = t*(t*(t*(t*(t*(1.1507452e-10F + (-2.096197e-12F)*t) + 2.5767882e-08F)) + 1.0F/1680.0F) - 1.0F/20.0F) + 1;
         } else {
             slope = 2*(1 - cosf(phi))/powf(cbrtf(6*(phi - sinf(phi))), 2);
         }
@@ -1097,7 +1098,7 @@ static inline float symrot_det_h_one__phi_f(float s)
 /* symrot_det_h_one_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 237 */
+ * ops: 327 */
 static inline float symrot_det_h_one_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1121,7 +1122,7 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)*cos(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))
  * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
- * ops: 285 */
+ * ops: 375 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1261,10 +1262,10 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
 
 /* symrot_det_h_one_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 6 in x below x = 0.764824, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
+ * H_0: Horner degree 7 in x below x = 1.43428, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
  * H_1: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 354 */
+ * ops: 426 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1281,8 +1282,8 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
         return;
     }
     float c_H_0, c_H_1, c_H_2;
-    if (x < 0.7648242F) {
-        c_H_0 = x*(x*(x*(x*(x*((1.5485168e-07F)*x + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
+    if (x < 1.4342812F) {
+        c_H_0 = x*(x*(x*(x*(x*(x*((1.3075291e-08F)*x + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
     } else {
@@ -1293,7 +1294,7 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
         const float w3 = powf(cbrtf(6*(phi - sinf(phi))), 2);
         const float w4 = w1*cosf(w0);
         c_H_0 = (1.0F/4.0F)*w2*w3;
-        c_H_1 = x < 1.4342812F ? x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : (1 - cosf(phi))/w3;
+        c_H_1 = (1 - cosf(phi))/w3;
         c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w2*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(phi - 2*w4);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
@@ -1324,7 +1325,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 1.4342812F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
@@ -1382,7 +1383,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float w1 = (u0*u0);
             const float w2 = cos0*sin0;
             c_H_0_lanes[k] = (1.0F/4.0F)*w0*w1;
-            poly_H_0_lanes[k] = x*(x*(x*(x*(x*((1.5485168e-07F)*x + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
+            poly_H_0_lanes[k] = x*(x*(x*(x*(x*(x*((1.3075291e-08F)*x + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
             c_H_1_lanes[k] = (1 - cos1)/w1;
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = (1.0F/12.0F)*w0*(3*phi + (1.0F/2.0F)*sin2 - 8*w2)/(phi - 2*w2);
@@ -1393,7 +1394,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float x = x_lanes[k];
             const float closed_H_0 = c_H_0_lanes[k];
             const float poly_H_0 = poly_H_0_lanes[k];
-            const float v_H_0 = x < 0.7648242F ? poly_H_0 : closed_H_0;
+            const float v_H_0 = x < 1.4342812F ? poly_H_0 : closed_H_0;
             c_H_0_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
@@ -1425,7 +1426,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
  * H_inverse_0: Horner degree 6 in x below x = 1.43428, else 2*(1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 335 */
+ * ops: 425 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1583,9 +1584,9 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
 /* symrot_det_h_one_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 5 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * G_2: Horner degree 4 in x below x = 0.764824, else (1 - cos(phi/2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 283 */
+ * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
+ * G_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi/2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * ops: 373 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1602,9 +1603,9 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
         return;
     }
     float c_G_1, c_G_2;
-    if (x < 0.7648242F) {
-        c_G_1 = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-        c_G_2 = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+    if (x < 1.4342812F) {
+        c_G_1 = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
+        c_G_2 = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
@@ -1641,7 +1642,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 1.4342812F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1680,9 +1681,9 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/u0;
-            poly_G_1_lanes[k] = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(u1*u1);
-            poly_G_2_lanes[k] = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1690,11 +1691,11 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             c_G_0_lanes[k] = !(x <= 11.2431345F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 0.7648242F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 1.4342812F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.7648242F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 1.4342812F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 11.2431345F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1715,10 +1716,10 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
 
 /* symrot_det_h_one_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0: Horner degree 6 in x below x = 0.764824, else cbrt(6*(phi - sin(phi)))**2/(8*sin(phi/2)**2)
- * K_1: Horner degree 4 in x below x = 0.764824, else (1 - cos(phi/2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * K_0: Horner degree 7 in x below x = 1.43428, else cbrt(6*(phi - sin(phi)))**2/(8*sin(phi/2)**2)
+ * K_1: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi/2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * K_2: Horner degree 11 in x below x = 2.63022, else (-sin(phi/2)/cbrt(6*(phi - sin(phi))) + cbrt(6*(phi - sin(phi)))**2/(8*sin(phi/2)**2))/cbrt(6*(phi - sin(phi)))**2
- * ops: 322 */
+ * ops: 412 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1735,9 +1736,9 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
         return;
     }
     float c_K_0, c_K_1, c_K_2;
-    if (x < 0.7648242F) {
-        c_K_0 = x*(x*(x*(x*(x*((7.742584e-08F)*x + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
-        c_K_1 = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+    if (x < 1.4342812F) {
+        c_K_0 = x*(x*(x*(x*(x*(x*((6.5376455e-09F)*x + 7.742584e-08F) + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
+        c_K_1 = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.1578103e-14F)*x + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
@@ -1779,7 +1780,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 1.4342812F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1820,9 +1821,9 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float w0 = 1.0F/(sin0*sin0);
             const float w1 = (u0*u0);
             c_K_0_lanes[k] = (1.0F/8.0F)*w0*w1;
-            poly_K_0_lanes[k] = x*(x*(x*(x*(x*((7.742584e-08F)*x + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
+            poly_K_0_lanes[k] = x*(x*(x*(x*(x*(x*((6.5376455e-09F)*x + 7.742584e-08F) + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
             c_K_1_lanes[k] = (1 - cos0)/(u1*u1);
-            poly_K_1_lanes[k] = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (-sin0/u0 + (1.0F/8.0F)*w0*w1)/w1;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.1578103e-14F)*x + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
         }
@@ -1831,11 +1832,11 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float x = x_lanes[k];
             const float closed_K_0 = c_K_0_lanes[k];
             const float poly_K_0 = poly_K_0_lanes[k];
-            const float v_K_0 = x < 0.7648242F ? poly_K_0 : closed_K_0;
+            const float v_K_0 = x < 1.4342812F ? poly_K_0 : closed_K_0;
             c_K_0_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.7648242F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 1.4342812F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -1863,7 +1864,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
  * H_inverse_0: Horner degree 6 in x below x = 1.43428, else 2*(1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 329 */
+ * ops: 419 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1897,10 +1898,10 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
 
 /* symrot_det_h_one_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 6 in x below x = 0.764824, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
+ * H_0: Horner degree 7 in x below x = 1.43428, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
  * H_1: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 348 */
+ * ops: 420 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1911,8 +1912,8 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
         return;
     }
     float c_H_0, c_H_1, c_H_2;
-    if (x < 0.7648242F) {
-        c_H_0 = x*(x*(x*(x*(x*((1.5485168e-07F)*x + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
+    if (x < 1.4342812F) {
+        c_H_0 = x*(x*(x*(x*(x*(x*((1.3075291e-08F)*x + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
     } else {
@@ -1923,7 +1924,7 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
         const float w3 = powf(cbrtf(6*(phi - sinf(phi))), 2);
         const float w4 = w1*cosf(w0);
         c_H_0 = (1.0F/4.0F)*w2*w3;
-        c_H_1 = x < 1.4342812F ? x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : (1 - cosf(phi))/w3;
+        c_H_1 = (1 - cosf(phi))/w3;
         c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w2*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(phi - 2*w4);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
@@ -1936,9 +1937,9 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
 
 /* symrot_det_h_one_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 0 in x below x = 1.92119e-14, else cos(phi/2)
- * nu: Horner degree 5 in x below x = 0.764824, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * ops: 251 */
+ * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
+ * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
+ * ops: 331 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1950,14 +1951,14 @@ static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4]
         return;
     }
     float c_e_0, c_nu;
-    if (x < 1.9211895e-14F) {
-        c_e_0 = 1;
-        c_nu = x*(x*(x*(x*((-1.7778216e-07F)*x - 2.6804134e-06F) - 71.0F/1612800.0F) - 19.0F/22400.0F) - 1.0F/40.0F) + 1;
+    if (x < 1.4342812F) {
+        c_e_0 = x*(x*(x*(x*(x*((-1.2203463e-08F)*x - 1.8955122e-07F) - 3.1893292e-06F) - 11.0F/179200.0F) - 1.0F/640.0F) - 1.0F/8.0F) + 1;
+        c_nu = x*(x*(x*(x*(x*((-1.2442092e-08F)*x - 1.7778216e-07F) - 2.6804134e-06F) - 71.0F/1612800.0F) - 19.0F/22400.0F) - 1.0F/40.0F) + 1;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
         c_e_0 = cosf(w0);
-        c_nu = x < 0.7648242F ? x*(x*(x*(x*((-1.7778216e-07F)*x - 2.6804134e-06F) - 71.0F/1612800.0F) - 19.0F/22400.0F) - 1.0F/40.0F) + 1 : 2*sinf(w0)/cbrtf(6*(phi - sinf(phi)));
+        c_nu = 2*sinf(w0)/cbrtf(6*(phi - sinf(phi)));
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
     e[0] = c_e_0;

@@ -474,8 +474,8 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/sqrt(d) (algebraic in x)
  * K_1 = 1/(2*(sqrt(d) + 2)) (algebraic in x)
- * K_2: Horner degree 1 in x below x = 1e-14, else 1/(4*sqrt(d)*(sqrt(d)/2 + 1))
- * ops: 81 */
+ * K_2: Horner degree 7 in x below x = 0.0346281, else 1/(4*sqrt(d)*(sqrt(d)/2 + 1))
+ * ops: 96 */
 static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -495,8 +495,8 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
     const double c_K_0 = 1.0/sqrt(d);
     const double c_K_1 = (1.0/2.0)/(sqrt(d) + 2);
     double c_K_2;
-    if (x < 9.99999999999999e-15) {
-        c_K_2 = (3.0/256.0)*x + 1.0/16.0;
+    if (x < 0.03462813501506715) {
+        c_K_2 = x*(x*(x*(x*(x*(x*((6435.0/4294967296.0)*x + 429.0/67108864.0) + 231.0/8388608.0) + 63.0/524288.0) + 35.0/65536.0) + 5.0/2048.0) + 3.0/256.0) + 1.0/16.0;
     } else {
         const double w0 = sqrt(d);
         c_K_2 = (1.0/4.0)/(w0*((1.0/2.0)*w0 + 1));
@@ -552,7 +552,7 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
             c_K_0_lanes[k] = u0;
             c_K_1_lanes[k] = (1.0/2.0)/(u1 + 2);
             c_K_2_lanes[k] = (1.0/4.0)*u0/((1.0/2.0)*u1 + 1);
-            poly_K_2_lanes[k] = (3.0/256.0)*x + 1.0/16.0;
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((6435.0/4294967296.0)*x + 429.0/67108864.0) + 231.0/8388608.0) + 63.0/524288.0) + 35.0/65536.0) + 5.0/2048.0) + 3.0/256.0) + 1.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -563,7 +563,7 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
             c_K_1_lanes[k] = !(x < 4.0) ? NAN : closed_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 9.99999999999999e-15 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 0.03462813501506715 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.0) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1207,8 +1207,8 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/sqrt(d) (algebraic in x)
  * K_1 = 1/(2*(sqrt(d) + 2)) (algebraic in x)
- * K_2: Horner degree 0 in x below x = 1e-14, else 1/(4*sqrt(d)*(sqrt(d)/2 + 1))
- * ops: 81 */
+ * K_2: Horner degree 7 in x below x = 0.41271, else 1/(4*sqrt(d)*(sqrt(d)/2 + 1))
+ * ops: 96 */
 static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1228,8 +1228,8 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
     const float c_K_0 = 1.0F/sqrtf(d);
     const float c_K_1 = (1.0F/2.0F)/(sqrtf(d) + 2);
     float c_K_2;
-    if (x < 1e-14F) {
-        c_K_2 = 1.0F/16.0F;
+    if (x < 0.4127098F) {
+        c_K_2 = x*(x*(x*(x*(x*(x*((1.4982652e-06F)*x + 6.392598e-06F) + 231.0F/8388608.0F) + 63.0F/524288.0F) + 35.0F/65536.0F) + 5.0F/2048.0F) + 3.0F/256.0F) + 1.0F/16.0F;
     } else {
         const float w0 = sqrtf(d);
         c_K_2 = (1.0F/4.0F)/(w0*((1.0F/2.0F)*w0 + 1));
@@ -1279,12 +1279,13 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             c_K_0_lanes[k] = u0;
             c_K_1_lanes[k] = (1.0F/2.0F)/(u1 + 2);
             c_K_2_lanes[k] = (1.0F/4.0F)*u0/((1.0F/2.0F)*u1 + 1);
-            poly_K_2_lanes[k] = 1.0F/16.0F;
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((1.4982652e-06F)*x + 6.392598e-06F) + 231.0F/8388608.0F) + 63.0F/524288.0F) + 35.0F/65536.0F) + 5.0F/2048.0F) + 3.0F/256.0F) + 1.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1295,7 +1296,7 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
             c_K_1_lanes[k] = !(x < 4.0F) ? NAN : closed_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
-            const float v_K_2 = x < 1e-14F ? poly_K_2 : closed_K_2;
+            const float v_K_2 = x < 0.4127098F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.0F) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {

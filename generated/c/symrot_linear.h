@@ -183,8 +183,8 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1/sqrt(d) (algebraic in x)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
- * H_2: Horner degree 1 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 78 */
+ * H_2: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 95 */
 static inline void symrot_linear_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -204,8 +204,8 @@ static inline void symrot_linear_tangent(const double p[3], double H[9])
     const double c_H_0 = 1.0/sqrt(d);
     const double c_H_1 = 1.0/(sqrt(d) + 1);
     double c_H_2;
-    if (x < 9.999999999999965e-15) {
-        c_H_2 = (3.0/8.0)*x + 1.0/2.0;
+    if (x < 0.0059512030463300695) {
+        c_H_2 = x*(x*(x*(x*(x*(x*((6435.0/32768.0)*x + 429.0/2048.0) + 231.0/1024.0) + 63.0/256.0) + 35.0/128.0) + 5.0/16.0) + 3.0/8.0) + 1.0/2.0;
     } else {
         const double w0 = sqrt(d);
         c_H_2 = 1/(w0*(w0 + 1));
@@ -262,7 +262,7 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
             c_H_0_lanes[k] = u0;
             c_H_1_lanes[k] = w0;
             c_H_2_lanes[k] = u0*w0;
-            poly_H_2_lanes[k] = (3.0/8.0)*x + 1.0/2.0;
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*((6435.0/32768.0)*x + 429.0/2048.0) + 231.0/1024.0) + 63.0/256.0) + 35.0/128.0) + 5.0/16.0) + 3.0/8.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -273,7 +273,7 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
             c_H_1_lanes[k] = !(x < 1.0) ? NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 9.999999999999965e-15 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 0.0059512030463300695 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 1.0) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -388,8 +388,8 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
 
 /* symrot_linear_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 1 in x below x = 1e-14, else 1/(sqrt(d)*cos(phi/2)**2)
- * ops: 39 */
+ * det_H: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*cos(phi/2)**2)
+ * ops: 48 */
 static inline double symrot_linear_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -398,8 +398,8 @@ static inline double symrot_linear_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 9.999999999999965e-15) {
-        c_det_H = (3.0/4.0)*x + 1;
+    if (x < 0.0059512030463300695) {
+        c_det_H = x*(x*(x*(x*(x*(x*((6435.0/16384.0)*x + 429.0/1024.0) + 231.0/512.0) + 63.0/128.0) + 35.0/64.0) + 5.0/8.0) + 3.0/4.0) + 1;
     } else {
         const double phi = symrot_linear__phi(sqrt(x), d);
         c_det_H = 1/(sqrt(d)*pow(cos((1.0/2.0)*phi), 2));
@@ -710,8 +710,8 @@ static inline void symrot_linear_pdot(const double p[3], const double omega[3], 
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1/sqrt(d) (algebraic in x)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
- * H_2: Horner degree 1 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 72 */
+ * H_2: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 89 */
 static inline void symrot_linear_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -725,8 +725,8 @@ static inline void symrot_linear_omega(const double p[3], const double pdot[3], 
     const double c_H_0 = 1.0/sqrt(d);
     const double c_H_1 = 1.0/(sqrt(d) + 1);
     double c_H_2;
-    if (x < 9.999999999999965e-15) {
-        c_H_2 = (3.0/8.0)*x + 1.0/2.0;
+    if (x < 0.0059512030463300695) {
+        c_H_2 = x*(x*(x*(x*(x*(x*((6435.0/32768.0)*x + 429.0/2048.0) + 231.0/1024.0) + 63.0/256.0) + 35.0/128.0) + 5.0/16.0) + 3.0/8.0) + 1.0/2.0;
     } else {
         const double w0 = sqrt(d);
         c_H_2 = 1/(w0*(w0 + 1));
@@ -741,9 +741,9 @@ static inline void symrot_linear_omega(const double p[3], const double pdot[3], 
 
 /* symrot_linear_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 1 in x below x = 1e-14, else cos(phi/2)
+ * e_0: Horner degree 7 in x below x = 0.0108534, else cos(phi/2)
  * nu = sqrt(2)/sqrt(sqrt(d) + 1) (algebraic in x)
- * ops: 46 */
+ * ops: 61 */
 static inline void symrot_linear_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -757,8 +757,8 @@ static inline void symrot_linear_to_quaternion(const double p[3], double e[4])
     }
     const double c_nu = sqrt(2)/sqrt(sqrt(d) + 1);
     double c_e_0;
-    if (x < 9.999999999999965e-15) {
-        c_e_0 = 1 + (-1.0/8.0)*x;
+    if (x < 0.010853448794044094) {
+        c_e_0 = x*(x*(x*(x*(x*(x*((-185725.0/33554432.0)*x - 29393.0/4194304.0) - 2431.0/262144.0) - 429.0/32768.0) - 21.0/1024.0) - 5.0/128.0) - 1.0/8.0) + 1;
     } else {
         const double phi = symrot_linear__phi(sqrt(x), d);
         c_e_0 = cos((1.0/2.0)*phi);
@@ -1029,8 +1029,8 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1/sqrt(d) (algebraic in x)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
- * H_2: Horner degree 0 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 78 */
+ * H_2: Horner degree 7 in x below x = 0.116472, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 95 */
 static inline void symrot_linear_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1050,8 +1050,8 @@ static inline void symrot_linear_tangent_f(const float p[3], float H[9])
     const float c_H_0 = 1.0F/sqrtf(d);
     const float c_H_1 = 1.0F/(sqrtf(d) + 1);
     float c_H_2;
-    if (x < 1e-14F) {
-        c_H_2 = 1.0F/2.0F;
+    if (x < 0.11647221F) {
+        c_H_2 = x*(x*(x*(x*(x*(x*((6435.0F/32768.0F)*x + 429.0F/2048.0F) + 231.0F/1024.0F) + 63.0F/256.0F) + 35.0F/128.0F) + 5.0F/16.0F) + 3.0F/8.0F) + 1.0F/2.0F;
     } else {
         const float w0 = sqrtf(d);
         c_H_2 = 1/(w0*(w0 + 1));
@@ -1101,13 +1101,14 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             const float w0 = 1.0F/(u1 + 1);
             c_H_0_lanes[k] = u0;
             c_H_1_lanes[k] = w0;
             c_H_2_lanes[k] = u0*w0;
-            poly_H_2_lanes[k] = 1.0F/2.0F;
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*((6435.0F/32768.0F)*x + 429.0F/2048.0F) + 231.0F/1024.0F) + 63.0F/256.0F) + 35.0F/128.0F) + 5.0F/16.0F) + 3.0F/8.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1118,7 +1119,7 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
             c_H_1_lanes[k] = !(x < 1.0F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 1e-14F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 0.11647221F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 1.0F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1233,8 +1234,8 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
 
 /* symrot_linear_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 0 in x below x = 1e-14, else 1/(sqrt(d)*cos(phi/2)**2)
- * ops: 39 */
+ * det_H: Horner degree 7 in x below x = 0.116472, else 1/(sqrt(d)*cos(phi/2)**2)
+ * ops: 48 */
 static inline float symrot_linear_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1243,8 +1244,8 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 1e-14F) {
-        c_det_H = 1;
+    if (x < 0.11647221F) {
+        c_det_H = x*(x*(x*(x*(x*(x*((6435.0F/16384.0F)*x + 429.0F/1024.0F) + 231.0F/512.0F) + 63.0F/128.0F) + 35.0F/64.0F) + 5.0F/8.0F) + 3.0F/4.0F) + 1;
     } else {
         const float phi = symrot_linear__phi_f(sqrtf(x), d);
         c_det_H = 1/(sqrtf(d)*powf(cosf((1.0F/2.0F)*phi), 2));
@@ -1256,8 +1257,8 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
- * G_2: Horner degree 2 in x below x = 0.00326076, else 2*sin(phi/4)**2/s**2
- * ops: 88 */
+ * G_2: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/s**2
+ * ops: 94 */
 static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1276,8 +1277,8 @@ static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
     }
     const float c_G_1 = (1.0F/2.0F)*sqrtf(2)/sqrtf(sqrtf(d) + 1);
     float c_G_2;
-    if (x < 0.0032607575F) {
-        c_G_2 = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
+    if (x < 0.11647221F) {
+        c_G_2 = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_linear__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
@@ -1349,7 +1350,7 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.70710677F*u0;
             c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_G_2_lanes[k] = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1359,7 +1360,7 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             c_G_1_lanes[k] = !(x < 1.0F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.0032607575F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.11647221F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 1.0F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1381,9 +1382,9 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
 /* symrot_linear_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/(2*sqrt(d)) (algebraic in x)
- * K_1: Horner degree 2 in x below x = 0.00326076, else 2*sin(phi/4)**2/s**2
+ * K_1: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 15 in x below x = 0.35302, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/s**2
- * ops: 131 */
+ * ops: 135 */
 static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1402,8 +1403,8 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
     }
     const float c_K_0 = (1.0F/2.0F)/sqrtf(d);
     float c_K_1, c_K_2;
-    if (x < 0.0032607575F) {
-        c_K_1 = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
+    if (x < 0.11647221F) {
+        c_K_1 = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
     } else {
         const float phi = symrot_linear__phi_f(sqrtf(x), d);
@@ -1491,7 +1492,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float w1 = 1.0F/(s*s);
             c_K_0_lanes[k] = w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = w1*(w0 - (1.0F/2.0F)/cos1);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
         }
@@ -1502,7 +1503,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             c_K_0_lanes[k] = !(x < 1.0F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.0032607575F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.11647221F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 1.0F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -1555,8 +1556,8 @@ static inline void symrot_linear_pdot_f(const float p[3], const float omega[3], 
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1/sqrt(d) (algebraic in x)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
- * H_2: Horner degree 0 in x below x = 1e-14, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 72 */
+ * H_2: Horner degree 7 in x below x = 0.116472, else 1/(sqrt(d)*(sqrt(d) + 1))
+ * ops: 89 */
 static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1570,8 +1571,8 @@ static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], 
     const float c_H_0 = 1.0F/sqrtf(d);
     const float c_H_1 = 1.0F/(sqrtf(d) + 1);
     float c_H_2;
-    if (x < 1e-14F) {
-        c_H_2 = 1.0F/2.0F;
+    if (x < 0.11647221F) {
+        c_H_2 = x*(x*(x*(x*(x*(x*((6435.0F/32768.0F)*x + 429.0F/2048.0F) + 231.0F/1024.0F) + 63.0F/256.0F) + 35.0F/128.0F) + 5.0F/16.0F) + 3.0F/8.0F) + 1.0F/2.0F;
     } else {
         const float w0 = sqrtf(d);
         c_H_2 = 1/(w0*(w0 + 1));
@@ -1586,9 +1587,9 @@ static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], 
 
 /* symrot_linear_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 0 in x below x = 1e-14, else cos(phi/2)
+ * e_0: Horner degree 7 in x below x = 0.20569, else cos(phi/2)
  * nu = sqrt(2)/sqrt(sqrt(d) + 1) (algebraic in x)
- * ops: 46 */
+ * ops: 61 */
 static inline void symrot_linear_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1602,8 +1603,8 @@ static inline void symrot_linear_to_quaternion_f(const float p[3], float e[4])
     }
     const float c_nu = sqrtf(2)/sqrtf(sqrtf(d) + 1);
     float c_e_0;
-    if (x < 1e-14F) {
-        c_e_0 = 1;
+    if (x < 0.20569007F) {
+        c_e_0 = x*(x*(x*(x*(x*(x*((-0.0055350363F)*x - 29393.0F/4194304.0F) - 2431.0F/262144.0F) - 429.0F/32768.0F) - 21.0F/1024.0F) - 5.0F/128.0F) - 1.0F/8.0F) + 1;
     } else {
         const float phi = symrot_linear__phi_f(sqrtf(x), d);
         c_e_0 = cosf((1.0F/2.0F)*phi);

@@ -70,9 +70,9 @@ static inline double symrot_rotation_vector_angle(const double p[3])
 /* symrot_rotation_vector_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)*cos(phi/2)/phi
- * R_2: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * ops: 58 */
+ * R_1: Horner degree 7 in x below x = 0.408665, else 2*sin(phi/2)*cos(phi/2)/phi
+ * R_2: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
+ * ops: 89 */
 static inline void symrot_rotation_vector_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -89,15 +89,15 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 5.028297529613113e-13) {
-        c_R_1 = 1 + (-1.0/6.0)*x;
-        c_R_2 = 1.0/2.0 + (-1.0/24.0)*x;
+    if (x < 0.4086652777619201) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
         c_R_1 = 2*w1*cos(w0)/phi;
-        c_R_2 = 2*(w1*w1)/(phi*phi);
+        c_R_2 = x < 0.7851233626304397 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*(w1*w1)/(phi*phi);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -127,7 +127,7 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 5.028297529613113e-13) {
+            if (!(x <= 39.47841760435743) || x < 0.4086652777619201) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -156,9 +156,9 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/phi;
-            poly_R_1_lanes[k] = 1 + (-1.0/6.0)*x;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_R_2_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -166,11 +166,11 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             c_R_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 5.028297529613113e-13 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 0.4086652777619201 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 5.028297529613113e-13 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.7851233626304397 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -192,9 +192,9 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
 /* symrot_rotation_vector_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
- * H_1: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
+ * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
  * H_2: Horner degree 8 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
- * ops: 79 */
+ * ops: 92 */
 static inline void symrot_rotation_vector_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -211,8 +211,8 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
         return;
     }
     double c_H_1, c_H_2;
-    if (x < 5.028297529613113e-13) {
-        c_H_1 = 1.0/2.0 + (-1.0/24.0)*x;
+    if (x < 0.7851233626304397) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
@@ -247,7 +247,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 5.028297529613113e-13) {
+            if (!(x <= 39.47841760435743) || x < 0.7851233626304397) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -284,7 +284,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_H_1_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
             c_H_2_lanes[k] = -(-phi + sin1)/(phi*phi*phi);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
         }
@@ -294,7 +294,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             c_H_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 5.028297529613113e-13 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.7851233626304397 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -433,8 +433,8 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
 
 /* symrot_rotation_vector_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 1 in x below x = 5.0283e-13, else 4*sin(phi/2)**2/phi**2
- * ops: 15 */
+ * det_H: Horner degree 7 in x below x = 0.785123, else 4*sin(phi/2)**2/phi**2
+ * ops: 28 */
 static inline double symrot_rotation_vector_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -442,8 +442,8 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 5.028297529613113e-13) {
-        c_det_H = 1 + (-1.0/12.0)*x;
+    if (x < 0.7851233626304397) {
+        c_det_H = x*(x*(x*(x*(x*(x*(1.0/43589145600.0 + (-1.0/10461394944000.0)*x) - 1.0/239500800.0) + 1.0/1814400.0) - 1.0/20160.0) + 1.0/360.0) - 1.0/12.0) + 1;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_det_H = 4*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
@@ -454,9 +454,9 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
 /* symrot_rotation_vector_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 1.85593e-12, else sin(phi/2)/phi
- * G_2: Horner degree 1 in x below x = 9.01516e-09, else 2*sin(phi/4)**2/phi**2
- * ops: 58 */
+ * G_1: Horner degree 7 in x below x = 1.50837, else sin(phi/2)/phi
+ * G_2: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
+ * ops: 90 */
 static inline void symrot_rotation_vector_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -473,13 +473,14 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 1.855928709321803e-12) {
-        c_G_1 = 1.0/2.0 + (-1.0/48.0)*x;
-        c_G_2 = 1.0/8.0 + (-1.0/384.0)*x;
+    if (x < 1.5083706105984414) {
+        c_G_1 = x*(x*(x*(x*(x*(x*(1.0/51011754393600.0 + (-2.333729166204778e-17)*x) - 1.0/81749606400.0) + 1.0/185794560.0) - 1.0/645120.0) + 1.0/3840.0) - 1.0/48.0) + 1.0/2.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        c_G_1 = sin((1.0/2.0)*phi)/phi;
-        c_G_2 = x < 9.015158901432458e-09 ? 1.0/8.0 + (-1.0/384.0)*x : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
+        const double w0 = (1.0/2.0)*phi;
+        c_G_1 = sin(w0)/phi;
+        c_G_2 = x < 2.897865491219691 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : (1 - cos(w0))/(phi*phi);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -509,7 +510,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 1.855928709321803e-12) {
+            if (!(x <= 39.47841760435743) || x < 1.5083706105984414) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -535,20 +536,12 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/4.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/phi;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-1.0/48.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(phi*phi);
-            poly_G_2_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/51011754393600.0 + (-2.333729166204778e-17)*x) - 1.0/81749606400.0) + 1.0/185794560.0) - 1.0/645120.0) + 1.0/3840.0) - 1.0/48.0) + 1.0/2.0;
+            c_G_2_lanes[k] = (1 - cos0)/(phi*phi);
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -556,11 +549,11 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             c_G_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 1.855928709321803e-12 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 1.5083706105984414 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 9.015158901432458e-09 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 2.897865491219691 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -582,9 +575,9 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
 /* symrot_rotation_vector_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
- * K_1: Horner degree 1 in x below x = 9.01516e-09, else 2*sin(phi/4)**2/phi**2
+ * K_1: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
  * K_2: Horner degree 8 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
- * ops: 82 */
+ * ops: 95 */
 static inline void symrot_rotation_vector_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -601,13 +594,14 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         return;
     }
     double c_K_1, c_K_2;
-    if (x < 9.015158901432458e-09) {
-        c_K_1 = 1.0/8.0 + (-1.0/384.0)*x;
+    if (x < 2.897865491219691) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
-        c_K_2 = x < 5.56734820089753 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
+        const double w0 = (1.0/2.0)*phi;
+        c_K_1 = (1 - cos(w0))/(phi*phi);
+        c_K_2 = x < 5.56734820089753 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin(w0))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0/2.0;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -637,7 +631,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 9.015158901432458e-09) {
+            if (!(x <= 39.47841760435743) || x < 2.897865491219691) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -653,7 +647,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -663,19 +657,11 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_K_1_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
-            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin1)/(phi*phi*phi);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_K_1_lanes[k] = (1 - cos0)/(phi*phi);
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
+            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin0)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -684,7 +670,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             c_K_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1.0/2.0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 9.015158901432458e-09 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 2.897865491219691 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -741,9 +727,9 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
 /* symrot_rotation_vector_omega: omega = H pdot (eq 20).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
- * H_1: Horner degree 1 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
+ * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
  * H_2: Horner degree 8 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
- * ops: 70 */
+ * ops: 83 */
 static inline void symrot_rotation_vector_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -754,8 +740,8 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
         return;
     }
     double c_H_1, c_H_2;
-    if (x < 5.028297529613113e-13) {
-        c_H_1 = 1.0/2.0 + (-1.0/24.0)*x;
+    if (x < 0.7851233626304397) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
@@ -772,9 +758,9 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
 
 /* symrot_rotation_vector_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 1 in x below x = 1.85593e-12, else cos(phi/2)
- * nu: Horner degree 1 in x below x = 1.85593e-12, else 2*sin(phi/2)/phi
- * ops: 18 */
+ * e_0: Horner degree 7 in x below x = 1.50837, else cos(phi/2)
+ * nu: Horner degree 7 in x below x = 1.50837, else 2*sin(phi/2)/phi
+ * ops: 53 */
 static inline void symrot_rotation_vector_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -786,9 +772,9 @@ static inline void symrot_rotation_vector_to_quaternion(const double p[3], doubl
         return;
     }
     double c_e_0, c_nu;
-    if (x < 1.855928709321803e-12) {
-        c_e_0 = 1 + (-1.0/8.0)*x;
-        c_nu = 1 + (-1.0/24.0)*x;
+    if (x < 1.5083706105984414) {
+        c_e_0 = x*(x*(x*(x*(x*(x*(1.0/1961990553600.0 + (-1.0/1428329123020800.0)*x) - 1.0/3715891200.0) + 1.0/10321920.0) - 1.0/46080.0) + 1.0/384.0) - 1.0/8.0) + 1;
+        c_nu = x*(x*(x*(x*(x*(x*(1.0/25505877196800.0 + (-4.667458332409556e-17)*x) - 1.0/40874803200.0) + 1.0/92897280.0) - 1.0/322560.0) + 1.0/1920.0) - 1.0/24.0) + 1;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         const double w0 = (1.0/2.0)*phi;
@@ -803,8 +789,8 @@ static inline void symrot_rotation_vector_to_quaternion(const double p[3], doubl
 }
 
 /* symrot_rotation_vector__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 1 in t = phi^2 below 6.57462e-14, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 41 */
+ * sigma: Horner degree 7 in t = phi^2 below 0.228327, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
 static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -830,8 +816,8 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 6.574622895991269e-14) {
-        sigma = (1.0/12.0)*t + 2;
+    if (t < 0.22832695303370756) {
+        sigma = t*(t*(t*(t*(t*(t*((8191.0/306070526361600.0)*t + 1414477.0/1339058552832000.0) + 73.0/1751777280.0) + 127.0/77414400.0) + 31.0/483840.0) + 7.0/2880.0) + 1.0/12.0) + 2;
     } else {
         sigma = phi/sin((1.0/2.0)*phi);
     }
@@ -949,9 +935,9 @@ static inline float symrot_rotation_vector_angle_f(const float p[3])
 /* symrot_rotation_vector_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)*cos(phi/2)/phi
- * R_2: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * ops: 58 */
+ * R_1: Horner degree 7 in x below x = 5.56735, else 2*sin(phi/2)*cos(phi/2)/phi
+ * R_2: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * ops: 85 */
 static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -968,9 +954,9 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
         return;
     }
     float c_R_1, c_R_2;
-    if (x < 5.028297e-13F) {
-        c_R_1 = 1;
-        c_R_2 = 1.0F/2.0F;
+    if (x < 5.567348F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
@@ -1006,7 +992,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 5.028297e-13F) {
+            if (!(x <= 39.478416F) || x < 5.567348F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1020,6 +1006,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
@@ -1034,9 +1021,9 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/phi;
-            poly_R_1_lanes[k] = 1;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_R_2_lanes[k] = 1.0F/2.0F;
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1044,11 +1031,11 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             c_R_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 5.028297e-13F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 5.567348F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 5.028297e-13F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 5.567348F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1070,9 +1057,9 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
 /* symrot_rotation_vector_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
- * H_1: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 4 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
- * ops: 67 */
+ * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + 2*sin(phi/2)*cos(phi/2))/phi**3
+ * ops: 82 */
 static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1089,13 +1076,15 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
         return;
     }
     float c_H_1, c_H_2;
-    if (x < 5.028297e-13F) {
-        c_H_1 = 1.0F/2.0F;
-        c_H_2 = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+    if (x < 5.567348F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
-        c_H_2 = x < 1.5083706F ? x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F : -(-phi + sinf(phi))/(phi*phi*phi);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_H_1 = 2*(w1*w1)/(phi*phi);
+        c_H_2 = -(-phi + 2*w1*cosf(w0))/(phi*phi*phi);
     }
     H[0] = -c_H_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1125,7 +1114,7 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 5.028297e-13F) {
+            if (!(x <= 39.478416F) || x < 5.567348F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1151,20 +1140,12 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_H_1_lanes[k] = 1.0F/2.0F;
-            c_H_2_lanes[k] = -(-phi + sin1)/(phi*phi*phi);
-            poly_H_2_lanes[k] = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = -(2*cos0*sin0 - phi)/(phi*phi*phi);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1172,11 +1153,11 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             c_H_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 5.028297e-13F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 5.567348F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 1.5083706F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 5.567348F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1311,8 +1292,8 @@ static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, cons
 
 /* symrot_rotation_vector_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 0 in x below x = 5.0283e-13, else 4*sin(phi/2)**2/phi**2
- * ops: 15 */
+ * det_H: Horner degree 6 in x below x = 5.56735, else 4*sin(phi/2)**2/phi**2
+ * ops: 24 */
 static inline float symrot_rotation_vector_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1320,8 +1301,8 @@ static inline float symrot_rotation_vector_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 5.028297e-13F) {
-        c_det_H = 1;
+    if (x < 5.567348F) {
+        c_det_H = x*(x*(x*(x*(x*((2.294149e-11F)*x - 4.175351e-09F) + 1.0F/1814400.0F) - 1.0F/20160.0F) + 1.0F/360.0F) - 1.0F/12.0F) + 1;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         c_det_H = 4*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
@@ -1332,9 +1313,9 @@ static inline float symrot_rotation_vector_tangent_det_f(const float p[3])
 /* symrot_rotation_vector_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 1.85593e-12, else sin(phi/2)/phi
- * G_2: Horner degree 0 in x below x = 1.85593e-12, else 2*sin(phi/4)**2/phi**2
- * ops: 57 */
+ * G_1: Horner degree 5 in x below x = 5.56735, else sin(phi/2)/phi
+ * G_2: Horner degree 4 in x below x = 5.56735, else (1 - cos(phi/2))/phi**2
+ * ops: 74 */
 static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1351,13 +1332,14 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
         return;
     }
     float c_G_1, c_G_2;
-    if (x < 1.8559286e-12F) {
-        c_G_1 = 1.0F/2.0F;
-        c_G_2 = 1.0F/8.0F;
+    if (x < 5.567348F) {
+        c_G_1 = x*(x*(x*(x*(5.382289e-09F + (-1.2232475e-11F)*x) - 1.0F/645120.0F) + 1.0F/3840.0F) - 1.0F/48.0F) + 1.0F/2.0F;
+        c_G_2 = x*(x*(x*((2.6911445e-10F)*x - 1.0F/10321920.0F) + 1.0F/46080.0F) - 1.0F/384.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        c_G_1 = sinf((1.0F/2.0F)*phi)/phi;
-        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_G_1 = sinf(w0)/phi;
+        c_G_2 = (1 - cosf(w0))/(phi*phi);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1387,7 +1369,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 1.8559286e-12F) {
+            if (!(x <= 39.478416F) || x < 5.567348F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1401,6 +1383,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
@@ -1412,20 +1395,12 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/4.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/phi;
-            poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(phi*phi);
-            poly_G_2_lanes[k] = 1.0F/8.0F;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(5.382289e-09F + (-1.2232475e-11F)*x) - 1.0F/645120.0F) + 1.0F/3840.0F) - 1.0F/48.0F) + 1.0F/2.0F;
+            c_G_2_lanes[k] = (1 - cos0)/(phi*phi);
+            poly_G_2_lanes[k] = x*(x*(x*((2.6911445e-10F)*x - 1.0F/10321920.0F) + 1.0F/46080.0F) - 1.0F/384.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1433,11 +1408,11 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             c_G_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 1.8559286e-12F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 5.567348F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 1.8559286e-12F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 5.567348F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1459,9 +1434,9 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
 /* symrot_rotation_vector_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
- * K_1: Horner degree 0 in x below x = 1.85593e-12, else 2*sin(phi/4)**2/phi**2
+ * K_1: Horner degree 4 in x below x = 5.56735, else (1 - cos(phi/2))/phi**2
  * K_2: Horner degree 4 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
- * ops: 70 */
+ * ops: 73 */
 static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1478,13 +1453,14 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
         return;
     }
     float c_K_1, c_K_2;
-    if (x < 1.8559286e-12F) {
-        c_K_1 = 1.0F/8.0F;
+    if (x < 5.567348F) {
+        c_K_1 = x*(x*(x*((2.6911445e-10F)*x - 1.0F/10321920.0F) + 1.0F/46080.0F) - 1.0F/384.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
-        c_K_2 = x < 5.567348F ? x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F : -1.0F/2.0F*(-phi + 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
+        const float w0 = (1.0F/2.0F)*phi;
+        c_K_1 = (1 - cosf(w0))/(phi*phi);
+        c_K_2 = -1.0F/2.0F*(-phi + 2*sinf(w0))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0F/2.0F;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1514,7 +1490,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 1.8559286e-12F) {
+            if (!(x <= 39.478416F) || x < 5.567348F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1530,7 +1506,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1540,19 +1516,11 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_K_1_lanes[k] = 1.0F/8.0F;
-            c_K_2_lanes[k] = -1.0F/2.0F*(-phi + 2*sin1)/(phi*phi*phi);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_K_1_lanes[k] = (1 - cos0)/(phi*phi);
+            poly_K_1_lanes[k] = x*(x*(x*((2.6911445e-10F)*x - 1.0F/10321920.0F) + 1.0F/46080.0F) - 1.0F/384.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = -1.0F/2.0F*(-phi + 2*sin0)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1561,7 +1529,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             c_K_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1.0F/2.0F;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 1.8559286e-12F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 5.567348F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -1618,9 +1586,9 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
 /* symrot_rotation_vector_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
- * H_1: Horner degree 0 in x below x = 5.0283e-13, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 4 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
- * ops: 58 */
+ * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + 2*sin(phi/2)*cos(phi/2))/phi**3
+ * ops: 73 */
 static inline void symrot_rotation_vector_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1631,13 +1599,15 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
         return;
     }
     float c_H_1, c_H_2;
-    if (x < 5.028297e-13F) {
-        c_H_1 = 1.0F/2.0F;
-        c_H_2 = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+    if (x < 5.567348F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
-        c_H_2 = x < 1.5083706F ? x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F : -(-phi + sinf(phi))/(phi*phi*phi);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_H_1 = 2*(w1*w1)/(phi*phi);
+        c_H_2 = -(-phi + 2*w1*cosf(w0))/(phi*phi*phi);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -1649,9 +1619,9 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
 
 /* symrot_rotation_vector_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 0 in x below x = 1.85593e-12, else cos(phi/2)
- * nu: Horner degree 0 in x below x = 1.85593e-12, else 2*sin(phi/2)/phi
- * ops: 18 */
+ * e_0: Horner degree 5 in x below x = 5.56735, else cos(phi/2)
+ * nu: Horner degree 5 in x below x = 5.56735, else 2*sin(phi/2)/phi
+ * ops: 41 */
 static inline void symrot_rotation_vector_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1663,9 +1633,9 @@ static inline void symrot_rotation_vector_to_quaternion_f(const float p[3], floa
         return;
     }
     float c_e_0, c_nu;
-    if (x < 1.8559286e-12F) {
-        c_e_0 = 1;
-        c_nu = 1;
+    if (x < 5.567348F) {
+        c_e_0 = x*(x*(x*(x*(1.0F/10321920.0F + (-2.6911445e-10F)*x) - 1.0F/46080.0F) + 1.0F/384.0F) - 1.0F/8.0F) + 1;
+        c_nu = x*(x*(x*(x*(1.0764578e-08F + (-2.446495e-11F)*x) - 1.0F/322560.0F) + 1.0F/1920.0F) - 1.0F/24.0F) + 1;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
@@ -1680,8 +1650,8 @@ static inline void symrot_rotation_vector_to_quaternion_f(const float p[3], floa
 }
 
 /* symrot_rotation_vector__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 0 in t = phi^2 below 6.57462e-14, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 41 */
+ * sigma: Horner degree 5 in t = phi^2 below 1.50116, else phi/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 53 */
 static inline int symrot_rotation_vector__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1707,8 +1677,8 @@ static inline int symrot_rotation_vector__from_quaternion_f(float e0, float e1, 
     const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
-    if (t < 6.5746237e-14F) {
-        sigma = 2;
+    if (t < 1.5011637F) {
+        sigma = t*(t*(t*(t*((4.1671964e-08F)*t + 1.6405216e-06F) + 31.0F/483840.0F) + 7.0F/2880.0F) + 1.0F/12.0F) + 2;
     } else {
         sigma = phi/sinf((1.0F/2.0F)*phi);
     }

@@ -92,8 +92,8 @@ static inline double symrot_sine_m3_angle(const double p[3])
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/s**2
- * ops: 86 */
+ * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/s**2
+ * ops: 92 */
 static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -112,8 +112,8 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = 1 - 4.0/27.0*x;
     double c_R_2;
-    if (x < 0.018918233509283077) {
-        c_R_2 = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+    if (x < 0.1294709423110196) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
@@ -147,7 +147,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0) || x < 0.018918233509283077) {
+            if (!(x < 9.0) || x < 0.1294709423110196) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -180,7 +180,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = 1 - 4.0/27.0*x;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -190,7 +190,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 9.0) ? NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.018918233509283077 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.1294709423110196 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -212,9 +212,9 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
 /* symrot_sine_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 14 in x below x = 0.864806, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
- * ops: 130 */
+ * ops: 135 */
 static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -233,8 +233,8 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
-    if (x < 0.018918233509283077) {
-        c_H_1 = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+    if (x < 0.1294709423110196) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
@@ -318,7 +318,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double w1 = 2*(sin0*sin0);
             c_H_0_lanes[k] = 3*u0;
             c_H_1_lanes[k] = w0*w1;
-            poly_H_1_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u0*w0*(-2.0/3.0*u1 + w1 + 2);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         }
@@ -329,7 +329,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 9.0) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.018918233509283077 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.1294709423110196 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 9.0) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -472,9 +472,9 @@ static inline double symrot_sine_m3_tangent_det(const double p[3])
 /* symrot_sine_m3_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 1.9012e-14, else sin(phi/2)/s
+ * G_1: Horner degree 7 in x below x = 0.129471, else sin(phi/2)/s
  * G_2: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/s**2
- * ops: 118 */
+ * ops: 129 */
 static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -492,8 +492,8 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 1.9011961863057287e-14) {
-        c_G_1 = 1.0/2.0 + (-5.0/432.0)*x;
+    if (x < 0.1294709423110196) {
+        c_G_1 = x*(x*(x*(x*(x*(x*((-1077205.0/962938848411648.0)*x - 56525.0/4458050224128.0) - 1547.0/10319560704.0) - 2431.0/1289945088.0) - 13.0/497664.0) - 1.0/2304.0) - 5.0/432.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
@@ -529,7 +529,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0) || x < 1.9011961863057287e-14) {
+            if (!(x < 9.0) || x < 0.1294709423110196) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -571,7 +571,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-5.0/432.0)*x;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1077205.0/962938848411648.0)*x - 56525.0/4458050224128.0) - 1547.0/10319560704.0) - 2431.0/1289945088.0) - 13.0/497664.0) - 1.0/2304.0) - 5.0/432.0) + 1.0/2.0;
             c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
         }
@@ -581,7 +581,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             c_G_0_lanes[k] = !(x < 9.0) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 1.9011961863057287e-14 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 0.1294709423110196 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 9.0) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
@@ -778,9 +778,9 @@ static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3],
 /* symrot_sine_m3_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 5 in x below x = 0.0189182, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 14 in x below x = 0.864806, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
- * ops: 124 */
+ * ops: 129 */
 static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -793,8 +793,8 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
     }
     const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
-    if (x < 0.018918233509283077) {
-        c_H_1 = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+    if (x < 0.1294709423110196) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
@@ -815,9 +815,9 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
 
 /* symrot_sine_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 1 in x below x = 1.9012e-14, else cos(phi/2)
- * nu: Horner degree 1 in x below x = 1.9012e-14, else 2*sin(phi/2)/s
- * ops: 44 */
+ * e_0: Horner degree 7 in x below x = 0.129471, else cos(phi/2)
+ * nu: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)/s
+ * ops: 75 */
 static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -830,9 +830,9 @@ static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
         return;
     }
     double c_e_0, c_nu;
-    if (x < 1.9011961863057287e-14) {
-        c_e_0 = 1 + (-1.0/8.0)*x;
-        c_nu = 1 + (-5.0/216.0)*x;
+    if (x < 0.1294709423110196) {
+        c_e_0 = x*(x*(x*(x*(x*(x*((-7429.0/1981355655168.0)*x - 96577.0/2229025112064.0) - 2717.0/5159780352.0) - 55.0/7962624.0) - 77.0/746496.0) - 7.0/3456.0) - 1.0/8.0) + 1;
+        c_nu = x*(x*(x*(x*(x*(x*((-1077205.0/481469424205824.0)*x - 56525.0/2229025112064.0) - 1547.0/5159780352.0) - 2431.0/644972544.0) - 13.0/248832.0) - 1.0/1152.0) - 5.0/216.0) + 1;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
@@ -848,8 +848,8 @@ static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
 }
 
 /* symrot_sine_m3__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 3 in t = phi^2 below 0.00281963, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 47 */
+ * sigma: Horner degree 7 in t = phi^2 below 0.228327, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
 static inline int symrot_sine_m3__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -875,8 +875,8 @@ static inline int symrot_sine_m3__from_quaternion(double e0, double e1, double e
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.002819628356600472) {
-        sigma = t*(t*((91.0/3359232.0)*t + 17.0/15552.0) + 5.0/108.0) + 2;
+    if (t < 0.22832695303370756) {
+        sigma = t*(t*(t*(t*(t*(t*((1.1066928531940517e-11)*t + 4.369448183506589e-10) + 75727.0/4388393189376.0) + 207913.0/304749527040.0) + 91.0/3359232.0) + 17.0/15552.0) + 5.0/108.0) + 2;
     } else {
         sigma = 3*sin((1.0/3.0)*phi)/sin((1.0/2.0)*phi);
     }
@@ -1137,7 +1137,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
  * H_1: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 5 in x below x = 0.462107, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
+ * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
  * ops: 125 */
 static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 {
@@ -1157,9 +1157,9 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
     }
     const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
-    if (x < 0.46210724F) {
+    if (x < 0.8648057F) {
         c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
@@ -1248,7 +1248,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             c_H_1_lanes[k] = w0*w1;
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + w1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1261,7 +1261,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             c_H_1_lanes[k] = !(x < 9.0F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 0.46210724F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 0.8648057F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 9.0F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1400,9 +1400,9 @@ static inline float symrot_sine_m3_tangent_det_f(const float p[3])
 /* symrot_sine_m3_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 1.9012e-14, else sin(phi/2)/s
+ * G_1: Horner degree 7 in x below x = 1.59536, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi/2))/s**2
- * ops: 100 */
+ * ops: 111 */
 static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1420,15 +1420,15 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
         return;
     }
     float c_G_1, c_G_2;
-    if (x < 1.9011963e-14F) {
-        c_G_1 = 1.0F/2.0F;
+    if (x < 1.5953637F) {
+        c_G_1 = x*(x*(x*(x*(x*(x*((-1.1186639e-09F)*x - 1.267931e-08F) - 1.4990948e-07F) - 1.8845764e-06F) - 13.0F/497664.0F) - 1.0F/2304.0F) - 5.0F/432.0F) + 1.0F/2.0F;
         c_G_2 = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
         c_G_1 = sinf(w0)/s;
-        c_G_2 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F : (1 - cosf(w0))/(s*s);
+        c_G_2 = (1 - cosf(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1458,7 +1458,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0F) || x < 1.9011963e-14F) {
+            if (!(x < 9.0F) || x < 1.5953637F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1492,7 +1492,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0F/2.0F;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1.1186639e-09F)*x - 1.267931e-08F) - 1.4990948e-07F) - 1.8845764e-06F) - 13.0F/497664.0F) - 1.0F/2304.0F) - 5.0F/432.0F) + 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
         }
@@ -1502,7 +1502,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             c_G_0_lanes[k] = !(x < 9.0F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 1.9011963e-14F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 1.5953637F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 9.0F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
@@ -1693,7 +1693,7 @@ static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3],
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
  * H_1: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 5 in x below x = 0.462107, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
+ * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
  * ops: 119 */
 static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
@@ -1707,9 +1707,9 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
     }
     const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
-    if (x < 0.46210724F) {
+    if (x < 0.8648057F) {
         c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
@@ -1728,9 +1728,9 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
 
 /* symrot_sine_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * e_0: Horner degree 0 in x below x = 1.9012e-14, else cos(phi/2)
- * nu: Horner degree 0 in x below x = 1.9012e-14, else 2*sin(phi/2)/s
- * ops: 44 */
+ * e_0: Horner degree 7 in x below x = 1.59536, else cos(phi/2)
+ * nu: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)/s
+ * ops: 75 */
 static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1743,9 +1743,9 @@ static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
         return;
     }
     float c_e_0, c_nu;
-    if (x < 1.9011963e-14F) {
-        c_e_0 = 1;
-        c_nu = 1;
+    if (x < 1.5953637F) {
+        c_e_0 = x*(x*(x*(x*(x*(x*((-3.749453e-09F)*x - 4.3327013e-08F) - 5.265728e-07F) - 55.0F/7962624.0F) - 77.0F/746496.0F) - 7.0F/3456.0F) - 1.0F/8.0F) + 1;
+        c_nu = x*(x*(x*(x*(x*(x*((-2.2373279e-09F)*x - 2.535862e-08F) - 2.9981896e-07F) - 3.7691527e-06F) - 13.0F/248832.0F) - 1.0F/1152.0F) - 5.0F/216.0F) + 1;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
@@ -1761,8 +1761,8 @@ static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
 }
 
 /* symrot_sine_m3__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 1 in t = phi^2 below 3.48198e-05, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 44 */
+ * sigma: Horner degree 5 in t = phi^2 below 1.50116, else 3*sin(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 53 */
 static inline int symrot_sine_m3__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1788,8 +1788,8 @@ static inline int symrot_sine_m3__from_quaternion_f(float e0, float e1, float e2
     const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
-    if (t < 3.4819823e-05F) {
-        sigma = (5.0F/108.0F)*t + 2;
+    if (t < 1.5011637F) {
+        sigma = t*(t*(t*(t*((1.7256202e-08F)*t + 6.822422e-07F) + 91.0F/3359232.0F) + 17.0F/15552.0F) + 5.0F/108.0F) + 2;
     } else {
         sigma = 3*sinf((1.0F/3.0F)*phi)/sinf((1.0F/2.0F)*phi);
     }

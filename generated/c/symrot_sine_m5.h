@@ -71,8 +71,8 @@ static inline double symrot_sine_m5_angle(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * ops: 67 */
+ * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * ops: 75 */
 static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -90,8 +90,8 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     double c_R_2;
-    if (x < 0.00423011441675066) {
-        c_R_2 = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+    if (x < 0.40644336131551395) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         c_R_2 = (2.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/pow(sin((1.0/5.0)*phi), 2);
@@ -124,7 +124,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844) || x < 0.00423011441675066) {
+            if (!(x < 22.612712429686844) || x < 0.40644336131551395) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -162,7 +162,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_R_1_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
             c_R_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
-            poly_R_2_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -172,7 +172,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.00423011441675066 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.40644336131551395 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -194,9 +194,9 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
 /* symrot_sine_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
  * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 112 */
+ * ops: 118 */
 static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -214,8 +214,8 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 0.00423011441675066) {
-        c_H_1 = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+    if (x < 0.40644336131551395) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
@@ -303,7 +303,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double w0 = 1.0/(sin0*sin0);
             c_H_0_lanes[k] = 5*u0;
             c_H_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
-            poly_H_1_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
             c_H_2_lanes[k] = (1.0/25.0)*w0*(-2.0/5.0*cos1*sin1/sin0 + 1.0/cos0);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         }
@@ -314,7 +314,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.00423011441675066 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.40644336131551395 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -498,8 +498,8 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
- * G_2: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
- * ops: 79 */
+ * G_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * ops: 88 */
 static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -517,8 +517,8 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = -1.0/250.0*sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/sqrt(sqrt(25 - x) + 5);
     double c_G_2;
-    if (x < 0.00423011441675066) {
-        c_G_2 = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+    if (x < 0.40644336131551395) {
+        c_G_2 = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         c_G_2 = (2.0/25.0)*pow(sin((1.0/4.0)*phi), 2)/pow(sin((1.0/5.0)*phi), 2);
@@ -599,7 +599,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
             c_G_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -609,7 +609,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.00423011441675066 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.40644336131551395 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -631,9 +631,9 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
 /* symrot_sine_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
- * K_1: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * K_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
  * K_2: Horner degree 21 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
- * ops: 131 */
+ * ops: 138 */
 static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -651,8 +651,8 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
     }
     const double c_K_0 = (5.0/2.0)/sqrt(25 - x);
     double c_K_1, c_K_2;
-    if (x < 0.00423011441675066) {
-        c_K_1 = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+    if (x < 0.40644336131551395) {
+        c_K_1 = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
@@ -746,7 +746,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double w0 = 1.0/(sin0*sin0);
             c_K_0_lanes[k] = (5.0/2.0)*u0;
             c_K_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
-            poly_K_1_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/250.0)*w0*(-2*sin2/sin0 + 5/cos0);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
         }
@@ -757,7 +757,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.00423011441675066 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.40644336131551395 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -817,9 +817,9 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
 /* symrot_sine_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 3 in x below x = 0.00423011, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
  * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 106 */
+ * ops: 112 */
 static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -831,8 +831,8 @@ static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3],
     }
     const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 0.00423011441675066) {
-        c_H_1 = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+    if (x < 0.40644336131551395) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
@@ -877,8 +877,8 @@ static inline void symrot_sine_m5_to_quaternion(const double p[3], double e[4])
 }
 
 /* symrot_sine_m5__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 5 in t = phi^2 below 0.0650594, else 5*sin(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 53 */
+ * sigma: Horner degree 7 in t = phi^2 below 0.228327, else 5*sin(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
 static inline int symrot_sine_m5__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -904,8 +904,8 @@ static inline int symrot_sine_m5__from_quaternion(double e0, double e1, double e
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.06505938434722405) {
-        sigma = t*(t*(t*(t*((81801313.0/2592000000000000.0)*t + 358487.0/288000000000.0) + 17623.0/360000000.0) + 1141.0/600000.0) + 7.0/100.0) + 2;
+    if (t < 0.22832695303370756) {
+        sigma = t*(t*(t*(t*(t*(t*((2.0254899202142057e-11)*t + 7.995858586568395e-10) + 81801313.0/2592000000000000.0) + 358487.0/288000000000.0) + 17623.0/360000000.0) + 1141.0/600000.0) + 7.0/100.0) + 2;
     } else {
         sigma = 5*sin((1.0/5.0)*phi)/sin((1.0/2.0)*phi);
     }
@@ -1428,8 +1428,8 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m5_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 4 in x below x = 1.47828, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
- * ops: 23 */
+ * det_H: Horner degree 6 in x below x = 2.78761, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
+ * ops: 25 */
 static inline float symrot_sine_m5_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1437,8 +1437,8 @@ static inline float symrot_sine_m5_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 1.4782778F) {
-        c_det_H = x*(x*(x*((5.04e-08F)*x + 7.0F/5000000.0F) + 1.0F/25000.0F) - 1.0F/20.0F) + 1;
+    if (x < 2.7876132F) {
+        c_det_H = x*(x*(x*(x*(x*((6.864e-11F)*x + 1.848e-09F) + 5.04e-08F) + 7.0F/5000000.0F) + 1.0F/25000.0F) - 1.0F/20.0F) + 1;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         const float w0 = (1.0F/5.0F)*phi;
@@ -1451,8 +1451,8 @@ static inline float symrot_sine_m5_tangent_det_f(const float p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
- * G_2: Horner degree 2 in x below x = 0.212112, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
- * ops: 79 */
+ * G_2: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * ops: 88 */
 static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1470,8 +1470,8 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
     }
     const float c_G_1 = -1.0F/250.0F*sqrtf(10)*(4*x - 10*sqrtf(25 - x) - 75)/sqrtf(sqrtf(25 - x) + 5);
     float c_G_2;
-    if (x < 0.21211211F) {
-        c_G_2 = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+    if (x < 5.1661544F) {
+        c_G_2 = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         c_G_2 = (2.0F/25.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/powf(sinf((1.0F/5.0F)*phi), 2);
@@ -1552,7 +1552,7 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = -0.0126491105F*u0*(-10*u1 + 4*x - 75);
             c_G_2_lanes[k] = (2.0F/25.0F)*(sin1*sin1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1562,7 +1562,7 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             c_G_1_lanes[k] = !(x < 22.612713F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.21211211F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 5.1661544F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612713F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1584,9 +1584,9 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
 /* symrot_sine_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
- * K_1: Horner degree 2 in x below x = 0.212112, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * K_1: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
  * K_2: Horner degree 9 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
- * ops: 95 */
+ * ops: 102 */
 static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1604,8 +1604,8 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
     }
     const float c_K_0 = (5.0F/2.0F)/sqrtf(25 - x);
     float c_K_1, c_K_2;
-    if (x < 0.21211211F) {
-        c_K_1 = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+    if (x < 5.1661544F) {
+        c_K_1 = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
@@ -1613,7 +1613,7 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
         const float w1 = sinf(w0);
         const float w2 = 1.0F/(w1*w1);
         c_K_1 = (2.0F/25.0F)*w2*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F : (1.0F/250.0F)*w2*(5/cosf(w0) - 2*sinf((1.0F/2.0F)*phi)/w1);
+        c_K_2 = (1.0F/250.0F)*w2*(5/cosf(w0) - 2*sinf((1.0F/2.0F)*phi)/w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1699,7 +1699,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float w0 = 1.0F/(sin0*sin0);
             c_K_0_lanes[k] = (5.0F/2.0F)*u0;
             c_K_1_lanes[k] = (2.0F/25.0F)*(sin1*sin1)*w0;
-            poly_K_1_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (1.0F/250.0F)*w0*(-2*sin2/sin0 + 5/cos0);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
         }
@@ -1710,7 +1710,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             c_K_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.21211211F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 5.1661544F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 22.612713F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -1830,8 +1830,8 @@ static inline void symrot_sine_m5_to_quaternion_f(const float p[3], float e[4])
 }
 
 /* symrot_sine_m5__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 1 in t = phi^2 below 0.000803424, else 5*sin(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 44 */
+ * sigma: Horner degree 5 in t = phi^2 below 1.50116, else 5*sin(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 53 */
 static inline int symrot_sine_m5__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1857,8 +1857,8 @@ static inline int symrot_sine_m5__from_quaternion_f(float e0, float e1, float e2
     const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
-    if (t < 0.0008034237F) {
-        sigma = (7.0F/100.0F)*t + 2;
+    if (t < 1.5011637F) {
+        sigma = t*(t*(t*(t*((3.155915e-08F)*t + 1.2447465e-06F) + 4.8952777e-05F) + 1141.0F/600000.0F) + 7.0F/100.0F) + 2;
     } else {
         sigma = 5*sinf((1.0F/5.0F)*phi)/sinf((1.0F/2.0F)*phi);
     }

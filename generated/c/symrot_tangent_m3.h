@@ -70,9 +70,9 @@ static inline double symrot_tangent_m3_angle(const double p[3])
 /* symrot_tangent_m3_rotation_matrix: rotation tensor R (eq 14).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 1 in x below x = 1e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 13 in x below x = 0.487118, else (1 - cos(phi))/s**2
- * ops: 101 */
+ * ops: 109 */
 static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -89,8 +89,8 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 1.0000000000000006e-14) {
-        c_R_1 = 1 + (-11.0/54.0)*x;
+    if (x < 0.06877716192024322) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
@@ -127,7 +127,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 1.0000000000000006e-14) {
+            if (!(x < 4.149515568880993e+180) || x < 0.06877716192024322) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -171,7 +171,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1 + (-11.0/54.0)*x;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
             c_R_2_lanes[k] = (1 - cos1)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         }
@@ -181,7 +181,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 1.0000000000000006e-14 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 0.06877716192024322 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
@@ -455,9 +455,9 @@ static inline double symrot_tangent_m3_tangent_det(const double p[3])
 /* symrot_tangent_m3_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 1.9012e-14, else sin(phi/2)/s
- * G_2: Horner degree 5 in x below x = 0.0189581, else 2*sin(phi/4)**2/s**2
- * ops: 74 */
+ * G_1: Horner degree 7 in x below x = 0.0687772, else sin(phi/2)/s
+ * G_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/s**2
+ * ops: 92 */
 static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -474,14 +474,14 @@ static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 1.9011961863057328e-14) {
-        c_G_1 = 1.0/2.0 + (-17.0/432.0)*x;
-        c_G_2 = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+    if (x < 0.06877716192024322) {
+        c_G_1 = x*(x*(x*(x*(x*(x*(2025115.0/4458050224128.0 + (-46876153.0/962938848411648.0)*x) - 44015.0/10319560704.0) + 17371.0/429981696.0) - 193.0/497664.0) + 79.0/20736.0) - 17.0/432.0) + 1.0/2.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
         c_G_1 = sin((1.0/2.0)*phi)/s;
-        c_G_2 = x < 0.018958083893503733 ? x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -511,7 +511,7 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 1.9011961863057328e-14) {
+            if (!(x < 4.149515568880993e+180) || x < 0.06877716192024322) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -552,9 +552,9 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-17.0/432.0)*x;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(2025115.0/4458050224128.0 + (-46876153.0/962938848411648.0)*x) - 44015.0/10319560704.0) + 17371.0/429981696.0) - 193.0/497664.0) + 79.0/20736.0) - 17.0/432.0) + 1.0/2.0;
             c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -562,11 +562,11 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 1.9011961863057328e-14 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 0.06877716192024322 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.018958083893503733 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.06877716192024322 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -588,9 +588,9 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
 /* symrot_tangent_m3_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 5 in x below x = 0.0189581, else 2*sin(phi/4)**2/s**2
+ * K_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 21 in x below x = 1.93909, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
- * ops: 130 */
+ * ops: 136 */
 static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -608,8 +608,8 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (9.0/2.0)/(x + 9);
     double c_K_1, c_K_2;
-    if (x < 0.018958083893503733) {
-        c_K_1 = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+    if (x < 0.06877716192024322) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
@@ -646,7 +646,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 0.018958083893503733) {
+            if (!(x < 4.149515568880993e+180) || x < 0.06877716192024322) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -690,7 +690,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double w1 = 1.0/(s*s);
             c_K_0_lanes[k] = (9.0/2.0)*w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/6.0)*w1*(27*w0 - 6*sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
         }
@@ -701,7 +701,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.018958083893503733 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.06877716192024322 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -785,8 +785,8 @@ static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[
 /* symrot_tangent_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * e_0 = -sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/(2*(x + 9)**(3/4)) (algebraic in x)
- * nu: Horner degree 1 in x below x = 1e-14, else 2*sin(phi/2)/s
- * ops: 42 */
+ * nu: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)/s
+ * ops: 53 */
 static inline void symrot_tangent_m3_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -799,8 +799,8 @@ static inline void symrot_tangent_m3_to_quaternion(const double p[3], double e[4
     }
     const double c_e_0 = -1.0/2.0*sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/pow(x + 9, 3.0/4.0);
     double c_nu;
-    if (x < 1.0000000000000006e-14) {
-        c_nu = 1 + (-17.0/216.0)*x;
+    if (x < 0.06877716192024322) {
+        c_nu = x*(x*(x*(x*(x*(x*(2025115.0/2229025112064.0 + (-46876153.0/481469424205824.0)*x) - 44015.0/5159780352.0) + 17371.0/214990848.0) - 193.0/248832.0) + 79.0/10368.0) - 17.0/216.0) + 1;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
@@ -814,8 +814,8 @@ static inline void symrot_tangent_m3_to_quaternion(const double p[3], double e[4
 }
 
 /* symrot_tangent_m3__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 5 in t = phi^2 below 0.0347285, else 3*tan(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 52 */
+ * sigma: Horner degree 7 in t = phi^2 below 0.12188, else 3*tan(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 58 */
 static inline int symrot_tangent_m3__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -841,8 +841,8 @@ static inline int symrot_tangent_m3__from_quaternion(double e0, double e1, doubl
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.034728524608297284) {
-        sigma = t*(t*(t*(t*((105958219.0/109709829734400.0)*t + 6354073.0/304749527040.0) + 7379.0/16796160.0) + 137.0/15552.0) + 17.0/108.0) + 2;
+    if (t < 0.12188031421952665) {
+        sigma = t*(t*(t*(t*(t*(t*((2.006345334189741e-09)*t + 4.41717815373116e-08) + 105958219.0/109709829734400.0) + 6354073.0/304749527040.0) + 7379.0/16796160.0) + 137.0/15552.0) + 17.0/108.0) + 2;
     } else {
         sigma = 3*tan((1.0/3.0)*phi)/sin((1.0/2.0)*phi);
     }
@@ -954,9 +954,9 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
 /* symrot_tangent_m3_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 0 in x below x = 1e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 12 in x below x = 1.93909, else 2*sin(phi/2)**2/s**2
- * ops: 97 */
+ * ops: 101 */
 static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -973,8 +973,8 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
         return;
     }
     float c_R_1, c_R_2;
-    if (x < 1e-14F) {
-        c_R_1 = 1;
+    if (x < 0.48711845F) {
+        c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
@@ -1012,7 +1012,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 1e-14F) {
+            if (!(x < 1.2676506e+30F) || x < 0.48711845F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1045,7 +1045,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
         }
@@ -1055,7 +1055,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 1e-14F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 0.48711845F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
@@ -1328,9 +1328,9 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
 /* symrot_tangent_m3_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 3 in x below x = 0.131361, else sin(phi/2)/s
+ * G_1: Horner degree 7 in x below x = 0.956738, else sin(phi/2)/s
  * G_2: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/s**2
- * ops: 92 */
+ * ops: 104 */
 static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1347,8 +1347,8 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
         return;
     }
     float c_G_1, c_G_2;
-    if (x < 0.13136065F) {
-        c_G_1 = x*(x*(79.0F/20736.0F + (-193.0F/497664.0F)*x) - 17.0F/432.0F) + 1.0F/2.0F;
+    if (x < 0.95673823F) {
+        c_G_1 = x*(x*(x*(x*(x*(x*(4.5426026e-07F + (-4.8680302e-08F)*x) - 4.265201e-06F) + 4.0399394e-05F) - 193.0F/497664.0F) + 79.0F/20736.0F) - 17.0F/432.0F) + 1.0F/2.0F;
         c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
@@ -1385,7 +1385,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 0.13136065F) {
+            if (!(x < 1.2676506e+30F) || x < 0.95673823F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1418,7 +1418,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(79.0F/20736.0F + (-193.0F/497664.0F)*x) - 17.0F/432.0F) + 1.0F/2.0F;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(4.5426026e-07F + (-4.8680302e-08F)*x) - 4.265201e-06F) + 4.0399394e-05F) - 193.0F/497664.0F) + 79.0F/20736.0F) - 17.0F/432.0F) + 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         }
@@ -1428,7 +1428,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 0.13136065F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 0.95673823F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
@@ -1644,8 +1644,8 @@ static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[
 /* symrot_tangent_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * e_0 = -sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/(2*(x + 9)**(3/4)) (algebraic in x)
- * nu: Horner degree 3 in x below x = 0.131361, else 2*sin(phi/2)/s
- * ops: 42 */
+ * nu: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/2)/s
+ * ops: 53 */
 static inline void symrot_tangent_m3_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1658,8 +1658,8 @@ static inline void symrot_tangent_m3_to_quaternion_f(const float p[3], float e[4
     }
     const float c_e_0 = -1.0F/2.0F*sqrtf(2)*(sqrtf(x + 9) - 6)*sqrtf(sqrtf(x + 9) + 3)/powf(x + 9, 3.0F/4.0F);
     float c_nu;
-    if (x < 0.13136065F) {
-        c_nu = x*(x*(79.0F/10368.0F + (-193.0F/248832.0F)*x) - 17.0F/216.0F) + 1;
+    if (x < 0.95673823F) {
+        c_nu = x*(x*(x*(x*(x*(x*(9.085205e-07F + (-9.7360605e-08F)*x) - 8.530402e-06F) + 8.079879e-05F) - 193.0F/248832.0F) + 79.0F/10368.0F) - 17.0F/216.0F) + 1;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
@@ -1673,8 +1673,8 @@ static inline void symrot_tangent_m3_to_quaternion_f(const float p[3], float e[4
 }
 
 /* symrot_tangent_m3__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 0 in t = phi^2 below 3.50952e-14, else 3*tan(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 43 */
+ * sigma: Horner degree 6 in t = phi^2 below 1.50116, else 3*tan(phi/3)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 55 */
 static inline int symrot_tangent_m3__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1700,8 +1700,8 @@ static inline int symrot_tangent_m3__from_quaternion_f(float e0, float e1, float
     const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
-    if (t < 3.509516e-14F) {
-        sigma = 2;
+    if (t < 1.5011637F) {
+        sigma = t*(t*(t*(t*(t*((4.417178e-08F)*t + 9.658042e-07F) + 2.085015e-05F) + 0.0004393266F) + 137.0F/15552.0F) + 17.0F/108.0F) + 2;
     } else {
         sigma = 3*tanf((1.0F/3.0F)*phi)/sinf((1.0F/2.0F)*phi);
     }

@@ -70,9 +70,9 @@ static inline double symrot_tangent_m5_angle(const double p[3])
 /* symrot_tangent_m5_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 9 in x below x = 0.41316, else (1 - cos(phi))/s**2
- * ops: 89 */
+ * ops: 97 */
 static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -89,8 +89,8 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 3.690968361342381e-14) {
-        c_R_1 = 1 + (-9.0/50.0)*x;
+    if (x < 0.1110480704185358) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
@@ -127,7 +127,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 3.690968361342381e-14) {
+            if (!(x <= 236.80339887498948) || x < 0.1110480704185358) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -171,7 +171,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1 + (-9.0/50.0)*x;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
             c_R_2_lanes[k] = (1 - cos1)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         }
@@ -181,7 +181,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             c_R_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 3.690968361342381e-14 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 0.1110480704185358 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
@@ -495,9 +495,9 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
 /* symrot_tangent_m5_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 3.69097e-14, else sin(phi/2)/s
- * G_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/4)**2/s**2
- * ops: 80 */
+ * G_1: Horner degree 7 in x below x = 0.111048, else sin(phi/2)/s
+ * G_2: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/s**2
+ * ops: 92 */
 static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -514,14 +514,14 @@ static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 3.690968361342381e-14) {
-        c_G_1 = 1.0/2.0 + (-11.0/400.0)*x;
+    if (x < 0.1110480704185358) {
+        c_G_1 = x*(x*(x*(x*(x*(x*(8357819.0/2048000000000000.0 + (-1.6919252294921874e-10)*x) - 500957.0/5120000000000.0) + 59547.0/25600000000.0) - 1747.0/32000000.0) + 1003.0/800000.0) - 11.0/400.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         c_G_1 = sin((1.0/2.0)*phi)/s;
-        c_G_2 = x < 0.1110480704185358 ? x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        c_G_2 = x < 0.2139271817059954 ? x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -551,7 +551,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 3.690968361342381e-14) {
+            if (!(x <= 236.80339887498948) || x < 0.1110480704185358) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -592,7 +592,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(8357819.0/2048000000000000.0 + (-1.6919252294921874e-10)*x) - 500957.0/5120000000000.0) + 59547.0/25600000000.0) - 1747.0/32000000.0) + 1003.0/800000.0) - 11.0/400.0) + 1.0/2.0;
             c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         }
@@ -602,11 +602,11 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             c_G_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 3.690968361342381e-14 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 0.1110480704185358 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.1110480704185358 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.2139271817059954 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -628,7 +628,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
 /* symrot_tangent_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/4)**2/s**2
+ * K_1: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 18 in x below x = 3.13745, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
  * ops: 127 */
 static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9])
@@ -648,7 +648,7 @@ static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (25.0/2.0)/(x + 25);
     double c_K_1, c_K_2;
-    if (x < 0.1110480704185358) {
+    if (x < 0.2139271817059954) {
         c_K_1 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
     } else {
@@ -686,7 +686,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 0.1110480704185358) {
+            if (!(x <= 236.80339887498948) || x < 0.2139271817059954) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -741,7 +741,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.1110480704185358 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.2139271817059954 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -837,8 +837,8 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
 /* symrot_tangent_m5_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -sqrt(2)*sqrt(sqrt(x + 25) + 5)*(x + 10*sqrt(x + 25) - 75)/(2*(x + 25)**(5/4)) (algebraic in x)
- * nu: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
- * ops: 44 */
+ * nu: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)/s
+ * ops: 55 */
 static inline void symrot_tangent_m5_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -851,8 +851,8 @@ static inline void symrot_tangent_m5_to_quaternion(const double p[3], double e[4
     }
     const double c_e_0 = -1.0/2.0*sqrt(2)*sqrt(sqrt(x + 25) + 5)*(x + 10*sqrt(x + 25) - 75)/pow(x + 25, 5.0/4.0);
     double c_nu;
-    if (x < 3.690968361342381e-14) {
-        c_nu = 1 + (-11.0/200.0)*x;
+    if (x < 0.1110480704185358) {
+        c_nu = x*(x*(x*(x*(x*(x*(8357819.0/1024000000000000.0 + (-3.383850458984375e-10)*x) - 500957.0/2560000000000.0) + 59547.0/12800000000.0) - 1747.0/16000000.0) + 1003.0/400000.0) - 11.0/200.0) + 1;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
@@ -1012,9 +1012,9 @@ static inline float symrot_tangent_m5_angle_f(const float p[3])
 /* symrot_tangent_m5_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi)/s
- * R_2: Horner degree 4 in x below x = 0.41316, else (1 - cos(phi))/s**2
- * ops: 69 */
+ * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * ops: 91 */
 static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1031,14 +1031,16 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
         return;
     }
     float c_R_1, c_R_2;
-    if (x < 3.6909684e-14F) {
-        c_R_1 = 1;
-        c_R_2 = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+    if (x < 1.5711837F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_R_1 = sinf(phi)/s;
-        c_R_2 = x < 0.41316044F ? x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F : (1 - cosf(phi))/(s*s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_1 = 2*w1*cosf(w0)/s;
+        c_R_2 = 2*(w1*w1)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1068,7 +1070,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
+            if (!(x < 236.8034F) || x < 1.5711837F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1088,7 +1090,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1100,10 +1102,10 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = sin0/s;
-            poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = (1 - cos0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_R_1_lanes[k] = 2*cos0*sin0/s;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1111,11 +1113,11 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             c_R_0_lanes[k] = !(x < 236.8034F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 3.6909684e-14F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 1.5711837F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 236.8034F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 0.41316044F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 1.5711837F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 236.8034F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1137,9 +1139,9 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 4 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 109 */
+ * ops: 118 */
 static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1157,16 +1159,17 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
     }
     const float c_H_0 = 25/(x + 25);
     float c_H_1, c_H_2;
-    if (x < 0.41316044F) {
-        c_H_1 = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+    if (x < 1.5711837F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
         const float w1 = (1.0F/2.0F)*phi;
-        c_H_1 = w0*(1 - cosf(phi));
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1196,7 +1199,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 0.41316044F) {
+            if (!(x < 236.8034F) || x < 1.5711837F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1216,7 +1219,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1225,26 +1228,15 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float w0 = 1.0F/(x + 25);
             const float w1 = 1.0F/(s*s);
             c_H_0_lanes[k] = 25*w0;
-            c_H_1_lanes[k] = w1*(1 - cos0);
-            poly_H_1_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w1*(-2*cos1*sin1/s + 25*w0);
+            c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = w1*(-2*cos0*sin0/s + 25*w0);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1254,7 +1246,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             c_H_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 0.41316044F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 1.5711837F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 236.8034F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
@@ -1403,8 +1395,8 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
 
 /* symrot_tangent_m5_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 6 in x below x = 0.801859, else 100*sin(phi/2)**2/(s**2*(x + 25))
- * ops: 25 */
+ * det_H: Horner degree 7 in x below x = 1.57118, else 100*sin(phi/2)**2/(s**2*(x + 25))
+ * ops: 29 */
 static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1412,8 +1404,8 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 0.80185854F) {
-        c_det_H = x*(x*(x*(x*(x*((2.4286385e-07F)*x - 4.244056e-06F) + 6.98344e-05F) - 5279.0F/5000000.0F) + 351.0F/25000.0F) - 3.0F/20.0F) + 1;
+    if (x < 1.5711837F) {
+        c_det_H = x*(x*(x*(x*(x*(x*(2.4286385e-07F + (-1.32864075e-08F)*x) - 4.244056e-06F) + 6.98344e-05F) - 5279.0F/5000000.0F) + 351.0F/25000.0F) - 3.0F/20.0F) + 1;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
@@ -1425,9 +1417,9 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
 /* symrot_tangent_m5_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi/2)/s
+ * G_1: Horner degree 6 in x below x = 1.57118, else sin(phi/2)/s
  * G_2: Horner degree 8 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
- * ops: 82 */
+ * ops: 90 */
 static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1444,8 +1436,8 @@ static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
         return;
     }
     float c_G_1, c_G_2;
-    if (x < 3.6909684e-14F) {
-        c_G_1 = 1.0F/2.0F;
+    if (x < 1.5711837F) {
+        c_G_1 = x*(x*(x*(x*(x*((4.0809662e-09F)*x - 9.784316e-08F) + 2.3260548e-06F) - 5.459375e-05F) + 1003.0F/800000.0F) - 11.0F/400.0F) + 1.0F/2.0F;
         c_G_2 = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
@@ -1482,7 +1474,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
+            if (!(x < 236.8034F) || x < 1.5711837F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1515,7 +1507,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0F/2.0F;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*((4.0809662e-09F)*x - 9.784316e-08F) + 2.3260548e-06F) - 5.459375e-05F) + 1003.0F/800000.0F) - 11.0F/400.0F) + 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
         }
@@ -1525,7 +1517,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             c_G_0_lanes[k] = !(x < 236.8034F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 3.6909684e-14F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 1.5711837F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 236.8034F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
@@ -1717,9 +1709,9 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 4 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 103 */
+ * ops: 112 */
 static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1731,16 +1723,17 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
     }
     const float c_H_0 = 25/(x + 25);
     float c_H_1, c_H_2;
-    if (x < 0.41316044F) {
-        c_H_1 = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+    if (x < 1.5711837F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
         const float w1 = (1.0F/2.0F)*phi;
-        c_H_1 = w0*(1 - cosf(phi));
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -1753,8 +1746,8 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
 /* symrot_tangent_m5_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -sqrt(2)*sqrt(sqrt(x + 25) + 5)*(x + 10*sqrt(x + 25) - 75)/(2*(x + 25)**(5/4)) (algebraic in x)
- * nu: Horner degree 0 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
- * ops: 44 */
+ * nu: Horner degree 6 in x below x = 1.57118, else 2*sin(phi/2)/s
+ * ops: 51 */
 static inline void symrot_tangent_m5_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1767,8 +1760,8 @@ static inline void symrot_tangent_m5_to_quaternion_f(const float p[3], float e[4
     }
     const float c_e_0 = -1.0F/2.0F*sqrtf(2)*sqrtf(sqrtf(x + 25) + 5)*(x + 10*sqrtf(x + 25) - 75)/powf(x + 25, 5.0F/4.0F);
     float c_nu;
-    if (x < 3.6909684e-14F) {
-        c_nu = 1;
+    if (x < 1.5711837F) {
+        c_nu = x*(x*(x*(x*(x*((8.1619325e-09F)*x - 1.9568633e-07F) + 4.6521095e-06F) - 1747.0F/16000000.0F) + 1003.0F/400000.0F) - 11.0F/200.0F) + 1;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
@@ -1782,8 +1775,8 @@ static inline void symrot_tangent_m5_to_quaternion_f(const float p[3], float e[4
 }
 
 /* symrot_tangent_m5__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 3 in t = phi^2 below 0.228327, else 5*tan(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 47 */
+ * sigma: Horner degree 5 in t = phi^2 below 1.50116, else 5*tan(phi/5)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 53 */
 static inline int symrot_tangent_m5__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1809,8 +1802,8 @@ static inline int symrot_tangent_m5__from_quaternion_f(float e0, float e1, float
     const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
-    if (t < 0.22832695F) {
-        sigma = t*(t*((0.00012116389F)*t + 2381.0F/600000.0F) + 11.0F/100.0F) + 2;
+    if (t < 1.5011637F) {
+        sigma = t*(t*(t*(t*((9.208976e-08F)*t + 3.4131197e-06F) + 0.00012116389F) + 2381.0F/600000.0F) + 11.0F/100.0F) + 2;
     } else {
         sigma = 5*tanf((1.0F/5.0F)*phi)/sinf((1.0F/2.0F)*phi);
     }

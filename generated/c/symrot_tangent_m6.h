@@ -70,9 +70,9 @@ static inline double symrot_tangent_m6_angle(const double p[3])
 /* symrot_tangent_m6_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 8 in x below x = 0.213555, else 2*sin(phi/2)**2/s**2
- * ops: 85 */
+ * ops: 93 */
 static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -89,8 +89,8 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 3.69096836134238e-14) {
-        c_R_1 = 1 + (-19.0/108.0)*x;
+    if (x < 0.11094775628437421) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
@@ -128,7 +128,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 3.69096836134238e-14) {
+            if (!(x < 108.0) || x < 0.11094775628437421) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -161,7 +161,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1 + (-19.0/108.0)*x;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
         }
@@ -171,7 +171,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             c_R_0_lanes[k] = !(x < 108.0) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 3.69096836134238e-14 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 0.11094775628437421 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 108.0) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
@@ -418,9 +418,9 @@ static inline double symrot_tangent_m6_tangent_det(const double p[3])
 /* symrot_tangent_m6_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 1 in x below x = 3.69097e-14, else sin(phi/2)/s
+ * G_1: Horner degree 7 in x below x = 0.213555, else sin(phi/2)/s
  * G_2: Horner degree 12 in x below x = 1.55153, else (1 - cos(phi/2))/s**2
- * ops: 94 */
+ * ops: 106 */
 static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -437,8 +437,8 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 3.69096836134238e-14) {
-        c_G_1 = 1.0/2.0 + (-11.0/432.0)*x;
+    if (x < 0.21355546857295157) {
+        c_G_1 = x*(x*(x*(x*(x*(x*(1309.0/1486016741376.0 + (-8437.0/320979616137216.0)*x) - 301.0/10319560704.0) + 1225.0/1289945088.0) - 5.0/165888.0) + 19.0/20736.0) - 11.0/432.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
@@ -475,7 +475,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 3.69096836134238e-14) {
+            if (!(x < 108.0) || x < 0.21355546857295157) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -508,7 +508,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/432.0)*x;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(1309.0/1486016741376.0 + (-8437.0/320979616137216.0)*x) - 301.0/10319560704.0) + 1225.0/1289945088.0) - 5.0/165888.0) + 19.0/20736.0) - 11.0/432.0) + 1.0/2.0;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
         }
@@ -518,7 +518,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             c_G_0_lanes[k] = !(x < 108.0) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 3.69096836134238e-14 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 0.21355546857295157 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 108.0) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
@@ -735,8 +735,8 @@ static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[
 /* symrot_tangent_m6_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -18*(x - 12)/(x + 36)**(3/2) (algebraic in x)
- * nu: Horner degree 1 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
- * ops: 29 */
+ * nu: Horner degree 7 in x below x = 0.213555, else 2*sin(phi/2)/s
+ * ops: 40 */
 static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -749,8 +749,8 @@ static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4
     }
     const double c_e_0 = -18*(x - 12)/pow(x + 36, 3.0/2.0);
     double c_nu;
-    if (x < 3.69096836134238e-14) {
-        c_nu = 1 + (-11.0/216.0)*x;
+    if (x < 0.21355546857295157) {
+        c_nu = x*(x*(x*(x*(x*(x*(1309.0/743008370688.0 + (-8437.0/160489808068608.0)*x) - 301.0/5159780352.0) + 1225.0/644972544.0) - 5.0/82944.0) + 19.0/10368.0) - 11.0/216.0) + 1;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         const double s = sqrt(x);
@@ -764,8 +764,8 @@ static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4
 }
 
 /* symrot_tangent_m6__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 2 in t = phi^2 below 2.82704e-06, else 6*tan(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 44 */
+ * sigma: Horner degree 7 in t = phi^2 below 0.228327, else 6*tan(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 59 */
 static inline int symrot_tangent_m6__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -791,8 +791,8 @@ static inline int symrot_tangent_m6__from_quaternion(double e0, double e1, doubl
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 2.8270409165227273e-06) {
-        sigma = t*((53.0/15552.0)*t + 11.0/108.0) + 2;
+    if (t < 0.22832695303370756) {
+        sigma = t*(t*(t*(t*(t*(t*((4.409262242954425e-11)*t + 1.7322265099038284e-09) + 7421137.0/109709829734400.0) + 794257.0/304749527040.0) + 1637.0/16796160.0) + 53.0/15552.0) + 11.0/108.0) + 2;
     } else {
         sigma = 6*tan((1.0/6.0)*phi)/sin((1.0/2.0)*phi);
     }
@@ -910,9 +910,9 @@ static inline float symrot_tangent_m6_angle_f(const float p[3])
 /* symrot_tangent_m6_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi)/s
+ * R_1: Horner degree 7 in x below x = 1.55153, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
- * ops: 93 */
+ * ops: 105 */
 static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -929,14 +929,16 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
         return;
     }
     float c_R_1, c_R_2;
-    if (x < 3.6909684e-14F) {
-        c_R_1 = 1;
+    if (x < 1.5515263F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_R_1 = sinf(phi)/s;
-        c_R_2 = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F : 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_1 = 2*w1*cosf(w0)/s;
+        c_R_2 = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F : 2*(w1*w1)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -966,7 +968,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 3.6909684e-14F) {
+            if (!(x < 108.0F) || x < 1.5515263F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -986,7 +988,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -996,19 +998,11 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_R_1_lanes[k] = sin0/s;
-            poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = 2*(sin1*sin1)/(s*s);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_R_1_lanes[k] = 2*cos0*sin0/s;
+            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1017,7 +1011,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             c_R_0_lanes[k] = !(x < 108.0F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 3.6909684e-14F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 1.5515263F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 108.0F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
@@ -1264,9 +1258,9 @@ static inline float symrot_tangent_m6_tangent_det_f(const float p[3])
 /* symrot_tangent_m6_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 0 in x below x = 3.69097e-14, else sin(phi/2)/s
+ * G_1: Horner degree 7 in x below x = 3.06078, else sin(phi/2)/s
  * G_2: Horner degree 10 in x below x = 6.19603, else (1 - cos(phi/2))/s**2
- * ops: 88 */
+ * ops: 100 */
 static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1283,8 +1277,8 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
         return;
     }
     float c_G_1, c_G_2;
-    if (x < 3.6909684e-14F) {
-        c_G_1 = 1.0F/2.0F;
+    if (x < 3.0607803F) {
+        c_G_1 = x*(x*(x*(x*(x*(x*(8.8087837e-10F + (-2.6285158e-11F)*x) - 2.9167909e-08F) + 9.496528e-07F) - 5.0F/165888.0F) + 19.0F/20736.0F) - 11.0F/432.0F) + 1.0F/2.0F;
         c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1372548e-16F)*x - 3.9035403e-15F) + 1.3331388e-13F) - 4.5247226e-12F) + 1.5236482e-10F) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
@@ -1321,7 +1315,7 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 3.6909684e-14F) {
+            if (!(x < 108.0F) || x < 3.0607803F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1354,7 +1348,7 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0F/2.0F;
+            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(8.8087837e-10F + (-2.6285158e-11F)*x) - 2.9167909e-08F) + 9.496528e-07F) - 5.0F/165888.0F) + 19.0F/20736.0F) - 11.0F/432.0F) + 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1372548e-16F)*x - 3.9035403e-15F) + 1.3331388e-13F) - 4.5247226e-12F) + 1.5236482e-10F) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
         }
@@ -1364,7 +1358,7 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             c_G_0_lanes[k] = !(x < 108.0F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 3.6909684e-14F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 3.0607803F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 108.0F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
@@ -1581,8 +1575,8 @@ static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[
 /* symrot_tangent_m6_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -18*(x - 12)/(x + 36)**(3/2) (algebraic in x)
- * nu: Horner degree 0 in x below x = 3.69097e-14, else 2*sin(phi/2)/s
- * ops: 29 */
+ * nu: Horner degree 7 in x below x = 3.06078, else 2*sin(phi/2)/s
+ * ops: 40 */
 static inline void symrot_tangent_m6_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1595,8 +1589,8 @@ static inline void symrot_tangent_m6_to_quaternion_f(const float p[3], float e[4
     }
     const float c_e_0 = -18*(x - 12)/powf(x + 36, 3.0F/2.0F);
     float c_nu;
-    if (x < 3.6909684e-14F) {
-        c_nu = 1;
+    if (x < 3.0607803F) {
+        c_nu = x*(x*(x*(x*(x*(x*(1.7617567e-09F + (-5.2570316e-11F)*x) - 5.8335818e-08F) + 1.8993056e-06F) - 5.0F/82944.0F) + 19.0F/10368.0F) - 11.0F/216.0F) + 1;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
@@ -1610,8 +1604,8 @@ static inline void symrot_tangent_m6_to_quaternion_f(const float p[3], float e[4
 }
 
 /* symrot_tangent_m6__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
- * sigma: Horner degree 0 in t = phi^2 below 6.57462e-14, else 6*tan(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
- * ops: 44 */
+ * sigma: Horner degree 5 in t = phi^2 below 1.50116, else 6*tan(phi/6)/sin(phi/2), phi = 2 atan2(|e|, e0)
+ * ops: 53 */
 static inline int symrot_tangent_m6__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1637,8 +1631,8 @@ static inline int symrot_tangent_m6__from_quaternion_f(float e0, float e1, float
     const float phi = 2*atan2f(e_norm, fabsf(e0));
     const float t = (phi*phi);
     float sigma;
-    if (t < 6.5746237e-14F) {
-        sigma = 2;
+    if (t < 1.5011637F) {
+        sigma = t*(t*(t*(t*((6.764332e-08F)*t + 2.6062617e-06F) + 9.7462755e-05F) + 53.0F/15552.0F) + 11.0F/108.0F) + 2;
     } else {
         sigma = 6*tanf((1.0F/6.0F)*phi)/sinf((1.0F/2.0F)*phi);
     }

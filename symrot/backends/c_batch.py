@@ -3,24 +3,28 @@
 A kernel ``symrot_NAME_F_batch(n, p, T)`` evaluates the tensor function F (R, H, H⁻¹, G or K,
 eqs 14, 22, 26, 81, 83) for n vectors. It prints the same plan as the single call
 (:class:`~symrot.backends.c_backend.FunctionWriter`), in blocks of ``SYMROT_BATCH_BLOCK`` vectors
-and three passes, so that the expensive middle pass has no branch and no library call:
+and four passes, so that the two expensive middle ones have no branch and no library call:
 
 1. **scalar pass** (k < block length, branches allowed): x = |p|², and for vectors inside the
-   validity range every operation a vectorizing compiler cannot handle: s = √x, d = p_max² − x
-   (``__complement``), φ (the plan's closed inverse or Newton iteration) and each *scalar atom* u
-   of the coefficient expressions, a maximal subexpression that is not arithmetic (√(x + 9),
-   ∛(6(φ − sin φ)), ...). Lanes past n get 0.
-2. **coefficient pass** (a loop of constant trip count over the block): every coefficient c(x),
-   both the Horner polynomial and the closed form of a :class:`~symrot.plan.Branch` selected by its
-   threshold, NaN outside the validity range. sin and cos of arguments c·φ with a bounded range
-   come from the branch-free kernel of :mod:`symrot.sincos_kernel` (one call gives both); any other
-   trig call is a scalar atom.
-3. **assembly** (k < block length): T = c0 I + c1 (p×) + c2 (p×)² entry by entry, as the single call.
+   validity range (and above the smallest threshold, when only closed forms need them) every
+   operation a vectorizing compiler cannot handle: s = √x, d = p_max² − x (``__complement``), φ
+   (the plan's closed inverse or Newton iteration) and each *scalar atom* u of the coefficient
+   expressions, a maximal subexpression that is not arithmetic (√(x + 9), ∛(6(φ − sin φ)), ...).
+   Other lanes, and lanes past n, get 0.
+2. **candidate pass** (constant trip count): every closed form and every Horner polynomial, for
+   every lane, stored. Nothing is conditional: under the default ``-ftrapping-math`` gcc moves an
+   operation used on one side of a select into that side and then will not execute it
+   speculatively, which blocks vectorization without AVX-512 masks. sin and cos of arguments c·φ
+   with a bounded range come from the branch-free kernel of :mod:`symrot.backends.c_sincos` (one
+   kernel gives both); any other trig call is a scalar atom.
+3. **select pass** (constant trip count): polynomial below the coefficient's threshold, closed form
+   above, NaN outside the validity range, between values loaded unconditionally.
+4. **assembly** (k < block length): T = c0 I + c1 (p×) + c2 (p×)² entry by entry, as the single call.
 
-The values differ from the single call only by the rounding of the sin/cos kernel (≈ 1 ulp where
-libm is ≈ 0.5 ulp); both are tested against mpmath. Lanes whose result is discarded may raise
-floating-point exception flags (a 0/0 in the closed form below its threshold, for example); the
-result never depends on them.
+The values differ from the single call only by the rounding of the sin/cos kernel (≤ 1.5 ulp
+where libm's is about 0.5); both are tested against mpmath. Lanes whose result is discarded may
+raise floating-point exception flags (a 0/0 in the closed form below its threshold, for example);
+the result never depends on them.
 """
 
 from __future__ import annotations
@@ -49,7 +53,7 @@ from .c_sincos import TRIG, SinCosWriter
 
 BLOCK = "SYMROT_BATCH_BLOCK"
 DEFAULT_BLOCK = 32
-"""Vectors per block: 8 to 16 vector iterations of AVX2/AVX-512, a few KB of stack."""
+"""Vectors per block: 8 (AVX2) or 4 (AVX-512) vector iterations per loop, 2–3 KB of stack."""
 LANE = sp.Symbol("pk[0]"), sp.Symbol("pk[1]"), sp.Symbol("pk[2]")
 
 
