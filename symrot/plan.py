@@ -24,7 +24,7 @@ for the sine family, ``D`` = p_max² − x):
     accepted only when it is accurate in float64 on a log grid of x, p = 0 exactly.
 ``Constant(value)``
     identically constant coefficient (e.g. H⁻¹₂ = 1/4 for 2 sin(φ/2)): emit the number.
-``Branch(threshold, horner, closed, safe_phi, measured_ulp, edge_ulp)``
+``Branch(threshold, horner, closed, safe_phi, measured_ulp, edge_ulp, accurate_threshold, accurate_terms)``
     with ``t`` the branch variable (x = |p|² for coefficients, φ² inside ``NewtonAngle`` and σ):
     if t < threshold evaluate the polynomial Σ horner[j] t^j (exact rationals, Horner order);
     else evaluate ``closed`` (an expression in ``PHI``, and ``S``/``D`` where the base angle of a
@@ -49,7 +49,8 @@ the grid point minimising the worse of the two, moved up for speed as far as a p
 ``CHEAP_TERMS`` terms still truncates below a quarter ulp, and the degree is the smallest meeting
 the target.  Among equivalent closed forms (as derived, half-angle forms of cos φ, everything in
 sin(φ/2), cos(φ/2)) the plan takes the one whose worst error is smallest, then the shortest
-polynomial, then the fewest distinct trigonometric arguments (sin a and cos a: one sincos).
+polynomial at the smallest switch the accuracy allows, then the fewest distinct trigonometric
+arguments (sin a and cos a: one sincos).
 """
 
 from __future__ import annotations
@@ -119,6 +120,18 @@ class Branch:
     measured_ulp: float
     edge_ulp: float = 0.0
     """Worst error of the closed form on the upper half of the range (towards φ_max)."""
+    accurate_threshold: float | None = None
+    """The smallest switch the accuracy allows (``threshold`` is moved up from it for speed), with
+    the first ``accurate_terms`` coefficients of ``horner``: for backends where a branch costs
+    more than a short polynomial saves, such as NumPy's masked passes over whole arrays."""
+    accurate_terms: int | None = None
+
+    @property
+    def smallest_switch(self) -> tuple[float, tuple[sp.Expr, ...]]:
+        """(switch, Horner coefficients) with the switch as small as the accuracy allows."""
+        if self.accurate_threshold is None or self.accurate_terms is None:
+            return self.threshold, self.horner
+        return self.accurate_threshold, self.horner[:self.accurate_terms]
 
 
 @dataclass(frozen=True)
@@ -243,7 +256,8 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     candidates += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
     branches = [_branch_for(form, series, variable_of_phi, phi_max, dtype) for form in candidates]
     return min(branches, key=lambda b: (max(_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
-                                        len(b.horner), trig_arguments(b.closed), b.edge_ulp, b.measured_ulp))
+                                        len(b.smallest_switch[1]), trig_arguments(b.closed), b.edge_ulp,
+                                        b.measured_ulp))
 
 
 def _error_class(ulp: float) -> float:
@@ -297,6 +311,11 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                 best, best_k = worst, k
         elif worst < best:
             best, best_k = worst, k
+    def terms_at(threshold: float) -> int:
+        target = max(0.25, tail(threshold, MAX_TERMS - 2))
+        return next((n for n in range(1, MAX_TERMS - 1) if tail(threshold, n) <= target), MAX_TERMS - 2)
+
+    accurate_threshold = float(t_values[best_k])
     # speed: a polynomial of up to CHEAP_TERMS terms costs less than the closed form's library
     # calls, so the switch moves up while such a polynomial still truncates below a quarter ulp
     # (the closed form then serves a smaller range, where its error can only be smaller)
@@ -305,10 +324,11 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     best = min(best, max(float(np.max(closed_error[best_k:near_zero])),
                          tail(t_values[best_k], MAX_TERMS - 2)))
     threshold = float(t_values[best_k])
-    target = max(0.25, tail(threshold, MAX_TERMS - 2))
-    degree = next((n for n in range(1, MAX_TERMS - 1) if tail(threshold, n) <= target), MAX_TERMS - 2)
+    accurate_terms = terms_at(accurate_threshold)
+    degree = max(terms_at(threshold), accurate_terms)
     edge = float(np.max(closed_error[near_zero:])) if near_zero < len(angles) else 0.0
-    return Branch(threshold, tuple(series[:degree]), closed, float(angles[best_k]), best, edge)
+    return Branch(threshold, tuple(series[:degree]), closed, float(angles[best_k]), best, edge,
+                  accurate_threshold, accurate_terms)
 
 
 @lru_cache(maxsize=64)

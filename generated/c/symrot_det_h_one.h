@@ -1071,8 +1071,7 @@ static inline float symrot_det_h_one__phi_f(float s)
         if (t < 5.567348F) {
             ratio = t*(t*(t*(t*((1.046132e-11F)*t + 2.8630982e-09F)) + 1.0F/8400.0F) - 1.0F/60.0F) + 1;
         } else {
-            const float ratio_w0 = (1.0F/2.0F)*phi;
-            ratio = cbrtf(6*phi - 12*sinf(ratio_w0)*cosf(ratio_w0))/phi;
+            ratio = cbrtf(6*phi - 6*sinf(phi))/phi;
         }
         if (t < 5.567348F) {
             slope = t*(t*(t*(t*(t*(1.1507452e-10F + (-2.096197e-12F)*t) + 2.5767882e-08F)) + 1.0F/1680.0F) - 1.0F/20.0F) + 1;
@@ -1325,7 +1324,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 1.4342812F) {
+            if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
@@ -1383,7 +1382,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float w1 = (u0*u0);
             const float w2 = cos0*sin0;
             c_H_0_lanes[k] = (1.0F/4.0F)*w0*w1;
-            poly_H_0_lanes[k] = x*(x*(x*(x*(x*(x*((1.3075291e-08F)*x + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
+            poly_H_0_lanes[k] = x*(x*(x*(x*(x*((1.5485168e-07F)*x + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
             c_H_1_lanes[k] = (1 - cos1)/w1;
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = (1.0F/12.0F)*w0*(3*phi + (1.0F/2.0F)*sin2 - 8*w2)/(phi - 2*w2);
@@ -1394,7 +1393,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float x = x_lanes[k];
             const float closed_H_0 = c_H_0_lanes[k];
             const float poly_H_0 = poly_H_0_lanes[k];
-            const float v_H_0 = x < 1.4342812F ? poly_H_0 : closed_H_0;
+            const float v_H_0 = x < 0.7648242F ? poly_H_0 : closed_H_0;
             c_H_0_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
@@ -1642,7 +1641,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 1.4342812F) {
+            if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1681,9 +1680,9 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/u0;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
+            poly_G_1_lanes[k] = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(u1*u1);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            poly_G_2_lanes[k] = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1691,11 +1690,11 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             c_G_0_lanes[k] = !(x <= 11.2431345F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 1.4342812F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 0.7648242F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 1.4342812F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.7648242F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 11.2431345F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1780,7 +1779,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 1.4342812F) {
+            if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1821,9 +1820,9 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float w0 = 1.0F/(sin0*sin0);
             const float w1 = (u0*u0);
             c_K_0_lanes[k] = (1.0F/8.0F)*w0*w1;
-            poly_K_0_lanes[k] = x*(x*(x*(x*(x*(x*((6.5376455e-09F)*x + 7.742584e-08F) + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
+            poly_K_0_lanes[k] = x*(x*(x*(x*(x*((7.742584e-08F)*x + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
             c_K_1_lanes[k] = (1 - cos0)/(u1*u1);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (-sin0/u0 + (1.0F/8.0F)*w0*w1)/w1;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.1578103e-14F)*x + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
         }
@@ -1832,11 +1831,11 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float x = x_lanes[k];
             const float closed_K_0 = c_K_0_lanes[k];
             const float poly_K_0 = poly_K_0_lanes[k];
-            const float v_K_0 = x < 1.4342812F ? poly_K_0 : closed_K_0;
+            const float v_K_0 = x < 0.7648242F ? poly_K_0 : closed_K_0;
             c_K_0_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 1.4342812F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.7648242F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

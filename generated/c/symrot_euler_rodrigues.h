@@ -552,7 +552,7 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
             c_K_0_lanes[k] = u0;
             c_K_1_lanes[k] = (1.0/2.0)/(u1 + 2);
             c_K_2_lanes[k] = (1.0/4.0)*u0/((1.0/2.0)*u1 + 1);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((6435.0/4294967296.0)*x + 429.0/67108864.0) + 231.0/8388608.0) + 63.0/524288.0) + 35.0/65536.0) + 5.0/2048.0) + 3.0/256.0) + 1.0/16.0;
+            poly_K_2_lanes[k] = (3.0/256.0)*x + 1.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -563,7 +563,7 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
             c_K_1_lanes[k] = !(x < 4.0) ? NAN : closed_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 0.03462813501506715 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 9.99999999999999e-15 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.0) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1279,13 +1279,12 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             c_K_0_lanes[k] = u0;
             c_K_1_lanes[k] = (1.0F/2.0F)/(u1 + 2);
             c_K_2_lanes[k] = (1.0F/4.0F)*u0/((1.0F/2.0F)*u1 + 1);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((1.4982652e-06F)*x + 6.392598e-06F) + 231.0F/8388608.0F) + 63.0F/524288.0F) + 35.0F/65536.0F) + 5.0F/2048.0F) + 3.0F/256.0F) + 1.0F/16.0F;
+            poly_K_2_lanes[k] = 1.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1296,7 +1295,7 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
             c_K_1_lanes[k] = !(x < 4.0F) ? NAN : closed_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
-            const float v_K_2 = x < 0.4127098F ? poly_K_2 : closed_K_2;
+            const float v_K_2 = x < 1e-14F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.0F) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {

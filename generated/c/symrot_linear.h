@@ -262,7 +262,7 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
             c_H_0_lanes[k] = u0;
             c_H_1_lanes[k] = w0;
             c_H_2_lanes[k] = u0*w0;
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*((6435.0/32768.0)*x + 429.0/2048.0) + 231.0/1024.0) + 63.0/256.0) + 35.0/128.0) + 5.0/16.0) + 3.0/8.0) + 1.0/2.0;
+            poly_H_2_lanes[k] = (3.0/8.0)*x + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -273,7 +273,7 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
             c_H_1_lanes[k] = !(x < 1.0) ? NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 0.0059512030463300695 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 9.999999999999965e-15 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 1.0) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1101,14 +1101,13 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             const float w0 = 1.0F/(u1 + 1);
             c_H_0_lanes[k] = u0;
             c_H_1_lanes[k] = w0;
             c_H_2_lanes[k] = u0*w0;
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*((6435.0F/32768.0F)*x + 429.0F/2048.0F) + 231.0F/1024.0F) + 63.0F/256.0F) + 35.0F/128.0F) + 5.0F/16.0F) + 3.0F/8.0F) + 1.0F/2.0F;
+            poly_H_2_lanes[k] = 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1119,7 +1118,7 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
             c_H_1_lanes[k] = !(x < 1.0F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 0.11647221F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 1e-14F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 1.0F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1350,7 +1349,7 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.70710677F*u0;
             c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
+            poly_G_2_lanes[k] = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1360,7 +1359,7 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             c_G_1_lanes[k] = !(x < 1.0F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.11647221F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.0032607575F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 1.0F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1492,7 +1491,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float w1 = 1.0F/(s*s);
             c_K_0_lanes[k] = w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = w1*(w0 - (1.0F/2.0F)/cos1);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
         }
@@ -1503,7 +1502,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             c_K_0_lanes[k] = !(x < 1.0F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.11647221F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.0032607575F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 1.0F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

@@ -127,7 +127,7 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 0.4086652777619201) {
+            if (!(x <= 39.47841760435743) || x < 5.028297529613113e-13) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -156,9 +156,9 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/phi;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
+            poly_R_1_lanes[k] = 1 + (-1.0/6.0)*x;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+            poly_R_2_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -166,11 +166,11 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             c_R_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 0.4086652777619201 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 5.028297529613113e-13 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.7851233626304397 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 5.028297529613113e-13 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -247,7 +247,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 0.7851233626304397) {
+            if (!(x <= 39.47841760435743) || x < 5.028297529613113e-13) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -284,7 +284,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
             c_H_2_lanes[k] = -(-phi + sin1)/(phi*phi*phi);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
         }
@@ -294,7 +294,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             c_H_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.7851233626304397 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 5.028297529613113e-13 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -455,7 +455,7 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 1.50837, else sin(phi/2)/phi
- * G_2: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
+ * G_2: Horner degree 7 in x below x = 2.89787, else 2*sin(phi/4)**2/phi**2
  * ops: 90 */
 static inline void symrot_rotation_vector_root_matrix(const double p[3], double G[9])
 {
@@ -478,9 +478,8 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
         c_G_2 = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        c_G_1 = sin(w0)/phi;
-        c_G_2 = x < 2.897865491219691 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : (1 - cos(w0))/(phi*phi);
+        c_G_1 = sin((1.0/2.0)*phi)/phi;
+        c_G_2 = x < 2.897865491219691 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -510,7 +509,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 1.5083706105984414) {
+            if (!(x <= 39.47841760435743) || x < 1.855928709321803e-12) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -536,12 +535,20 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/phi;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/51011754393600.0 + (-2.333729166204778e-17)*x) - 1.0/81749606400.0) + 1.0/185794560.0) - 1.0/645120.0) + 1.0/3840.0) - 1.0/48.0) + 1.0/2.0;
-            c_G_2_lanes[k] = (1 - cos0)/(phi*phi);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-1.0/48.0)*x;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/(phi*phi);
+            poly_G_2_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -549,11 +556,11 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             c_G_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 1.5083706105984414 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 1.855928709321803e-12 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 2.897865491219691 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 9.015158901432458e-09 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -575,7 +582,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
 /* symrot_rotation_vector_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
- * K_1: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
+ * K_1: Horner degree 7 in x below x = 2.89787, else 2*sin(phi/4)**2/phi**2
  * K_2: Horner degree 8 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
  * ops: 95 */
 static inline void symrot_rotation_vector_root_tangent(const double p[3], double K[9])
@@ -599,9 +606,8 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         c_K_2 = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        c_K_1 = (1 - cos(w0))/(phi*phi);
-        c_K_2 = x < 5.56734820089753 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin(w0))/(phi*phi*phi);
+        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
+        c_K_2 = x < 5.56734820089753 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0/2.0;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -631,7 +637,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 2.897865491219691) {
+            if (!(x <= 39.47841760435743) || x < 9.015158901432458e-09) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -647,7 +653,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -657,11 +663,19 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_K_1_lanes[k] = (1 - cos0)/(phi*phi);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
-            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin0)/(phi*phi*phi);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
+            poly_K_1_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
+            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin1)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -670,7 +684,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             c_K_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1.0/2.0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 2.897865491219691 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 9.015158901432458e-09 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -992,7 +1006,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 5.567348F) {
+            if (!(x <= 39.478416F) || x < 5.028297e-13F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1006,7 +1020,6 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
@@ -1021,9 +1034,9 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/phi;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
+            poly_R_1_lanes[k] = 1;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+            poly_R_2_lanes[k] = 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1031,11 +1044,11 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             c_R_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 5.567348F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 5.028297e-13F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 5.567348F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 5.028297e-13F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1058,7 +1071,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + 2*sin(phi/2)*cos(phi/2))/phi**3
+ * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
  * ops: 82 */
 static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9])
 {
@@ -1081,10 +1094,8 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
         c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_H_1 = 2*(w1*w1)/(phi*phi);
-        c_H_2 = -(-phi + 2*w1*cosf(w0))/(phi*phi*phi);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
+        c_H_2 = -(-phi + sinf(phi))/(phi*phi*phi);
     }
     H[0] = -c_H_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1114,7 +1125,7 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 5.567348F) {
+            if (!(x <= 39.478416F) || x < 5.028297e-13F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1140,12 +1151,20 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = -(2*cos0*sin0 - phi)/(phi*phi*phi);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+            poly_H_1_lanes[k] = 1.0F/2.0F;
+            c_H_2_lanes[k] = -(-phi + sin1)/(phi*phi*phi);
+            poly_H_2_lanes[k] = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1153,11 +1172,11 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             c_H_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 5.567348F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 5.028297e-13F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 5.567348F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 1.5083706F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1314,7 +1333,7 @@ static inline float symrot_rotation_vector_tangent_det_f(const float p[3])
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 5 in x below x = 5.56735, else sin(phi/2)/phi
- * G_2: Horner degree 4 in x below x = 5.56735, else (1 - cos(phi/2))/phi**2
+ * G_2: Horner degree 4 in x below x = 5.56735, else 2*sin(phi/4)**2/phi**2
  * ops: 74 */
 static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float G[9])
 {
@@ -1337,9 +1356,8 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
         c_G_2 = x*(x*(x*((2.6911445e-10F)*x - 1.0F/10321920.0F) + 1.0F/46080.0F) - 1.0F/384.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        c_G_1 = sinf(w0)/phi;
-        c_G_2 = (1 - cosf(w0))/(phi*phi);
+        c_G_1 = sinf((1.0F/2.0F)*phi)/phi;
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1369,7 +1387,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 5.567348F) {
+            if (!(x <= 39.478416F) || x < 1.8559286e-12F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1383,7 +1401,6 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
@@ -1395,12 +1412,20 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/phi;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(5.382289e-09F + (-1.2232475e-11F)*x) - 1.0F/645120.0F) + 1.0F/3840.0F) - 1.0F/48.0F) + 1.0F/2.0F;
-            c_G_2_lanes[k] = (1 - cos0)/(phi*phi);
-            poly_G_2_lanes[k] = x*(x*(x*((2.6911445e-10F)*x - 1.0F/10321920.0F) + 1.0F/46080.0F) - 1.0F/384.0F) + 1.0F/8.0F;
+            poly_G_1_lanes[k] = 1.0F/2.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/(phi*phi);
+            poly_G_2_lanes[k] = 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1408,11 +1433,11 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             c_G_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 5.567348F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 1.8559286e-12F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 5.567348F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 1.8559286e-12F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1434,7 +1459,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
 /* symrot_rotation_vector_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
- * K_1: Horner degree 4 in x below x = 5.56735, else (1 - cos(phi/2))/phi**2
+ * K_1: Horner degree 4 in x below x = 5.56735, else 2*sin(phi/4)**2/phi**2
  * K_2: Horner degree 4 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
  * ops: 73 */
 static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float K[9])
@@ -1458,9 +1483,8 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
         c_K_2 = x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        c_K_1 = (1 - cosf(w0))/(phi*phi);
-        c_K_2 = -1.0F/2.0F*(-phi + 2*sinf(w0))/(phi*phi*phi);
+        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
+        c_K_2 = -1.0F/2.0F*(-phi + 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0F/2.0F;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1490,7 +1514,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.478416F) || x < 5.567348F) {
+            if (!(x <= 39.478416F) || x < 1.8559286e-12F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1506,7 +1530,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1516,11 +1540,19 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_K_1_lanes[k] = (1 - cos0)/(phi*phi);
-            poly_K_1_lanes[k] = x*(x*(x*((2.6911445e-10F)*x - 1.0F/10321920.0F) + 1.0F/46080.0F) - 1.0F/384.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = -1.0F/2.0F*(-phi + 2*sin0)/(phi*phi*phi);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
+            poly_K_1_lanes[k] = 1.0F/8.0F;
+            c_K_2_lanes[k] = -1.0F/2.0F*(-phi + 2*sin1)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1529,7 +1561,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             c_K_0_lanes[k] = !(x <= 39.478416F) ? NAN : 1.0F/2.0F;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 5.567348F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 1.8559286e-12F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 39.478416F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -1587,7 +1619,7 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + 2*sin(phi/2)*cos(phi/2))/phi**3
+ * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
  * ops: 73 */
 static inline void symrot_rotation_vector_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
@@ -1604,10 +1636,8 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
         c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_H_1 = 2*(w1*w1)/(phi*phi);
-        c_H_2 = -(-phi + 2*w1*cosf(w0))/(phi*phi*phi);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
+        c_H_2 = -(-phi + sinf(phi))/(phi*phi*phi);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];

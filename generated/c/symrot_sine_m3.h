@@ -147,7 +147,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0) || x < 0.1294709423110196) {
+            if (!(x < 9.0) || x < 0.018918233509283077) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -180,7 +180,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = 1 - 4.0/27.0*x;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            poly_R_2_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -190,7 +190,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 9.0) ? NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.1294709423110196 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.018918233509283077 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -318,7 +318,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double w1 = 2*(sin0*sin0);
             c_H_0_lanes[k] = 3*u0;
             c_H_1_lanes[k] = w0*w1;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u0*w0*(-2.0/3.0*u1 + w1 + 2);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         }
@@ -329,7 +329,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 9.0) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.1294709423110196 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.018918233509283077 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 9.0) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -529,7 +529,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0) || x < 0.1294709423110196) {
+            if (!(x < 9.0) || x < 1.9011961863057287e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -571,7 +571,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1077205.0/962938848411648.0)*x - 56525.0/4458050224128.0) - 1547.0/10319560704.0) - 2431.0/1289945088.0) - 13.0/497664.0) - 1.0/2304.0) - 5.0/432.0) + 1.0/2.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-5.0/432.0)*x;
             c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
         }
@@ -581,7 +581,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             c_G_0_lanes[k] = !(x < 9.0) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 0.1294709423110196 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 1.9011961863057287e-14 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 9.0) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
@@ -1248,7 +1248,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             c_H_1_lanes[k] = w0*w1;
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + w1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+            poly_H_2_lanes[k] = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1261,7 +1261,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             c_H_1_lanes[k] = !(x < 9.0F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 0.8648057F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 0.46210724F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 9.0F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1458,7 +1458,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0F) || x < 1.5953637F) {
+            if (!(x < 9.0F) || x < 1.9011963e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1492,7 +1492,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1.1186639e-09F)*x - 1.267931e-08F) - 1.4990948e-07F) - 1.8845764e-06F) - 13.0F/497664.0F) - 1.0F/2304.0F) - 5.0F/432.0F) + 1.0F/2.0F;
+            poly_G_1_lanes[k] = 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
         }
@@ -1502,7 +1502,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             c_G_0_lanes[k] = !(x < 9.0F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 1.5953637F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 1.9011963e-14F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 9.0F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];

@@ -124,7 +124,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844) || x < 0.40644336131551395) {
+            if (!(x < 22.612712429686844) || x < 0.00423011441675066) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -162,7 +162,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_R_1_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
             c_R_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            poly_R_2_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -172,7 +172,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.40644336131551395 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.00423011441675066 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -303,7 +303,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double w0 = 1.0/(sin0*sin0);
             c_H_0_lanes[k] = 5*u0;
             c_H_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
             c_H_2_lanes[k] = (1.0/25.0)*w0*(-2.0/5.0*cos1*sin1/sin0 + 1.0/cos0);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         }
@@ -314,7 +314,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.40644336131551395 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.00423011441675066 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -599,7 +599,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
             c_G_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            poly_G_2_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -609,7 +609,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.40644336131551395 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.00423011441675066 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -746,7 +746,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double w0 = 1.0/(sin0*sin0);
             c_K_0_lanes[k] = (5.0/2.0)*u0;
             c_K_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            poly_K_1_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/250.0)*w0*(-2*sin2/sin0 + 5/cos0);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
         }
@@ -757,7 +757,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.40644336131551395 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.00423011441675066 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -1552,7 +1552,7 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = -0.0126491105F*u0*(-10*u1 + 4*x - 75);
             c_G_2_lanes[k] = (2.0F/25.0F)*(sin1*sin1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
+            poly_G_2_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1562,7 +1562,7 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             c_G_1_lanes[k] = !(x < 22.612713F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 5.1661544F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.21211211F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612713F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1699,7 +1699,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float w0 = 1.0F/(sin0*sin0);
             c_K_0_lanes[k] = (5.0F/2.0F)*u0;
             c_K_1_lanes[k] = (2.0F/25.0F)*(sin1*sin1)*w0;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (1.0F/250.0F)*w0*(-2*sin2/sin0 + 5/cos0);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
         }
@@ -1710,7 +1710,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             c_K_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 5.1661544F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.21211211F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 22.612713F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

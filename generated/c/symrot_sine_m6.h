@@ -1278,7 +1278,7 @@ static inline float symrot_sine_m6_tangent_det_f(const float p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
- * G_2: Horner degree 6 in x below x = 5.28621, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
+ * G_2: Horner degree 6 in x below x = 5.28621, else sin(phi/4)**2/(18*sin(phi/6)**2)
  * ops: 69 */
 static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
 {
@@ -1301,7 +1301,7 @@ static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
         c_G_2 = x*(x*(x*(x*(x*((-8.411749e-13F)*x - 4.0825024e-11F) - 2.1318738e-09F) - 1.0F/7962624.0F) - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
-        c_G_2 = (1.0F/36.0F)*(1 - cosf((1.0F/2.0F)*phi))/powf(sinf((1.0F/6.0F)*phi), 2);
+        c_G_2 = (1.0F/18.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/powf(sinf((1.0F/6.0F)*phi), 2);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1331,7 +1331,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0F) || x < 5.2862067F) {
+            if (!(x < 27.0F) || x < 0.77943236F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1357,7 +1357,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = (1.0F/4.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -1366,11 +1366,10 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = 1.0F/2.0F - 1.0F/54.0F*x;
-            c_G_2_lanes[k] = (1.0F/36.0F)*(1 - cos1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*((-8.411749e-13F)*x - 4.0825024e-11F) - 2.1318738e-09F) - 1.0F/7962624.0F) - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = (1.0F/18.0F)*(sin1*sin1)/(sin0*sin0);
+            poly_G_2_lanes[k] = x*(x*((-1.0F/7962624.0F)*x - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1380,7 +1379,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             c_G_1_lanes[k] = !(x < 27.0F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 5.2862067F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.77943236F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 27.0F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1402,7 +1401,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
 /* symrot_sine_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 3/sqrt(36 - x) (algebraic in x)
- * K_1: Horner degree 6 in x below x = 5.28621, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
+ * K_1: Horner degree 6 in x below x = 5.28621, else sin(phi/4)**2/(18*sin(phi/6)**2)
  * K_2: Horner degree 7 in x below x = 5.28621, else (-2*cos(phi/6) - cos(phi/2) + 3)/(216*sin(phi/6)**2*cos(phi/6))
  * ops: 92 */
 static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
@@ -1429,10 +1428,9 @@ static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
         const float w0 = (1.0F/6.0F)*phi;
         const float w1 = powf(sinf(w0), -2);
-        const float w2 = cosf((1.0F/2.0F)*phi);
-        const float w3 = cosf(w0);
-        c_K_1 = (1.0F/36.0F)*w1*(1 - w2);
-        c_K_2 = (1.0F/216.0F)*w1*(-w2 - 2*w3 + 3)/w3;
+        const float w2 = cosf(w0);
+        c_K_1 = (1.0F/18.0F)*w1*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = (1.0F/216.0F)*w1*(-2*w2 - cosf((1.0F/2.0F)*phi) + 3)/w2;
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1495,7 +1493,7 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = (1.0F/4.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -1504,13 +1502,23 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a2_a = (1.0F/2.0F)*phi;
+            const float a2_q = rintf(a2_a*0.63661975F);
+            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
+            const float a2_z = a2_r*a2_r;
+            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
+            const float a2_h = rintf(0.5F*a2_j - 0.25F);
+            const float a2_odd = a2_j - 2*a2_h;
+            const float a2_up = fabsf(a2_j - 1.5F) - 0.5F;
+            const float cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
             const float w0 = 1.0F/(sin0*sin0);
             c_K_0_lanes[k] = 3*u0;
-            c_K_1_lanes[k] = (1.0F/36.0F)*w0*(1 - cos1);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*((-8.411749e-13F)*x - 4.0825024e-11F) - 2.1318738e-09F) - 1.0F/7962624.0F) - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/216.0F)*w0*(-2*cos0 - cos1 + 3)/cos0;
+            c_K_1_lanes[k] = (1.0F/18.0F)*(sin1*sin1)*w0;
+            poly_K_1_lanes[k] = x*(x*((-1.0F/7962624.0F)*x - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/216.0F)*w0*(-2*cos0 - cos2 + 3)/cos0;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.480556e-14F)*x + 1.3365334e-12F) + 5.1816374e-11F) + 2.0349704e-09F) + 8.139882e-08F) + 5.0F/1492992.0F) + 1.0F/6912.0F) + 11.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1520,7 +1528,7 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             c_K_0_lanes[k] = !(x < 27.0F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 5.2862067F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.77943236F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 27.0F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

@@ -127,7 +127,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 0.06877716192024322) {
+            if (!(x < 4.149515568880993e+180) || x < 1.0000000000000006e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -171,7 +171,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
+            poly_R_1_lanes[k] = 1 + (-11.0/54.0)*x;
             c_R_2_lanes[k] = (1 - cos1)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         }
@@ -181,7 +181,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 0.06877716192024322 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 1.0000000000000006e-14 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
@@ -511,7 +511,7 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 0.06877716192024322) {
+            if (!(x < 4.149515568880993e+180) || x < 1.9011961863057328e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -552,9 +552,9 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(2025115.0/4458050224128.0 + (-46876153.0/962938848411648.0)*x) - 44015.0/10319560704.0) + 17371.0/429981696.0) - 193.0/497664.0) + 79.0/20736.0) - 17.0/432.0) + 1.0/2.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-17.0/432.0)*x;
             c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -562,11 +562,11 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 0.06877716192024322 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 1.9011961863057328e-14 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.06877716192024322 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.018958083893503733 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -646,7 +646,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 0.06877716192024322) {
+            if (!(x < 4.149515568880993e+180) || x < 0.018958083893503733) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -690,7 +690,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double w1 = 1.0/(s*s);
             c_K_0_lanes[k] = (9.0/2.0)*w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/6.0)*w1*(27*w0 - 6*sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
         }
@@ -701,7 +701,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.06877716192024322 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.018958083893503733 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -1012,7 +1012,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 0.48711845F) {
+            if (!(x < 1.2676506e+30F) || x < 1e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1045,7 +1045,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
+            poly_R_1_lanes[k] = 1;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
         }
@@ -1055,7 +1055,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 0.48711845F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 1e-14F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
@@ -1385,7 +1385,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 0.95673823F) {
+            if (!(x < 1.2676506e+30F) || x < 0.13136065F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1418,7 +1418,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(4.5426026e-07F + (-4.8680302e-08F)*x) - 4.265201e-06F) + 4.0399394e-05F) - 193.0F/497664.0F) + 79.0F/20736.0F) - 17.0F/432.0F) + 1.0F/2.0F;
+            poly_G_1_lanes[k] = x*(x*(79.0F/20736.0F + (-193.0F/497664.0F)*x) - 17.0F/432.0F) + 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         }
@@ -1428,7 +1428,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 0.95673823F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 0.13136065F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];

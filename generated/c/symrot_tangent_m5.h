@@ -127,7 +127,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 0.1110480704185358) {
+            if (!(x <= 236.80339887498948) || x < 3.690968361342381e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -171,7 +171,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
+            poly_R_1_lanes[k] = 1 + (-9.0/50.0)*x;
             c_R_2_lanes[k] = (1 - cos1)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         }
@@ -181,7 +181,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             c_R_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 0.1110480704185358 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 3.690968361342381e-14 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
@@ -551,7 +551,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 0.1110480704185358) {
+            if (!(x <= 236.80339887498948) || x < 3.690968361342381e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -592,7 +592,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(8357819.0/2048000000000000.0 + (-1.6919252294921874e-10)*x) - 500957.0/5120000000000.0) + 59547.0/25600000000.0) - 1747.0/32000000.0) + 1003.0/800000.0) - 11.0/400.0) + 1.0/2.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
             c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         }
@@ -602,11 +602,11 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             c_G_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 0.1110480704185358 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 3.690968361342381e-14 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.2139271817059954 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.1110480704185358 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -686,7 +686,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 0.2139271817059954) {
+            if (!(x <= 236.80339887498948) || x < 0.1110480704185358) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -741,7 +741,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.2139271817059954 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.1110480704185358 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -1012,8 +1012,8 @@ static inline float symrot_tangent_m5_angle_f(const float p[3])
 /* symrot_tangent_m5_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * R_1: Horner degree 7 in x below x = 1.57118, else sin(phi)/s
+ * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/s**2
  * ops: 91 */
 static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R[9])
 {
@@ -1037,10 +1037,8 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_R_1 = 2*w1*cosf(w0)/s;
-        c_R_2 = 2*(w1*w1)/(s*s);
+        c_R_1 = sinf(phi)/s;
+        c_R_2 = (1 - cosf(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1070,7 +1068,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 1.5711837F) {
+            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1090,7 +1088,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1102,10 +1100,10 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_R_1_lanes[k] = sin0/s;
+            poly_R_1_lanes[k] = 1;
+            c_R_2_lanes[k] = (1 - cos0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1113,11 +1111,11 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             c_R_0_lanes[k] = !(x < 236.8034F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 1.5711837F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 3.6909684e-14F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 236.8034F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 1.5711837F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.41316044F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 236.8034F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1139,7 +1137,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/s**2
  * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
  * ops: 118 */
 static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
@@ -1167,9 +1165,8 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
         const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
+        c_H_1 = w0*(1 - cosf(phi));
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1199,7 +1196,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 1.5711837F) {
+            if (!(x < 236.8034F) || x < 0.41316044F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1219,7 +1216,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1228,15 +1225,26 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float w0 = 1.0F/(x + 25);
             const float w1 = 1.0F/(s*s);
             c_H_0_lanes[k] = 25*w0;
-            c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w1*(-2*cos0*sin0/s + 25*w0);
+            c_H_1_lanes[k] = w1*(1 - cos0);
+            poly_H_1_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = w1*(-2*cos1*sin1/s + 25*w0);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1246,7 +1254,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             c_H_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 1.5711837F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.41316044F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 236.8034F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
@@ -1474,7 +1482,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 1.5711837F) {
+            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1507,7 +1515,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*((4.0809662e-09F)*x - 9.784316e-08F) + 2.3260548e-06F) - 5.459375e-05F) + 1003.0F/800000.0F) - 11.0F/400.0F) + 1.0F/2.0F;
+            poly_G_1_lanes[k] = 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
         }
@@ -1517,7 +1525,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             c_G_0_lanes[k] = !(x < 236.8034F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 1.5711837F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 3.6909684e-14F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 236.8034F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
@@ -1709,7 +1717,7 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/s**2
  * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
  * ops: 112 */
 static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
@@ -1731,9 +1739,8 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
         const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
+        c_H_1 = w0*(1 - cosf(phi));
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];

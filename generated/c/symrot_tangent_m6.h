@@ -128,7 +128,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 0.11094775628437421) {
+            if (!(x < 108.0) || x < 3.69096836134238e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -161,7 +161,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
+            poly_R_1_lanes[k] = 1 + (-19.0/108.0)*x;
             c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
         }
@@ -171,7 +171,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             c_R_0_lanes[k] = !(x < 108.0) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 0.11094775628437421 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 3.69096836134238e-14 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 108.0) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
@@ -475,7 +475,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 0.21355546857295157) {
+            if (!(x < 108.0) || x < 3.69096836134238e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -508,7 +508,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(1309.0/1486016741376.0 + (-8437.0/320979616137216.0)*x) - 301.0/10319560704.0) + 1225.0/1289945088.0) - 5.0/165888.0) + 19.0/20736.0) - 11.0/432.0) + 1.0/2.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/432.0)*x;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
         }
@@ -518,7 +518,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             c_G_0_lanes[k] = !(x < 108.0) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 0.21355546857295157 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 3.69096836134238e-14 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 108.0) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
@@ -910,7 +910,7 @@ static inline float symrot_tangent_m6_angle_f(const float p[3])
 /* symrot_tangent_m6_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 1.55153, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 7 in x below x = 1.55153, else sin(phi)/s
  * R_2: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
  * ops: 105 */
 static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R[9])
@@ -935,10 +935,8 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_R_1 = 2*w1*cosf(w0)/s;
-        c_R_2 = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F : 2*(w1*w1)/(s*s);
+        c_R_1 = sinf(phi)/s;
+        c_R_2 = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F : 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -968,7 +966,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 1.5515263F) {
+            if (!(x < 108.0F) || x < 3.6909684e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -988,7 +986,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -998,11 +996,19 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_R_1_lanes[k] = sin0/s;
+            poly_R_1_lanes[k] = 1;
+            c_R_2_lanes[k] = 2*(sin1*sin1)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1011,7 +1017,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             c_R_0_lanes[k] = !(x < 108.0F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 1.5515263F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 3.6909684e-14F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x < 108.0F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
@@ -1315,7 +1321,7 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 3.0607803F) {
+            if (!(x < 108.0F) || x < 3.6909684e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1348,7 +1354,7 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(8.8087837e-10F + (-2.6285158e-11F)*x) - 2.9167909e-08F) + 9.496528e-07F) - 5.0F/165888.0F) + 19.0F/20736.0F) - 11.0F/432.0F) + 1.0F/2.0F;
+            poly_G_1_lanes[k] = 1.0F/2.0F;
             c_G_2_lanes[k] = (1 - cos0)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1372548e-16F)*x - 3.9035403e-15F) + 1.3331388e-13F) - 4.5247226e-12F) + 1.5236482e-10F) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
         }
@@ -1358,7 +1364,7 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             c_G_0_lanes[k] = !(x < 108.0F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 3.0607803F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 3.6909684e-14F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 108.0F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];

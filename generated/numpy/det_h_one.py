@@ -541,17 +541,11 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.11031240806298934
+    small = x < 1.9211893090849666e-14
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -8.286380574805527e-10
-        series = -1.2203463534465907e-08 + t * series
-        series = -1.8955121406990826e-07 + t * series
-        series = -3.189329117063492e-06 + t * series
-        series = -6.138392857142858e-05 + t * series
-        series = -0.0015625 + t * series
-        series = -0.125 + t * series
+        series = -0.125
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -705,12 +699,11 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -1.244209181073502e-08
-        series = -1.7778215165910478e-07 + t * series
+        series = -1.7778215165910478e-07
         series = -2.680413429576376e-06 + t * series
         series = -4.402281746031746e-05 + t * series
         series = -0.0008482142857142857 + t * series
@@ -747,12 +740,11 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
+        series = 1.548516833380779e-07
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -820,12 +812,11 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
+        series = 1.548516833380779e-07
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -960,12 +951,11 @@ def _G_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -6.22104590536751e-09
-        series = -8.889107582955239e-08 + t * series
+        series = -8.889107582955239e-08
         series = -1.340206714788188e-06 + t * series
         series = -2.201140873015873e-05 + t * series
         series = -0.00042410714285714285 + t * series
@@ -981,13 +971,11 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 8.286380574805527e-10
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -1003,12 +991,11 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 6.5376456526666615e-09
-        series = 7.742584166903895e-08 + t * series
+        series = 7.742584166903895e-08
         series = 9.256715506715507e-07 + t * series
         series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
@@ -1025,13 +1012,11 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 8.286380574805527e-10
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -1075,17 +1060,10 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 1.921189444436213e-14
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = -1.2203463534465907e-08
-        series = -1.8955121406990826e-07 + t * series
-        series = -3.189329117063492e-06 + t * series
-        series = -6.138392857142858e-05 + t * series
-        series = -0.0015625 + t * series
-        series = -0.125 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small
@@ -1095,33 +1073,27 @@ def _e_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _ratio_32(t, phi):
-    small = t < 5.567347935831094
+    small = t < 1.5083706018396157
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
-        series = 1.0461319985129509e-11
-        series = 2.863098101193339e-09 + t * series
-        series = t * series
-        series = 0.00011904761904761905 + t * series
+        series = 0.00011904761904761905
         series = -0.016666666666666666 + t * series
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
         big = ~small
         phi = phi[big]
-        w0 = (0.5)*phi
-        out[big] = numpy.cbrt(6*phi - 12*numpy.sin(w0)*numpy.cos(w0))/phi
+        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/phi
     return out
 
 
 def _slope_32(t, phi):
-    small = t < 5.567347935831094
+    small = t < 1.5083706018396157
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
-        series = -2.0961968240879805e-12
-        series = 1.150745198364246e-10 + t * series
-        series = 2.5767882910740054e-08 + t * series
+        series = 2.5767882910740054e-08
         series = t * series
         series = 0.0005952380952380953 + t * series
         series = -0.05 + t * series

@@ -100,17 +100,11 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.03462813501506715
+    small = x < 9.99999999999999e-15
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.498265191912651e-06
-        series = 6.3925981521606445e-06 + t * series
-        series = 2.753734588623047e-05 + t * series
-        series = 0.0001201629638671875 + t * series
-        series = 0.0005340576171875 + t * series
-        series = 0.00244140625 + t * series
-        series = 0.01171875 + t * series
+        series = 0.01171875
         series = 0.0625 + t * series
         out[small] = series
     if not small.all():
@@ -233,18 +227,10 @@ def _K_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.412709807020161
+    small = x < 1.0000000233721942e-14
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 1.498265191912651e-06
-        series = 6.3925981521606445e-06 + t * series
-        series = 2.753734588623047e-05 + t * series
-        series = 0.0001201629638671875 + t * series
-        series = 0.0005340576171875 + t * series
-        series = 0.00244140625 + t * series
-        series = 0.01171875 + t * series
-        series = 0.0625 + t * series
+        series = 0.0625
         out[small] = series
     if not small.all():
         big = ~small

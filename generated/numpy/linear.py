@@ -40,17 +40,11 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.0059512030463300695
+    small = x < 9.999999999999965e-15
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 0.39276123046875
-        series = 0.4189453125 + t * series
-        series = 0.451171875 + t * series
-        series = 0.4921875 + t * series
-        series = 0.546875 + t * series
-        series = 0.625 + t * series
-        series = 0.75 + t * series
+        series = 0.75
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -82,17 +76,11 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.0059512030463300695
+    small = x < 9.999999999999965e-15
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 0.196380615234375
-        series = 0.20947265625 + t * series
-        series = 0.2255859375 + t * series
-        series = 0.24609375 + t * series
-        series = 0.2734375 + t * series
-        series = 0.3125 + t * series
-        series = 0.375 + t * series
+        series = 0.375
         series = 0.5 + t * series
         out[small] = series
     if not small.all():
@@ -225,17 +213,11 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.010853448794044094
+    small = x < 9.999999999999965e-15
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -0.005535036325454712
-        series = -0.0070078372955322266 + t * series
-        series = -0.009273529052734375 + t * series
-        series = -0.013092041015625 + t * series
-        series = -0.0205078125 + t * series
-        series = -0.0390625 + t * series
-        series = -0.125 + t * series
+        series = -0.125
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -279,18 +261,10 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.11647220712673427
+    small = x < 1.0000000233721917e-14
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 0.39276123046875
-        series = 0.4189453125 + t * series
-        series = 0.451171875 + t * series
-        series = 0.4921875 + t * series
-        series = 0.546875 + t * series
-        series = 0.625 + t * series
-        series = 0.75 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small
@@ -327,18 +301,10 @@ def _H_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.11647220712673427
+    small = x < 1.0000000233721917e-14
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 0.196380615234375
-        series = 0.20947265625 + t * series
-        series = 0.2255859375 + t * series
-        series = 0.24609375 + t * series
-        series = 0.2734375 + t * series
-        series = 0.3125 + t * series
-        series = 0.375 + t * series
-        series = 0.5 + t * series
+        series = 0.5
         out[small] = series
     if not small.all():
         big = ~small
@@ -375,15 +341,11 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.11647220712673427
+    small = x < 0.0032607575010940625
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 0.005535036325454712
-        series = 0.0070078372955322266 + t * series
-        series = 0.009273529052734375 + t * series
-        series = 0.013092041015625 + t * series
-        series = 0.0205078125 + t * series
+        series = 0.0205078125
         series = 0.0390625 + t * series
         series = 0.125 + t * series
         out[small] = series
@@ -402,15 +364,11 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.11647220712673427
+    small = x < 0.0032607575010940625
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 0.005535036325454712
-        series = 0.0070078372955322266 + t * series
-        series = 0.009273529052734375 + t * series
-        series = 0.013092041015625 + t * series
-        series = 0.0205078125 + t * series
+        series = 0.0205078125
         series = 0.0390625 + t * series
         series = 0.125 + t * series
         out[small] = series
@@ -454,18 +412,10 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.20569006626255124
+    small = x < 1.0000000233721917e-14
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = -0.005535036325454712
-        series = -0.0070078372955322266 + t * series
-        series = -0.009273529052734375 + t * series
-        series = -0.013092041015625 + t * series
-        series = -0.0205078125 + t * series
-        series = -0.0390625 + t * series
-        series = -0.125 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small

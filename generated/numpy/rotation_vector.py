@@ -28,17 +28,11 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.5083706105984414
+    small = x < 1.855928709321803e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -4.667458332409556e-17
-        series = 3.920664999224027e-14 + t * series
-        series = -2.446494959515793e-11 + t * series
-        series = 1.076457782186949e-08 + t * series
-        series = -3.1001984126984127e-06 + t * series
-        series = 0.0005208333333333333 + t * series
-        series = -0.041666666666666664 + t * series
+        series = -0.041666666666666664
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -50,17 +44,11 @@ def _nu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.05763114601220996
+    small = x < 1.9211893090849678e-14
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 8.885707928780019e-08
-        series = 8.769843839288284e-07 + t * series
-        series = 8.655503447170115e-06 + t * series
-        series = 8.542768959435626e-05 + t * series
-        series = 0.0008432539682539683 + t * series
-        series = 0.008333333333333333 + t * series
-        series = 0.08333333333333333 + t * series
+        series = 0.08333333333333333
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -75,17 +63,11 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7851233626304397
+    small = x < 5.028297529613113e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -9.55895466477477e-14
-        series = 2.294149119545945e-11 + t * series
-        series = -4.17535139757362e-09 + t * series
-        series = 5.511463844797178e-07 + t * series
-        series = -4.96031746031746e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.08333333333333333 + t * series
+        series = -0.08333333333333333
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -101,17 +83,11 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.4086652777619201
+    small = x < 5.028297529613113e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -7.647163731819816e-13
-        series = 1.6059043836821613e-10 + t * series
-        series = -2.505210838544172e-08 + t * series
-        series = 2.7557319223985893e-06 + t * series
-        series = -0.0001984126984126984 + t * series
-        series = 0.008333333333333333 + t * series
-        series = -0.16666666666666666 + t * series
+        series = -0.16666666666666666
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -124,17 +100,11 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7851233626304397
+    small = x < 5.028297529613113e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -4.779477332387385e-14
-        series = 1.1470745597729725e-11 + t * series
-        series = -2.08767569878681e-09 + t * series
-        series = 2.755731922398589e-07 + t * series
-        series = -2.48015873015873e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = -0.041666666666666664 + t * series
+        series = -0.041666666666666664
         series = 0.5 + t * series
         out[small] = series
     if not small.all():
@@ -150,17 +120,11 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7851233626304397
+    small = x < 5.028297529613113e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -4.779477332387385e-14
-        series = 1.1470745597729725e-11 + t * series
-        series = -2.08767569878681e-09 + t * series
-        series = 2.755731922398589e-07 + t * series
-        series = -2.48015873015873e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = -0.041666666666666664 + t * series
+        series = -0.041666666666666664
         series = 0.5 + t * series
         out[small] = series
     if not small.all():
@@ -240,17 +204,11 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.5083706105984414
+    small = x < 1.855928709321803e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -2.333729166204778e-17
-        series = 1.9603324996120133e-14 + t * series
-        series = -1.2232474797578965e-11 + t * series
-        series = 5.382288910934745e-09 + t * series
-        series = -1.5500992063492063e-06 + t * series
-        series = 0.00026041666666666666 + t * series
-        series = -0.020833333333333332 + t * series
+        series = -0.020833333333333332
         series = 0.5 + t * series
         out[small] = series
     if not small.all():
@@ -262,24 +220,17 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.897865491219691
+    small = x < 9.015158901432458e-09
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -7.292903644389931e-19
-        series = 7.001187498614334e-16 + t * series
-        series = -5.096864498991235e-13 + t * series
-        series = 2.691144455467372e-10 + t * series
-        series = -9.68812003968254e-08 + t * series
-        series = 2.170138888888889e-05 + t * series
-        series = -0.0026041666666666665 + t * series
+        series = -0.0026041666666666665
         series = 0.125 + t * series
         out[small] = series
     if not small.all():
         big = ~small
         phi = phi[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/phi**2
+        out[big] = 2*numpy.sin((0.25)*phi)**2/phi**2
     return out
 
 
@@ -288,24 +239,17 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.897865491219691
+    small = x < 9.015158901432458e-09
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -7.292903644389931e-19
-        series = 7.001187498614334e-16 + t * series
-        series = -5.096864498991235e-13 + t * series
-        series = 2.691144455467372e-10 + t * series
-        series = -9.68812003968254e-08 + t * series
-        series = 2.170138888888889e-05 + t * series
-        series = -0.0026041666666666665 + t * series
+        series = -0.0026041666666666665
         series = 0.125 + t * series
         out[small] = series
     if not small.all():
         big = ~small
         phi = phi[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/phi**2
+        out[big] = 2*numpy.sin((0.25)*phi)**2/phi**2
     return out
 
 
@@ -333,17 +277,11 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.5083706105984414
+    small = x < 1.855928709321803e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -7.001187498614334e-16
-        series = 5.096864498991235e-13 + t * series
-        series = -2.691144455467372e-10 + t * series
-        series = 9.68812003968254e-08 + t * series
-        series = -2.170138888888889e-05 + t * series
-        series = 0.0026041666666666665 + t * series
-        series = -0.125 + t * series
+        series = -0.125
         series = 1.0 + t * series
         out[small] = series
     if not small.all():
@@ -360,17 +298,11 @@ def _angle_64(s, d):
 def _scale_64(e0, e_norm):
     phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
     t = phi * phi
-    small = t < 0.22832695303370756
+    small = t < 6.574622895991269e-14
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
-        series = 2.676180584053667e-11
-        series = 1.0563219935442674e-09 + t * series
-        series = 4.1671964143752336e-08 + t * series
-        series = 1.6405216600529101e-06 + t * series
-        series = 6.407076719576719e-05 + t * series
-        series = 0.0024305555555555556 + t * series
-        series = 0.08333333333333333 + t * series
+        series = 0.08333333333333333
         series = 2.0 + t * series
         out[small] = series
     if not small.all():
@@ -385,16 +317,10 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 1.855928654006444e-12
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = -2.446494959515793e-11
-        series = 1.076457782186949e-08 + t * series
-        series = -3.1001984126984127e-06 + t * series
-        series = 0.0005208333333333333 + t * series
-        series = -0.041666666666666664 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small
@@ -405,17 +331,10 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7851233424843009
+    small = x < 1.9211894444362143e-14
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 8.769843839288284e-07
-        series = 8.655503447170115e-06 + t * series
-        series = 8.542768959435626e-05 + t * series
-        series = 0.0008432539682539683 + t * series
-        series = 0.008333333333333333 + t * series
-        series = 0.08333333333333333 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small
@@ -429,17 +348,10 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 5.028297329387876e-13
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 2.294149119545945e-11
-        series = -4.17535139757362e-09 + t * series
-        series = 5.511463844797178e-07 + t * series
-        series = -4.96031746031746e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.08333333333333333 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small
@@ -454,18 +366,10 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 5.028297329387876e-13
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = -7.647163731819816e-13
-        series = 1.6059043836821613e-10 + t * series
-        series = -2.505210838544172e-08 + t * series
-        series = 2.7557319223985893e-06 + t * series
-        series = -0.0001984126984126984 + t * series
-        series = 0.008333333333333333 + t * series
-        series = -0.16666666666666666 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small
@@ -477,17 +381,10 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 5.028297329387876e-13
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 1.1470745597729725e-11
-        series = -2.08767569878681e-09 + t * series
-        series = 2.755731922398589e-07 + t * series
-        series = -2.48015873015873e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = -0.041666666666666664 + t * series
-        series = 0.5 + t * series
+        series = 0.5
         out[small] = series
     if not small.all():
         big = ~small
@@ -502,17 +399,10 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 5.028297329387876e-13
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 1.1470745597729725e-11
-        series = -2.08767569878681e-09 + t * series
-        series = 2.755731922398589e-07 + t * series
-        series = -2.48015873015873e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = -0.041666666666666664 + t * series
-        series = 0.5 + t * series
+        series = 0.5
         out[small] = series
     if not small.all():
         big = ~small
@@ -523,13 +413,11 @@ def _H_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 1.5083706018396157
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 7.647163731819816e-13
-        series = -1.6059043836821613e-10 + t * series
-        series = 2.505210838544172e-08 + t * series
+        series = 2.505210838544172e-08
         series = -2.7557319223985893e-06 + t * series
         series = 0.0001984126984126984 + t * series
         series = -0.008333333333333333 + t * series
@@ -538,9 +426,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = -(2*cos_half*sin_half - phi)/phi**3
+        out[big] = -(-phi + numpy.sin(phi))/phi**3
     return out
 
 
@@ -581,16 +467,10 @@ def _G_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 1.855928654006444e-12
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = -1.2232474797578965e-11
-        series = 5.382288910934745e-09 + t * series
-        series = -1.5500992063492063e-06 + t * series
-        series = 0.00026041666666666666 + t * series
-        series = -0.020833333333333332 + t * series
-        series = 0.5 + t * series
+        series = 0.5
         out[small] = series
     if not small.all():
         big = ~small
@@ -601,21 +481,15 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 1.855928654006444e-12
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 2.691144455467372e-10
-        series = -9.68812003968254e-08 + t * series
-        series = 2.170138888888889e-05 + t * series
-        series = -0.0026041666666666665 + t * series
-        series = 0.125 + t * series
+        series = 0.125
         out[small] = series
     if not small.all():
         big = ~small
         phi = phi[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/phi**2
+        out[big] = 2*numpy.sin((0.25)*phi)**2/phi**2
     return out
 
 
@@ -624,21 +498,15 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 1.855928654006444e-12
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = 2.691144455467372e-10
-        series = -9.68812003968254e-08 + t * series
-        series = 2.170138888888889e-05 + t * series
-        series = -0.0026041666666666665 + t * series
-        series = 0.125 + t * series
+        series = 0.125
         out[small] = series
     if not small.all():
         big = ~small
         phi = phi[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/phi**2
+        out[big] = 2*numpy.sin((0.25)*phi)**2/phi**2
     return out
 
 
@@ -662,16 +530,10 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
+    small = x < 1.855928654006444e-12
     out = numpy.empty_like(x)
     if small.any():
-        t = x[small]
-        series = -2.691144455467372e-10
-        series = 9.68812003968254e-08 + t * series
-        series = -2.170138888888889e-05 + t * series
-        series = 0.0026041666666666665 + t * series
-        series = -0.125 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     if not small.all():
         big = ~small
@@ -687,16 +549,10 @@ def _angle_32(s, d):
 def _scale_32(e0, e_norm):
     phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
     t = phi * phi
-    small = t < 1.5011636704730478
+    small = t < 6.574623607796752e-14
     out = numpy.empty_like(t)
     if small.any():
-        t = t[small]
-        series = 4.1671964143752336e-08
-        series = 1.6405216600529101e-06 + t * series
-        series = 6.407076719576719e-05 + t * series
-        series = 0.0024305555555555556 + t * series
-        series = 0.08333333333333333 + t * series
-        series = 2.0 + t * series
+        series = 2.0
         out[small] = series
     if not small.all():
         big = ~small

@@ -18,7 +18,10 @@ and four passes, so that the two expensive middle ones have no branch and no lib
    with a bounded range come from the branch-free kernel of :mod:`symrot.backends.c_sincos` (one
    kernel gives both); any other trig call is a scalar atom.
 3. **select pass** (constant trip count): polynomial below the coefficient's threshold, closed form
-   above, NaN outside the validity range, between values loaded unconditionally.
+   above, NaN outside the validity range, between values loaded unconditionally. Both candidates
+   are computed for every lane anyway, so the batch kernels take the plan's smallest accurate
+   switch and shortest polynomial (``Branch.smallest_switch``), not the single call's switch, which
+   is moved up to skip library calls.
 4. **assembly** (k < block length): T = c0 I + c1 (p×) + c2 (p×)² entry by entry, as the single call.
 
 The values differ from the single call only by the rounding of the sin/cos kernel (≤ 1.5 ulp
@@ -167,7 +170,7 @@ class BatchWriter:
         speculate an arithmetic operation that the source only performs on one side of a branch
         (gcc sinks it there), and such a loop is not vectorized without masked instructions.
         """
-        polynomials = [c.horner for c in plan.values() if isinstance(c, Branch)]
+        polynomials = [c.smallest_switch[1] for c in plan.values() if isinstance(c, Branch)]
         uses_x = any(len(h) > 1 for h in polynomials) or any(
             X_SYMBOL in e.free_symbols for e in [*reduced.values(), *(value for _, value in replacements)])
         body: list[Statement] = []
@@ -185,7 +188,7 @@ class BatchWriter:
                 body.append({"kind": "set", "name": f"c_{name}_lanes[k]", "value": self.c(reduced[name])})
             if isinstance(coefficient, Branch):
                 body.append({"kind": "set", "name": f"poly_{name}_lanes[k]",
-                             "value": self.c(horner(coefficient.horner, X_SYMBOL))})
+                             "value": self.c(horner(coefficient.smallest_switch[1], X_SYMBOL))})
         return body
 
     def select_pass(self, plan: dict[str, Coefficient]) -> list[Statement]:
@@ -200,7 +203,7 @@ class BatchWriter:
             else:
                 body.append({"kind": "let", "type": self.t, "name": value, "value": f"c_{name}_lanes[k]"})
             if isinstance(coefficient, Branch):
-                threshold = self.printer.literal(coefficient.threshold)
+                threshold = self.printer.literal(coefficient.smallest_switch[0])
                 body.append({"kind": "let", "type": self.t, "name": f"poly_{name}",
                              "value": f"poly_{name}_lanes[k]"})
                 body.append({"kind": "let", "type": self.t, "name": f"v_{name}",
@@ -229,7 +232,7 @@ class BatchWriter:
         if any(isinstance(plan[name], Algebraic) and closed[name].free_symbols & set(inputs)
                for name in closed):
             return None
-        thresholds = [c.threshold for c in plan.values() if isinstance(c, Branch)]
+        thresholds = [c.smallest_switch[0] for c in plan.values() if isinstance(c, Branch)]
         return min(thresholds) if thresholds else None
 
     def scalar_pass(self, lanes: Lanes, inputs: list[sp.Symbol], below: float | None) -> list[Statement]:

@@ -82,13 +82,16 @@ COS_HALF = sp.Symbol("cos_half")
 def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = False) -> list[str]:
     """Statements returning the Branch value from ``variable`` (t) and ``phi``: the Horner
     polynomial on the lanes with t < threshold, the closed form on the others (each computed on
-    its own lanes only, so neither can divide by zero and no work is wasted)."""
-    lines = [f"small = {variable} < {branch.threshold!r}", f"out = numpy.empty_like({variable})",
+    its own lanes only, so neither can divide by zero and no work is wasted). The switch is the
+    smallest the accuracy allows: a second branch costs a masked pass over the arrays, more than
+    a longer polynomial saves here (unlike in C, which uses ``branch.threshold``)."""
+    threshold, horner = branch.smallest_switch
+    lines = [f"small = {variable} < {threshold!r}", f"out = numpy.empty_like({variable})",
              "if small.any():"]
-    if len(branch.horner) > 1:
+    if len(horner) > 1:
         lines.append(f"    t = {variable}[small]")
-    lines.append(f"    series = {_literal(branch.horner[-1])}")
-    for c in reversed(branch.horner[:-1]):
+    lines.append(f"    series = {_literal(horner[-1])}")
+    for c in reversed(horner[:-1]):
         lines.append(f"    series = {_literal(c)} + t * series" if c != 0 else "    series = t * series")
     lines.append("    out[small] = series")
     lines += ["if not small.all():", "    big = ~small"]
