@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import mpmath
 import numpy as np
 import pytest
 import sympy as sp
 
 from symrot.api import derive
-from symrot.plan import Algebraic, Branch, ClosedAngle, Constant, NewtonAngle, X, evaluation_plan
+from symrot.plan import CHEAP_TERMS, Algebraic, Branch, ClosedAngle, Constant, NewtonAngle, X, evaluation_plan
 
 
 @pytest.fixture(scope="module")
@@ -74,10 +75,6 @@ def test_small_rotations_take_short_polynomials_not_library_calls(label: str, dt
     """The switch moves up as far as CHEAP_TERMS terms stay accurate: for the rotation vector,
     R's coefficients are polynomials up to |φ| > 0.5 (the accuracy alone would switch at
     |φ| ~ 1e-6), and those polynomials match 50-digit mpmath at the switch to within an ulp."""
-    import mpmath
-
-    from symrot.plan import CHEAP_TERMS
-
     derivation = derive("rotation_vector").derivation
     plan = evaluation_plan(derivation, "rotation_vector")
     epsilon = float(np.finfo(dtype).eps)

@@ -48,10 +48,9 @@ from .c_backend import (
     FunctionWriter,
     P,
     Statement,
-    horner,
     tensor_entries,
 )
-from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter
+from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
 from .c_sincos import TRIG, SinCosWriter
 
 BLOCK = "SYMROT_BATCH_BLOCK"
