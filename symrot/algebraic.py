@@ -7,11 +7,12 @@ angles are expanded (``expand_trig``), half angles of θ replaced by their radic
 on the validity range, so the positive roots), products of radicals combined and their radicands
 expanded (√(4 − √x)·√(4 + √x) → √(16 − x)).
 
-An algebraic form is only *accepted* when it is accurate in floating point: it is evaluated by
-the NumPy printer in float64 on a log grid of x from 10⁻³⁰⁰ to the edge of the range and compared
-with the closed form at 30 digits. Forms whose radicals cancel (1 − √(1 − x) near x = 0) are
-rationalized (``radsimp`` of the form or of its reciprocal) and re-checked; a form that still
-fails is rejected and the coefficient gets a Taylor/closed-form branch instead.
+An algebraic form is only *accepted* when it is accurate in floating point: it is evaluated in
+float64 (:mod:`symrot.evaluation`, identical on every machine) on a log grid of x from 10⁻³⁰⁰ to
+the edge of the range and compared with the closed form at 30 digits. Forms whose radicals
+cancel (1 − √(1 − x) near x = 0) are rationalized (``radsimp`` of the form or of its reciprocal)
+and re-checked; a form that still fails is rejected and the coefficient gets a Taylor/closed-form
+branch instead.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from .evaluation import log_grid, model_function
 from .functions import mpmath_namespace
 from .parsing import PHI
 from .timeouts import bounded
@@ -93,17 +95,13 @@ def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
 
 def _check_grid(p_max: float) -> np.ndarray:
     top = (p_max * (1 - 1e-9)) ** 2 if math.isfinite(p_max) else UNBOUNDED_TOP
-    return np.concatenate([[0.0], np.geomspace(1e-300, top, CHECK_POINTS)])
+    return np.concatenate([[0.0], log_grid(1e-300, top, CHECK_POINTS)])
 
 
 def worst_ulp(candidate: sp.Expr, closed: sp.Expr, inverse: sp.Expr, p_max: float) -> float:
-    """Worst float64 error of ``candidate`` (NumPy printer) against ``closed`` at φ(√x), 30 digits."""
-    from .backends.numpy_backend import print_expression
-
-    source = f"def f(x):\n    return {print_expression(candidate)}\n"
-    namespace: dict[str, object] = {"numpy": np}
-    exec(compile(source, "<symrot algebraic>", "exec"), namespace)
-    function = namespace["f"]
+    """Worst float64 error of ``candidate`` (ideal-libm model, :mod:`symrot.evaluation`) against
+    ``closed`` at φ(√x), 30 digits."""
+    function = model_function(candidate, [X])
     reference = sp.lambdify(PHI, closed, modules=[mpmath_namespace(), "mpmath"])
     angle = sp.lambdify(S, inverse, modules=[mpmath_namespace(), "mpmath"])
     value_at_zero = candidate.subs(X, 0)
@@ -113,9 +111,9 @@ def worst_ulp(candidate: sp.Expr, closed: sp.Expr, inverse: sp.Expr, p_max: floa
     worst = 0.0
     grid = _check_grid(p_max)
     digits = 30 + int(math.log10(grid[-1])) // 2 + 10  # φ is within ~1/√x of a pole
-    with mpmath.workdps(digits), np.errstate(all="ignore"):
+    with mpmath.workdps(digits):
         for x in grid:
-            value = float(function(np.float64(x)))  # type: ignore[operator]
+            value = float(function(np.float64(x)))
             phi = angle(mpmath.sqrt(mpmath.mpf(x)))
             try:
                 exact = mpmath.mpf(value_at_zero) if x == 0 else reference(phi)

@@ -14,13 +14,14 @@ converges only linearly. So beyond a switch s₀ the start is a polynomial in a 
 φ(v) is interpolated at Chebyshev nodes (values from a 30-digit bisection) by a polynomial in
 y = 2v − 1, stored in monomial (Horner) form; the degree is the smallest whose start is within
 ``START_TOLERANCE`` (relative to φ_max) at the midpoints. s₀ is where the reverted series' own
-relative error reaches ``SERIES_TOLERANCE``. Plan-time numerics only (mpmath, NumPy); no SymPy
-call that can hang.
+relative error reaches ``SERIES_TOLERANCE``. Plan-time numerics only (mpmath, and NumPy arithmetic
+that is the same on every CPU); no SymPy call that can hang.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -28,6 +29,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from .evaluation import log_grid
 from .functions import mpmath_namespace
 from .parsing import PHI
 
@@ -109,7 +111,7 @@ def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, .
     with mpmath.workdps(DIGITS):
         top = mpmath.mpf(phi_max)
 
-        def phi_at_v(v: float) -> float:
+        def phi_at_v(v: float | mpmath.mpf) -> float:
             if v >= 1:
                 return phi_max
             return float(_phi_of_s(f, _s_of_v(kind, scale, order, mpmath.mpf(v)), top))
@@ -118,10 +120,7 @@ def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, .
         check_values = np.array([phi_at_v(v) for v in checks])
         best: tuple[float, tuple[float, ...]] = (math.inf, ())
         for degree in DEGREES:
-            nodes = np.cos(np.pi * (np.arange(degree + 1) + 0.5) / (degree + 1))
-            values = np.array([phi_at_v((y + 1) / 2) for y in nodes])
-            chebyshev = np.polynomial.chebyshev.Chebyshev.fit(nodes, values, degree, domain=[-1, 1])
-            monomial = chebyshev.convert(kind=np.polynomial.Polynomial).coef
+            monomial = np.array(chebyshev_interpolant(lambda y: phi_at_v((y + 1) / 2), degree))
             estimate = np.polynomial.polynomial.polyval(2 * checks - 1, monomial)
             error = float(np.max(np.abs(estimate - check_values))) / phi_max
             if error < best[0]:
@@ -132,11 +131,45 @@ def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, .
     return FarStart(kind, float(scale), order, best[1], switch, best[0])
 
 
+def chebyshev_interpolant(function: Callable[[mpmath.mpf], float], degree: int) -> list[float]:
+    """Monomial coefficients (in y, constant first) of the polynomial of ``degree`` interpolating
+    ``function`` at the Chebyshev nodes y_k = cos(π(k + ½)/(n + 1)) of [−1, 1].
+
+    Computed in mpmath (DIGITS) from the discrete orthogonality of T_j at those nodes,
+    c_j = (2 − δ_j0)/(n + 1) Σ_k f(y_k) T_j(y_k), and the exact integer recurrence of T_j's
+    monomial coefficients; rounded to float64 only at the end. No BLAS/LAPACK least squares (whose
+    results depend on the CPU kernel OpenBLAS picks) and no NumPy transcendental function (whose
+    results depend on the SIMD extensions): every machine prints the same coefficients."""
+    with mpmath.workdps(DIGITS):
+        return _chebyshev_interpolant(function, degree + 1)
+
+
+def _chebyshev_interpolant(function: Callable[[mpmath.mpf], float], n: int) -> list[float]:
+    angles = [mpmath.pi * (k + mpmath.mpf(1) / 2) / n for k in range(n)]
+    values = [mpmath.mpf(function(mpmath.cos(a))) for a in angles]
+    pairs = list(zip(values, angles, strict=True))
+    chebyshev = [mpmath.mpf(1 if j == 0 else 2) / n * mpmath.fsum(v * mpmath.cos(j * a) for v, a in pairs)
+                 for j in range(n)]
+    # T_0 = 1, T_1 = y, T_{j+1} = 2y T_j − T_{j−1}: integer monomial coefficients
+    basis: list[list[int]] = [[1], [0, 1]]
+    while len(basis) < n:
+        previous, current = basis[-2], basis[-1]
+        following = [0, *(2 * c for c in current)]
+        for i, c in enumerate(previous):
+            following[i] -= c
+        basis.append(following)
+    monomial = [mpmath.mpf(0)] * n
+    for c, polynomial in zip(chebyshev, basis, strict=False):
+        for i, b in enumerate(polynomial):
+            monomial[i] += c * b
+    return [float(m) for m in monomial]
+
+
 def _series_switch(f: object, series: tuple[sp.Expr, ...], phi_max: float) -> float:
     """Largest s on a log grid below which the reverted series is within SERIES_TOLERANCE."""
     coefficients = [mpmath.mpf(sp.N(c, DIGITS)) for c in series]
     switch = 0.0
-    for angle in np.geomspace(1e-6, phi_max * 0.99, 80):
+    for angle in log_grid(1e-6, phi_max * 0.99, 80):
         s = f(mpmath.mpf(angle))  # type: ignore[operator]
         estimate = s * mpmath.polyval(coefficients[::-1], s * s)
         if abs(estimate - angle) > SERIES_TOLERANCE * angle:

@@ -55,6 +55,7 @@ arguments (sin a and cos a: one sincos).
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, replace
 from functools import lru_cache
@@ -74,6 +75,7 @@ from .algebraic import (
 )
 from .algebraic import X as X  # re-exported: the symbol of the coefficients' variable x = |p|²
 from .core import Derivation, derive_expression
+from .evaluation import log_grid, model_function
 from .functions import RealCbrt, mpmath_namespace
 from .newton_start import FarStart, far_start
 from .parsing import PHI
@@ -236,17 +238,11 @@ def _mp_function(expr: sp.Expr) -> object:
     return sp.lambdify(PHI, expr, modules=[mpmath_namespace(), "mpmath"])
 
 
-def _np_function(expr: sp.Expr) -> object:
-    from .backends.numpy_backend import numpy_function
-
-    return numpy_function(expr)
-
-
 def _angle_grid(phi_max: float) -> np.ndarray:
     """Log grid towards 0 plus points approaching the edge of the range (φ_max − 10⁻ᵏ φ_max)."""
     end = min(phi_max, 4 * np.pi)
-    edge = end * (1 - np.geomspace(0.25, 1e-6, EDGE_POINTS))
-    return np.unique(np.concatenate([np.geomspace(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
+    edge = end * (1 - log_grid(0.25, 1e-6, EDGE_POINTS))
+    return np.unique(np.concatenate([log_grid(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
 
 
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
@@ -265,13 +261,16 @@ def _error_class(ulp: float) -> float:
     a form 2 ulp off everywhere beats one that is exact inside but infinite next to φ_max."""
     if ulp <= CLOSED_TOLERANCE_ULP:
         return 0.0
-    return float(np.ceil(np.log2(ulp / CLOSED_TOLERANCE_ULP))) if np.isfinite(ulp) else np.inf
+    if not math.isfinite(ulp):
+        return math.inf
+    mantissa, exponent = math.frexp(ulp / CLOSED_TOLERANCE_ULP)  # exact: no libm log2
+    return float(exponent if mantissa > 0.5 else exponent - 1)
 
 
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type) -> Branch:
     epsilon = float(np.finfo(dtype).eps)
-    mp_closed, np_closed = _mp_function(closed), _np_function(closed)
+    mp_closed, model_closed = _mp_function(closed), model_function(closed, [PHI])
     to_t = sp.lambdify(PHI, variable_of_phi, modules=[mpmath_namespace(), "mpmath"])
     angles = _angle_grid(phi_max)
     scale0 = abs(float(series[0])) or 1.0
@@ -285,8 +284,7 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
             samples: np.ndarray = np.unique(np.asarray(angle * (1 - JITTER * np.arange(JITTER_SAMPLES)),
                                                        dtype=dtype))
             samples = samples[samples.astype(np.float64) < phi_max * (1 - 2 * epsilon)]  # rounded inside
-            with np.errstate(all="ignore"):
-                values = np.asarray(np_closed(samples), dtype=np.float64)  # type: ignore[operator]
+            values = np.asarray(model_closed(samples), dtype=np.float64)
             worst = 0.0
             for sample, value in zip(samples, np.broadcast_to(values, samples.shape), strict=True):
                 reference = float(mp_closed(mpmath.mpf(float(sample))))  # type: ignore[operator]

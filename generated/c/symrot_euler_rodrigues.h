@@ -495,7 +495,7 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
     const double c_K_0 = 1.0/sqrt(d);
     const double c_K_1 = (1.0/2.0)/(sqrt(d) + 2);
     double c_K_2;
-    if (x < 0.03462813501506715) {
+    if (x < 0.03462813501506714) {
         c_K_2 = x*(x*(x*(x*(x*(x*((6435.0/4294967296.0)*x + 429.0/67108864.0) + 231.0/8388608.0) + 63.0/524288.0) + 35.0/65536.0) + 5.0/2048.0) + 3.0/256.0) + 1.0/16.0;
     } else {
         const double w0 = sqrt(d);

@@ -89,7 +89,7 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 0.4086652777619201) {
+    if (x < 0.4086652777619188) {
         c_R_1 = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
     } else {
@@ -97,7 +97,7 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
         c_R_1 = 2*w1*cos(w0)/phi;
-        c_R_2 = x < 0.7851233626304397 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*(w1*w1)/(phi*phi);
+        c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*(w1*w1)/(phi*phi);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -127,7 +127,7 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 5.028297529613113e-13) {
+            if (!(x <= 39.47841760435743) || x < 5.028297529613116e-13) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -166,11 +166,11 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             c_R_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 5.028297529613113e-13 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 5.028297529613116e-13 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 5.028297529613113e-13 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 5.028297529613116e-13 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -193,8 +193,8 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 8 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
- * ops: 92 */
+ * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * ops: 90 */
 static inline void symrot_rotation_vector_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -211,13 +211,13 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
         return;
     }
     double c_H_1, c_H_2;
-    if (x < 0.7851233626304397) {
+    if (x < 0.7851233626304374) {
         c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
-        c_H_2 = x < 1.5083706105984414 ? x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0 : -(-phi + sin(phi))/(phi*phi*phi);
+        c_H_2 = -(-phi + sin(phi))/(phi*phi*phi);
     }
     H[0] = -c_H_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -247,7 +247,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 5.028297529613113e-13) {
+            if (!(x <= 39.47841760435743) || x < 5.028297529613116e-13) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -286,7 +286,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
             poly_H_1_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
             c_H_2_lanes[k] = -(-phi + sin1)/(phi*phi*phi);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -294,11 +294,11 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             c_H_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 5.028297529613113e-13 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 5.028297529613116e-13 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 1.5083706105984414 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 0.7851233626304374 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -339,7 +339,7 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
         return;
     }
     double c_H_inverse_2;
-    if (x < 5.56734820089753) {
+    if (x < 5.5673482008975155) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.336734257095045e-31)*x + 3.6859949406653103e-29) + 1.455172475614865e-27) + 5.744790668872202e-26) + 2.267952452337683e-24) + 8.953517427037546e-23) + 3.534707039629467e-21) + 1.3954464685812522e-19) + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
@@ -374,7 +374,7 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 5.56734820089753) {
+            if (!(x <= 39.47841760435743) || x < 5.5673482008975155) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -412,7 +412,7 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
             c_H_inverse_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
-            const double v_H_inverse_2 = x < 5.56734820089753 ? poly_H_inverse_2 : closed_H_inverse_2;
+            const double v_H_inverse_2 = x < 5.5673482008975155 ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
@@ -442,7 +442,7 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 0.7851233626304397) {
+    if (x < 0.7851233626304374) {
         c_det_H = x*(x*(x*(x*(x*(x*(1.0/43589145600.0 + (-1.0/10461394944000.0)*x) - 1.0/239500800.0) + 1.0/1814400.0) - 1.0/20160.0) + 1.0/360.0) - 1.0/12.0) + 1;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
@@ -473,13 +473,13 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 1.5083706105984414) {
+    if (x < 1.5083706105984371) {
         c_G_1 = x*(x*(x*(x*(x*(x*(1.0/51011754393600.0 + (-2.333729166204778e-17)*x) - 1.0/81749606400.0) + 1.0/185794560.0) - 1.0/645120.0) + 1.0/3840.0) - 1.0/48.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_G_1 = sin((1.0/2.0)*phi)/phi;
-        c_G_2 = x < 2.897865491219691 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
+        c_G_2 = x < 2.897865491219683 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -509,7 +509,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 1.855928709321803e-12) {
+            if (!(x <= 39.47841760435743) || x < 1.8559287093218047e-12) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -556,11 +556,11 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             c_G_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 1.855928709321803e-12 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 1.8559287093218047e-12 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 9.015158901432458e-09 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 1.8559287093218047e-12 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -601,13 +601,13 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         return;
     }
     double c_K_1, c_K_2;
-    if (x < 2.897865491219691) {
+    if (x < 2.897865491219683) {
         c_K_1 = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
-        c_K_2 = x < 5.56734820089753 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
+        c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0/2.0;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -637,7 +637,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 9.015158901432458e-09) {
+            if (!(x <= 39.47841760435743) || x < 1.8559287093218047e-12) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -684,11 +684,11 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             c_K_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1.0/2.0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 9.015158901432458e-09 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 1.8559287093218047e-12 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 5.56734820089753 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 5.5673482008975155 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -723,7 +723,7 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
         return;
     }
     double c_H_inverse_2;
-    if (x < 5.56734820089753) {
+    if (x < 5.5673482008975155) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.336734257095045e-31)*x + 3.6859949406653103e-29) + 1.455172475614865e-27) + 5.744790668872202e-26) + 2.267952452337683e-24) + 8.953517427037546e-23) + 3.534707039629467e-21) + 1.3954464685812522e-19) + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
@@ -742,8 +742,8 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 8 in x below x = 1.50837, else -(-phi + sin(phi))/phi**3
- * ops: 83 */
+ * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * ops: 81 */
 static inline void symrot_rotation_vector_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -754,13 +754,13 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
         return;
     }
     double c_H_1, c_H_2;
-    if (x < 0.7851233626304397) {
+    if (x < 0.7851233626304374) {
         c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
-        c_H_2 = x < 1.5083706105984414 ? x*(x*(x*(x*(x*(x*(x*((8.22063524662433e-18)*x - 1.0/355687428096000.0) + 1.0/1307674368000.0) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0 : -(-phi + sin(phi))/(phi*phi*phi);
+        c_H_2 = -(-phi + sin(phi))/(phi*phi*phi);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -786,7 +786,7 @@ static inline void symrot_rotation_vector_to_quaternion(const double p[3], doubl
         return;
     }
     double c_e_0, c_nu;
-    if (x < 1.5083706105984414) {
+    if (x < 1.5083706105984371) {
         c_e_0 = x*(x*(x*(x*(x*(x*(1.0/1961990553600.0 + (-1.0/1428329123020800.0)*x) - 1.0/3715891200.0) + 1.0/10321920.0) - 1.0/46080.0) + 1.0/384.0) - 1.0/8.0) + 1;
         c_nu = x*(x*(x*(x*(x*(x*(1.0/25505877196800.0 + (-4.667458332409556e-17)*x) - 1.0/40874803200.0) + 1.0/92897280.0) - 1.0/322560.0) + 1.0/1920.0) - 1.0/24.0) + 1;
     } else {
@@ -830,7 +830,7 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.22832695303370756) {
+    if (t < 0.22832695303370731) {
         sigma = t*(t*(t*(t*(t*(t*((8191.0/306070526361600.0)*t + 1414477.0/1339058552832000.0) + 73.0/1751777280.0) + 127.0/77414400.0) + 31.0/483840.0) + 7.0/2880.0) + 1.0/12.0) + 2;
     } else {
         sigma = phi/sin((1.0/2.0)*phi);

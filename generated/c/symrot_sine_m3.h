@@ -92,8 +92,8 @@ static inline double symrot_sine_m3_angle(const double p[3])
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/s**2
- * ops: 92 */
+ * R_2: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
+ * ops: 101 */
 static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -112,12 +112,12 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = 1 - 4.0/27.0*x;
     double c_R_2;
-    if (x < 0.1294709423110196) {
-        c_R_2 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+    if (x < 0.4621072324955599) {
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+        c_R_2 = (1 - cos(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -147,7 +147,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0) || x < 0.018918233509283077) {
+            if (!(x < 9.0) || x < 0.4621072324955599) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -168,7 +168,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -177,10 +177,11 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 1 - 4.0/27.0*x;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            c_R_2_lanes[k] = (1 - cos0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -190,7 +191,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 9.0) ? NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.018918233509283077 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.4621072324955599 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -212,9 +213,9 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
 /* symrot_sine_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 14 in x below x = 0.864806, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
- * ops: 135 */
+ * H_1: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
+ * H_2: Horner degree 9 in x below x = 0.245082, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
+ * ops: 129 */
 static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -233,17 +234,16 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
-    if (x < 0.1294709423110196) {
-        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+    if (x < 0.24508162850254916) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
-        const double w1 = 2*pow(sin((1.0/2.0)*phi), 2);
-        const double w2 = sqrt(d);
-        c_H_1 = w0*w1;
-        c_H_2 = x < 0.8648056668462036 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0 : w0*(w1 - 2.0/3.0*w2 + 2)/w2;
+        const double w1 = sqrt(d);
+        c_H_1 = x < 0.4621072324955599 ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0 : w0*(1 - cos(phi));
+        c_H_2 = w0*(-2.0/3.0*w1 + 2*pow(sin((1.0/2.0)*phi), 2) + 2)/w1;
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -304,7 +304,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -313,14 +313,24 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = 1.0/(s*s);
-            const double w1 = 2*(sin0*sin0);
             c_H_0_lanes[k] = 3*u0;
-            c_H_1_lanes[k] = w0*w1;
-            poly_H_1_lanes[k] = x*(x*(x*(x*((-91.0/544195584.0)*x - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-            c_H_2_lanes[k] = u0*w0*(-2.0/3.0*u1 + w1 + 2);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+            c_H_1_lanes[k] = w0*(1 - cos0);
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            c_H_2_lanes[k] = u0*w0*(2*(sin1*sin1) - 2.0/3.0*u1 + 2);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -329,11 +339,11 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 9.0) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.018918233509283077 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.4621072324955599 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 9.0) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 0.8648056668462036 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 0.24508162850254916 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 9.0) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -449,8 +459,8 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m3_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 14 in x below x = 0.864806, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
- * ops: 69 */
+ * det_H: Horner degree 7 in x below x = 0.0682556, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
+ * ops: 48 */
 static inline double symrot_sine_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -459,8 +469,8 @@ static inline double symrot_sine_m3_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 0.8648056668462036) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4033090849969884e-15)*x + 1.3065291481006443e-14) + 1.2194272048939348e-13) + 1.141383863780723e-12) + 29393.0/2742118830047232.0) + 46189.0/457019805007872.0) + 12155.0/12694994583552.0) + 715.0/78364164096.0) + 143.0/1632586752.0) + 77.0/90699264.0) + 7.0/839808.0) + 35.0/419904.0) + 5.0/5832.0) + 1.0/108.0) + 1;
+    if (x < 0.06825555929208893) {
+        c_det_H = x*(x*(x*(x*(x*(x*((715.0/78364164096.0)*x + 143.0/1632586752.0) + 77.0/90699264.0) + 7.0/839808.0) + 35.0/419904.0) + 5.0/5832.0) + 1.0/108.0) + 1;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
@@ -492,14 +502,14 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 0.1294709423110196) {
+    if (x < 0.1294709423110197) {
         c_G_1 = x*(x*(x*(x*(x*(x*((-1077205.0/962938848411648.0)*x - 56525.0/4458050224128.0) - 1547.0/10319560704.0) - 2431.0/1289945088.0) - 13.0/497664.0) - 1.0/2304.0) - 5.0/432.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
         c_G_1 = sin((1.0/2.0)*phi)/s;
-        c_G_2 = x < 0.8648056668462036 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        c_G_2 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -585,7 +595,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 9.0) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.8648056668462036 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.8648056668462011 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.0) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -628,7 +638,7 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
     }
     const double c_K_0 = (3.0/2.0)/sqrt(d);
     double c_K_1, c_K_2;
-    if (x < 0.8648056668462036) {
+    if (x < 0.8648056668462011) {
         c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
     } else {
@@ -636,7 +646,7 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 1.5953637712864257 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*w0*(-6*sin((1.0/2.0)*phi)/s + 9/sqrt(d));
+        c_K_2 = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*w0*(-6*sin((1.0/2.0)*phi)/s + 9/sqrt(d));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -726,11 +736,11 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 9.0) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.8648056668462036 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.8648056668462011 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 9.0) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 1.5953637712864257 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 1.595363771286421 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 9.0) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -778,9 +788,9 @@ static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3],
 /* symrot_sine_m3_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 14 in x below x = 0.864806, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
- * ops: 129 */
+ * H_1: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
+ * H_2: Horner degree 9 in x below x = 0.245082, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
+ * ops: 123 */
 static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -793,17 +803,16 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
     }
     const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
-    if (x < 0.1294709423110196) {
-        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+    if (x < 0.24508162850254916) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
-        const double w1 = 2*pow(sin((1.0/2.0)*phi), 2);
-        const double w2 = sqrt(d);
-        c_H_1 = w0*w1;
-        c_H_2 = x < 0.8648056668462036 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.016545424984942e-16)*x + 6.532645740503222e-15) + 6.097136024469674e-14) + 5.706919318903615e-13) + 29393.0/5484237660094464.0) + 46189.0/914039610015744.0) + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0 : w0*(w1 - 2.0/3.0*w2 + 2)/w2;
+        const double w1 = sqrt(d);
+        c_H_1 = x < 0.4621072324955599 ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0 : w0*(1 - cos(phi));
+        c_H_2 = w0*(-2.0/3.0*w1 + 2*pow(sin((1.0/2.0)*phi), 2) + 2)/w1;
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -830,7 +839,7 @@ static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
         return;
     }
     double c_e_0, c_nu;
-    if (x < 0.1294709423110196) {
+    if (x < 0.1294709423110197) {
         c_e_0 = x*(x*(x*(x*(x*(x*((-7429.0/1981355655168.0)*x - 96577.0/2229025112064.0) - 2717.0/5159780352.0) - 55.0/7962624.0) - 77.0/746496.0) - 7.0/3456.0) - 1.0/8.0) + 1;
         c_nu = x*(x*(x*(x*(x*(x*((-1077205.0/481469424205824.0)*x - 56525.0/2229025112064.0) - 1547.0/5159780352.0) - 2431.0/644972544.0) - 13.0/248832.0) - 1.0/1152.0) - 5.0/216.0) + 1;
     } else {
@@ -875,7 +884,7 @@ static inline int symrot_sine_m3__from_quaternion(double e0, double e1, double e
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.22832695303370756) {
+    if (t < 0.22832695303370731) {
         sigma = t*(t*(t*(t*(t*(t*((1.1066928531940517e-11)*t + 4.369448183506589e-10) + 75727.0/4388393189376.0) + 207913.0/304749527040.0) + 91.0/3359232.0) + 17.0/15552.0) + 5.0/108.0) + 2;
     } else {
         sigma = 3*sin((1.0/3.0)*phi)/sin((1.0/2.0)*phi);
@@ -1016,8 +1025,8 @@ static inline float symrot_sine_m3_angle_f(const float p[3])
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
- * ops: 101 */
+ * R_2: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
+ * ops: 92 */
 static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1036,12 +1045,12 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
     }
     const float c_R_1 = 1 - 4.0F/27.0F*x;
     float c_R_2;
-    if (x < 2.8627653F) {
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+    if (x < 1.5953637F) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        c_R_2 = (1 - cosf(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1071,7 +1080,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0F) || x < 2.8627653F) {
+            if (!(x < 9.0F) || x < 0.46210724F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1092,7 +1101,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1101,10 +1110,11 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 1 - 4.0F/27.0F*x;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1 - cos0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*((-11.0F/5038848.0F)*x - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1114,7 +1124,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             c_R_1_lanes[k] = !(x < 9.0F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 2.8627653F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.46210724F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1136,9 +1146,9 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
 /* symrot_sine_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
  * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
- * ops: 125 */
+ * ops: 116 */
 static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1158,15 +1168,14 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
     const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
     if (x < 0.8648057F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+        c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
-        const float w1 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_H_1 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*w1;
-        c_H_2 = w0*(w1 + 4*powf(sinf((1.0F/6.0F)*phi), 2))/sqrtf(d);
+        c_H_1 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*(1 - cosf(phi));
+        c_H_2 = w0*(4*powf(sinf((1.0F/6.0F)*phi), 2) + 2*powf(sinf((1.0F/2.0F)*phi), 2))/sqrtf(d);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1222,7 +1231,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1231,7 +1240,8 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const float a1_a = (1.0F/6.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
@@ -1242,12 +1252,21 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a2_a = (1.0F/2.0F)*phi;
+            const float a2_q = rintf(a2_a*0.63661975F);
+            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
+            const float a2_z = a2_r*a2_r;
+            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
+            const float a2_h = rintf(0.5F*a2_j - 0.25F);
+            const float a2_odd = a2_j - 2*a2_h;
+            const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             const float w0 = 1.0F/(s*s);
-            const float w1 = 2*(sin0*sin0);
             c_H_0_lanes[k] = 3*u0;
-            c_H_1_lanes[k] = w0*w1;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + w1);
+            c_H_1_lanes[k] = w0*(1 - cos0);
+            poly_H_1_lanes[k] = x*(x*(x*((-11.0F/5038848.0F)*x - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + 2*(sin2*sin2));
             poly_H_2_lanes[k] = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1257,7 +1276,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             c_H_0_lanes[k] = !(x < 9.0F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 2.8627653F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.46210724F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 9.0F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
@@ -1377,8 +1396,8 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m3_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 12 in x below x = 2.86277, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
- * ops: 63 */
+ * det_H: Horner degree 6 in x below x = 0.864806, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
+ * ops: 45 */
 static inline float symrot_sine_m3_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1387,8 +1406,8 @@ static inline float symrot_sine_m3_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 2.8627653F) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.2194273e-13F)*x + 1.1413839e-12F) + 1.0719084e-11F) + 1.0106564e-10F) + 9.57464e-10F) + 9.124069e-09F) + 8.7591054e-08F) + 8.489595e-07F) + 7.0F/839808.0F) + 35.0F/419904.0F) + 5.0F/5832.0F) + 1.0F/108.0F) + 1;
+    if (x < 0.8648057F) {
+        c_det_H = x*(x*(x*(x*(x*((8.7591054e-08F)*x + 8.489595e-07F) + 7.0F/839808.0F) + 35.0F/419904.0F) + 5.0F/5832.0F) + 1.0F/108.0F) + 1;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
@@ -1692,9 +1711,9 @@ static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3],
 /* symrot_sine_m3_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 10 in x below x = 2.86277, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
  * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
- * ops: 119 */
+ * ops: 110 */
 static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1708,15 +1727,14 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
     const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
     if (x < 0.8648057F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+        c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
-        const float w1 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_H_1 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-9.26838e-13F)*x - 9.856247e-12F) - 1.0701068e-10F) - 1.1931475e-09F) - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*w1;
-        c_H_2 = w0*(w1 + 4*powf(sinf((1.0F/6.0F)*phi), 2))/sqrtf(d);
+        c_H_1 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*(1 - cosf(phi));
+        c_H_2 = w0*(4*powf(sinf((1.0F/6.0F)*phi), 2) + 2*powf(sinf((1.0F/2.0F)*phi), 2))/sqrtf(d);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];

@@ -71,8 +71,8 @@ static inline double symrot_sine_m5_angle(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * ops: 75 */
+ * R_2: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * ops: 81 */
 static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -90,8 +90,8 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     double c_R_2;
-    if (x < 0.40644336131551395) {
-        c_R_2 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+    if (x < 0.776938784878973) {
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         c_R_2 = (2.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/pow(sin((1.0/5.0)*phi), 2);
@@ -124,7 +124,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844) || x < 0.00423011441675066) {
+            if (!(x < 22.612712429686844) || x < 0.776938784878973) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -162,7 +162,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_R_1_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
             c_R_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
-            poly_R_2_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -172,7 +172,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.00423011441675066 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.776938784878973 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -194,9 +194,9 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
 /* symrot_sine_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 118 */
+ * H_1: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_2: Horner degree 21 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 142 */
 static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -214,9 +214,9 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 0.40644336131551395) {
-        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.776938784878973) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double w0 = (1.0/5.0)*phi;
@@ -225,7 +225,7 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
         const double w3 = (1.0/2.0)*phi;
         const double w4 = sin(w3);
         c_H_1 = (2.0/25.0)*w2*(w4*w4);
-        c_H_2 = x < 2.7876134135933768 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
+        c_H_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -303,9 +303,9 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double w0 = 1.0/(sin0*sin0);
             c_H_0_lanes[k] = 5*u0;
             c_H_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
-            poly_H_1_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
             c_H_2_lanes[k] = (1.0/25.0)*w0*(-2.0/5.0*cos1*sin1/sin0 + 1.0/cos0);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -314,11 +314,11 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.00423011441675066 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.776938784878973 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 2.7876134135933768 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 5.166154456090205 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -360,7 +360,7 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
     }
     const double c_H_inverse_0 = (1.0/5.0)*sqrt(25 - x);
     double c_H_inverse_2;
-    if (x < 2.7876134135933768) {
+    if (x < 2.787613413593369) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
@@ -454,7 +454,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             c_H_inverse_1_lanes[k] = !(x < 22.612712429686844) ? NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
-            const double v_H_inverse_2 = x < 2.7876134135933768 ? poly_H_inverse_2 : closed_H_inverse_2;
+            const double v_H_inverse_2 = x < 2.787613413593369 ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
@@ -475,8 +475,8 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m5_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 15 in x below x = 2.78761, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
- * ops: 52 */
+ * det_H: Horner degree 6 in x below x = 0.212112, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
+ * ops: 25 */
 static inline double symrot_sine_m5_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -484,8 +484,8 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 2.7876134135933768) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.20216078e-23)*x + 3.1023504e-22) + 8.02332e-21) + 2.08012e-19) + 5.408312e-18) + 1.410864e-16) + 3.69512e-15) + 9.724e-14) + 1287.0/500000000000000.0) + 429.0/6250000000000.0) + 231.0/125000000000.0) + 63.0/1250000000.0) + 7.0/5000000.0) + 1.0/25000.0) - 1.0/20.0) + 1;
+    if (x < 0.21211211978633254) {
+        c_det_H = x*(x*(x*(x*(x*((429.0/6250000000000.0)*x + 231.0/125000000000.0) + 63.0/1250000000.0) + 7.0/5000000.0) + 1.0/25000.0) - 1.0/20.0) + 1;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double w0 = (1.0/5.0)*phi;
@@ -498,8 +498,8 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
- * G_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
- * ops: 88 */
+ * G_2: Horner degree 14 in x below x = 2.78761, else (1 - cos(phi/2))/(25*sin(phi/5)**2)
+ * ops: 109 */
 static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -517,11 +517,11 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = -1.0/250.0*sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/sqrt(sqrt(25 - x) + 5);
     double c_G_2;
-    if (x < 0.40644336131551395) {
-        c_G_2 = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+    if (x < 2.787613413593369) {
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        c_G_2 = (2.0/25.0)*pow(sin((1.0/4.0)*phi), 2)/pow(sin((1.0/5.0)*phi), 2);
+        c_G_2 = (1.0/25.0)*(1 - cos((1.0/2.0)*phi))/pow(sin((1.0/5.0)*phi), 2);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -587,7 +587,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/4.0)*phi;
+            const double a1_a = (1.0/2.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -596,10 +596,11 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_G_1_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
-            c_G_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            c_G_2_lanes[k] = (1.0/25.0)*(1 - cos1)/(sin0*sin0);
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -609,7 +610,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.00423011441675066 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 2.787613413593369 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -631,9 +632,9 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
 /* symrot_sine_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * K_1: Horner degree 14 in x below x = 2.78761, else (1 - cos(phi/2))/(25*sin(phi/5)**2)
  * K_2: Horner degree 21 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
- * ops: 138 */
+ * ops: 159 */
 static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -651,16 +652,17 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
     }
     const double c_K_0 = (5.0/2.0)/sqrt(25 - x);
     double c_K_1, c_K_2;
-    if (x < 0.40644336131551395) {
-        c_K_1 = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+    if (x < 2.787613413593369) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double w0 = (1.0/5.0)*phi;
         const double w1 = sin(w0);
         const double w2 = 1.0/(w1*w1);
-        c_K_1 = (2.0/25.0)*w2*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 5.166154456090218 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*w2*(5/cos(w0) - 2*sin((1.0/2.0)*phi)/w1);
+        const double w3 = (1.0/2.0)*phi;
+        c_K_1 = (1.0/25.0)*w2*(1 - cos(w3));
+        c_K_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*w2*(5/cos(w0) - 2*sin(w3)/w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -723,7 +725,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/4.0)*phi;
+            const double a1_a = (1.0/2.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -733,21 +735,13 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a2_a = (1.0/2.0)*phi;
-            const double a2_q = rint(a2_a*0.6366197723675814);
-            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
-            const double a2_z = a2_r*a2_r;
-            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
-            const double a2_h = rint(0.5*a2_j - 0.25);
-            const double a2_odd = a2_j - 2*a2_h;
-            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const double w0 = 1.0/(sin0*sin0);
             c_K_0_lanes[k] = (5.0/2.0)*u0;
-            c_K_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
-            poly_K_1_lanes[k] = x*(x*((-663.0/2560000000.0)*x - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/250.0)*w0*(-2*sin2/sin0 + 5/cos0);
+            c_K_1_lanes[k] = (1.0/25.0)*w0*(1 - cos1);
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/250.0)*w0*(-2*sin1/sin0 + 5/cos0);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -757,11 +751,11 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 22.612712429686844) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.00423011441675066 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 2.787613413593369 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 22.612712429686844) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 5.166154456090218 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 5.166154456090205 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 22.612712429686844) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -797,7 +791,7 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
     }
     const double c_H_inverse_0 = (1.0/5.0)*sqrt(25 - x);
     double c_H_inverse_2;
-    if (x < 2.7876134135933768) {
+    if (x < 2.787613413593369) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
@@ -817,9 +811,9 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
 /* symrot_sine_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 112 */
+ * H_1: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_2: Horner degree 21 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 136 */
 static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -831,9 +825,9 @@ static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3],
     }
     const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 0.40644336131551395) {
-        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.776938784878973) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double w0 = (1.0/5.0)*phi;
@@ -842,7 +836,7 @@ static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3],
         const double w3 = (1.0/2.0)*phi;
         const double w4 = sin(w3);
         c_H_1 = (2.0/25.0)*w2*(w4*w4);
-        c_H_2 = x < 2.7876134135933768 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
+        c_H_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -904,7 +898,7 @@ static inline int symrot_sine_m5__from_quaternion(double e0, double e1, double e
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.22832695303370756) {
+    if (t < 0.22832695303370731) {
         sigma = t*(t*(t*(t*(t*(t*((2.0254899202142057e-11)*t + 7.995858586568395e-10) + 81801313.0/2592000000000000.0) + 358487.0/288000000000.0) + 17623.0/360000000.0) + 1141.0/600000.0) + 7.0/100.0) + 2;
     } else {
         sigma = 5*sin((1.0/5.0)*phi)/sin((1.0/2.0)*phi);
@@ -1024,7 +1018,7 @@ static inline float symrot_sine_m5_angle_f(const float p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * R_2: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
  * ops: 72 */
 static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9])
 {
@@ -1047,7 +1041,7 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
         c_R_2 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        c_R_2 = (2.0F/25.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/powf(sinf((1.0F/5.0F)*phi), 2);
+        c_R_2 = (1.0F/25.0F)*(1 - cosf(phi))/powf(sinf((1.0F/5.0F)*phi), 2);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1077,7 +1071,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612713F) || x < 2.7876132F) {
+            if (!(x < 22.612713F) || x < 0.21211211F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1103,7 +1097,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -1112,10 +1106,11 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
-            c_R_2_lanes[k] = (2.0F/25.0F)*(sin1*sin1)/(sin0*sin0);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1.0F/25.0F)*(1 - cos1)/(sin0*sin0);
+            poly_R_2_lanes[k] = x*(x*((33.0F/10000000.0F)*x + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1125,7 +1120,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             c_R_1_lanes[k] = !(x < 22.612713F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 2.7876132F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.21211211F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612713F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1147,7 +1142,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
 /* symrot_sine_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_1: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
  * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
  * ops: 97 */
 static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
@@ -1174,11 +1169,10 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         const float w0 = (1.0F/5.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = 1.0F/(w1*w1);
+        const float w2 = (1.0F/25.0F)/(w1*w1);
         const float w3 = (1.0F/2.0F)*phi;
-        const float w4 = sinf(w3);
-        c_H_1 = (2.0F/25.0F)*w2*(w4*w4);
-        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : (1.0F/25.0F)*w2*(1.0F/cosf(w0) - 2.0F/5.0F*w4*cosf(w3)/w1);
+        c_H_1 = w2*(1 - cosf(phi));
+        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : w2*(1.0F/cosf(w0) - 2.0F/5.0F*sinf(w3)*cosf(w3)/w1);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1241,7 +1235,7 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -1250,14 +1244,25 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float w0 = 1.0F/(sin0*sin0);
+            const float a2_a = (1.0F/2.0F)*phi;
+            const float a2_q = rintf(a2_a*0.63661975F);
+            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
+            const float a2_z = a2_r*a2_r;
+            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
+            const float a2_h = rintf(0.5F*a2_j - 0.25F);
+            const float a2_odd = a2_j - 2*a2_h;
+            const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const float a2_up = fabsf(a2_j - 1.5F) - 0.5F;
+            const float cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
+            const float w0 = (1.0F/25.0F)/(sin0*sin0);
             c_H_0_lanes[k] = 5*u0;
-            c_H_1_lanes[k] = (2.0F/25.0F)*(sin1*sin1)*w0;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = (1.0F/25.0F)*w0*(-2.0F/5.0F*cos1*sin1/sin0 + 1.0F/cos0);
+            c_H_1_lanes[k] = w0*(1 - cos1);
+            poly_H_1_lanes[k] = x*(x*((33.0F/10000000.0F)*x + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = w0*(-2.0F/5.0F*cos2*sin2/sin0 + 1.0F/cos0);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1267,7 +1272,7 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             c_H_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 2.7876132F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.21211211F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 22.612713F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
@@ -1770,7 +1775,7 @@ static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3],
 /* symrot_sine_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * H_1: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
  * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
  * ops: 91 */
 static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
@@ -1791,11 +1796,10 @@ static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3],
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         const float w0 = (1.0F/5.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = 1.0F/(w1*w1);
+        const float w2 = (1.0F/25.0F)/(w1*w1);
         const float w3 = (1.0F/2.0F)*phi;
-        const float w4 = sinf(w3);
-        c_H_1 = (2.0F/25.0F)*w2*(w4*w4);
-        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : (1.0F/25.0F)*w2*(1.0F/cosf(w0) - 2.0F/5.0F*w4*cosf(w3)/w1);
+        c_H_1 = w2*(1 - cosf(phi));
+        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : w2*(1.0F/cosf(w0) - 2.0F/5.0F*sinf(w3)*cosf(w3)/w1);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];

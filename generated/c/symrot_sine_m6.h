@@ -71,7 +71,7 @@ static inline double symrot_sine_m6_angle(const double p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * R_2: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
  * ops: 69 */
 static inline void symrot_sine_m6_rotation_matrix(const double p[3], double R[9])
 {
@@ -90,11 +90,11 @@ static inline void symrot_sine_m6_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = -1.0/1458.0*(x - 36)*(x - 27)*(x - 9)/sqrt(36 - x);
     double c_R_2;
-    if (x < 5.286206912907958) {
+    if (x < 5.286206912907945) {
         c_R_2 = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        c_R_2 = (1.0/18.0)*pow(4*pow(sin((1.0/6.0)*phi), 2) - 3, 2);
+        c_R_2 = (1.0/18.0)*pow(-2*cos((1.0/3.0)*phi) - 1, 2);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -145,7 +145,7 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/6.0)*phi;
+            const double a0_a = (1.0/3.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -154,9 +154,10 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = -1.0/1458.0*u0*(x - 36)*(x - 27)*(x - 9);
-            c_R_2_lanes[k] = (1.0/18.0)*((4*(sin0*sin0) - 3)*(4*(sin0*sin0) - 3));
+            c_R_2_lanes[k] = (1.0/18.0)*((-2*cos0 - 1)*(-2*cos0 - 1));
             poly_R_2_lanes[k] = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -167,7 +168,7 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 27.0) ? NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 5.286206912907958 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 5.286206912907945 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 27.0) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -189,7 +190,7 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
 /* symrot_sine_m6_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 6/sqrt(36 - x) (algebraic in x)
- * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * H_1: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
  * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
  * ops: 71 */
 static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
@@ -210,11 +211,11 @@ static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
     const double c_H_0 = 6/sqrt(36 - x);
     const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/sqrt(36 - x);
     double c_H_1;
-    if (x < 5.286206912907958) {
+    if (x < 5.286206912907945) {
         c_H_1 = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        c_H_1 = (1.0/18.0)*pow(4*pow(sin((1.0/6.0)*phi), 2) - 3, 2);
+        c_H_1 = (1.0/18.0)*pow(-2*cos((1.0/3.0)*phi) - 1, 2);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -265,7 +266,7 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/6.0)*phi;
+            const double a0_a = (1.0/3.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -274,9 +275,10 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_H_0_lanes[k] = 6*u0;
-            c_H_1_lanes[k] = (1.0/18.0)*((4*(sin0*sin0) - 3)*(4*(sin0*sin0) - 3));
+            c_H_1_lanes[k] = (1.0/18.0)*((-2*cos0 - 1)*(-2*cos0 - 1));
             poly_H_1_lanes[k] = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
             c_H_2_lanes[k] = (1.0/1458.0)*u0*((x*x) - 72*x + 1539);
         }
@@ -287,7 +289,7 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 27.0) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 5.286206912907958 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 5.286206912907945 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 27.0) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 27.0) ? NAN : closed_H_2;
@@ -419,8 +421,8 @@ static inline double symrot_sine_m6_tangent_det(const double p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
- * G_2: Horner degree 16 in x below x = 5.28621, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
- * ops: 99 */
+ * G_2: Horner degree 10 in x below x = 1.48742, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
+ * ops: 81 */
 static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -438,8 +440,8 @@ static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = 1.0/2.0 - 1.0/54.0*x;
     double c_G_2;
-    if (x < 5.286206912907958) {
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+    if (x < 1.4874214491843358) {
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
         c_G_2 = (1.0/36.0)*(1 - cos((1.0/2.0)*phi))/pow(sin((1.0/6.0)*phi), 2);
@@ -472,7 +474,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0) || x < 5.286206912907958) {
+            if (!(x < 27.0) || x < 1.4874214491843358) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -511,7 +513,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_G_1_lanes[k] = 1.0/2.0 - 1.0/54.0*x;
             c_G_2_lanes[k] = (1.0/36.0)*(1 - cos1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -521,7 +523,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 27.0) ? NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 5.286206912907958 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 1.4874214491843358 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 27.0) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -543,9 +545,9 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
 /* symrot_sine_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 3/sqrt(36 - x) (algebraic in x)
- * K_1: Horner degree 16 in x below x = 5.28621, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
- * K_2: Horner degree 7 in x below x = 0.407121, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(216*(1 - 2*sin(phi/12)**2)*sin(phi/6)**2)
- * ops: 123 */
+ * K_1: Horner degree 10 in x below x = 1.48742, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
+ * K_2: Horner degree 10 in x below x = 1.48742, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(216*(1 - 2*sin(phi/12)**2)*sin(phi/6)**2)
+ * ops: 113 */
 static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -563,14 +565,14 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
     }
     const double c_K_0 = 3/sqrt(36 - x);
     double c_K_1, c_K_2;
-    if (x < 0.40712125242855757) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
-        c_K_2 = x*(x*(x*(x*(x*(x*((3.4805559101996437e-14)*x + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
+    if (x < 1.4874214491843358) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((6.389071489848162e-19)*x + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
         const double w0 = pow(sin((1.0/6.0)*phi), -2);
         const double w1 = pow(sin((1.0/12.0)*phi), 2);
-        c_K_1 = x < 5.286206912907958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0 : (1.0/36.0)*w0*(1 - cos((1.0/2.0)*phi));
+        c_K_1 = (1.0/36.0)*w0*(1 - cos((1.0/2.0)*phi));
         c_K_2 = (1.0/216.0)*w0*(4*w1 + 2*pow(sin((1.0/4.0)*phi), 2))/(1 - 2*w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
@@ -667,9 +669,9 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double w1 = (sin2*sin2);
             c_K_0_lanes[k] = 3*u0;
             c_K_1_lanes[k] = (1.0/36.0)*w0*(1 - cos1);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-4.866075841112221e-29)*x - 1.936458476593151e-27) - 7.761482055678407e-26) - 3.136640232049648e-24) - 1.2798620772933016e-22) - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/216.0)*w0*(2*(sin3*sin3) + 4*w1)/(1 - 2*w1);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.4805559101996437e-14)*x + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((6.389071489848162e-19)*x + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -678,11 +680,11 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 27.0) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 5.286206912907958 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 1.4874214491843358 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 27.0) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 0.40712125242855757 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 1.4874214491843358 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 27.0) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -729,7 +731,7 @@ static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3],
 /* symrot_sine_m6_omega: omega = H pdot (eq 20).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 6/sqrt(36 - x) (algebraic in x)
- * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * H_1: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
  * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
  * ops: 65 */
 static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3], double omega[3])
@@ -744,11 +746,11 @@ static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3],
     const double c_H_0 = 6/sqrt(36 - x);
     const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/sqrt(36 - x);
     double c_H_1;
-    if (x < 5.286206912907958) {
+    if (x < 5.286206912907945) {
         c_H_1 = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        c_H_1 = (1.0/18.0)*pow(4*pow(sin((1.0/6.0)*phi), 2) - 3, 2);
+        c_H_1 = (1.0/18.0)*pow(-2*cos((1.0/3.0)*phi) - 1, 2);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -810,7 +812,7 @@ static inline int symrot_sine_m6__from_quaternion(double e0, double e1, double e
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.22832695303370756) {
+    if (t < 0.22832695303370731) {
         sigma = t*(t*(t*(t*(t*(t*((2.2132506202906736e-11)*t + 7943.0/9091467475200.0) + 1847.0/53569252800.0) + 809.0/595213920.0) + 7.0/131220.0) + 1.0/486.0) + 2.0/27.0) + 2;
     } else {
         sigma = 6*sin((1.0/6.0)*phi)/sin((1.0/2.0)*phi);

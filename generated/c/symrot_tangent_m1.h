@@ -393,7 +393,7 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = (1.0/2.0)*sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
     double c_G_2;
-    if (x < 0.0059868318985626615) {
+    if (x < 0.005986831898562644) {
         c_G_2 = x*(x*(x*(x*(x*(x*(1308365.0/33554432.0 + (-76546627.0/2147483648.0)*x) - 181215.0/4194304.0) + 12767.0/262144.0) - 1843.0/32768.0) + 69.0/1024.0) - 11.0/128.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m1__phi(sqrt(x));
@@ -480,7 +480,7 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
             c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 7.889013259849932e-06 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 7.889013259849922e-06 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -522,7 +522,7 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (1.0/2.0)/(x + 1);
     double c_K_1, c_K_2;
-    if (x < 0.0059868318985626615) {
+    if (x < 0.005986831898562644) {
         c_K_1 = x*(x*(x*(x*(x*(x*(1308365.0/33554432.0 + (-76546627.0/2147483648.0)*x) - 181215.0/4194304.0) + 12767.0/262144.0) - 1843.0/32768.0) + 69.0/1024.0) - 11.0/128.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
     } else {
@@ -530,7 +530,7 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 0.1318263071600862 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*((1.0/2.0)/(x + 1) - sin((1.0/2.0)*phi)/s);
+        c_K_2 = x < 0.13182630716008584 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*((1.0/2.0)/(x + 1) - sin((1.0/2.0)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -560,7 +560,7 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 7.889013259849932e-06) {
+            if (!(x < 4.149515568880993e+180) || x < 7.889013259849922e-06) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -615,11 +615,11 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 7.889013259849932e-06 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 7.889013259849922e-06 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 0.1318263071600862 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 0.13182630716008584 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -706,7 +706,7 @@ static inline void symrot_tangent_m1_to_quaternion(const double p[3], double e[4
     }
     const double c_nu = sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
     double c_e_0;
-    if (x < 0.010972538680756351) {
+    if (x < 0.01097253868075628) {
         c_e_0 = x*(x*(x*(x*(x*(x*(181215.0/4194304.0 + (-1308365.0/33554432.0)*x) - 12767.0/262144.0) + 1843.0/32768.0) - 69.0/1024.0) + 11.0/128.0) - 1.0/8.0) + 1;
     } else {
         const double phi = symrot_tangent_m1__phi(sqrt(x));
@@ -1259,7 +1259,7 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.70710677F*u0*u1;
             c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*((12767.0F/262144.0F)*x - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
+            poly_G_2_lanes[k] = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1269,7 +1269,7 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.03724894F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.0017890878F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1292,8 +1292,8 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
  * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 1/(2*(x + 1)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/s**2
- * K_2: Horner degree 8 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
- * ops: 98 */
+ * K_2: Horner degree 13 in x below x = 0.258954, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
+ * ops: 112 */
 static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1313,13 +1313,13 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
     float c_K_1, c_K_2;
     if (x < 0.13182631F) {
         c_K_1 = x*(x*(x*(x*(x*(x*(0.038992316F + (-0.0356448F)*x) - 181215.0F/4194304.0F) + 12767.0F/262144.0F) - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*(0.45584974F + (-0.4596311F)*x) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
     } else {
         const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
         c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = w0*((1.0F/2.0F)/(x + 1) - sinf((1.0F/2.0F)*phi)/s);
+        c_K_2 = x < 0.2589544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F : w0*((1.0F/2.0F)/(x + 1) - sinf((1.0F/2.0F)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1349,7 +1349,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 0.03724894F) {
+            if (!(x < 1.2676506e+30F) || x < 0.0017890878F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1393,9 +1393,9 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float w1 = 1.0F/(s*s);
             c_K_0_lanes[k] = w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*((12767.0F/262144.0F)*x - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = w1*(w0 - sin1/s);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(0.45584974F + (-0.4596311F)*x) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1404,11 +1404,11 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.03724894F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.0017890878F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
-            const float v_K_2 = x < 0.13182631F ? poly_K_2 : closed_K_2;
+            const float v_K_2 = x < 0.2589544F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {

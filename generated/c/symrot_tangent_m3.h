@@ -70,9 +70,9 @@ static inline double symrot_tangent_m3_angle(const double p[3])
 /* symrot_tangent_m3_rotation_matrix: rotation tensor R (eq 14).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 13 in x below x = 0.487118, else (1 - cos(phi))/s**2
- * ops: 109 */
+ * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * R_2: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * ops: 97 */
 static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -89,15 +89,14 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 0.06877716192024322) {
+    if (x < 0.06877716192024325) {
         c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        c_R_1 = 2*sin(w0)*cos(w0)/s;
-        c_R_2 = x < 0.4871184501507491 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : (1 - cos(phi))/(s*s);
+        c_R_1 = sin(phi)/s;
+        c_R_2 = x < 0.13136065202211897 ? x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -147,7 +146,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -157,9 +156,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = phi;
+            const double a1_a = (1.0/2.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -168,12 +165,11 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_R_1_lanes[k] = sin0/s;
             poly_R_1_lanes[k] = 1 + (-11.0/54.0)*x;
-            c_R_2_lanes[k] = (1 - cos1)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin1*sin1)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -185,7 +181,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.4871184501507491 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.13136065202211897 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -207,9 +203,9 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
 /* symrot_tangent_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 13 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 102 */
+ * ops: 90 */
 static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -228,12 +224,12 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
     const double c_H_0 = 9/(x + 9);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1;
-    if (x < 0.4871184501507491) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    if (x < 0.13136065202211897) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        c_H_1 = (1 - cos(phi))/(s*s);
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -293,7 +289,7 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -302,11 +298,10 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_H_0_lanes[k] = 9/(x + 9);
-            c_H_1_lanes[k] = (1 - cos0)/(s*s);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/(s*s);
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -316,7 +311,7 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             c_H_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.4871184501507491 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.13136065202211897 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_2;
@@ -433,8 +428,8 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
 
 /* symrot_tangent_m3_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
- * det_H: Horner degree 11 in x below x = 0.251942, else 36*sin(phi/2)**2/(s**2*(x + 9))
- * ops: 41 */
+ * det_H: Horner degree 9 in x below x = 0.131361, else 36*sin(phi/2)**2/(s**2*(x + 9))
+ * ops: 35 */
 static inline double symrot_tangent_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -442,8 +437,8 @@ static inline double symrot_tangent_m3_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 0.2519423440547372) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(60995261.0/8226356490141696.0 + (-9.345602752961522e-10)*x) - 26573665.0/457019805007872.0) + 5708089.0/12694994583552.0) - 2410387.0/705277476864.0) + 124507.0/4897760256.0) - 50027.0/272097792.0) + 9677.0/7558272.0) - 3547.0/419904.0) + 299.0/5832.0) - 29.0/108.0) + 1;
+    if (x < 0.13136065202211897) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(5708089.0/12694994583552.0 + (-26573665.0/457019805007872.0)*x) - 2410387.0/705277476864.0) + 124507.0/4897760256.0) - 50027.0/272097792.0) + 9677.0/7558272.0) - 3547.0/419904.0) + 299.0/5832.0) - 29.0/108.0) + 1;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
@@ -474,7 +469,7 @@ static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 0.06877716192024322) {
+    if (x < 0.06877716192024325) {
         c_G_1 = x*(x*(x*(x*(x*(x*(2025115.0/4458050224128.0 + (-46876153.0/962938848411648.0)*x) - 44015.0/10319560704.0) + 17371.0/429981696.0) - 193.0/497664.0) + 79.0/20736.0) - 17.0/432.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
     } else {
@@ -566,7 +561,7 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.018958083893503733 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.01895808389350374 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -608,7 +603,7 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (9.0/2.0)/(x + 9);
     double c_K_1, c_K_2;
-    if (x < 0.06877716192024322) {
+    if (x < 0.06877716192024325) {
         c_K_1 = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
     } else {
@@ -616,7 +611,7 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 1.9390924142768224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0 : (1.0/6.0)*w0*(27/(x + 9) - 6*sin((1.0/2.0)*phi)/s);
+        c_K_2 = x < 1.9390924142768158 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0 : (1.0/6.0)*w0*(27/(x + 9) - 6*sin((1.0/2.0)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -646,7 +641,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 0.018958083893503733) {
+            if (!(x < 4.149515568880993e+180) || x < 0.01895808389350374) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -701,11 +696,11 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.018958083893503733 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.01895808389350374 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 1.9390924142768224 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 1.9390924142768158 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -752,9 +747,9 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
 /* symrot_tangent_m3_omega: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 13 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 96 */
+ * ops: 84 */
 static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -767,12 +762,12 @@ static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[
     const double c_H_0 = 9/(x + 9);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1;
-    if (x < 0.4871184501507491) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(6.4019928256931574e-12 + (-7.381889686768641e-13)*x) - 5.535711739336506e-11) + 2615977.0/5484237660094464.0) - 46189.0/11284439629824.0) + 887315.0/25389989167104.0) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    if (x < 0.13136065202211897) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        c_H_1 = (1 - cos(phi))/(s*s);
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -799,7 +794,7 @@ static inline void symrot_tangent_m3_to_quaternion(const double p[3], double e[4
     }
     const double c_e_0 = -1.0/2.0*sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/pow(x + 9, 3.0/4.0);
     double c_nu;
-    if (x < 0.06877716192024322) {
+    if (x < 0.06877716192024325) {
         c_nu = x*(x*(x*(x*(x*(x*(2025115.0/2229025112064.0 + (-46876153.0/481469424205824.0)*x) - 44015.0/5159780352.0) + 17371.0/214990848.0) - 193.0/248832.0) + 79.0/10368.0) - 17.0/216.0) + 1;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
@@ -841,7 +836,7 @@ static inline int symrot_tangent_m3__from_quaternion(double e0, double e1, doubl
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.12188031421952665) {
+    if (t < 0.12188031421952669) {
         sigma = t*(t*(t*(t*(t*(t*((2.006345334189741e-09)*t + 4.41717815373116e-08) + 105958219.0/109709829734400.0) + 6354073.0/304749527040.0) + 7379.0/16796160.0) + 137.0/15552.0) + 17.0/108.0) + 2;
     } else {
         sigma = 3*tan((1.0/3.0)*phi)/sin((1.0/2.0)*phi);
@@ -955,8 +950,8 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 12 in x below x = 1.93909, else 2*sin(phi/2)**2/s**2
- * ops: 101 */
+ * R_2: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * ops: 83 */
 static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -975,14 +970,13 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
     float c_R_1, c_R_2;
     if (x < 0.48711845F) {
         c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_R_1 = 2*w1*cosf(w0)/s;
-        c_R_2 = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F : 2*(w1*w1)/(s*s);
+        c_R_1 = 2*sinf(w0)*cosf(w0)/s;
+        c_R_2 = (1 - cosf(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1044,10 +1038,21 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1 - cos1)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1059,7 +1064,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 1.9390924F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.48711845F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1081,9 +1086,9 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 12 in x below x = 1.93909, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 98 */
+ * ops: 80 */
 static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1102,12 +1107,12 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
     const float c_H_0 = 9/(x + 9);
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
     float c_H_1;
-    if (x < 1.9390924F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+    if (x < 0.48711845F) {
+        c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        c_H_1 = (1 - cosf(phi))/(s*s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1167,7 +1172,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1176,10 +1181,11 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_H_0_lanes[k] = 9/(x + 9);
-            c_H_1_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+            c_H_1_lanes[k] = (1 - cos0)/(s*s);
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1189,7 +1195,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             c_H_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 1.9390924F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.48711845F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_2;
@@ -1306,8 +1312,8 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
 
 /* symrot_tangent_m3_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
- * det_H: Horner degree 13 in x below x = 1.93909, else 36*sin(phi/2)**2/(s**2*(x + 9))
- * ops: 47 */
+ * det_H: Horner degree 6 in x below x = 0.487118, else 36*sin(phi/2)**2/(s**2*(x + 9))
+ * ops: 25 */
 static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1315,8 +1321,8 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
         return NAN;
     }
     float c_det_H;
-    if (x < 1.9390924F) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.1664401e-10F + (-1.4436824e-11F)*x) - 9.345603e-10F) + 7.4146143e-09F) - 5.8145545e-08F) + 4.4963303e-07F) - 3.4176435e-06F) + 2.5421212e-05F) - 0.0001838567F) + 9677.0F/7558272.0F) - 3547.0F/419904.0F) + 299.0F/5832.0F) - 29.0F/108.0F) + 1;
+    if (x < 0.48711845F) {
+        c_det_H = x*(x*(x*(x*(x*((2.5421212e-05F)*x - 0.0001838567F) + 9677.0F/7558272.0F) - 3547.0F/419904.0F) + 299.0F/5832.0F) - 29.0F/108.0F) + 1;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
@@ -1329,8 +1335,8 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.956738, else sin(phi/2)/s
- * G_2: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/s**2
- * ops: 104 */
+ * G_2: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/s**2
+ * ops: 92 */
 static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1349,13 +1355,12 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
     float c_G_1, c_G_2;
     if (x < 0.95673823F) {
         c_G_1 = x*(x*(x*(x*(x*(x*(4.5426026e-07F + (-4.8680302e-08F)*x) - 4.265201e-06F) + 4.0399394e-05F) - 193.0F/497664.0F) + 79.0F/20736.0F) - 17.0F/432.0F) + 1.0F/2.0F;
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+        c_G_2 = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        c_G_1 = sinf(w0)/s;
-        c_G_2 = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F : (1 - cosf(w0))/(s*s);
+        c_G_1 = sinf((1.0F/2.0F)*phi)/s;
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1385,7 +1390,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 0.13136065F) {
+            if (!(x < 1.2676506e+30F) || x < 1.9011963e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1415,12 +1420,20 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(79.0F/20736.0F + (-193.0F/497664.0F)*x) - 17.0F/432.0F) + 1.0F/2.0F;
-            c_G_2_lanes[k] = (1 - cos0)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+            poly_G_1_lanes[k] = 1.0F/2.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1428,11 +1441,11 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 0.13136065F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 1.9011963e-14F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 1.9390924F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.95673823F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1454,9 +1467,9 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
 /* symrot_tangent_m3_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/s**2
+ * K_1: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 21 in x below x = 4.19813, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
- * ops: 148 */
+ * ops: 136 */
 static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1474,16 +1487,15 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
     }
     const float c_K_0 = (9.0F/2.0F)/(x + 9);
     float c_K_1, c_K_2;
-    if (x < 1.9390924F) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+    if (x < 0.95673823F) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
-        const float w1 = (1.0F/2.0F)*phi;
-        c_K_1 = w0*(1 - cosf(w1));
-        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w0*(27/(x + 9) - 6*sinf(w1)/s);
+        c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w0*(27/(x + 9) - 6*sinf((1.0F/2.0F)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1513,7 +1525,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 1.9390924F) {
+            if (!(x < 1.2676506e+30F) || x < 0.95673823F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1533,7 +1545,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1543,14 +1555,22 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = 1.0F/(x + 9);
             const float w1 = 1.0F/(s*s);
             c_K_0_lanes[k] = (9.0F/2.0F)*w0;
-            c_K_1_lanes[k] = w1*(1 - cos0);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(27*w0 - 6*sin0/s);
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(27*w0 - 6*sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1560,7 +1580,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 1.9390924F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.95673823F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -1611,9 +1631,9 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m3_omega_f: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 12 in x below x = 1.93909, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 92 */
+ * ops: 74 */
 static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1626,12 +1646,12 @@ static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[
     const float c_H_0 = 9/(x + 9);
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
     float c_H_1;
-    if (x < 1.9390924F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4019927e-12F)*x - 5.5357118e-11F) + 4.769992e-10F) - 4.0931587e-09F) + 3.4947433e-08F) - 2.9653222e-07F) + 2.4963451e-06F) - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+    if (x < 0.48711845F) {
+        c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        c_H_1 = (1 - cosf(phi))/(s*s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];

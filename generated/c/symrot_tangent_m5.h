@@ -71,8 +71,8 @@ static inline double symrot_tangent_m5_angle(const double p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 9 in x below x = 0.41316, else (1 - cos(phi))/s**2
- * ops: 97 */
+ * R_2: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * ops: 93 */
 static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -89,15 +89,16 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 0.1110480704185358) {
+    if (x < 0.11104807041853587) {
         c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        c_R_1 = 2*sin(w0)*cos(w0)/s;
-        c_R_2 = x < 0.41316041360625944 ? x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : (1 - cos(phi))/(s*s);
+        const double w1 = sin(w0);
+        c_R_1 = 2*w1*cos(w0)/s;
+        c_R_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : 2*(w1*w1)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -159,21 +160,10 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1 + (-9.0/50.0)*x;
-            c_R_2_lanes[k] = (1 - cos1)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -185,7 +175,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             c_R_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.41316041360625944 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.21392718170599553 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -207,9 +197,9 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
 /* symrot_tangent_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 138 */
+ * ops: 134 */
 static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -227,16 +217,17 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 25/(x + 25);
     double c_H_1, c_H_2;
-    if (x < 0.41316041360625944) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+    if (x < 0.21392718170599553) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
         const double w1 = (1.0/2.0)*phi;
-        c_H_1 = w0*(1 - cos(phi));
-        c_H_2 = x < 3.1374537386488224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*sin(w1)*cos(w1)/s);
+        const double w2 = sin(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*w2*cos(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -266,7 +257,7 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 0.41316041360625944) {
+            if (!(x <= 236.80339887498948) || x < 0.21392718170599553) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -286,7 +277,7 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -295,26 +286,15 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const double w0 = 1.0/(x + 25);
             const double w1 = 1.0/(s*s);
             c_H_0_lanes[k] = 25*w0;
-            c_H_1_lanes[k] = w1*(1 - cos0);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
-            c_H_2_lanes[k] = w1*(-2*cos1*sin1/s + 25*w0);
+            c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+            c_H_2_lanes[k] = w1*(-2*cos0*sin0/s + 25*w0);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -324,11 +304,11 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             c_H_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.41316041360625944 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.21392718170599553 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 3.1374537386488224 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 3.1374537386488126 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -370,7 +350,7 @@ static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double H
     }
     const double c_H_inverse_0 = (1.0/25.0)*x + 1;
     double c_H_inverse_2;
-    if (x < 6.511791226584078) {
+    if (x < 6.511791226584059) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
@@ -407,7 +387,7 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 6.511791226584078) {
+            if (!(x <= 236.80339887498948) || x < 6.511791226584059) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -452,7 +432,7 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             c_H_inverse_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
-            const double v_H_inverse_2 = x < 6.511791226584078 ? poly_H_inverse_2 : closed_H_inverse_2;
+            const double v_H_inverse_2 = x < 6.511791226584059 ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
@@ -473,8 +453,8 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
 
 /* symrot_tangent_m5_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 15 in x below x = 1.57118, else 100*sin(phi/2)**2/(s**2*(x + 25))
- * ops: 53 */
+ * det_H: Horner degree 8 in x below x = 0.213927, else 100*sin(phi/2)**2/(s**2*(x + 25))
+ * ops: 31 */
 static inline double symrot_tangent_m5_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -482,8 +462,8 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
         return NAN;
     }
     double c_det_H;
-    if (x < 1.5711836845444251) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(9.778632622432e-18 + (-4.5732425583628e-19)*x) - 2.069196198448e-16) + 4.32659709712e-15) - 8.9230635128e-14) + 1.8109456592e-12) - 3.606187528e-11) + 7.01918024e-10) - 33216019.0/2500000000000000.0) + 1517899.0/6250000000000.0) - 530507.0/125000000000.0) + 87293.0/1250000000.0) - 5279.0/5000000.0) + 351.0/25000.0) - 3.0/20.0) + 1;
+    if (x < 0.21392718170599553) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*((7.01918024e-10)*x - 33216019.0/2500000000000000.0) + 1517899.0/6250000000000.0) - 530507.0/125000000000.0) + 87293.0/1250000000.0) - 5279.0/5000000.0) + 351.0/25000.0) - 3.0/20.0) + 1;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
@@ -496,8 +476,8 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.111048, else sin(phi/2)/s
- * G_2: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/s**2
- * ops: 92 */
+ * G_2: Horner degree 18 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
+ * ops: 124 */
 static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -514,14 +494,15 @@ static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 0.1110480704185358) {
+    if (x < 0.11104807041853587) {
         c_G_1 = x*(x*(x*(x*(x*(x*(8357819.0/2048000000000000.0 + (-1.6919252294921874e-10)*x) - 500957.0/5120000000000.0) + 59547.0/25600000000.0) - 1747.0/32000000.0) + 1003.0/800000.0) - 11.0/400.0) + 1.0/2.0;
-        c_G_2 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        c_G_1 = sin((1.0/2.0)*phi)/s;
-        c_G_2 = x < 0.2139271817059954 ? x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        const double w0 = (1.0/2.0)*phi;
+        c_G_1 = sin(w0)/s;
+        c_G_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : (1 - cos(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -581,20 +562,12 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/4.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+            c_G_2_lanes[k] = (1 - cos0)/(s*s);
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -606,7 +579,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             c_G_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.1110480704185358 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 3.1374537386488126 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -628,9 +601,9 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
 /* symrot_tangent_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/s**2
+ * K_1: Horner degree 18 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
  * K_2: Horner degree 18 in x below x = 3.13745, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
- * ops: 127 */
+ * ops: 159 */
 static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -648,15 +621,16 @@ static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (25.0/2.0)/(x + 25);
     double c_K_1, c_K_2;
-    if (x < 0.2139271817059954) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+    if (x < 3.1374537386488126) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
-        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 3.1374537386488224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0 : (1.0/10.0)*w0*(125/(x + 25) - 10*sin((1.0/2.0)*phi)/s);
+        const double w1 = (1.0/2.0)*phi;
+        c_K_1 = w0*(1 - cos(w1));
+        c_K_2 = (1.0/10.0)*w0*(125/(x + 25) - 10*sin(w1)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -686,7 +660,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 0.1110480704185358) {
+            if (!(x <= 236.80339887498948) || x < 3.1374537386488126) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -706,7 +680,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -716,22 +690,14 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double w0 = 1.0/(x + 25);
             const double w1 = 1.0/(s*s);
             c_K_0_lanes[k] = (25.0/2.0)*w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/10.0)*w1*(125*w0 - 10*sin1/s);
+            c_K_1_lanes[k] = w1*(1 - cos0);
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/10.0)*w1*(125*w0 - 10*sin0/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -741,11 +707,11 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x <= 236.80339887498948) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.1110480704185358 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 3.1374537386488126 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 3.1374537386488224 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 3.1374537386488126 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x <= 236.80339887498948) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -781,7 +747,7 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
     }
     const double c_H_inverse_0 = (1.0/25.0)*x + 1;
     double c_H_inverse_2;
-    if (x < 6.511791226584078) {
+    if (x < 6.511791226584059) {
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
@@ -801,9 +767,9 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
 /* symrot_tangent_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.41316, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 132 */
+ * ops: 128 */
 static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -815,16 +781,17 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
     }
     const double c_H_0 = 25/(x + 25);
     double c_H_1, c_H_2;
-    if (x < 0.41316041360625944) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(8.523086e-11 + (-3.99257716e-12)*x) - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+    if (x < 0.21392718170599553) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = 1.0/(s*s);
         const double w1 = (1.0/2.0)*phi;
-        c_H_1 = w0*(1 - cos(phi));
-        c_H_2 = x < 3.1374537386488224 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*sin(w1)*cos(w1)/s);
+        const double w2 = sin(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*w2*cos(w1)/s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -851,7 +818,7 @@ static inline void symrot_tangent_m5_to_quaternion(const double p[3], double e[4
     }
     const double c_e_0 = -1.0/2.0*sqrt(2)*sqrt(sqrt(x + 25) + 5)*(x + 10*sqrt(x + 25) - 75)/pow(x + 25, 5.0/4.0);
     double c_nu;
-    if (x < 0.1110480704185358) {
+    if (x < 0.11104807041853587) {
         c_nu = x*(x*(x*(x*(x*(x*(8357819.0/1024000000000000.0 + (-3.383850458984375e-10)*x) - 500957.0/2560000000000.0) + 59547.0/12800000000.0) - 1747.0/16000000.0) + 1003.0/400000.0) - 11.0/200.0) + 1;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
@@ -893,7 +860,7 @@ static inline int symrot_tangent_m5__from_quaternion(double e0, double e1, doubl
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.22832695303370756) {
+    if (t < 0.22832695303370731) {
         sigma = t*(t*(t*(t*(t*(t*((6.28986084965754e-11)*t + 2.424361005796223e-09) + 9.208975986552029e-08) + 6880849.0/2016000000000.0) + 43619.0/360000000.0) + 2381.0/600000.0) + 11.0/100.0) + 2;
     } else {
         sigma = 5*tan((1.0/5.0)*phi)/sin((1.0/2.0)*phi);
@@ -1013,7 +980,7 @@ static inline float symrot_tangent_m5_angle_f(const float p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 1.57118, else sin(phi)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
  * ops: 91 */
 static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R[9])
 {
@@ -1038,7 +1005,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         c_R_1 = sinf(phi)/s;
-        c_R_2 = (1 - cosf(phi))/(s*s);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1098,12 +1065,20 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_R_1_lanes[k] = sin0/s;
             poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = (1 - cos0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin1*sin1)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(201.0F/50000.0F + (-2471.0F/10000000.0F)*x) - 11.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1115,7 +1090,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             c_R_1_lanes[k] = !(x < 236.8034F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 0.41316044F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.111048065F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 236.8034F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1137,7 +1112,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
  * ops: 118 */
 static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
@@ -1165,8 +1140,9 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
         const float w1 = (1.0F/2.0F)*phi;
-        c_H_1 = w0*(1 - cosf(phi));
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1196,7 +1172,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 0.41316044F) {
+            if (!(x < 236.8034F) || x < 0.111048065F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1216,7 +1192,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1225,26 +1201,15 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float w0 = 1.0F/(x + 25);
             const float w1 = 1.0F/(s*s);
             c_H_0_lanes[k] = 25*w0;
-            c_H_1_lanes[k] = w1*(1 - cos0);
-            poly_H_1_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w1*(-2*cos1*sin1/s + 25*w0);
+            c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
+            poly_H_1_lanes[k] = x*(x*(201.0F/50000.0F + (-2471.0F/10000000.0F)*x) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = w1*(-2*cos0*sin0/s + 25*w0);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1254,7 +1219,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             c_H_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 0.41316044F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.111048065F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 236.8034F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
@@ -1337,7 +1302,7 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 6.5117908F) {
+            if (!(x < 236.8034F) || x < 3.1374536F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1372,7 +1337,7 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float w0 = (s*s);
             c_H_inverse_0_lanes[k] = (1.0F/25.0F)*x + 1;
             c_H_inverse_2_lanes[k] = (-1.0F/2.0F*cos0*s/sin0 + (1.0F/25.0F)*w0 + 1)/w0;
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
+            poly_H_inverse_2_lanes[k] = x*(x*(x*(1.16e-08F + (-5.6e-11F)*x) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1382,7 +1347,7 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             c_H_inverse_1_lanes[k] = !(x < 236.8034F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const float poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
-            const float v_H_inverse_2 = x < 6.5117908F ? poly_H_inverse_2 : closed_H_inverse_2;
+            const float v_H_inverse_2 = x < 3.1374536F ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x < 236.8034F) ? NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1426,7 +1391,7 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.57118, else sin(phi/2)/s
- * G_2: Horner degree 8 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
+ * G_2: Horner degree 8 in x below x = 3.13745, else 2*sin(phi/4)**2/s**2
  * ops: 90 */
 static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
 {
@@ -1450,9 +1415,8 @@ static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        c_G_1 = sinf(w0)/s;
-        c_G_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F : (1 - cosf(w0))/(s*s);
+        c_G_1 = sinf((1.0F/2.0F)*phi)/s;
+        c_G_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F : 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1512,11 +1476,19 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = (1 - cos0)/(s*s);
+            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1551,7 +1523,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
 /* symrot_tangent_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 8 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
+ * K_1: Horner degree 8 in x below x = 3.13745, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 14 in x below x = 6.51179, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
  * ops: 117 */
 static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9])
@@ -1578,9 +1550,8 @@ static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9]
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
-        const float w1 = (1.0F/2.0F)*phi;
-        c_K_1 = w0*(1 - cosf(w1));
-        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*w0*(125/(x + 25) - 10*sinf(w1)/s);
+        c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*w0*(125/(x + 25) - 10*sinf((1.0F/2.0F)*phi)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1630,7 +1601,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1640,14 +1611,22 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = 1.0F/(x + 25);
             const float w1 = 1.0F/(s*s);
             c_K_0_lanes[k] = (25.0F/2.0F)*w0;
-            c_K_1_lanes[k] = w1*(1 - cos0);
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/10.0F)*w1*(125*w0 - 10*sin0/s);
+            c_K_2_lanes[k] = (1.0F/10.0F)*w1*(125*w0 - 10*sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1717,7 +1696,7 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
  * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
  * ops: 112 */
 static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
@@ -1739,8 +1718,9 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
         const float s = sqrtf(x);
         const float w0 = 1.0F/(s*s);
         const float w1 = (1.0F/2.0F)*phi;
-        c_H_1 = w0*(1 - cosf(phi));
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*sinf(w1)*cosf(w1)/s);
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];

@@ -71,7 +71,7 @@ static inline double symrot_tangent_m6_angle(const double p[3])
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 8 in x below x = 0.213555, else 2*sin(phi/2)**2/s**2
+ * R_2: Horner degree 8 in x below x = 0.213555, else (1 - cos(phi))/s**2
  * ops: 93 */
 static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R[9])
 {
@@ -89,16 +89,15 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 0.11094775628437421) {
+    if (x < 0.11094775628437428) {
         c_R_1 = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        c_R_1 = 2*w1*cos(w0)/s;
-        c_R_2 = x < 0.21355546857295157 ? x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0 : 2*(w1*w1)/(s*s);
+        c_R_1 = 2*sin(w0)*cos(w0)/s;
+        c_R_2 = x < 0.21355546857295174 ? x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0 : (1 - cos(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -160,9 +159,20 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1 + (-19.0/108.0)*x;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            c_R_2_lanes[k] = (1 - cos1)/(s*s);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -175,7 +185,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             c_R_1_lanes[k] = !(x < 108.0) ? NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.21355546857295157 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.21355546857295174 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 108.0) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -197,7 +207,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
 /* symrot_tangent_m6_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1: Horner degree 8 in x below x = 0.213555, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 8 in x below x = 0.213555, else (1 - cos(phi))/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
  * ops: 76 */
 static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
@@ -218,12 +228,12 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
     const double c_H_0 = 36/(x + 36);
     const double c_H_2 = 6912/pow(x + 36, 3);
     double c_H_1;
-    if (x < 0.21355546857295157) {
+    if (x < 0.21355546857295174) {
         c_H_1 = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         const double s = sqrt(x);
-        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+        c_H_1 = (1 - cos(phi))/(s*s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -253,7 +263,7 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 0.21355546857295157) {
+            if (!(x < 108.0) || x < 0.21355546857295174) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -273,7 +283,7 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -282,10 +292,11 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double w0 = x + 36;
             c_H_0_lanes[k] = 36/w0;
-            c_H_1_lanes[k] = 2*(sin0*sin0)/(s*s);
+            c_H_1_lanes[k] = (1 - cos0)/(s*s);
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = 6912/(w0*w0*w0);
         }
@@ -296,7 +307,7 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             c_H_0_lanes[k] = !(x < 108.0) ? NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.21355546857295157 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.21355546857295174 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 108.0) ? NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 108.0) ? NAN : closed_H_2;
@@ -437,7 +448,7 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 0.21355546857295157) {
+    if (x < 0.21355546857295174) {
         c_G_1 = x*(x*(x*(x*(x*(x*(1309.0/1486016741376.0 + (-8437.0/320979616137216.0)*x) - 301.0/10319560704.0) + 1225.0/1289945088.0) - 5.0/165888.0) + 19.0/20736.0) - 11.0/432.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
@@ -445,7 +456,7 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         c_G_1 = sin(w0)/s;
-        c_G_2 = x < 1.5515262672070247 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0 : (1 - cos(w0))/(s*s);
+        c_G_2 = x < 1.55152626720702 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0 : (1 - cos(w0))/(s*s);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -522,7 +533,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             c_G_1_lanes[k] = !(x < 108.0) ? NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 1.5515262672070247 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 1.55152626720702 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 108.0) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -565,7 +576,7 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
     const double c_K_0 = 18/(x + 36);
     const double c_K_2 = (sqrt(x + 36) + 24)/(pow(x + 36, 3.0/2.0)*(sqrt(x + 36) + 6));
     double c_K_1;
-    if (x < 1.5515262672070247) {
+    if (x < 1.55152626720702) {
         c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.539712705750998e-20)*x - 3.2995413180211223e-18) + 1.1372547251929727e-16) - 3.903540135397517e-15) + 1.3331388532585672e-13) - 4.524722683259537e-12) + 2717.0/17832200896512.0) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
@@ -653,7 +664,7 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x < 108.0) ? NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 1.5515262672070247 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 1.55152626720702 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 108.0) ? NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             c_K_2_lanes[k] = !(x < 108.0) ? NAN : closed_K_2;
@@ -702,7 +713,7 @@ static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[
 /* symrot_tangent_m6_omega: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1: Horner degree 8 in x below x = 0.213555, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 8 in x below x = 0.213555, else (1 - cos(phi))/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
  * ops: 70 */
 static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[3], double omega[3])
@@ -717,12 +728,12 @@ static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[
     const double c_H_0 = 36/(x + 36);
     const double c_H_2 = 6912/pow(x + 36, 3);
     double c_H_1;
-    if (x < 0.21355546857295157) {
+    if (x < 0.21355546857295174) {
         c_H_1 = x*(x*(x*(x*(x*(x*(x*((649.0/50779978334208.0)*x - 19.0/52242776064.0) + 131.0/13060694016.0) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         const double s = sqrt(x);
-        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+        c_H_1 = (1 - cos(phi))/(s*s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -749,7 +760,7 @@ static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4
     }
     const double c_e_0 = -18*(x - 12)/pow(x + 36, 3.0/2.0);
     double c_nu;
-    if (x < 0.21355546857295157) {
+    if (x < 0.21355546857295174) {
         c_nu = x*(x*(x*(x*(x*(x*(1309.0/743008370688.0 + (-8437.0/160489808068608.0)*x) - 301.0/5159780352.0) + 1225.0/644972544.0) - 5.0/82944.0) + 19.0/10368.0) - 11.0/216.0) + 1;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
@@ -791,7 +802,7 @@ static inline int symrot_tangent_m6__from_quaternion(double e0, double e1, doubl
     const double phi = 2*atan2(e_norm, fabs(e0));
     const double t = (phi*phi);
     double sigma;
-    if (t < 0.22832695303370756) {
+    if (t < 0.22832695303370731) {
         sigma = t*(t*(t*(t*(t*(t*((4.409262242954425e-11)*t + 1.7322265099038284e-09) + 7421137.0/109709829734400.0) + 794257.0/304749527040.0) + 1637.0/16796160.0) + 53.0/15552.0) + 11.0/108.0) + 2;
     } else {
         sigma = 6*tan((1.0/6.0)*phi)/sin((1.0/2.0)*phi);
@@ -911,8 +922,8 @@ static inline float symrot_tangent_m6_angle_f(const float p[3])
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 1.55153, else sin(phi)/s
- * R_2: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
- * ops: 105 */
+ * R_2: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/s**2
+ * ops: 87 */
 static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -931,12 +942,12 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
     float c_R_1, c_R_2;
     if (x < 1.5515263F) {
         c_R_1 = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         c_R_1 = sinf(phi)/s;
-        c_R_2 = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F : 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        c_R_2 = (1 - cosf(phi))/(s*s);
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -996,20 +1007,12 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = sin0/s;
             poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1 - cos0)/(s*s);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(67.0F/10077696.0F + (-2.6552954e-07F)*x) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1021,7 +1024,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             c_R_1_lanes[k] = !(x < 108.0F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 6.1960254F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.7966812F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 108.0F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1043,9 +1046,9 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m6_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 88 */
+ * ops: 70 */
 static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1064,12 +1067,12 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
     const float c_H_0 = 36/(x + 36);
     const float c_H_2 = 6912/powf(x + 36, 3);
     float c_H_1;
-    if (x < 6.1960254F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+    if (x < 1.5515263F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        c_H_1 = (1 - cosf(phi))/(s*s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1099,7 +1102,7 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 6.1960254F) {
+            if (!(x < 108.0F) || x < 0.7966812F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1119,7 +1122,7 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1128,11 +1131,12 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const float w0 = x + 36;
             c_H_0_lanes[k] = 36/w0;
-            c_H_1_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+            c_H_1_lanes[k] = (1 - cos0)/(s*s);
+            poly_H_1_lanes[k] = x*(x*(x*(x*(67.0F/10077696.0F + (-2.6552954e-07F)*x) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = 6912/(w0*w0*w0);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1142,7 +1146,7 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             c_H_0_lanes[k] = !(x < 108.0F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 6.1960254F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.7966812F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 108.0F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 108.0F) ? NAN : closed_H_2;
@@ -1548,9 +1552,9 @@ static inline void symrot_tangent_m6_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m6_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 36/(x + 36) (algebraic in x)
- * H_1: Horner degree 12 in x below x = 6.19603, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/s**2
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 82 */
+ * ops: 64 */
 static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1563,12 +1567,12 @@ static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[
     const float c_H_0 = 36/(x + 36);
     const float c_H_2 = 6912/powf(x + 36, 3);
     float c_H_1;
-    if (x < 6.1960254F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5863364e-17F)*x - 4.866641e-16F) + 1.4724016e-14F) - 4.3816483e-13F) + 1.2780628e-11F) - 3.6368664e-10F) + 1.0030095e-08F) - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+    if (x < 1.5515263F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        c_H_1 = (1 - cosf(phi))/(s*s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];

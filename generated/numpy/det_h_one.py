@@ -24,7 +24,7 @@ P_MAX_SQUARED = 11.243134665607636  # fl(p_max^2); inside the range: x = |p|^2 <
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283314
+    small = x < 1.4342812090283275
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -53,11 +53,14 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.4031334653787326
+    small = x < 0.764824235244299
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -5.1339188726594446e-12
+        series = -2.4717768942862145e-15
+        series = -3.1172082783912966e-14 + t * series
+        series = -3.9741810435255436e-13 + t * series
+        series = -5.1339188726594446e-12 + t * series
         series = -6.740882557422226e-11 + t * series
         series = -9.035261398610608e-10 + t * series
         series = -1.244209181073502e-08 + t * series
@@ -77,11 +80,15 @@ def _nu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.4031334653787326
+    small = x < 0.764824235244299
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 4.0027973542176834e-11
+        series = 1.5905201294923517e-14
+        series = 1.1265276036398177e-13 + t * series
+        series = 7.978953359858307e-13 + t * series
+        series = 5.651354180596242e-12 + t * series
+        series = 4.0027973542176834e-11 + t * series
         series = 2.8351938089872594e-10 + t * series
         series = 2.0082446735268566e-09 + t * series
         series = 1.4225834946840515e-08 + t * series
@@ -103,15 +110,11 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283314
+    small = x < 0.764824235244299
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 3.0039990891728625e-19
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
+        series = 5.253841918550812e-15
         series = 6.068442620832808e-14 + t * series
         series = 7.02588589607731e-13 + t * series
         series = 8.157249203307483e-12 + t * series
@@ -143,11 +146,14 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.4031334653787326
+    small = x < 0.764824235244299
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 5.001592370976041e-12
+        series = 2.4273770483331233e-15
+        series = 3.054732998294483e-14 + t * series
+        series = 3.8844043825273724e-13 + t * series
+        series = 5.001592370976041e-12 + t * series
         series = 6.539638581589419e-11 + t * series
         series = 8.716860870222215e-10 + t * series
         series = 1.1911667949082915e-08 + t * series
@@ -167,7 +173,7 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283314
+    small = x < 1.4342812090283275
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -196,15 +202,11 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283314
+    small = x < 0.764824235244299
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 3.0039990891728625e-19
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
+        series = 5.253841918550812e-15
         series = 6.068442620832808e-14 + t * series
         series = 7.02588589607731e-13 + t * series
         series = 8.157249203307483e-12 + t * series
@@ -228,7 +230,7 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283314
+    small = x < 1.4342812090283275
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -257,7 +259,7 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222724141611
+    small = x < 2.6302227241416043
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -295,7 +297,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283314
+    small = x < 1.4342812090283275
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -328,7 +330,7 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222724141611
+    small = x < 2.6302227241416043
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -372,11 +374,14 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.4031334653787326
+    small = x < 0.764824235244299
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -2.5669594363297223e-12
+        series = -1.2358884471431072e-15
+        series = -1.5586041391956483e-14 + t * series
+        series = -1.9870905217627718e-13 + t * series
+        series = -2.5669594363297223e-12 + t * series
         series = -3.370441278711113e-11 + t * series
         series = -4.517630699305304e-10 + t * series
         series = -6.22104590536751e-09 + t * series
@@ -396,17 +401,11 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222724141611
+    small = x < 1.4342812090283275
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 2.0267443963482225e-26
-        series = 2.464306843655364e-25 + t * series
-        series = 3.0079808258545666e-24 + t * series
-        series = 3.687361714465075e-23 + t * series
-        series = 4.541735732543677e-22 + t * series
-        series = 5.623858631914075e-21 + t * series
-        series = 7.005500832060205e-20 + t * series
+        series = 7.005500832060205e-20
         series = 8.78575012329886e-19 + t * series
         series = 1.1103729250660078e-17 + t * series
         series = 1.415858727786663e-16 + t * series
@@ -426,22 +425,16 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+        out[big] = 2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283314
+    small = x < 0.764824235244299
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.5019995445864313e-19
-        series = 1.7235273973410984e-18 + t * series
-        series = 1.9803468699690516e-17 + t * series
-        series = 2.2788644458698284e-16 + t * series
-        series = 2.626920959275406e-15 + t * series
+        series = 2.626920959275406e-15
         series = 3.034221310416404e-14 + t * series
         series = 3.512942948038655e-13 + t * series
         series = 4.078624601653741e-12 + t * series
@@ -465,17 +458,11 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222724141611
+    small = x < 1.4342812090283275
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 2.0267443963482225e-26
-        series = 2.464306843655364e-25 + t * series
-        series = 3.0079808258545666e-24 + t * series
-        series = 3.687361714465075e-23 + t * series
-        series = 4.541735732543677e-22 + t * series
-        series = 5.623858631914075e-21 + t * series
-        series = 7.005500832060205e-20 + t * series
+        series = 7.005500832060205e-20
         series = 8.78575012329886e-19 + t * series
         series = 1.1103729250660078e-17 + t * series
         series = 1.415858727786663e-16 + t * series
@@ -495,14 +482,12 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+        out[big] = 2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222724141611
+    small = x < 2.6302227241416043
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -556,7 +541,7 @@ def _e_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _ratio_64(t, phi):
-    small = t < 0.7851233626304397
+    small = t < 0.7851233626304374
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
@@ -572,13 +557,12 @@ def _ratio_64(t, phi):
     if not small.all():
         big = ~small
         phi = phi[big]
-        w0 = (0.5)*phi
-        out[big] = numpy.cbrt(6*phi - 12*numpy.sin(w0)*numpy.cos(w0))/phi
+        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/phi
     return out
 
 
 def _slope_64(t, phi):
-    small = t < 1.5083706105984414
+    small = t < 1.5083706105984371
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
@@ -612,32 +596,32 @@ def _angle_64(s, d):
     start = 1.0 + s2 * start
     v = 1.0 - numpy.cbrt(numpy.maximum(1.0 - s / 3.3530783864394875, 0.0))
     y = 2.0 * v - 1.0
-    far = -1.9799649845617596e-05
-    far = 3.845712059591823e-05 + y * far
-    far = 6.944290860171888e-05 + y * far
-    far = -0.0001466954306176658 + y * far
-    far = -0.00014373224275280463 + y * far
-    far = 0.0003115313529609402 + y * far
-    far = 0.00012868823229833358 + y * far
-    far = -0.00030993305996142973 + y * far
-    far = -0.00016808026446555073 + y * far
-    far = 0.0003578223364733247 + y * far
-    far = -0.00011488832383323612 + y * far
-    far = 0.00015591438323289667 + y * far
-    far = -0.0004915899408385197 + y * far
-    far = 0.0008726139854363284 + y * far
-    far = -0.0014078691985324407 + y * far
-    far = 0.002564052915767814 + y * far
-    far = -0.00441490398383476 + y * far
-    far = 0.008868914251229019 + y * far
-    far = -0.01410305605515404 + y * far
-    far = 0.0374013021897593 + y * far
-    far = -0.05443155201399025 + y * far
-    far = 0.17235578974251842 + y * far
-    far = -0.4721849231422934 + y * far
-    far = 2.919122883842764 + y * far
-    far = 3.688874917307175 + y * far
-    phi = numpy.where(s < 0.6986294588918617, s * start, far)
+    far = -1.979456946368366e-05
+    far = 3.845923283356135e-05 + y * far
+    far = 6.940558049065732e-05 + y * far
+    far = -0.0001467069417704233 + y * far
+    far = -0.00014361441577429634 + y * far
+    far = 0.0003115583333528588 + y * far
+    far = 0.00012847745214711797 + y * far
+    far = -0.0003099684923909368 + y * far
+    far = -0.0001678436288606955 + y * far
+    far = 0.00035785075169448037 + y * far
+    far = -0.00011506234184706436 + y * far
+    far = 0.00015590021809761445 + y * far
+    far = -0.000491505148100637 + y * far
+    far = 0.0008726182091765766 + y * far
+    far = -0.0014078962528680332 + y * far
+    far = 0.0025640522715133797 + y * far
+    far = -0.004414898527649544 + y * far
+    far = 0.008868914263147634 + y * far
+    far = -0.014103056706279935 + y * far
+    far = 0.03740130220064722 + y * far
+    far = -0.05443155197308994 + y * far
+    far = 0.1723557897410232 + y * far
+    far = -0.47218492314335037 + y * far
+    far = 2.919122883842834 + y * far
+    far = 3.6888749173071784 + y * far
+    phi = numpy.where(s < 0.6986294588918609, s * start, far)
     phi = numpy.clip(phi, 0.0, 6.283185307179586).astype(s.dtype)
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
@@ -656,11 +640,13 @@ def _angle_64(s, d):
 def _scale_64(e0, e_norm):
     phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
     t = phi * phi
-    small = t < 0.8013171044383103
+    small = t < 1.5011636131873347
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
-        series = 9.165622812957786e-15
+        series = 5.879215449421489e-18
+        series = 2.3211137300576825e-16 + t * series
+        series = 9.165622812957786e-15 + t * series
         series = 3.620429902548073e-13 + t * series
         series = 1.430275196509799e-11 + t * series
         series = 5.645976592827012e-10 + t * series
@@ -674,16 +660,20 @@ def _scale_64(e0, e_norm):
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/numpy.sin((0.5)*phi)
+        w0 = (0.5)*phi
+        w1 = numpy.sin(w0)
+        out[big] = numpy.cbrt(6*phi - 12*w1*numpy.cos(w0))/w1
     return out
 
 
 def _p_prime_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 2.630222574480542
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -9.50993765619616e-09
+        series = -4.569666554548725e-11
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
         series = -1.4686206650492366e-07 + t * series
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
@@ -694,7 +684,9 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = 4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
@@ -714,7 +706,8 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
         big = ~small
         phi = phi[big]
         sin_half = sin_half[big]
-        out[big] = 2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+        cos_half = cos_half[big]
+        out[big] = -2*sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi)
     return out
 
 
@@ -740,11 +733,23 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7648242161335777
+    small = x < 4.619481091176478
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.548516833380779e-07
+        series = 2.6209591715593697e-20
+        series = 3.0039990891728625e-19 + t * series
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -769,12 +774,11 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 0.7648242161335777
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.1911667949082915e-08
-        series = 1.683039183039183e-07 + t * series
+        series = 1.683039183039183e-07
         series = 2.4930426716141e-06 + t * series
         series = 3.968253968253968e-05 + t * series
         series = 0.0007142857142857143 + t * series
@@ -784,19 +788,19 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        out[big] = 2*w0/numpy.cbrt(6*phi - 12*w0)
+        w0 = numpy.sin(phi)
+        out[big] = w0/numpy.cbrt(6*phi - 6*w0)
     return out
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 2.630222574480542
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -4.75496882809808e-09
+        series = -2.2848332772743624e-11
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
         series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
@@ -807,16 +811,30 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = 2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7648242161335777
+    small = x < 4.619481091176478
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.548516833380779e-07
+        series = 2.6209591715593697e-20
+        series = 3.0039990891728625e-19 + t * series
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -833,11 +851,13 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 2.630222574480542
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -4.75496882809808e-09
+        series = -2.2848332772743624e-11
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
         series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
@@ -848,7 +868,9 @@ def _H_1_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = 2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
@@ -887,11 +909,13 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 2.630222574480542
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = -9.50993765619616e-09
+        series = -4.569666554548725e-11
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
         series = -1.4686206650492366e-07 + t * series
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
@@ -902,7 +926,9 @@ def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        out[big] = 4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
@@ -966,16 +992,21 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
         big = ~small
         phi = phi[big]
         sin_half = sin_half[big]
-        out[big] = sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
+        cos_half = cos_half[big]
+        out[big] = -sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi)
     return out
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7648242161335777
+    small = x < 2.630222574480542
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.8955121406990826e-07
+        series = 4.242513271852192e-12
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -984,18 +1015,29 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        sin_half = sin_half[big]
         cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+        out[big] = (1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7648242161335777
+    small = x < 4.619481091176478
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 7.742584166903895e-08
+        series = 1.3104795857796848e-20
+        series = 1.5019995445864313e-19 + t * series
+        series = 1.7235273973410984e-18 + t * series
+        series = 1.9803468699690516e-17 + t * series
+        series = 2.2788644458698284e-16 + t * series
+        series = 2.626920959275406e-15 + t * series
+        series = 3.034221310416404e-14 + t * series
+        series = 3.512942948038655e-13 + t * series
+        series = 4.078624601653741e-12 + t * series
+        series = 4.7515127524272383e-11 + t * series
+        series = 5.558692794351005e-10 + t * series
+        series = 6.5376456526666615e-09 + t * series
+        series = 7.742584166903895e-08 + t * series
         series = 9.256715506715507e-07 + t * series
         series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
@@ -1012,11 +1054,15 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7648242161335777
+    small = x < 2.630222574480542
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 1.8955121406990826e-07
+        series = 4.242513271852192e-12
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -1025,18 +1071,24 @@ def _K_1_32(x, phi, s, d, sin_half, cos_half):
     if not small.all():
         big = ~small
         phi = phi[big]
-        sin_half = sin_half[big]
         cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
+        out[big] = (1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222574480542
+    small = x < 4.619481091176478
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 3.157810155130715e-14
+        series = 1.1742209353136828e-21
+        series = 1.3462827495637501e-20 + t * series
+        series = 1.5454156215361094e-19 + t * series
+        series = 1.7764157194142527e-18 + t * series
+        series = 2.0451064003372294e-17 + t * series
+        series = 2.3586252560910385e-16 + t * series
+        series = 2.725820183855303e-15 + t * series
+        series = 3.157810155130715e-14 + t * series
         series = 3.6688033619582197e-13 + t * series
         series = 4.277333653830018e-12 + t * series
         series = 5.008208696060211e-11 + t * series
@@ -1053,9 +1105,10 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
         big = ~small
         phi = phi[big]
         sin_half = sin_half[big]
-        w0 = numpy.cbrt(6*phi - 6*numpy.sin(phi))
+        cos_half = cos_half[big]
+        w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
         w1 = w0**2
-        out[big] = (-sin_half/w0 + (0.125)*w1/sin_half**2)/w1
+        out[big] = (sin_half/w0 + (0.125)*w1/sin_half**2)/w1
     return out
 
 
@@ -1073,7 +1126,7 @@ def _e_0_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _ratio_32(t, phi):
-    small = t < 1.5083706018396157
+    small = t < 0.7851233424843009
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
@@ -1084,12 +1137,13 @@ def _ratio_32(t, phi):
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/phi
+        w0 = (0.5)*phi
+        out[big] = numpy.cbrt(6*phi - 12*numpy.sin(w0)*numpy.cos(w0))/phi
     return out
 
 
 def _slope_32(t, phi):
-    small = t < 1.5083706018396157
+    small = t < 2.897865308578332
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
@@ -1102,7 +1156,9 @@ def _slope_32(t, phi):
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
+        w0 = (0.5)*phi
+        w1 = numpy.sin(w0)
+        out[big] = 4*w1**2/numpy.cbrt(6*phi - 12*w1*numpy.cos(w0))**2
     return out
 
 
@@ -1118,32 +1174,32 @@ def _angle_32(s, d):
     start = 1.0 + s2 * start
     v = 1.0 - numpy.cbrt(numpy.maximum(1.0 - s / 3.3530783864394875, 0.0))
     y = 2.0 * v - 1.0
-    far = -1.9799649845617596e-05
-    far = 3.845712059591823e-05 + y * far
-    far = 6.944290860171888e-05 + y * far
-    far = -0.0001466954306176658 + y * far
-    far = -0.00014373224275280463 + y * far
-    far = 0.0003115313529609402 + y * far
-    far = 0.00012868823229833358 + y * far
-    far = -0.00030993305996142973 + y * far
-    far = -0.00016808026446555073 + y * far
-    far = 0.0003578223364733247 + y * far
-    far = -0.00011488832383323612 + y * far
-    far = 0.00015591438323289667 + y * far
-    far = -0.0004915899408385197 + y * far
-    far = 0.0008726139854363284 + y * far
-    far = -0.0014078691985324407 + y * far
-    far = 0.002564052915767814 + y * far
-    far = -0.00441490398383476 + y * far
-    far = 0.008868914251229019 + y * far
-    far = -0.01410305605515404 + y * far
-    far = 0.0374013021897593 + y * far
-    far = -0.05443155201399025 + y * far
-    far = 0.17235578974251842 + y * far
-    far = -0.4721849231422934 + y * far
-    far = 2.919122883842764 + y * far
-    far = 3.688874917307175 + y * far
-    phi = numpy.where(s < 0.6986294588918617, s * start, far)
+    far = -1.979456946368366e-05
+    far = 3.845923283356135e-05 + y * far
+    far = 6.940558049065732e-05 + y * far
+    far = -0.0001467069417704233 + y * far
+    far = -0.00014361441577429634 + y * far
+    far = 0.0003115583333528588 + y * far
+    far = 0.00012847745214711797 + y * far
+    far = -0.0003099684923909368 + y * far
+    far = -0.0001678436288606955 + y * far
+    far = 0.00035785075169448037 + y * far
+    far = -0.00011506234184706436 + y * far
+    far = 0.00015590021809761445 + y * far
+    far = -0.000491505148100637 + y * far
+    far = 0.0008726182091765766 + y * far
+    far = -0.0014078962528680332 + y * far
+    far = 0.0025640522715133797 + y * far
+    far = -0.004414898527649544 + y * far
+    far = 0.008868914263147634 + y * far
+    far = -0.014103056706279935 + y * far
+    far = 0.03740130220064722 + y * far
+    far = -0.05443155197308994 + y * far
+    far = 0.1723557897410232 + y * far
+    far = -0.47218492314335037 + y * far
+    far = 2.919122883842834 + y * far
+    far = 3.6888749173071784 + y * far
+    phi = numpy.where(s < 0.6986294588918609, s * start, far)
     phi = numpy.clip(phi, 0.0, 6.283185307179586).astype(s.dtype)
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
@@ -1176,9 +1232,7 @@ def _scale_32(e0, e_norm):
     if not small.all():
         big = ~small
         phi = phi[big]
-        w0 = (0.5)*phi
-        w1 = numpy.sin(w0)
-        out[big] = numpy.cbrt(6*phi - 12*w1*numpy.cos(w0))/w1
+        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/numpy.sin((0.5)*phi)
     return out
 
 

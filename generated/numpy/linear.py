@@ -112,14 +112,11 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.11647220631481629
+    small = x < 0.0649445220708132
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 0.0015769325991740776
-        series = 0.0017386131018401613 + t * series
-        series = 0.0019299437302723321 + t * series
-        series = 0.002159137935754174 + t * series
+        series = 0.002159137935754174
         series = 0.00243758516411674 + t * series
         series = 0.002781492528356466 + t * series
         series = 0.0032146330158866476 + t * series
@@ -146,14 +143,11 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.11647220631481629
+    small = x < 0.0649445220708132
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 0.0015769325991740776
-        series = 0.0017386131018401613 + t * series
-        series = 0.0019299437302723321 + t * series
-        series = 0.002159137935754174 + t * series
+        series = 0.002159137935754174
         series = 0.00243758516411674 + t * series
         series = 0.002781492528356466 + t * series
         series = 0.0032146330158866476 + t * series
@@ -176,16 +170,11 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.20569005717897526
+    small = x < 0.116472206314816
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 0.05885971719125154
-        series = 0.06018356076598873 + t * series
-        series = 0.061600857483278565 + t * series
-        series = 0.0631231337187008 + t * series
-        series = 0.06476400687636197 + t * series
-        series = 0.06653969900370939 + t * series
+        series = 0.06653969900370939
         series = 0.06846971320104332 + t * series
         series = 0.07057773738575546 + t * series
         series = 0.07289287133907002 + t * series

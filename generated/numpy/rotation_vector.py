@@ -28,7 +28,7 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.855928709321803e-12
+    small = x < 1.8559287093218047e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -63,7 +63,7 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.028297529613113e-13
+    small = x < 5.028297529613116e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -83,7 +83,7 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.028297529613113e-13
+    small = x < 5.028297529613116e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -100,7 +100,7 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.028297529613113e-13
+    small = x < 5.028297529613116e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -120,7 +120,7 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.028297529613113e-13
+    small = x < 5.028297529613116e-13
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -136,12 +136,11 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.5083706105984414
+    small = x < 0.7851233626304374
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
-        series = 8.22063524662433e-18
-        series = -2.8114572543455206e-15 + t * series
+        series = -2.8114572543455206e-15
         series = 7.647163731819816e-13 + t * series
         series = -1.6059043836821613e-10 + t * series
         series = 2.505210838544172e-08 + t * series
@@ -166,7 +165,7 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.56734820089753
+    small = x < 5.5673482008975155
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -204,7 +203,7 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.855928709321803e-12
+    small = x < 1.8559287093218047e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -220,7 +219,7 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 9.015158901432458e-09
+    small = x < 1.8559287093218047e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -239,7 +238,7 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 9.015158901432458e-09
+    small = x < 1.8559287093218047e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -254,7 +253,7 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.56734820089753
+    small = x < 5.5673482008975155
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -277,7 +276,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.855928709321803e-12
+    small = x < 1.8559287093218047e-12
     out = numpy.empty_like(x)
     if small.any():
         t = x[small]
@@ -298,7 +297,7 @@ def _angle_64(s, d):
 def _scale_64(e0, e_norm):
     phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
     t = phi * phi
-    small = t < 6.574622895991269e-14
+    small = t < 6.574622895991266e-14
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]

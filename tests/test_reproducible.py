@@ -1,0 +1,98 @@
+"""Code generation is bit-reproducible across machines (issue 15).
+
+Nothing whose result depends on the CPU may feed ``generated/``: NumPy dispatches ``sin``,
+``power``, ``geomspace``, … to SIMD kernels chosen at run time (their last bits differ between
+AVX-512, AVX2 and baseline x86-64), and OpenBLAS picks its kernels by CPU (``OPENBLAS_CORETYPE``).
+The plan layer therefore measures with :mod:`symrot.evaluation` (an mpmath-backed ideal libm) and
+fits with exact Chebyshev interpolation. These tests regenerate the files whose plans use every
+such measurement (a Newton start and its fit: eq 35; closed forms with switches: the rotation
+vector; the sine-family fold: euler_rodrigues) in fresh interpreters made to behave like other
+machines, and compare bytes with ``generated/``.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+from symrot.evaluation import log_grid, model_function
+from symrot.newton_start import chebyshev_interpolant
+from symrot.parsing import PHI
+
+ROOT = Path(__file__).resolve().parent.parent
+NAMES = ("det_h_one", "rotation_vector", "euler_rodrigues")
+RENDER = """
+import sys
+from symrot.api import derive
+from symrot.backends.numpy_backend import module_source
+from symrot.plan import evaluation_plan
+for name in sys.argv[1:]:
+    sys.stdout.write(module_source(evaluation_plan(derive(name).derivation, name)))
+    sys.stdout.write("\\0")
+"""
+
+
+def _numpy_dispatched_features() -> list[str]:
+    """The SIMD targets NumPy dispatches to on this CPU (beyond its baseline)."""
+    from numpy._core import _multiarray_umath as umath
+
+    return [f for f in umath.__cpu_dispatch__ if umath.__cpu_features__.get(f)]
+
+
+def _machines() -> list[dict[str, str]]:
+    baseline_numpy = " ".join(_numpy_dispatched_features())
+    machines = [{"OPENBLAS_CORETYPE": "Haswell", "OPENBLAS_NUM_THREADS": "1"},
+                {"OPENBLAS_CORETYPE": "Zen"}]
+    if baseline_numpy:  # a CPU without AVX2/AVX-512, as far as NumPy can tell
+        machines.append({"OPENBLAS_CORETYPE": "Sandybridge", "NPY_DISABLE_CPU_FEATURES": baseline_numpy})
+    return machines
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("machine", _machines(), ids=lambda m: ",".join(f"{k}={v}" for k, v in m.items()))
+def test_generated_numpy_modules_are_the_same_on_other_cpus(machine: dict[str, str]) -> None:
+    env = {**os.environ, **machine}
+    result = subprocess.run([sys.executable, "-c", RENDER, *NAMES], capture_output=True, text=True,
+                            env=env, cwd=ROOT, timeout=600, check=False)
+    assert result.returncode == 0, result.stderr[-2000:]
+    rendered = result.stdout.split("\0")[:-1]
+    for name, text in zip(NAMES, rendered, strict=True):
+        committed = (ROOT / "generated" / "numpy" / f"{name}.py").read_text(encoding="utf-8")
+        assert text == committed, (f"generated/numpy/{name}.py differs under {machine}: "
+                                   "the plan depends on the CPU")
+
+
+def test_model_functions_are_correctly_rounded() -> None:
+    """Each elementary call of the model is the nearest float to the exact value (mpmath, 60 digits)."""
+    x = np.array([1e-300, 1e-8, 0.3, 1.0, 2.5, 6.2, 1e3])
+    function = model_function(sp.sin(PHI) + 0 * PHI, [PHI])
+    with mpmath.workdps(60):
+        exact = [float(mpmath.sin(mpmath.mpf(float(v)))) for v in x]
+    assert function(x).tolist() == exact
+    single = model_function(sp.exp(-PHI / 3) * sp.atan(PHI), [PHI])(x.astype(np.float32))
+    assert single.dtype == np.float32
+
+
+def test_model_treats_points_off_the_real_domain_as_nan() -> None:
+    values = model_function(sp.sqrt(1 - PHI) + sp.asin(PHI), [PHI])(np.array([0.5, 2.0]))
+    assert np.isfinite(values[0]) and np.isnan(values[1])
+
+
+def test_log_grid_is_exact_at_the_ends_and_monotone() -> None:
+    grid = log_grid(1e-7, 6.283185307179586, 56)
+    assert grid[0] == 1e-7 and grid[-1] == 6.283185307179586 and np.all(np.diff(grid) > 0)
+    with mpmath.workdps(40):
+        ratio = mpmath.mpf(grid[1]) / mpmath.mpf(grid[0])
+    assert abs(float(ratio) - (6.283185307179586 / 1e-7) ** (1 / 55)) < 1e-13
+
+
+def test_chebyshev_interpolant_reproduces_a_polynomial_exactly() -> None:
+    coefficients = chebyshev_interpolant(lambda y: 1 - 2 * y + 3 * y**3, 5)
+    assert np.allclose(coefficients, [1, -2, 0, 3, 0, 0], atol=1e-15)
