@@ -29,7 +29,7 @@ setup-system: ## Install gcc, clang (+ sanitizer runtime), Eigen (bench peer), a
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
 	fi
 
-setup-bench: ## Install the benchmark peer SymForce in $(SYMFORCE_VENV) (bench/c_speed.py; not needed by the tests)
+setup-bench: ## Install the benchmark peer SymForce in a venv (SYMFORCE_VENV, default /tmp/symforce_venv; bench/c_speed.py only)
 	test -x $(SYMFORCE_VENV)/bin/python || $(PYTHON) -m venv $(SYMFORCE_VENV)
 	$(SYMFORCE_VENV)/bin/pip install -q symforce
 

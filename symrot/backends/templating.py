@@ -3,7 +3,7 @@
 Strict (``StrictUndefined``: a missing variable is an error, never an empty string), no
 auto-escaping (we emit code and LaTeX, not HTML), trailing newlines kept, and nothing
 time-dependent is ever passed in, so output is byte-identical across runs. Templates live in the
-top-level ``templates/`` directory, installed as the ``symrot.templates`` package.
+``symrot/templates/`` directory (the ``symrot.templates`` package, shipped in the wheel).
 """
 
 from __future__ import annotations
