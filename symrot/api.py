@@ -14,8 +14,9 @@ import sympy as sp
 from .core import SCALAR_NAMES, TENSOR_NAMES, Derivation, Tensor, derive_expression
 from .errors import SymrotError
 from .parsing import parse_expression
-from .registry import NamedParameterization, find_by_expression, is_identifier, lookup
+from .registry import NamedParameterization, find_by_expression, is_identifier, looks_like_a_name, lookup
 from .timeouts import time_limit
+from .validation import validate
 
 DERIVE_TIME_LIMIT = 60.0
 DEFAULT_SERIES_TERMS = 6
@@ -27,7 +28,7 @@ def resolve(expression: str | sp.Expr) -> tuple[sp.Expr, NamedParameterization |
     if isinstance(expression, sp.Expr):
         return expression, find_by_expression(expression)
     text = expression.strip() if isinstance(expression, str) else expression
-    if isinstance(text, str) and is_identifier(text):
+    if isinstance(text, str) and (is_identifier(text) or looks_like_a_name(text)):
         entry = lookup(text)
         return entry.expression, entry
     expr = parse_expression(text)
@@ -41,6 +42,8 @@ class DerivationResult:
     derivation: Derivation
     entry: NamedParameterization | None
     normalized: bool = False
+    original_kappa: sp.Expr | None = None
+    """κ of the expression as given, when ``normalize`` divided it out (eq 12)."""
 
     # -- direct access ------------------------------------------------------------------------
     @property
@@ -71,6 +74,7 @@ class DerivationResult:
             "equation": self.entry.equation if self.entry else None,
             "kappa": str(d.kappa),
             "normalized": self.normalized,
+            "original_kappa": str(self.original_kappa) if self.original_kappa is not None else None,
         }
         out.update({name: str(d.scalars[name]) for name in SCALAR_NAMES})
         for name in TENSOR_NAMES:
@@ -121,9 +125,11 @@ def derive(expression: str | sp.Expr, normalize: bool = False) -> DerivationResu
     expr, entry = resolve(expression)
     with time_limit(DERIVE_TIME_LIMIT, "derivation"):
         derivation = derive_expression(expr, normalize=normalize)
-    if normalize and derivation.p != expr:
+        original_kappa = validate(expr).kappa if normalize else None
+    normalized = normalize and derivation.p != expr
+    if normalized:
         entry = find_by_expression(derivation.p)
-    return DerivationResult(derivation, entry, normalized=normalize and derivation.p != expr)
+    return DerivationResult(derivation, entry, normalized=normalized, original_kappa=original_kappa)
 
 
 __all__ = ["DerivationResult", "SymrotError", "derive", "resolve"]

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import argparse
 import difflib
-import json
 import sys
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
+from . import strict_json
 from .api import derive
 from .registry import NAMED
 
@@ -28,7 +28,7 @@ def derivation_json() -> dict[str, str | bytes]:
     out: dict[str, str | bytes] = {}
     for name in NAMED:
         data = derive(name).to_dict(series_terms=8)
-        out[f"derivations/{name}.json"] = json.dumps(data, indent=2, sort_keys=True) + "\n"
+        out[f"derivations/{name}.json"] = strict_json.dumps(data, indent=2, sort_keys=True) + "\n"
     return out
 
 
@@ -80,10 +80,11 @@ def producers() -> list[tuple[str, Producer]]:
 
 
 def render(only: str | None = None) -> dict[str, Content]:
+    from .cli.progress import each
+
     files: dict[str, Content] = {}
-    for prefix, producer in producers():
-        if only and not prefix.startswith(only):
-            continue
+    selected = [(prefix, producer) for prefix, producer in producers() if not only or prefix.startswith(only)]
+    for _prefix, producer in each(selected, "symrot.generate"):
         files.update(producer())
     return dict(sorted(files.items()))
 

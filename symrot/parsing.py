@@ -14,8 +14,9 @@ functions in :data:`FUNCTIONS`.
 from __future__ import annotations
 
 import ast
+import difflib
 import unicodedata
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from fractions import Fraction
 
 import sympy as sp
@@ -107,6 +108,12 @@ def _bracket_depth(text: str) -> int:
     return deepest
 
 
+
+def _did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """"; did you mean X?" for the closest of ``choices``, or ""."""
+    close = difflib.get_close_matches(word[:40], list(choices), n=1, cutoff=0.6)
+    return f"; did you mean {close[0]}?" if close else ""
+
 class _Builder:
     """Turns a whitelisted AST into SymPy, rejecting everything else with a clear message."""
 
@@ -162,8 +169,9 @@ class _Builder:
             return self.extra_names[node.id]
         if node.id in FUNCTIONS:
             raise ParseError(f"function '{node.id}' must be called with one argument")
-        known = ", ".join(sorted(_VARIABLES) + sorted(_CONSTANTS) + sorted(self.extra_names))
-        raise ParseError(f"unknown name '{node.id[:40]}' (allowed names: {known})")
+        names = sorted(_VARIABLES) + sorted(_CONSTANTS) + sorted(self.extra_names)
+        raise ParseError(f"unknown name '{node.id[:40]}'{_did_you_mean(node.id, names)} "
+                         f"(allowed names: {', '.join(names)})")
 
     def _binary(self, node: ast.BinOp, depth: int) -> sp.Expr:
         left = self.build(node.left, depth + 1)
@@ -200,7 +208,8 @@ class _Builder:
         name = node.func.id
         if name not in FUNCTIONS:
             allowed = ", ".join(FUNCTIONS)
-            raise ParseError(f"unknown function '{name[:40]}' (allowed: {allowed})")
+            raise ParseError(f"unknown function '{name[:40]}'{_did_you_mean(name, FUNCTIONS)} "
+                             f"(allowed: {allowed})")
         if node.keywords or len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
             raise ParseError(f"function '{name}' takes exactly one argument")
         argument = self.build(node.args[0], depth + 1)

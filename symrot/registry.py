@@ -7,6 +7,7 @@ property of Section 3.2 that defines it, so that ``symrot solve`` can derive it 
 
 from __future__ import annotations
 
+import difflib
 import re
 from dataclasses import dataclass
 
@@ -14,7 +15,7 @@ import sympy as sp
 
 from .errors import UnknownName
 from .functions import RealCbrt
-from .parsing import PHI
+from .parsing import FUNCTIONS, PHI
 
 MAX_FAMILY_ORDER = 1000
 
@@ -79,6 +80,8 @@ NAMED = (*_FIXED, "sine_m4")
 """The named parameterizations that ``make generate`` writes (Table 1 and eq 35)."""
 
 _FAMILY = re.compile(r"^(sine|tangent|cayley)_m([1-9][0-9]*)$")
+_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_EXPRESSION_WORDS = {"phi", "pi", *FUNCTIONS}
 
 
 def family_member(family: str, m: int) -> NamedParameterization:
@@ -107,12 +110,27 @@ def lookup(identifier: str) -> NamedParameterization:
     match = _FAMILY.match(identifier)
     if match and len(match.group(2)) <= 4:
         return family_member(match.group(1), int(match.group(2)))
+    raise UnknownName(unknown_name_message(identifier))
+
+
+def unknown_name_message(identifier: str) -> str:
+    """"unknown parameterization …", with the closest registry names and the list of all of them."""
+    order = re.search(r"([0-9]+)$", identifier)
+    families = [f"{family}_m{order.group(1) if order else 'N'}" for family in ("sine", "tangent", "cayley")]
+    close = difflib.get_close_matches(identifier.lower(), [*_FIXED, *families], n=3, cutoff=0.6)
+    hint = f"; did you mean {' or '.join(close)}?" if close else ""
     known = ", ".join([*_FIXED, "sine_mN", "tangent_mN", "cayley_mN"])
-    raise UnknownName(f"unknown parameterization '{identifier[:60]}' (known: {known})")
+    return f"unknown parameterization '{identifier[:60]}'{hint} (registry names: {known})"
 
 
 def is_identifier(text: str) -> bool:
     return text in _FIXED or bool(_FAMILY.match(text))
+
+
+def looks_like_a_name(text: str) -> bool:
+    """A bare word that is no part of the expression language (phi, pi, function names): a
+    registry identifier, possibly misspelt."""
+    return bool(_WORD.fullmatch(text)) and text not in _EXPRESSION_WORDS
 
 
 def find_by_expression(expr: sp.Expr) -> NamedParameterization | None:

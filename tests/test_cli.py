@@ -58,7 +58,7 @@ def test_registry_name_and_normalization(capsys: pytest.CaptureFixture[str]) -> 
         (["derive", "sqrt(phi)"], "not real-analytic"),
         (["derive", "__import__('os').system('true')"], "cannot be called"),
         (["derive", "x + phi"], "unknown name 'x'"),
-        (["derive", "nonexistent_m0"], "unknown name"),
+        (["derive", "nonexistent_m0"], "unknown parameterization"),
         (["derive", "phi**3"], "kappa"),
         (["derive", "(" * 100 + "phi" + ")" * 100], "nested too deeply"),
     ],

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import argparse
 import difflib
-import json
 import sys
 from pathlib import Path
 from typing import Any
+
+from .. import strict_json
 
 EXIT_CHECK_FAILED = 1
 DEFAULT_ERRATA = "docs/errata.md"
@@ -38,18 +39,20 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..audit import run_all
+    from ..audit import all_checks, run_all
     from ..audit.report import REGENERATE, as_json, errata_markdown, table
     from ..errors import SymrotError
+    from .progress import each
 
     only = {key.strip() for key in args.only.split(",")} if args.only else None
-    results = run_all(only=only)
+    selected = [c for c in all_checks() if only is None or c.equation in only]
+    results = [result for check in each(selected, "symrot audit") for result in run_all([check])]
     if only is not None and not results:
         raise SymrotError(
             f"no check has the key(s) {args.only!r} (keys: 1-102, 'text after (N): ...', "
             "'Table 1 <row> <column>'; see symrot audit --json)"
         )
-    print(json.dumps(as_json(results), indent=2) if args.json else table(results))
+    print(strict_json.dumps(as_json(results), indent=2) if args.json else table(results))
     failed = any(r.outcome is None for r in results)
     if only is None:
         text = errata_markdown(results)

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
 from typing import Any
 
+from .. import strict_json
 from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
 
@@ -46,11 +46,22 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
 
     from ..backends import emitter
     from ..errors import SymrotError
+    from ..plan import evaluation_plan
+    from ..singularities import validity
+    from .progress import stages
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
         raise SymrotError(f"--name {name!r} is not a valid identifier")
-    for path in emitter(args.emit)(result.derivation, name, Path(args.out)):
+    emit = emitter(args.emit)
+    with stages(f"symrot: --emit {args.emit}", 3) as progress:
+        progress.start("validity range (Section 3.4)")
+        validity(result.derivation)
+        progress.start("evaluation plan (float64, float32)")
+        evaluation_plan(result.derivation, name)  # cached: the backend prints this plan
+        progress.start("printing")
+        paths = emit(result.derivation, name, Path(args.out))
+    for path in paths:
         print(path)
     return 0
 
@@ -60,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "emit", None):
         return emit_code(result, args)
     if args.json:
-        print(json.dumps(result.to_dict(series_terms=args.terms), indent=2))
+        print(strict_json.dumps(result.to_dict(series_terms=args.terms), indent=2))
     else:
         print(summary(result, args.terms))
     return 0
@@ -99,6 +110,9 @@ def summary(result: DerivationResult, terms: int) -> str:
         title += f"    [{result.entry.identifier}, eq {result.entry.equation}]"
     lines.append(title)
     kappa_note = "" if d.kappa == 1 else "   (not unit-normalized; --normalize divides p by it)"
+    if result.original_kappa is not None:
+        kappa_note = (f"   (normalized: p divided by the kappa {result.original_kappa} of the input)"
+                      if result.normalized else "   (--normalize: already unit-normalized)")
     lines.append(f"kappa = lim p/phi (eq 12) = {d.kappa}{kappa_note}")
     lines.append("")
     lines.append("Scalar functions")

@@ -10,6 +10,7 @@ from ..api import resolve
 from ..backends.figures import FIGURES, render
 from ..errors import SymrotError
 from ..validation import validate
+from .progress import each
 
 
 def register(subparsers: Any) -> None:
@@ -36,9 +37,9 @@ def run(args: argparse.Namespace) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise SymrotError(f"cannot create {args.out}: {exc.strerror}") from None
-    for number in args.figure or sorted(FIGURES):
-        for fmt in formats:
-            path = args.out / f"figure{number}.{fmt}"
-            path.write_bytes(render(number, fmt, extra))
-            print(path)
+    jobs = [(number, fmt) for number in args.figure or sorted(FIGURES) for fmt in formats]
+    for number, fmt in each(jobs, "symrot plot"):
+        path = args.out / f"figure{number}.{fmt}"
+        path.write_bytes(render(number, fmt, extra))
+        print(path)
     return 0

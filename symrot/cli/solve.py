@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
 from typing import Any
 
+from .. import strict_json
 from ..registry import find_by_expression
 from ..solve import solve_property
 
@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
         "equation": entry.equation if entry else None,
     }
     if args.json:
-        print(json.dumps(data, indent=2))
+        print(strict_json.dumps(data, indent=2))
         return 0
     if solution.expression is None:
         print("No closed form found; exact Taylor series of p from a power-series ansatz:")
