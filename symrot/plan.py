@@ -104,6 +104,9 @@ JITTER_SAMPLES = 6
 ALGEBRAIC_BUDGET_SECONDS = 20.0
 PRECISIONS: dict[str, type[np.floating]] = {"float64": np.float64, "float32": np.float32}
 CLOSED_TOLERANCE_ULP = 1.5
+ANGLE_TOLERANCE_ULP = 2.0
+"""A closed inverse φ(s) is printed only when its measured error (beyond the conditioning of φ(s),
+see :func:`closed_angle_error`) stays within this; otherwise the Newton angle is used."""
 NEWTON_ITERATIONS = 6
 START_TERMS = 8
 
@@ -223,7 +226,10 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
         return S
     if p.has(RealCbrt):
         return None
-    solutions: list[sp.Expr] = bounded(10, [], sp.solve, sp.Eq(p, S), PHI)
+    try:
+        solutions: list[sp.Expr] = bounded(10, [], sp.solve, sp.Eq(p, S), PHI)
+    except Exception:
+        return None  # no closed inverse: the plan uses the Newton angle
     for candidate in solutions:
         if candidate.has(sp.I) or candidate.free_symbols != {S}:
             continue
@@ -232,6 +238,42 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
         if value.is_real and abs(value - probe / kappa) < sp.Rational(1, 10**6):
             return sp.simplify(candidate) if len(str(candidate)) < 80 else candidate
     return None
+
+
+def closed_angle_error(inverse: sp.Expr, p: sp.Expr, phi_max: float, dtype: type) -> float:
+    """Worst error of the closed inverse φ(s) evaluated in ``dtype`` (ideal libm,
+    :mod:`symrot.evaluation`), in ulp of φ, beyond one rounding of s inside the formula (the
+    condition number s/(φ p′) of φ(s)); the reference is the exact inverse of the rounded s.
+
+    Measured from the smallest normal number (float32) or 10⁻³⁰⁰ to the edge of the range: a closed
+    form that cancels (asinh printed as log(s + √(s² + 1)), Cardano's formula) loses every digit
+    for small s or far out, and must not be printed (issue 16)."""
+    epsilon = float(np.finfo(dtype).eps)
+    smallest = 1e-300 if dtype is np.float64 else float(np.finfo(np.float32).tiny) * 16
+    end = min(phi_max, 4 * math.pi)
+    angles = np.concatenate([log_grid(smallest, end * (1 - 1e-6), GRID_POINTS),
+                             end * (1 - log_grid(0.25, 1e-6, EDGE_POINTS))])
+    model = model_function(inverse, [S])
+    with mpmath.workdps(40):
+        p_of = sp.lambdify(PHI, p, modules=[mpmath_namespace(), "mpmath"])
+        slope_of = sp.lambdify(PHI, sp.diff(p, PHI), modules=[mpmath_namespace(), "mpmath"])
+        exact_of = sp.lambdify(S, inverse, modules=[mpmath_namespace(), "mpmath"])
+        worst = 0.0
+        for angle in angles:
+            s = dtype(float(p_of(mpmath.mpf(float(angle)))))
+            if not np.isfinite(s) or s == 0:
+                continue
+            value = float(model(s))
+            exact = exact_of(mpmath.mpf(float(s)))
+            if not mpmath.isfinite(exact) or exact == 0:
+                continue
+            if not math.isfinite(value):
+                return math.inf
+            slope = slope_of(exact)
+            condition = float(abs(mpmath.mpf(float(s)) / (exact * slope))) if slope != 0 else math.inf
+            error = float(abs(mpmath.mpf(value) - exact) / abs(exact)) / epsilon
+            worst = max(worst, error - min(condition, 1e300))  # one rounding of s inside is allowed
+    return worst
 
 
 def _mp_function(expr: sp.Expr) -> object:
@@ -369,7 +411,8 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype)
         coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, phi_max, p_max, dtype)
         scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
-        angle = (ClosedAngle(inverse) if inverse is not None
+        angle = (ClosedAngle(inverse) if inverse is not None and complement is None
+                 and closed_angle_error(inverse, p, phi_max, dtype) <= ANGLE_TOLERANCE_ULP
                  else _newton_angle(derivation, phi_max, p_max, dtype))
         if complement is not None:
             assert inverse is not None

@@ -1,0 +1,42 @@
+"""Plans for generating functions outside the paper's families (issue 16): the angle is chosen by
+measurement, and SymPy's solver failures fall back to the Newton angle instead of escaping."""
+
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from symrot.api import derive
+from symrot.parsing import PHI
+from symrot.plan import NewtonAngle, closed_angle_error, closed_inverse, evaluation_plan
+
+
+def test_a_solver_that_raises_means_no_closed_inverse() -> None:
+    # sympy.solve raises NotImplementedError ("multiple generators") for this equation
+    assert closed_inverse(PHI * sp.cos(PHI / 4), sp.Integer(1)) is None
+
+
+def test_a_cancelling_closed_inverse_is_measured_and_rejected() -> None:
+    s = sp.Symbol("s", nonnegative=True)
+    cancelling = sp.log(s + sp.sqrt(s**2 + 1))  # asinh(s) as SymPy's solver may print it
+    assert closed_angle_error(cancelling, sp.sinh(PHI), 2 * np.pi, np.float64) > 1e6
+    assert closed_angle_error(sp.asinh(s), sp.sinh(PHI), 2 * np.pi, np.float64) <= 1.0
+    assert closed_angle_error(4 * sp.atan(s / 4), 4 * sp.tan(PHI / 4), 2 * np.pi, np.float32) <= 1.0
+
+
+def test_user_function_angle_keeps_relative_accuracy_down_to_1e_300() -> None:
+    derivation = derive("sinh(phi)").derivation
+    plan = evaluation_plan(derivation, "sinh_user")
+    namespace: dict[str, object] = {}
+    from symrot.backends.numpy_backend import module_source
+
+    exec(compile(module_source(plan), "<sinh_user>", "exec"), namespace)
+    angle = namespace["angle"]
+    magnitudes = np.array([1e-300, 1e-30, 1e-9, 1e-3, 0.5, 3.0])
+    got = angle(np.stack([magnitudes, 0 * magnitudes, 0 * magnitudes], axis=-1))  # type: ignore[operator]
+    with mpmath.workdps(50):
+        exact = [float(mpmath.asinh(mpmath.mpf(float(m)))) for m in magnitudes]
+    assert np.all(np.abs(got - exact) <= 2 * np.finfo(float).eps * np.abs(exact))
+    # SymPy's inverse of sinh cancels for small s: the measured plan takes the Newton angle
+    assert all(isinstance(p.angle, NewtonAngle) for p in plan.precisions.values())
