@@ -64,8 +64,13 @@ def tidy_radicals(expr: sp.Expr) -> sp.Expr:
 
 
 def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
-    """c(φ(√x)) with trigonometry removed, or None (time-bounded)."""
+    """c(φ(√x)) with trigonometry removed, or None (time-bounded).
+
+    Only an inverse built on an inverse trigonometric function can make sin/cos of φ algebraic in
+    s (asinh, atanh, Cardano's radicals, the identity φ = s cannot): for those, no time is spent."""
     base = base_angle(inverse)
+    if base is None and not inverse.has(*INVERSE_FUNCTIONS):
+        return None
 
     def reduce() -> sp.Expr:
         if base is None:
