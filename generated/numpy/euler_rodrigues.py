@@ -316,7 +316,11 @@ E0_MIN = 0.0
 
 
 def _as_float(value, name, shape):
+    """value as a float32 or float64 array of shape (..., *shape); ValueError for anything else
+    (complex, bool, object, string and datetime input is refused, never silently converted)."""
     value = numpy.asarray(value)
+    if value.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must be a real float or integer array, got dtype {value.dtype}")
     if value.dtype != numpy.float32:
         value = value.astype(numpy.float64)
     if value.ndim < len(shape) or value.shape[value.ndim - len(shape):] != shape:
@@ -441,8 +445,9 @@ def _tensor_block(p, name, out):
 
 
 def _apply(p, v, name):
+    v = _as_float(v, "the second argument", (3,))
     p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
-    v = numpy.asarray(v, dtype=p.dtype)
+    v = v.astype(p.dtype)
     table = _COEFFICIENTS[suffix]
     x = state[0]
     a = table[name + "_0"](*state)[..., None]
