@@ -75,6 +75,7 @@ from .algebraic import (
 )
 from .algebraic import X as X  # re-exported: the symbol of the coefficients' variable x = |p|²
 from .core import Derivation, derive_expression
+from .domain import FIRST_POWER, domain_limit
 from .evaluation import log_grid, model_function
 from .functions import RealCbrt, mpmath_namespace
 from .newton_start import FarStart, far_start
@@ -171,6 +172,9 @@ class PrecisionPlan:
     coefficients: dict[str, Coefficient]
     quaternion_scale: QuaternionScale
     """σ with **p** = σ **e** for from_quaternion (see :mod:`symrot.quaternion_plan`)."""
+    x_limit: float = 2.0**600
+    """Edge of the domain for unbounded p: every output is NaN for x = |p|² ≥ x_limit, the largest
+    power of two up to which every printed form is right (:mod:`symrot.domain`)."""
 
 
 @dataclass(frozen=True)
@@ -421,9 +425,31 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
         elif inverse is not None:
             coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
                             if isinstance(c, Branch) else c for n, c in coefficients.items()}
-        precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale)
+        limit = _domain_limit(derivation, coefficients, angle, inverse, phi_max, p_max, dtype)
+        precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale,
+                                          limit)
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
                           _p_max_squared(p, limits.phi_max, p_max))
+
+
+def _domain_limit(derivation: Derivation, coefficients: dict[str, Coefficient],
+                  angle: ClosedAngle | NewtonAngle, inverse: sp.Expr | None, phi_max: float, p_max: float,
+                  dtype: type) -> float:
+    """x_limit of :class:`PrecisionPlan`: the printed forms as the backends evaluate them above
+    x = 2^32 (algebraic forms, the closed side of branches, the closed angle), swept by
+    :func:`symrot.domain.domain_limit`."""
+    raw = {**derivation.coefficient_expressions(), QUATERNION_SCALAR: quaternion_scalar()}
+    printed: dict[str, tuple[str, sp.Expr]] = {}
+    for name, coefficient in coefficients.items():
+        if isinstance(coefficient, Algebraic):
+            printed[name] = ("algebraic", coefficient.expression)
+        elif isinstance(coefficient, Branch) and max(coefficient.threshold,
+                                                     coefficient.smallest_switch[0]) < 2.0**FIRST_POWER:
+            printed[name] = ("closed", coefficient.closed)
+    references = {name: raw[name] for name in coefficients}
+    if isinstance(angle, ClosedAngle):
+        printed["angle"], references["angle"] = ("closed", angle.expression), PHI
+    return domain_limit(printed, references, derivation.p, inverse, phi_max, p_max, dtype)
 
 
 def _p_max_squared(p: sp.Expr, phi_max: sp.Expr, p_max: float) -> sp.Float | None:

@@ -1,0 +1,118 @@
+"""The documented domain of generated code: the largest x = |p|² up to which every printed form is right.
+
+Outside the validity range every output is NaN. When p is unbounded (p → ∞ at φ_max: the tangent
+family, eqs 33–34, 36) the range is cut off at a large power of two instead, x < 2^600 in float64
+and 2^100 in float32, so that x = |p|² itself never overflows. That is not enough: the *printed*
+forms can overflow long before x does (Wiener–Milenkovic's H₂ = 128/(x + 16)² overflows for
+x > 1.3·10¹⁵⁴, i.e. |p| ≳ 10⁷⁷, and gave 1.6·10⁻¹⁵⁹·I instead of NaN, issue 17).
+
+:func:`domain_limit` therefore evaluates every printed coefficient (algebraic forms, the closed side
+of branches, the closed angle) in the target precision with the ideal-libm model of
+:mod:`symrot.evaluation`, at x = 2^k for k = :data:`FIRST_POWER` … top, against mpmath at a
+precision that resolves φ next to φ_max, and returns the largest 2^k below which all of them are
+finite and within :data:`WRONG_ULP` of the output they feed (:func:`_weight_and_scale`).
+Backends print that bound as the edge of the domain. A form that is merely less accurate (a few
+ulp) does not move the bound: the error model chose it; this sweep catches overflow, underflow and
+cancellation that make a result wrong, not imprecise.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from .algebraic import D, S, X
+from .evaluation import model_function
+from .functions import mpmath_namespace
+from .parsing import PHI
+
+TOP_POWER = {"float64": 600, "float32": 100}
+"""x < 2^TOP_POWER: the cut-off of unbounded ranges (x itself must stay finite)."""
+FIRST_POWER = 32
+"""The sweep starts at x = 2^32: below it the plan's own error model has measured every form."""
+WRONG_ULP = 64.0
+"""A relative error beyond this many ulp is a wrong result, not an imprecise one."""
+
+
+def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mapping[str, sp.Expr],
+                 p: sp.Expr, inverse: sp.Expr | None, phi_max: float, p_max: float, dtype: type) -> float:
+    """The largest 2^k ≤ 2^TOP_POWER with every form right for x < 2^k (module docstring).
+
+    ``coefficients``: name → (kind, expression) with kind "algebraic" (in x, d) or "closed" (in φ,
+    s, d), as printed; ``references``: name → c(φ) for every coefficient (also those not swept:
+    a tensor's scale needs all three of its coefficients)."""
+    label = "float64" if dtype is np.float64 else "float32"
+    top = TOP_POWER[label]
+    if math.isfinite(p_max) and p_max * p_max < 2.0**FIRST_POWER:
+        return 2.0**top
+    epsilon = float(np.finfo(dtype).eps)
+    models = {name: model_function(expression, [X, PHI, S, D])
+              for name, (_, expression) in coefficients.items()}
+    exact = {name: sp.lambdify(PHI, expression, modules=[mpmath_namespace(), "mpmath"])
+             for name, expression in references.items()}
+    angle_of = _angle_function(p, inverse, phi_max)
+    complement = p_max * p_max if math.isfinite(p_max) else math.inf
+    for k in range(FIRST_POWER, top + 1):
+        x = 2.0**k
+        if x >= complement:
+            break
+        digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
+        with mpmath.workdps(digits):
+            s_exact = mpmath.sqrt(mpmath.mpf(x))
+            phi = angle_of(s_exact)
+            values = {name: function(phi) for name, function in exact.items()}
+            arguments = (dtype(x), dtype(float(phi)), dtype(float(s_exact)),
+                         dtype(complement - x if math.isfinite(complement) else 0.0))
+            for name, model in models.items():
+                reference = values[name]
+                if not mpmath.isfinite(reference):
+                    continue
+                value = float(model(*arguments))
+                weight, scale = _weight_and_scale(name, values, s_exact)
+                allowed = WRONG_ULP * epsilon * max(scale, float(np.finfo(dtype).tiny))
+                if not math.isfinite(value) or float(abs(mpmath.mpf(value) - reference) * weight) > allowed:
+                    return 2.0 ** (k - 1) if k > FIRST_POWER else 2.0**FIRST_POWER
+    return 2.0**top
+
+
+def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf) -> tuple[mpmath.mpf, float]:
+    """How an error in coefficient ``name`` shows in the output, and the output's scale.
+
+    A tensor coefficient c_k multiplies (p×)^k, of norm s^k: its error counts as |δc_k| s^k against
+    the tensor's size max_j |c_j| s^j (so R₁ = sin φ/s next to a pole is judged on sin φ, and an
+    H₂ that underflows to 0 while H₀ does too is caught). e₀ and ν s/2 are quaternion components
+    (scale 1); every other scalar, and the angle, keeps its own relative accuracy."""
+    tensor, _, power = name.rpartition("_")
+    if tensor and power.isdigit() and f"{tensor}_0" in values:
+        weight = s ** int(power)
+        scale = max(abs(values.get(f"{tensor}_{j}", mpmath.mpf(0))) * s**j for j in range(3))
+        return weight, float(scale)
+    if name == "e_0":
+        return mpmath.mpf(1), 1.0
+    if name == "nu":
+        return s / 2, 1.0
+    return mpmath.mpf(1), float(abs(values[name]))
+
+
+def _angle_function(p: sp.Expr, inverse: sp.Expr | None,
+                    phi_max: float) -> Callable[[mpmath.mpf], mpmath.mpf]:
+    """φ(s) at the current mpmath precision: the closed inverse, or bisection on p(φ) = s."""
+    if inverse is not None:
+        closed = sp.lambdify(S, inverse, modules=[mpmath_namespace(), "mpmath"])
+        return closed
+    p_of = sp.lambdify(PHI, p, modules=[mpmath_namespace(), "mpmath"])
+
+    def bisect(s: mpmath.mpf) -> mpmath.mpf:
+        low, high = mpmath.mpf(0), mpmath.mpf(phi_max)
+        for _ in range(int(mpmath.mp.prec) + 8):
+            middle = (low + high) / 2
+            value = p_of(middle)
+            low, high = (middle, high) if (mpmath.isfinite(value) and value < s) else (low, middle)
+        return (low + high) / 2
+
+    return bisect
