@@ -15,7 +15,6 @@ import sympy as sp
 
 from ..parsing import PHI
 from ..validation import validate
-from .checks import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, dual_outcome, settle
 from .numeric import (
     TOLERANCE,
@@ -32,6 +31,7 @@ from .numeric import (
     vector,
 )
 from .proof import EPS, MU, NU, U_VECTOR, P
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
 
 E = sp.symbols("e0:4")
 F = sp.symbols("f0:4")
@@ -281,10 +281,6 @@ def _after75() -> Outcome:
     )
 
 
-def _definition(reason: str) -> Outcome:
-    return Outcome(DEFINITION, reason)
-
-
 def _e(ops: Any, phi: Any) -> tuple[Any, Any]:
     return ops.cos(phi / 2), ops.sin(phi / 2)
 
@@ -305,7 +301,7 @@ CHECKS = [
         "48",
         r"e_0 = \cos\frac{\varphi}{2}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines the scalar part e0; used by (50), (51), (64), (68)-(75), (84), (85), (96)"
         ),
     ),
@@ -313,7 +309,7 @@ CHECKS = [
         "49",
         r"\mathbf{e} = \sin\frac{\varphi}{2}\,\mathbf{u}",
         "definition",
-        lambda: _definition("defines the vector part e; used with (48)"),
+        lambda: definition("defines the vector part e; used with (48)"),
     ),
     Check(
         "50",
@@ -334,7 +330,7 @@ CHECKS = [
         "52",
         r"\underline{e} := \begin{bmatrix} e_0 \\ \mathbf{e} \end{bmatrix}",
         "definition",
-        lambda: _definition("defines the quaternion array; used by (53)-(73)"),
+        lambda: definition("defines the quaternion array; used by (53)-(73)"),
     ),
     Check(
         "53",
@@ -342,7 +338,7 @@ CHECKS = [
         r"\mathbf{e}_2 \\ e_{10} \mathbf{e}_2 + e_{20} \mathbf{e}_1 - \mathbf{e}_1 \times \mathbf{e}_2 "
         r"\end{bmatrix}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines the product o (the Hamilton product e2 e1); its compatibility with "
             "R3 = R2 R1 is proved in (67) and with (7), (8) numerically"
         ),
@@ -352,14 +348,14 @@ CHECKS = [
         r"\mathcal{M}_{l}(\underline{e}) = \begin{bmatrix} e_{0} & -\mathbf{e}^{T} \\ \mathbf{e} & "
         r"e_{0}\mathbf{I} + (\mathbf{e}\times) \end{bmatrix}",
         "definition",
-        lambda: _definition("defines M_l; used by (56)-(61), (66)"),
+        lambda: definition("defines M_l; used by (56)-(61), (66)"),
     ),
     Check(
         "55",
         r"\mathcal{M}_{r}(\underline{e}) = \begin{bmatrix} e_{0} & -\mathbf{e}^{T} \\ \mathbf{e} & "
         r"e_{0}\mathbf{I} - (\mathbf{e}\times) \end{bmatrix}",
         "definition",
-        lambda: _definition("defines M_r; used by (56)-(61), (66), (71)"),
+        lambda: definition("defines M_r; used by (56)-(61), (66), (71)"),
     ),
     Check(
         "56",
@@ -401,7 +397,7 @@ CHECKS = [
         "60",
         r"\underline{e}^* := \begin{bmatrix} e_0 \\ -\mathbf{e} \end{bmatrix}",
         "definition",
-        lambda: _definition("defines the conjugate; used by (61), (66), (67), (71)-(73)"),
+        lambda: definition("defines the conjugate; used by (61), (66), (67), (71)-(73)"),
     ),
     Check(
         "61",
@@ -447,7 +443,7 @@ CHECKS = [
     ),
     Check("64", r"e_i = \frac{1}{\Delta_k} E_{ik}, \quad i = 0, 1, 2, 3", "symbolic + numeric", _eq64),
     Check(
-        "65", r"\Delta_k = \sqrt{E_{kk}}", "definition", lambda: _definition("defines Delta_k; used by (64)")
+        "65", r"\Delta_k = \sqrt{E_{kk}}", "definition", lambda: definition("defines Delta_k; used by (64)")
     ),
     Check(
         "text after (65): max",
@@ -507,7 +503,7 @@ CHECKS = [
         "69",
         r"\underline{\omega} = \begin{bmatrix} \omega_0 \\ \boldsymbol{\omega} \end{bmatrix}",
         "definition",
-        lambda: _definition("defines the angular-velocity quaternion; used by (70)-(73)"),
+        lambda: definition("defines the angular-velocity quaternion; used by (70)-(73)"),
     ),
     Check(
         "text after (69): omega0",
@@ -519,7 +515,7 @@ CHECKS = [
         "70",
         r"\underline{\omega} = \mathcal{H}(\underline{e})\,\underline{\dot{e}}",
         "definition",
-        lambda: _definition("defines the operator H(e); (71) is checked against trajectories"),
+        lambda: definition("defines the operator H(e); (71) is checked against trajectories"),
     ),
     Check(
         "71",

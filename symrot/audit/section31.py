@@ -17,7 +17,6 @@ import sympy as sp
 from ..parsing import PHI
 from ..series import coefficient_list, taylor_series
 from ..validation import validate
-from .checks import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, Sweep, conclude, evidence, settle, sweep_function
 from .kinematics import describe, tensor_at, trajectory_sweep
 from .numeric import (
@@ -38,6 +37,7 @@ from .numeric import (
     unit,
 )
 from .proof import DP, EPS, EYE, MU, NU, U_CROSS, P, Verdict, at_e1, core_tensor, identity
+from .records import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
 from .subjects import Subject, scope, subjects
 
 PX = P * U_CROSS
@@ -352,10 +352,6 @@ def _r_text() -> Outcome:
     return Outcome(HOLDS, f"each equality symbolic (generic p) and numeric (< 1e-45) [{scope()}]")
 
 
-def _definition(reason: str) -> Outcome:
-    return Outcome(DEFINITION, reason)
-
-
 def _mu_limit() -> Outcome:
     h = core_tensor("H")
     return _limits(
@@ -374,7 +370,7 @@ CHECKS = [
         "11",
         r"\mathbf{p} = p(\varphi) \,\mathbf{u}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines the parameter vector; every later check builds p this way "
             "(p = p(phi) u; symbrot.core.tensor_definitions)"
         ),
@@ -383,7 +379,7 @@ CHECKS = [
         "12",
         r"\lim_{\varphi \to 0} \frac{p(\varphi)}{\varphi} = \kappa",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines kappa; symrot.validation computes it from the exact Taylor "
             "series (used by (13), the kappa statements after (32), (33), (75), (98), "
             "(101))"
@@ -401,7 +397,7 @@ CHECKS = [
         "15",
         r"\nu(\varphi) = \frac{2\sin(\varphi/2)}{p(\varphi)}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines nu; used by (14), (17)-(19), (22)-(27), (38), (41)-(47), (74), "
             "(75), (81), (83) and Table 1"
         ),
@@ -410,7 +406,7 @@ CHECKS = [
         "16",
         r"\varepsilon(\varphi) = \frac{2\tan(\varphi/2)}{p(\varphi)}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines epsilon; used by (14), (17)-(19), (22), (23), (26), (27), (38), "
             "(43)-(47), (74), (81), (83), (95) and Table 1"
         ),
@@ -463,7 +459,7 @@ CHECKS = [
         "20",
         r"\boldsymbol{\omega} = \mathbf{H}(\mathbf{p})\,\dot{\mathbf{p}}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines H as the tensor mapping p_dot to omega; (22), (25), (26) are "
             "checked against omega = axial(R_dot R^T) on trajectories"
         ),
@@ -486,7 +482,7 @@ CHECKS = [
         "21",
         r"\mu(\varphi) := \frac{1}{p'(\varphi)}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines mu; used by (22)-(27), (35), (37), (39), (83), (85) and the "
             "statements after (75) and (98)"
         ),
