@@ -29,6 +29,7 @@ def _registry() -> list[Check]:
         rescaling,
         section2,
         section31,
+        section31_tangent,
         section32,
         table1,
     )
@@ -36,6 +37,7 @@ def _registry() -> list[Check]:
     return [
         *section2.CHECKS,
         *section31.CHECKS,
+        *section31_tangent.CHECKS,
         *section32.CHECKS,
         *table1.CHECKS,
         *rescaling.CHECKS,
