@@ -23,6 +23,7 @@ from .records import (
 def _registry() -> list[Check]:
     from . import (
         appendix_a,
+        appendix_a_rates,
         appendix_b,
         appendix_c,
         appendix_d,
@@ -42,6 +43,7 @@ def _registry() -> list[Check]:
         *table1.CHECKS,
         *rescaling.CHECKS,
         *appendix_a.CHECKS,
+        *appendix_a_rates.CHECKS,
         *appendix_b.CHECKS,
         *appendix_c.CHECKS,
         *appendix_d.CHECKS,
