@@ -7,9 +7,9 @@ quaternion e = (e₀, **e**), scalar first):
   coefficient of the plan; e₀ is planned here as the coefficient ``e_0`` of x = |p|².
 * ``from_quaternion``: on the hemisphere e₀ ≥ 0 (|φ| ≤ π, which *is* rescaling, eqs 40–47),
   **p** = σ **e** with σ = p(φ)/sin(φ/2) (the inverse of eq 75). σ is planned as
-  :class:`QuaternionScale`: trig-free in e₀ when substituting φ = 2 acos e₀ leaves an algebraic
-  function (e.g. 4/(1 + e₀) for 4 tan(φ/4), 2/e₀ for 2 tan(φ/2)), otherwise a
-  :class:`~symrot.plan.Branch` in t = φ² with φ = 2 atan2(|**e**|, e₀) (never acos).
+  :class:`~symrot.plan_ir.QuaternionScale`: trig-free in e₀ when substituting φ = 2 acos e₀
+  leaves an algebraic function (e.g. 4/(1 + e₀) for 4 tan(φ/4), 2/e₀ for 2 tan(φ/2)), otherwise
+  a :class:`~symrot.plan_ir.Branch` in t = φ² with φ = 2 atan2(|**e**|, e₀) (never acos).
 * validity of the result: with e₀ ≥ 0 the angle is at most π, so every parameterization whose
   range exceeds π represents every rotation; a range φ_max ≤ π needs e₀ > cos(φ_max/2)
   (``e0_min``), otherwise the result is the documented out-of-range value.
@@ -19,32 +19,19 @@ Pure planning (SymPy + the plan's error model); backends print it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import sympy as sp
 
 from .core import Derivation
 from .functions import RealCbrt
 from .parsing import PHI
+from .plan_ir import QuaternionScale as QuaternionScale  # re-exported: defined with the plan's IR
 from .series import coefficient_list, compose_even_in_x, taylor_series
 from .timeouts import bounded
-
-if TYPE_CHECKING:  # symrot.plan imports this module
-    from .plan import Branch
 
 E0 = sp.Symbol("e0", positive=True)
 """The scalar part e₀ of the unit quaternion on the hemisphere e₀ ≥ 0."""
 QUATERNION_SCALAR = "e_0"
 """Name of the plan coefficient e₀ = cos(φ/2) (eq 74) among the coefficients of x."""
-
-
-@dataclass(frozen=True)
-class QuaternionScale:
-    """σ = p(φ)/sin(φ/2), **p** = σ **e**: ``algebraic`` in :data:`E0` or ``branch`` in t = φ²."""
-
-    algebraic: sp.Expr | None
-    branch: Branch | None
 
 
 def quaternion_scalar() -> sp.Expr:

@@ -1,37 +1,30 @@
-"""Appendix A, Euler–Rodrigues parameters: eqs (48)–(75) and the statements around them.
+"""Appendix A, Euler–Rodrigues parameters, eqs (48)–(67): the quaternion algebra.
 
 Quaternion identities are polynomial identities in the components (e₀, e₁, e₂, e₃): they are
-proved exactly by expansion, reduced modulo the normality condition e₀² + e·e = 1 (50) where
-the paper invokes it. Rates (68)–(73) are checked on random trajectories at 60 digits.
+proved exactly by expansion (:func:`exact_identity`), reduced modulo the normality condition
+e₀² + e·e = 1 (50) where the paper invokes it. Rates and the link to p, eqs (68)–(75), are in
+:mod:`symrot.audit.appendix_a_rates`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from ..validation import validate
-from .checks import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
-from .claims import Claim, dual_outcome, settle
+from .claims import dual_outcome
 from .numeric import (
     TOLERANCE,
-    Trajectory,
     Vector,
-    cross,
-    derivative,
     fmt,
     precision,
     random_axis,
-    relative,
     rng,
     rotation,
     vector,
 )
-from .proof import EPS, MU, NU, U_VECTOR, P
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
 
 E = sp.symbols("e0:4")
 F = sp.symbols("f0:4")
@@ -95,9 +88,10 @@ def _zero(m: sp.Matrix, modulo_normality: bool) -> bool:
     return True
 
 
-def _exact(
+def exact_identity(
     label: str, pairs: list[tuple[sp.Matrix, sp.Matrix]], modulo_normality: bool, note: str = ""
 ) -> Outcome:
+    """Each (lhs, rhs) pair equal as polynomials in e₀..e₃ (modulo (50) if ``modulo_normality``)."""
     for index, (lhs, rhs) in enumerate(pairs):
         if not _zero(lhs - rhs, modulo_normality):
             raise AuditInconsistency(f"{label}: equality {index + 1} fails")
@@ -123,7 +117,7 @@ def _eq62() -> Outcome:
     trace = r.trace()
     axial = sp.Matrix([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]]) / 2
     printed = _block(1 + trace, 2 * axial, 2 * axial, (1 - trace) * sp.eye(3) + r + r.T) / 4
-    return _exact(
+    return exact_identity(
         "62",
         [(printed, Q * Q.T)],
         modulo_normality=True,
@@ -187,104 +181,6 @@ def _max_text() -> Outcome:
     )
 
 
-def _quaternion_path(label: str) -> tuple[Trajectory, Callable[[mpmath.mpf], mpmath.matrix]]:
-    path = Trajectory(label)
-
-    def e(t: mpmath.mpf) -> mpmath.matrix:
-        half = path.phi(t) / 2
-        return mpmath.matrix([mpmath.cos(half), *(mpmath.sin(half) * path.u(t))])
-
-    return path, e
-
-
-def _hamilton(left: mpmath.matrix, right: mpmath.matrix) -> mpmath.matrix:
-    """(53) numerically: left ∘ right."""
-    a, b = left[0], vector([left[1], left[2], left[3]])
-    c, d = right[0], vector([right[1], right[2], right[3]])
-    vec = c * b + a * d - cross(d, b)
-    return mpmath.matrix([a * c - sum(b[i] * d[i] for i in range(3)), vec[0], vec[1], vec[2]])
-
-
-def _rates(which: str) -> Outcome:
-    """(68), ω₀ = 0 (after 69), (71), (72), (73) on random trajectories."""
-    worst = mpmath.mpf(0)
-    with precision():
-        for k in range(SAMPLES):
-            path, e = _quaternion_path(f"rates:{which}:{k}")
-            t = path.t
-            q, q_dot = e(t), derivative(e, t)
-            omega = path.spin()
-            e0, ev = q[0], vector([q[1], q[2], q[3]])
-            e0_dot, ev_dot = q_dot[0], vector([q_dot[1], q_dot[2], q_dot[3]])
-            omega4 = mpmath.matrix([0, *omega])
-            conj = mpmath.matrix([q[0], -q[1], -q[2], -q[3]])
-            if which == "68":
-                value = relative(2 * e0 * ev_dot - 2 * e0_dot * ev + 2 * cross(ev, ev_dot) - omega, omega)
-            elif which == "69":
-                value = abs(2 * (e0 * e0_dot + sum(ev[i] * ev_dot[i] for i in range(3))))
-            elif which == "71":
-                m_r = mpmath.matrix(4, 4)
-                m_r[0, 0] = e0
-                for i in range(3):
-                    m_r[0, i + 1], m_r[i + 1, 0] = -ev[i], ev[i]
-                block = e0 * mpmath.eye(3) - mpmath.matrix(
-                    [[0, -ev[2], ev[1]], [ev[2], 0, -ev[0]], [-ev[1], ev[0], 0]]
-                )
-                for i in range(3):
-                    for j in range(3):
-                        m_r[i + 1, j + 1] = block[i, j]
-                value = relative(2 * m_r.T * q_dot - omega4, omega4)
-            elif which == "72":
-                value = relative(2 * _hamilton(q_dot, conj) - omega4, omega4)
-            else:
-                value = relative(_hamilton(omega4, q) / 2 - q_dot, q_dot)
-            worst = max(worst, value)
-    if worst > TOLERANCE:
-        raise AuditInconsistency(f"({which}) residual {fmt(worst)}")
-    return Outcome(
-        HOLDS,
-        f"numeric: e(t) = (cos(phi/2), sin(phi/2) u) on random trajectories, omega = "
-        f"axial(R_dot R^T) of eq (1): residual < 1e-45 on {SAMPLES} trajectories",
-    )
-
-
-def _eq71() -> Outcome:
-    exact = _exact(
-        "71",
-        [
-            (m_right(Q).T, m_right(conjugate(Q))),
-            (2 * m_right(Q).T * sp.Matrix(F), 2 * compose(sp.Matrix(F), conjugate(Q))),
-        ],
-        modulo_normality=False,
-    )
-    rates = _rates("71")
-    return Outcome(
-        HOLDS, f"{exact.evidence} (M_r(e)^T = M_r(e*), 2 M_r(e)^T e_dot = 2 e_dot o e*); {rates.evidence}"
-    )
-
-
-def _after75() -> Outcome:
-    p = sp.sin(PHI / 2)
-    kappa = validate(p).kappa
-    e0 = sp.cos(PHI / 2)
-    results = [
-        settle("after75:mu", Claim(MU, 2 / e0, p=p)),
-        settle("after75:nu", Claim(NU, sp.Integer(2), p=p)),
-        settle("after75:eps", Claim(EPS, MU, p=p)),
-    ]
-    if kappa != sp.Rational(1, 2) or any(r.status != HOLDS for r in results):
-        raise AuditInconsistency("statement after (75)")
-    return Outcome(
-        HOLDS,
-        f"p = e means p = sin(phi/2) (75 with nu = 2), kappa = {kappa} (exact series); "
-        "mu = 2/e0, nu = 2, eps = mu: " + "; ".join(r.evidence for r in results),
-    )
-
-
-def _definition(reason: str) -> Outcome:
-    return Outcome(DEFINITION, reason)
-
-
 def _e(ops: Any, phi: Any) -> tuple[Any, Any]:
     return ops.cos(phi / 2), ops.sin(phi / 2)
 
@@ -305,7 +201,7 @@ CHECKS = [
         "48",
         r"e_0 = \cos\frac{\varphi}{2}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines the scalar part e0; used by (50), (51), (64), (68)-(75), (84), (85), (96)"
         ),
     ),
@@ -313,7 +209,7 @@ CHECKS = [
         "49",
         r"\mathbf{e} = \sin\frac{\varphi}{2}\,\mathbf{u}",
         "definition",
-        lambda: _definition("defines the vector part e; used with (48)"),
+        lambda: definition("defines the vector part e; used with (48)"),
     ),
     Check(
         "50",
@@ -334,7 +230,7 @@ CHECKS = [
         "52",
         r"\underline{e} := \begin{bmatrix} e_0 \\ \mathbf{e} \end{bmatrix}",
         "definition",
-        lambda: _definition("defines the quaternion array; used by (53)-(73)"),
+        lambda: definition("defines the quaternion array; used by (53)-(73)"),
     ),
     Check(
         "53",
@@ -342,7 +238,7 @@ CHECKS = [
         r"\mathbf{e}_2 \\ e_{10} \mathbf{e}_2 + e_{20} \mathbf{e}_1 - \mathbf{e}_1 \times \mathbf{e}_2 "
         r"\end{bmatrix}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines the product o (the Hamilton product e2 e1); its compatibility with "
             "R3 = R2 R1 is proved in (67) and with (7), (8) numerically"
         ),
@@ -352,21 +248,23 @@ CHECKS = [
         r"\mathcal{M}_{l}(\underline{e}) = \begin{bmatrix} e_{0} & -\mathbf{e}^{T} \\ \mathbf{e} & "
         r"e_{0}\mathbf{I} + (\mathbf{e}\times) \end{bmatrix}",
         "definition",
-        lambda: _definition("defines M_l; used by (56)-(61), (66)"),
+        lambda: definition("defines M_l; used by (56)-(61), (66)"),
     ),
     Check(
         "55",
         r"\mathcal{M}_{r}(\underline{e}) = \begin{bmatrix} e_{0} & -\mathbf{e}^{T} \\ \mathbf{e} & "
         r"e_{0}\mathbf{I} - (\mathbf{e}\times) \end{bmatrix}",
         "definition",
-        lambda: _definition("defines M_r; used by (56)-(61), (66), (71)"),
+        lambda: definition("defines M_r; used by (56)-(61), (66), (71)"),
     ),
     Check(
         "56",
         r"\underline{e}_2 \circ \underline{e}_1 = \mathcal{M}_l(\underline{e}_2) \, \underline{e}_1 = "
         r"\mathcal{M}_r(\underline{e}_1) \, \underline{e}_2",
         "exact",
-        lambda: _exact("56", [(compose(Q2, Q), m_left(Q2) * Q), (compose(Q2, Q), m_right(Q) * Q2)], False),
+        lambda: exact_identity(
+            "56", [(compose(Q2, Q), m_left(Q2) * Q), (compose(Q2, Q), m_right(Q) * Q2)], False
+        ),
     ),
     Check(
         "57",
@@ -374,7 +272,7 @@ CHECKS = [
         r"(\underline{e}) \,\mathcal{M}_{r}(\underline{e})^{T} = \begin{bmatrix} 1 & \mathbf{0}^{T} \\ "
         r"\mathbf{0} & \mathbf{I} \end{bmatrix}",
         "exact",
-        lambda: _exact(
+        lambda: exact_identity(
             "57", [(m_left(Q) * m_left(Q).T, sp.eye(4)), (m_right(Q) * m_right(Q).T, sp.eye(4))], True
         ),
     ),
@@ -383,7 +281,7 @@ CHECKS = [
         r"\mathcal{R}(\underline{e}) := \mathcal{M}_l(\underline{e}) \, \mathcal{M}_r(\underline{e})^T "
         r"= \mathcal{M}_r(\underline{e})^T \mathcal{M}_l(\underline{e})",
         "exact",
-        lambda: _exact(
+        lambda: exact_identity(
             "58",
             [(m_left(Q) * m_right(Q).T, m_right(Q).T * m_left(Q))],
             False,
@@ -395,20 +293,22 @@ CHECKS = [
         r"\mathcal{R}(\underline{e}) = \begin{bmatrix} 1 & \mathbf{0}^T \\ \mathbf{0} & \mathbf{R} "
         r"\end{bmatrix}",
         "exact",
-        lambda: _exact("59", [(m_left(Q) * m_right(Q).T, _embed(rotation51(Q)))], True, "R from (51)"),
+        lambda: exact_identity(
+            "59", [(m_left(Q) * m_right(Q).T, _embed(rotation51(Q)))], True, "R from (51)"
+        ),
     ),
     Check(
         "60",
         r"\underline{e}^* := \begin{bmatrix} e_0 \\ -\mathbf{e} \end{bmatrix}",
         "definition",
-        lambda: _definition("defines the conjugate; used by (61), (66), (67), (71)-(73)"),
+        lambda: definition("defines the conjugate; used by (61), (66), (67), (71)-(73)"),
     ),
     Check(
         "61",
         r"\mathcal{M}_{l}(\underline{e}^{*}) \,\mathcal{M}_{r}(\underline{e}^{*})^{T} = \dots"
         r"\begin{bmatrix} 1 & \mathbf{0}^{T} \\ \mathbf{0} & \mathbf{R}^{T} \end{bmatrix}",
         "exact",
-        lambda: _exact(
+        lambda: exact_identity(
             "61",
             [
                 (m_left(conjugate(Q)), m_left(Q).T),
@@ -438,7 +338,7 @@ CHECKS = [
         r"[\underline{E}]_{\mathcal{B}} = \begin{bmatrix} e_0^2 & e_0e_1 & e_0e_2 & e_0e_3\\ \dots "
         r"& e_3^2 \end{bmatrix}",
         "exact",
-        lambda: _exact(
+        lambda: exact_identity(
             "63",
             [(Q * Q.T, sp.Matrix(4, 4, lambda i, j: E[i] * E[j]))],
             False,
@@ -447,7 +347,7 @@ CHECKS = [
     ),
     Check("64", r"e_i = \frac{1}{\Delta_k} E_{ik}, \quad i = 0, 1, 2, 3", "symbolic + numeric", _eq64),
     Check(
-        "65", r"\Delta_k = \sqrt{E_{kk}}", "definition", lambda: _definition("defines Delta_k; used by (64)")
+        "65", r"\Delta_k = \sqrt{E_{kk}}", "definition", lambda: definition("defines Delta_k; used by (64)")
     ),
     Check(
         "text after (65): max",
@@ -461,7 +361,7 @@ CHECKS = [
         r"\underline{w} = \mathcal{R}(\underline{e}) \, \underline{v} = \underline{e} \circ \underline{v} "
         r"\circ \underline{e}^*",
         "exact",
-        lambda: _exact(
+        lambda: exact_identity(
             "66",
             [
                 (m_left(Q) * m_right(Q).T * PURE, compose(Q, compose(PURE, conjugate(Q)))),
@@ -476,7 +376,7 @@ CHECKS = [
         r"(\underline{e}_1)\,\underline{v} = \dots = \mathcal{R}(\underline{e}_2 \circ \underline{e}_1)\,"
         r"\underline{v}",
         "exact",
-        lambda: _exact(
+        lambda: exact_identity(
             "67",
             [
                 (
@@ -495,67 +395,5 @@ CHECKS = [
             False,
             "for every quaternion v, so e3 = +-(e2 o e1)",
         ),
-    ),
-    Check(
-        "68",
-        r"\boldsymbol{\omega} = 2e_0 \,\dot{\mathbf{e}} - 2\dot{e}_0 \,\mathbf{e} + 2 \,\mathbf{e} "
-        r"\times \,\dot{\mathbf{e}}",
-        "numeric trajectory",
-        lambda: _rates("68"),
-    ),
-    Check(
-        "69",
-        r"\underline{\omega} = \begin{bmatrix} \omega_0 \\ \boldsymbol{\omega} \end{bmatrix}",
-        "definition",
-        lambda: _definition("defines the angular-velocity quaternion; used by (70)-(73)"),
-    ),
-    Check(
-        "text after (69): omega0",
-        r"\omega_0 = 2 (e_0 \dot{e}_0 + \mathbf{e} \cdot \dot{\mathbf{e}}) = 0",
-        "numeric trajectory",
-        lambda: _rates("69"),
-    ),
-    Check(
-        "70",
-        r"\underline{\omega} = \mathcal{H}(\underline{e})\,\underline{\dot{e}}",
-        "definition",
-        lambda: _definition("defines the operator H(e); (71) is checked against trajectories"),
-    ),
-    Check(
-        "71",
-        r"\mathcal{H}(\underline{e}) = 2 \,\mathcal{M}_r(\underline{e})^T = 2 \,\mathcal{M}_r"
-        r"(\underline{e}^*)",
-        "exact + numeric trajectory",
-        _eq71,
-    ),
-    Check(
-        "72",
-        r"\underline{\omega} = 2\,\underline{\dot{e}} \circ \underline{e}^*",
-        "numeric trajectory",
-        lambda: _rates("72"),
-    ),
-    Check(
-        "73",
-        r"\underline{\dot{e}} = \frac{1}{2}\,\underline{\omega}\circ\underline{e}",
-        "numeric trajectory",
-        lambda: _rates("73"),
-    ),
-    Check(
-        "74",
-        r"e_0 = \frac{\nu}{\varepsilon}",
-        "symbolic + numeric",
-        lambda: settle("74", Claim(NU / EPS, sp.cos(PHI / 2))),
-    ),
-    Check(
-        "75",
-        r"\mathbf{e} = \frac{\nu}{2} \mathbf{p}",
-        "symbolic + numeric",
-        lambda: settle("75", Claim(NU / 2 * P * U_VECTOR, sp.sin(PHI / 2) * U_VECTOR)),
-    ),
-    Check(
-        "text after (75): p = e",
-        r"\mu = 2/e_0, \nu = 2, \text{ and } \varepsilon = \mu",
-        "symbolic + numeric",
-        _after75,
     ),
 ]

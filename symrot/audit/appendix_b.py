@@ -14,11 +14,11 @@ import sympy as sp
 
 from ..core import root_tangent
 from ..parsing import PHI
-from .checks import DEFINITION, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, evidence, settle, settle_dual
 from .kinematics import describe, tensor_at, trajectory_sweep
 from .numeric import TOLERANCE, Trajectory, derivative, fmt, precision, relative, skew
 from .proof import EPS, EYE, GENERIC_P, MU, NU, U_CROSS, P, core_tensor, generic
+from .records import HOLDS, AuditInconsistency, Check, Outcome, definition
 from .subjects import scope, subject
 
 ORDERS = range(1, 7)
@@ -116,17 +116,13 @@ def _eq83(label: str, printed: sp.Matrix, p: sp.Expr | None) -> Outcome:
     return Outcome(HOLDS, text)
 
 
-def _definition(reason: str) -> Outcome:
-    return Outcome(DEFINITION, reason)
-
-
 CHECKS = [
     Check(
         "76",
         r"\mathbf{G}_{(m)} := \mathbf{I} + \sin \frac{\varphi}{m} \left( \mathbf{u} \times \right) + "
         r"\left( 1 - \cos \frac{\varphi}{m} \right) \left( \mathbf{u} \times \right)^2",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines the m-th root (the rotation by phi/m about u, eq 1); used by (77)-(85), "
             "(102) and the core (symrot.core.root_tensor)"
         ),
@@ -136,7 +132,7 @@ CHECKS = [
         "78",
         r"\dot{\mathbf{G}}_{(m)} = \boldsymbol{\gamma}_{(m)} \times \mathbf{G}_{(m)}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines gamma_(m) (as (9) defines omega, with the dot printed here); the "
             "audit computes it as axial(G_dot G^T) on trajectories for (79), (80), (83), (85)"
         ),
@@ -152,7 +148,7 @@ CHECKS = [
         "80",
         r"\boldsymbol{\gamma}_{(m)} = \mathbf{K}_{(m)} \dot{\mathbf{p}}",
         "definition",
-        lambda: _definition("defines K_(m); the core derives it from (79) (symrot.core.root_tangent)"),
+        lambda: definition("defines K_(m); the core derives it from (79) (symrot.core.root_tangent)"),
     ),
     Check(
         "text after (80): H = K_(1)",
@@ -172,7 +168,7 @@ CHECKS = [
         "82",
         r"\boldsymbol{\gamma} = \mathbf{K} \, \dot{\mathbf{p}}",
         "definition",
-        lambda: _definition("K = K_(2) and gamma = gamma_(2) (80 with m = 2); used by (83), (85)"),
+        lambda: definition("K = K_(2) and gamma = gamma_(2) (80 with m = 2); used by (83), (85)"),
     ),
     Check(
         "83",

@@ -17,10 +17,10 @@ import sympy as sp
 from ..core import root_tangent, root_tensor
 from ..parsing import PHI
 from ..series import coefficient_list, taylor_series
-from .checks import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, dual_outcome, settle
 from .numeric import TOLERANCE, fmt, precision, random_angle, random_axis, relative, rng, rotation, skew
 from .proof import NU, U_VECTOR, P
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
 
 ORDER = 24
 """Exact series comparisons through φ^(ORDER − 1)."""
@@ -292,16 +292,12 @@ def _eq91() -> Outcome:
     )
 
 
-def _definition(reason: str) -> Outcome:
-    return Outcome(DEFINITION, reason)
-
-
 CHECKS = [
     Check(
         "86",
         r"\boldsymbol{\varphi} = \boldsymbol{\varphi} \, \mathbf{u}",
         "definition",
-        lambda: _definition("names the rotation vector p = phi u (eq 30); used by (87)-(91)"),
+        lambda: definition("names the rotation vector p = phi u (eq 30); used by (87)-(91)"),
     ),
     Check(
         "text after (86): mu, nu, eps",

@@ -14,7 +14,6 @@ import sympy as sp
 from ..parsing import PHI
 from ..registry import family_member
 from ..validation import validate
-from .checks import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, dual_outcome, evidence, settle, settle_dual, sweep_function
 from .kinematics import describe, tensor_at, trajectory_sweep
 from .numeric import (
@@ -32,6 +31,7 @@ from .numeric import (
     skew,
 )
 from .proof import EPS, EYE, MU, NU, U_CROSS, P, at_e1, core_tensor, identity
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
 from .subjects import Subject, scope, subject, subjects
 
 ORDERS = range(1, 7)
@@ -278,10 +278,6 @@ def _eq101() -> Outcome:
     )
 
 
-def _definition(reason: str) -> Outcome:
-    return Outcome(DEFINITION, reason)
-
-
 CHECKS = [
     Check(
         "92",
@@ -370,7 +366,7 @@ CHECKS = [
         r"\operatorname{cay}_{(m)}(\mathbf{A}) := (\mathbf{I} + \mathbf{A})^m (\mathbf{I} - "
         r"\mathbf{A})^{-m}",
         "definition",
-        lambda: _definition("defines the m-th order Cayley transform; used by (100)-(102)"),
+        lambda: definition("defines the m-th order Cayley transform; used by (100)-(102)"),
     ),
     Check(
         "text after (99): codomain",

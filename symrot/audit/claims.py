@@ -19,7 +19,6 @@ import mpmath
 import sympy as sp
 
 from ..parsing import PHI
-from .checks import ERRATUM, HOLDS, AuditInconsistency, Outcome
 from .numeric import (
     REFUTED,
     TOLERANCE,
@@ -33,6 +32,7 @@ from .numeric import (
     rng,
 )
 from .proof import DP, U1, U2, U3, P, Verdict, at_e1, identity
+from .records import ERRATUM, HOLDS, AuditInconsistency, Outcome
 from .subjects import Subject, subject, subjects
 
 ARGUMENTS = (PHI, P, DP, U1, U2, U3)

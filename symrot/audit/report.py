@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections import Counter
 from typing import Any
 
-from .checks import ERRATUM, NOT_RUN, Result
+from .records import ERRATUM, NOT_RUN, Result
 from .subjects import names
 
 REGENERATE = "make audit"

@@ -15,7 +15,6 @@ import mpmath
 import sympy as sp
 
 from ..parsing import PHI
-from .checks import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, settle, sweep_function
 from .numeric import (
     REFUTED,
@@ -34,6 +33,7 @@ from .numeric import (
     unit,
 )
 from .proof import NU, P, is_zero
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .subjects import Subject, scope, subjects
 
 WM = 4 * sp.tan(PHI / 4)

@@ -11,7 +11,6 @@ import mpmath
 import sympy as sp
 
 from ..parsing import PHI
-from .checks import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, settle
 from .numeric import (
     REFUTED,
@@ -31,6 +30,7 @@ from .numeric import (
     skew,
 )
 from .proof import EYE, U_CROSS, U_VECTOR, at_e1, is_zero, matrix_is_zero
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 
 R_EQ1 = EYE + sp.sin(PHI) * U_CROSS + (1 - sp.cos(PHI)) * U_CROSS**2
 """Eq (1) as printed: R = I + sin φ (u×) + (1 − cos φ)(u×)²."""

@@ -15,9 +15,9 @@ from ..functions import RealCbrt
 from ..parsing import PHI
 from ..registry import family_member, lookup
 from ..validation import validate
-from .checks import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, settle
 from .proof import DP, EPS, MU, NU, P, is_zero
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
 
 C = sp.Symbol("c", positive=True)
 P0 = sp.cos(PHI / 4)
@@ -250,16 +250,12 @@ def _eq38() -> Outcome:
     )
 
 
-def _definition(reason: str) -> Outcome:
-    return Outcome(DEFINITION, reason)
-
-
 CHECKS = [
     Check(
         "30",
         r"p(\varphi) = \varphi",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "chooses the rotation vector (kappa = 1); a Table-1 row and one of the "
             "generating functions of every 'any p' check"
         ),
@@ -295,7 +291,7 @@ CHECKS = [
         r"p(\varphi) = m \sin \frac{\varphi}{m}, \quad \text{and} \quad p(\varphi) = m \tan "
         r"\frac{\varphi}{m}",
         "definition",
-        lambda: _definition(
+        lambda: definition(
             "defines the sine and tangent families; members m = 1..6 are generating "
             "functions of every 'any p' check"
         ),

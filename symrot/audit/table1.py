@@ -18,8 +18,8 @@ from ..core import derive_expression, scalar_definitions
 from ..parsing import PHI
 from ..registry import lookup
 from ..singularities import validity
-from .checks import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .claims import Claim, evidence
+from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
 from .section2 import R_EQ1
 
 HALF, QUARTER = PHI / 2, PHI / 4

@@ -2,7 +2,7 @@
 
 A kernel ``symrot_NAME_F_batch(n, p, T)`` evaluates the tensor function F (R, H, H⁻¹, G or K,
 eqs 14, 22, 26, 81, 83) for n vectors. It prints the same plan as the single call
-(:class:`~symrot.backends.c_backend.FunctionWriter`), in blocks of ``SYMROT_BATCH_BLOCK`` vectors
+(:class:`~symrot.backends.c_writer.FunctionWriter`), in blocks of ``SYMROT_BATCH_BLOCK`` vectors
 and four passes, so that the two expensive middle ones have no branch and no library call:
 
 1. **scalar pass** (k < block length, branches allowed): x = |p|², and for vectors inside the
@@ -38,20 +38,11 @@ import sympy as sp
 
 from ..algebraic import D, S, X
 from ..parsing import PHI
-from ..plan import Algebraic, Branch, Coefficient, Constant
-from .c_backend import (
-    OUTPUT_NAMES,
-    PHI_SYMBOL,
-    TENSOR_OF,
-    X_SYMBOL,
-    CFunction,
-    FunctionWriter,
-    P,
-    Statement,
-    tensor_entries,
-)
+from ..plan_ir import Algebraic, Branch, Coefficient, Constant
+from .c_functions import OUTPUT_NAMES, TENSOR_OF, CFunction, P, tensor_entries
 from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
 from .c_sincos import TRIG, SinCosWriter
+from .c_writer import PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
 
 BLOCK = "SYMROT_BATCH_BLOCK"
 DEFAULT_BLOCK = 32

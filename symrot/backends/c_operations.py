@@ -24,9 +24,9 @@ from typing import Any
 import sympy as sp
 
 from ..parsing import PHI
-from ..plan import Branch
+from ..plan_ir import Branch
 from ..quaternion_plan import E0
-from .c_backend import LARGEST, PHI_SYMBOL, T_SYMBOL, FunctionWriter, Statement, ops_of
+from .c_writer import LARGEST, PHI_SYMBOL, T_SYMBOL, FunctionWriter, Statement, ops_of
 
 E_SYMBOL = sp.Symbol("c0", real=True)
 NAN = "NAN"

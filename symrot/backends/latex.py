@@ -8,18 +8,30 @@ singularity analysis; the templates under ``templates/latex/`` only lay them out
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES, Derivation
 from ..parsing import PHI
+from ..registry import NamedParameterization
 from .templating import render
 
-if TYPE_CHECKING:
-    from ..api import DerivationResult
+
+class NamedDerivation(Protocol):
+    """What the tables and sheets read: a derivation and its registry entry, if any.
+
+    :class:`symrot.api.DerivationResult` is one; the backend depends on this shape, not on the API.
+    """
+
+    @property
+    def derivation(self) -> Derivation: ...
+
+    @property
+    def entry(self) -> NamedParameterization | None: ...
 
 
 class PaperLatexPrinter(LatexPrinter):
@@ -112,13 +124,13 @@ def _escape(text: str) -> str:
     return text.replace("-$>$", r"$\to$")
 
 
-def title_of(result: DerivationResult) -> str:
+def title_of(result: NamedDerivation) -> str:
     if result.entry is not None:
         return _escape(result.entry.title)
-    return "$p = " + latex(result.p) + "$"
+    return "$p = " + latex(result.derivation.p) + "$"
 
 
-def table(results: list[DerivationResult], extra_columns: tuple[str, ...] = (),
+def table(results: Sequence[NamedDerivation], extra_columns: tuple[str, ...] = (),
           paper_validity: dict[str, sp.Expr] | None = None) -> str:
     """Table 1 (name, p, p′, ν, ε, validity) plus optional μ, det H and singularity columns.
 
@@ -159,7 +171,7 @@ def table(results: list[DerivationResult], extra_columns: tuple[str, ...] = (),
     return render("latex/table.tex.j2", headers=headers, rows=rows, notes=notes)
 
 
-def sheet(result: DerivationResult, series_terms: int = 4) -> str:
+def sheet(result: NamedDerivation, series_terms: int = 4) -> str:
     """A derivation sheet: every derived formula with the paper equation it instantiates."""
     d = result.derivation
     scalars = [
@@ -201,7 +213,7 @@ def standalone(body: str, landscape: bool = False) -> str:
     return render("latex/standalone.tex.j2", body=body, landscape=landscape)
 
 
-def derivation_display(result: DerivationResult) -> str:
+def derivation_display(result: NamedDerivation) -> str:
     """A compact LaTeX block (for Jupyter) of p, κ and the scalar functions."""
     d = result.derivation
     rows = [

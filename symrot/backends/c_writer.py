@@ -1,0 +1,368 @@
+"""The statements of the C functions of one plan in one precision: the layer under the C backend.
+
+:class:`FunctionWriter` turns the evaluation plan of :mod:`symrot.plan` into statements (dicts that
+``templates/c/header.h.j2`` prints) with :class:`~symrot.backends.c_printer.SymrotCPrinter`; the
+header (:mod:`symrot.backends.c_backend`), the ``_batch`` kernels (:mod:`symrot.backends.c_batch`)
+and the operations (:mod:`symrot.backends.c_operations`) build on it. How a plan becomes C:
+
+* x = |p|² once; outside the validity range (``!(x < p_max²)``, or ``!(x < 2^600)`` (2^100 in
+  float) when p is unbounded, which also catches inf and NaN) every output is NaN; for the sine
+  family also d = p_max² − x with fma-exact products and TwoSum (``__complement``), which the plan's
+  expressions use instead of k² − x;
+* coefficients: a :class:`~symrot.plan.Constant` is folded into the output expressions, an
+  :class:`~symrot.plan.Algebraic` one is a single expression in x (no branch, no trig); the
+  :class:`~symrot.plan.Branch` ones of a function share one ``if (x < smallest threshold)``:
+  below it every coefficient is its Horner polynomial, above it φ is computed once, the closed
+  forms share common subexpressions (``sympy.cse``, inside that branch only, where x > 0) and a
+  coefficient whose own threshold is larger still takes its polynomial (sin and cos are libm's
+  here, ≈ 0.5 ulp; the ``_batch`` kernels of :mod:`symrot.backends.c_batch` use the vectorizable
+  kernel of :mod:`symrot.backends.c_sincos` instead);
+* φ: the plan's closed inverse, or its safeguarded Newton iteration (a helper function with the
+  plan's fixed iteration count, bracket and Taylor-safe ratio and slope branches). ``angle`` needs
+  |p| itself, accurately down to the smallest subnormal: below x = 2⁻⁶⁰⁰ (2⁻¹⁰⁰ in float) the
+  norm is computed on p scaled by an exact power of two;
+* tensors T = c0 I + c1 (p×) + c2 (p×)² entry by entry
+  (:func:`~symrot.backends.c_functions.tensor_entries`), vectors as c0 v + c1 p×v + c2 p×(p×v)
+  (:func:`~symrot.backends.c_functions.vector_entries`).
+
+``/* ops: N */`` is the number of operations on the longest path through the function, as
+counted by ``sympy.count_ops`` (a call such as ``sin`` counts one; Newton iterations multiplied).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import sympy as sp
+
+from ..algebraic import S, X
+from ..newton_start import FarStart
+from ..parsing import PHI
+from ..plan_ir import Algebraic, Branch, ClosedAngle, Constant, EvaluationPlan, NewtonAngle, PrecisionPlan
+from .c_functions import OUTPUT_NAMES, TENSOR_OF, VECTOR_NAMES, CFunction, P, tensor_entries, vector_entries
+from .c_printer import Precision, SymrotCPrinter, horner
+
+# -- statements ------------------------------------------------------------------------------------
+Statement = dict[str, Any]
+TINY_X = {"double": (sp.Integer(2) ** -600, sp.Integer(2) ** 600),
+          "float": (sp.Integer(2) ** -100, sp.Integer(2) ** 100)}
+"""Below x = first, |p| is computed on q = p · second (an exact power of two): for every p with
+|p|² < first, down to the smallest subnormal, q² is a normal number and cannot overflow."""
+LARGEST = {"double": sp.Float("1.7976931348623157e308", 20), "float": sp.Float("3.4028234663852886e38", 20)}
+PLAN_LABEL = {"double": "float64", "float": "float32"}
+MANTISSA = {"double": 53, "float": 24}
+X_SYMBOL = sp.Symbol("x", real=True)
+S_SYMBOL = sp.Symbol("s", real=True)
+PHI_SYMBOL = sp.Symbol("phi", real=True)
+T_SYMBOL = sp.Symbol("t", real=True)
+
+
+def ops_of(statements: list[Statement]) -> int:
+    """Operations on the longest path through ``statements`` (see the module docstring)."""
+    total = 0
+    for statement in statements:
+        total += int(statement.get("ops", 0))
+        if statement["kind"] == "if":
+            total += 1 + max(ops_of(statement["then"]), ops_of(statement["otherwise"]))
+        elif statement["kind"] == "loop":
+            total += int(statement["times"]) * ops_of(statement["body"])
+    return total
+
+
+class FunctionWriter:
+    """Statements of the C functions of one plan in one precision."""
+
+    def __init__(self, plan: EvaluationPlan, header: str, precision: Precision) -> None:
+        self.plan = plan
+        self.header = header
+        self.precision = precision
+        self.ctype = precision
+        self.suffix = "" if precision == "double" else "_f"
+        self.printer = SymrotCPrinter(precision)
+        self.precision_plan: PrecisionPlan = plan.precisions[PLAN_LABEL[precision]]
+
+    # -- small helpers ---------------------------------------------------------------------------
+    def c(self, expr: sp.Expr) -> str:
+        return str(self.printer.doprint(expr))
+
+    def let(self, name: str, value: sp.Expr) -> Statement:
+        return {"kind": "let", "type": self.ctype, "name": name, "value": self.c(value),
+                "ops": sp.count_ops(value)}
+
+    def set(self, name: str, value: sp.Expr | str, ops: int | None = None) -> Statement:
+        text = value if isinstance(value, str) else self.c(value)
+        count = ops if ops is not None else (0 if isinstance(value, str) else sp.count_ops(value))
+        return {"kind": "set", "name": name, "value": text, "ops": count}
+
+    @property
+    def angle_helper(self) -> str:
+        return f"symrot_{self.header}__phi{self.suffix}"
+
+    def squared_norm(self) -> Statement:
+        return self.let("x", P[0] ** 2 + P[1] ** 2 + P[2] ** 2)
+
+    @property
+    def bound(self) -> float:
+        """p_max² rounded to this precision (see ``EvaluationPlan.boundary``)."""
+        return self.plan.boundary(MANTISSA[self.precision])[0]
+
+    @property
+    def inside_operator(self) -> str:
+        """``<=`` when the rounded p_max² lies below the exact one (x equal to it is inside), else ``<``."""
+        return "<=" if self.plan.boundary(MANTISSA[self.precision])[1] else "<"
+
+    def prologue(self) -> list[Statement]:
+        """x = |p|², and d = p_max² − x (compensated) when the plan uses the fold complement."""
+        statements = [self.squared_norm()]
+        if self.plan.complement is not None:
+            statements.append({"kind": "let", "type": self.ctype, "name": "d",
+                               "value": f"{self.complement_helper}(p)", "ops": 20})
+        return statements
+
+    @property
+    def complement_helper(self) -> str:
+        return f"symrot_{self.header}__complement{self.suffix}"
+
+    def angle_call(self, s_text: str) -> str:
+        extra = ", d" if self.plan.complement is not None else ""
+        return f"{self.angle_helper}({s_text}{extra})"
+
+    def complement_function(self) -> dict[str, Any]:
+        """d = p_max² − |p|²: exact products (fma) and error-free sums (TwoSum), then one rounding."""
+        t = self.ctype
+        fma = "fma" if t == "double" else "fmaf"
+        k2 = self.printer.literal(sp.Integer(self.plan.complement) if self.plan.complement is not None else 0)
+        statements: list[Statement] = [{"kind": "declare", "type": t, "names": [f"high = {k2}", "low = 0"]},
+                                       {"kind": "declare", "type": "int", "names": ["i"]}]
+        body: list[Statement] = [
+            {"kind": "let", "type": t, "name": "square", "value": "p[i] * p[i]", "ops": 1},
+            {"kind": "let", "type": t, "name": "error", "value": f"{fma}(p[i], p[i], -square)", "ops": 1},
+            {"kind": "let", "type": t, "name": "total", "value": "high - square", "ops": 1},
+            {"kind": "let", "type": t, "name": "virtual_", "value": "total - high", "ops": 1},
+            {"kind": "set", "name": "low",
+             "value": "low + (((high - (total - virtual_)) + (-square - virtual_)) - error)", "ops": 6},
+            {"kind": "set", "name": "high", "value": "total", "ops": 0},
+        ]
+        statements.append({"kind": "loop", "header": "i = 0; i < 3; ++i", "body": body, "times": 3})
+        statements.append({"kind": "return", "value": "high + low", "ops": 1})
+        return {"c_name": self.complement_helper, "summary": "internal: d = p_max^2 - |p|^2, compensated",
+                "equation": "31-32, 36", "ops": ops_of(statements),
+                "notes": ["Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2",
+                          "rounded would leave no correct digit of p_max^2 - x (error-free products by",
+                          "fma, TwoSum)."],
+                "signature": f"{t} {self.complement_helper}(const {t} p[3])", "statements": statements,
+                "batch_signature": None, "output": None}
+
+    def out_of_range(self) -> sp.Expr:
+        """The C condition (as text) under which every output is NaN."""
+        if math.isfinite(self.plan.p_max):
+            return f"!(x {self.inside_operator} {self.printer.literal(self.bound)})"
+        return f"!(x < {self.printer.literal(TINY_X[self.precision][1])})"
+
+    # -- φ ---------------------------------------------------------------------------------------
+    def branch_value(self, branch: Branch, variable: sp.Symbol, target: str) -> Statement:
+        """if (t < threshold) target = Horner(t) else target = closed(phi) (phi > 0 there)."""
+        closed = branch.closed.subs(PHI, PHI_SYMBOL)
+        replacements, (reduced,) = sp.cse([closed], symbols=sp.numbered_symbols(f"{target}_w"))
+        otherwise = [self.let(str(symbol), value) for symbol, value in replacements]
+        otherwise.append(self.set(target, reduced))
+        return {"kind": "if", "condition": f"{variable} < {self.printer.literal(branch.threshold)}",
+                "then": [self.set(target, horner(branch.horner, variable))], "otherwise": otherwise}
+
+    def angle_function(self) -> dict[str, Any]:
+        """The helper φ(s), s = |p| ≥ 0: the closed inverse or the safeguarded Newton iteration."""
+        angle = self.precision_plan.angle
+        extra = f", {self.ctype} d" if self.plan.complement is not None else ""
+        signature = f"{self.ctype} {self.angle_helper}({self.ctype} s{extra})"
+        if isinstance(angle, ClosedAngle):
+            expression = angle.expression.subs(S, S_SYMBOL)
+            statements: list[Statement] = [{"kind": "return", "value": self.c(expression),
+                                            "ops": sp.count_ops(expression)}]
+            note = f"phi = {sp.sstr(angle.expression)} (closed inverse of p(phi))"
+        else:
+            statements = self.newton(angle)
+            note = (f"phi by {angle.iterations} safeguarded Newton steps on phi*g(phi^2) = s from the "
+                    f"reverted series, bracket [0, {angle.phi_max:.17g}]")
+        return {"c_name": self.angle_helper, "summary": "internal: phi from s = |p|", "equation": "11",
+                "notes": [note], "ops": ops_of(statements), "signature": signature,
+                "statements": statements, "batch_signature": None, "output": None}
+
+    def newton(self, angle: NewtonAngle) -> list[Statement]:
+        s2 = sp.Symbol("s2", real=True)
+        start = S_SYMBOL * horner(angle.start, s2)
+        body: list[Statement] = [
+            self.let("t", PHI_SYMBOL**2),
+            {"kind": "declare", "type": self.ctype, "names": ["ratio", "slope", "residual", "step"]},
+            self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
+            self.branch_value(angle.slope, T_SYMBOL, "slope"),
+            self.set("residual", PHI_SYMBOL * sp.Symbol("ratio") - S_SYMBOL),
+            {"kind": "if", "condition": "residual > 0", "then": [self.set("high", "phi")],
+             "otherwise": [self.set("low", "phi")]},
+            self.set("step", PHI_SYMBOL - sp.Symbol("residual") / sp.Symbol("slope")),
+            {"kind": "if", "condition": "slope > 0 && step >= low && step <= high",
+             "then": [self.set("phi", "step")],
+             "otherwise": [self.set("phi", (sp.Symbol("low") + sp.Symbol("high")) / 2)]},
+        ]
+        phi_max = self.printer.literal(angle.phi_max)
+        far = angle.far
+        y = sp.Symbol("y", real=True)
+        far_value = horner(tuple(sp.Float(c, 17) for c in far.coefficients), y)
+        return [
+            self.let("s2", S_SYMBOL**2),
+            {"kind": "let", "type": self.ctype, "name": "v", "value": self.far_variable(far), "ops": 4},
+            self.let("y", 2 * sp.Symbol("v", real=True) - 1),
+            {"kind": "declare", "type": self.ctype,
+             "names": [f"phi = s < {self.printer.literal(far.switch)} ? {self.c(start)} : "
+                       f"{self.c(far_value)}",
+                       "low = 0", f"high = {phi_max}"],
+             "ops": 1 + max(sp.count_ops(start), sp.count_ops(far_value))},
+            {"kind": "declare", "type": "int", "names": ["k"]},
+            {"kind": "if", "condition": f"phi > {phi_max}", "then": [self.set("phi", "high")],
+             "otherwise": []},
+            {"kind": "loop", "header": f"k = 0; k < {angle.iterations}; ++k", "body": body,
+             "times": angle.iterations},
+            {"kind": "return", "value": "phi"},
+        ]
+
+    def far_variable(self, far: FarStart) -> str:
+        """v(s) of the far-field Newton start (symrot.newton_start), as C."""
+        f = "" if self.precision == "double" else "f"
+        ratio = f"s / {self.printer.literal(far.scale)}"
+        if far.kind == "fold":
+            inner = f"fmax{f}(1 - {ratio}, 0)"
+            root = {2: f"sqrt{f}({inner})", 3: f"cbrt{f}({inner})"}.get(
+                far.order, f"pow{f}({inner}, {self.printer.literal(sp.Rational(1, far.order))})")
+            return f"1 - {root}"
+        if far.kind == "linear":
+            return f"fmin{f}({ratio}, 1)"
+        return f"s / (s + {self.printer.literal(far.scale)})"
+
+    def norm(self) -> list[Statement]:
+        """s = |p| without underflow (x = |p|² is already computed)."""
+        small, scale = TINY_X[self.precision]
+        q = [sp.Symbol(f"q{i}", real=True) for i in range(3)]
+        scaled = [self.let(f"q{i}", P[i] * scale) for i in range(3)]
+        scaled.append(self.set("s", sp.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2) / scale))
+        return [{"kind": "declare", "type": self.ctype, "names": ["s"]},
+                {"kind": "if", "condition": f"x < {self.printer.literal(small)}", "then": scaled,
+                 "otherwise": [self.set("s", sp.sqrt(X_SYMBOL))]}]
+
+    # -- coefficients ----------------------------------------------------------------------------
+    def coefficients(self, names: list[str]) -> tuple[list[Statement], dict[str, sp.Expr]]:
+        """Statements computing ``names`` and the expression standing for each in the outputs."""
+        plan = self.precision_plan.coefficients
+        values: dict[str, sp.Expr] = {}
+        statements: list[Statement] = []
+        branches = {n: plan[n] for n in names if isinstance(plan[n], Branch)}
+        for name in names:
+            coefficient = plan[name]
+            if isinstance(coefficient, Constant):
+                values[name] = sp.sympify(coefficient.value)
+            elif isinstance(coefficient, Algebraic):
+                statements.append(self.let(f"c_{name}", coefficient.expression.subs(X, X_SYMBOL)))
+                values[name] = sp.Symbol(f"c_{name}")
+        if not branches:
+            return statements, values
+        for name in branches:
+            values[name] = sp.Symbol(f"c_{name}")
+        statements.append({"kind": "declare", "type": self.ctype, "names": [f"c_{n}" for n in branches]})
+        smallest = min(b.threshold for b in branches.values())  # type: ignore[union-attr]
+        below = [self.set(f"c_{n}", horner(b.horner, X_SYMBOL)) for n, b in branches.items()]  # type: ignore[union-attr]
+        closed = [b.closed.subs(PHI, PHI_SYMBOL) for b in branches.values()]  # type: ignore[union-attr]
+        replacements, reduced = sp.cse(closed, symbols=sp.numbered_symbols("w"))
+        above: list[Statement] = []
+        if any(b.closed.has(PHI) for b in branches.values()):  # type: ignore[union-attr]
+            above.append({"kind": "let", "type": self.ctype, "name": "phi",
+                          "value": self.angle_call(self.c(sp.sqrt(X_SYMBOL))),
+                          "ops": 2 + ops_of(self.angle_function()["statements"])})
+        if any(b.closed.has(S) for b in branches.values()):  # type: ignore[union-attr]
+            above.append(self.let("s", sp.sqrt(X_SYMBOL)))
+        above += [self.let(str(symbol), value) for symbol, value in replacements]
+        for (name, branch), value in zip(branches.items(), reduced, strict=True):
+            assert isinstance(branch, Branch)
+            if branch.threshold > smallest:
+                polynomial = horner(branch.horner, X_SYMBOL)
+                text = (f"x < {self.printer.literal(branch.threshold)} ? {self.c(polynomial)} : "
+                        f"{self.c(value)}")
+                above.append(self.set(f"c_{name}", text,
+                                      1 + max(sp.count_ops(polynomial), sp.count_ops(value))))
+            else:
+                above.append(self.set(f"c_{name}", value))
+        statements.append({"kind": "if", "condition": f"x < {self.printer.literal(smallest)}",
+                           "then": below, "otherwise": above})
+        return statements, values
+
+    # -- the public functions --------------------------------------------------------------------
+    def validity_notes(self) -> list[str]:
+        plan = self.plan
+        if math.isfinite(plan.p_max):
+            return [f"Valid for |p| < {plan.p_max:.17g} (|phi| < {plan.phi_max:.17g}); outside it, and for "
+                    "non-finite p, every output is NaN."]
+        bound = "2^600" if self.precision == "double" else "2^100"
+        return [f"Valid for every p with |p|^2 < {bound} (|phi| < {plan.phi_max:.17g}); otherwise, and for "
+                "non-finite p, every output is NaN."]
+
+    def coefficient_notes(self, names: list[str]) -> list[str]:
+        notes = []
+        for name in names:
+            c = self.precision_plan.coefficients[name]
+            if isinstance(c, Constant):
+                notes.append(f"{name} = {sp.sstr(c.value)} (constant)")
+            elif isinstance(c, Algebraic):
+                notes.append(f"{name} = {sp.sstr(c.expression)} (algebraic in x)")
+            else:
+                notes.append(f"{name}: Horner degree {len(c.horner) - 1} in x below x = {c.threshold:.6g}, "
+                             f"else {sp.sstr(c.closed)}")
+        return notes
+
+    def function(self, spec: CFunction) -> dict[str, Any]:
+        name = f"symrot_{self.header}_{spec.name}{self.suffix}"
+        t = self.ctype
+        statements: list[Statement] = self.prologue()
+        notes = self.validity_notes()
+        if spec.kind == "scalar":
+            signature = f"{t} {name}(const {t} p[3])"
+            statements.append({"kind": "if", "condition": self.out_of_range(),
+                               "then": [{"kind": "return", "value": "NAN"}], "otherwise": []})
+            if spec.name == "angle":
+                statements += self.norm()
+                statements.append({"kind": "return", "value": self.angle_call("s"),
+                                   "ops": ops_of(self.angle_function()["statements"])})
+                notes.append(self.angle_function()["notes"][0])
+            else:
+                body, values = self.coefficients(["det_H"])
+                statements += body
+                statements.append({"kind": "return", "value": self.c(values["det_H"]), "ops": 0})
+                notes += self.coefficient_notes(["det_H"])
+            return self.context(spec, name, signature, statements, notes, None, None)
+        tensor = TENSOR_OF[spec.name]
+        names = [f"{tensor}_{k}" for k in range(3)]
+        body, values = self.coefficients(names)
+        a, b, c = (values[n] for n in names)
+        if spec.kind == "matrix":
+            output = OUTPUT_NAMES[spec.name]
+            signature = f"void {name}(const {t} p[3], {t} {output}[9])"
+            nan = [self.set(f"{output}[{i}]", "NAN") for i in range(9)] + [{"kind": "return", "value": ""}]
+            outputs = [self.set(f"{output}[{i}]", entry) for i, entry in enumerate(tensor_entries(a, b, c))]
+            batch = f"void {name}_batch(size_t n, const {t} *p, {t} *{output})"
+        else:
+            given, output = VECTOR_NAMES[spec.name]
+            signature = f"void {name}(const {t} p[3], const {t} {given}[3], {t} {output}[3])"
+            nan = [self.set(f"{output}[{i}]", "NAN") for i in range(3)] + [{"kind": "return", "value": ""}]
+            v = tuple(sp.Symbol(f"{given}[{i}]", real=True) for i in range(3))
+            w = tuple(sp.Symbol(f"w{i}", real=True) for i in range(3))
+            cross, entries = vector_entries(a, b, c, v, w)
+            outputs = [self.let(f"w{i}", cross[i]) for i in range(3)]
+            outputs += [self.set(f"{output}[{i}]", entry) for i, entry in enumerate(entries)]
+            batch = None
+        statements.append({"kind": "if", "condition": self.out_of_range(), "then": nan, "otherwise": []})
+        statements += body + outputs
+        notes += self.coefficient_notes(names)
+        return self.context(spec, name, signature, statements, notes, batch, output)
+
+    def context(self, spec: CFunction, name: str, signature: str, statements: list[Statement],
+                notes: list[str], batch: str | None, output: str | None) -> dict[str, Any]:
+        return {"c_name": name, "summary": spec.summary, "equation": spec.equation, "notes": notes,
+                "ops": ops_of(statements), "signature": signature, "statements": statements,
+                "batch_signature": batch, "output": output}

@@ -1,0 +1,155 @@
+"""The intermediate representation of an evaluation plan: what :mod:`symrot.plan` decides and every
+backend prints.
+
+Its own module so that the planners (:mod:`symrot.plan`, :mod:`symrot.quaternion_plan`) and the
+backends share it without importing each other; :mod:`symrot.plan` re-exports every name.
+
+IR (all frozen dataclasses, SymPy expressions in the symbols ``PHI``, ``S`` = |p|, ``X`` = x and,
+for the sine family, ``D`` = p_max² − x):
+
+``EvaluationPlan``
+    ``name``, ``p`` (generating function), ``p_max`` (float, ``inf`` when unbounded: outside
+    |p| < p_max every output is NaN), ``phi_max`` (float), ``precisions``: {"float64": …,
+    "float32": …} → ``PrecisionPlan``, ``e0_min`` (operations, :mod:`symrot.quaternion_plan`) and
+    ``complement`` (p_max² when expressions use ``D``, which backends compute with compensated
+    arithmetic: :func:`symrot.algebraic.fold_complement`).
+``PrecisionPlan``
+    ``dtype``, ``epsilon``, ``angle`` (``ClosedAngle`` or ``NewtonAngle``), ``coefficients``:
+    {name → ``Constant``, ``Algebraic`` or ``Branch``}, ``quaternion_scale`` (σ = p(φ)/sin(φ/2)).
+``Algebraic(expression)``
+    the coefficient as an algebraic function of x (and d) with no branch (e.g. 1 + x/4 for H⁻¹₀ of
+    2 tan(φ/2)); found by substituting the closed inverse φ(s) (:mod:`symrot.algebraic`) and
+    accepted only when it is accurate in float64 on a log grid of x, p = 0 exactly.
+``Constant(value)``
+    identically constant coefficient (e.g. H⁻¹₂ = 1/4 for 2 sin(φ/2)): emit the number.
+``Branch(threshold, horner, closed, safe_phi, measured_ulp, edge_ulp, accurate_threshold, accurate_terms)``
+    with ``t`` the branch variable (x = |p|² for coefficients, φ² inside ``NewtonAngle`` and σ):
+    if t < threshold evaluate the polynomial Σ horner[j] t^j (exact rationals, Horner order);
+    else evaluate ``closed`` (an expression in ``PHI``, and ``S``/``D`` where the base angle of a
+    closed inverse was substituted).  Each branch is evaluated only where it applies (or on
+    guarded inputs), so neither ever divides by zero.  Common subexpressions may only be shared
+    *inside* one branch.
+``ClosedAngle(expression)``
+    φ = expression(S), S = |p| = √x, the closed-form inverse of p(φ) (e.g. 4 atan(S/4); for the
+    sine family k asin(S/k) becomes k atan2(S, √D), accurate up to the fold).
+``NewtonAngle(start, ratio, slope, iterations, phi_max, far)``
+    φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s, started from the odd reverted series
+    φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from the fold-aware interpolant ``far``
+    (:mod:`symrot.newton_start`) above it, where ``ratio`` = g (Branch in t = φ² for p(φ)/φ,
+    Taylor-safe) and ``slope`` (Branch in t = φ² for p′(φ)).  Safeguard: keep a bracket
+    [lo, hi] ⊂ [0, phi_max], shrink it by the sign of r and bisect when a step leaves it.
+``QuaternionScale(algebraic, branch)``
+    σ = p(φ)/sin(φ/2) of from_quaternion (:mod:`symrot.quaternion_plan`): algebraic in e₀, or a
+    ``Branch`` in t = φ².
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mpmath
+import sympy as sp
+
+from .newton_start import FarStart
+
+
+@dataclass(frozen=True)
+class Constant:
+    value: sp.Expr
+
+
+@dataclass(frozen=True)
+class Branch:
+    threshold: float
+    horner: tuple[sp.Expr, ...]
+    closed: sp.Expr
+    safe_phi: float
+    measured_ulp: float
+    edge_ulp: float = 0.0
+    """Worst error of the closed form on the upper half of the range (towards φ_max)."""
+    accurate_threshold: float | None = None
+    """The smallest switch the accuracy allows (``threshold`` is moved up from it for speed), with
+    the first ``accurate_terms`` coefficients of ``horner``: for backends where a branch costs
+    more than a short polynomial saves, such as NumPy's masked passes over whole arrays."""
+    accurate_terms: int | None = None
+
+    @property
+    def smallest_switch(self) -> tuple[float, tuple[sp.Expr, ...]]:
+        """(switch, Horner coefficients) with the switch as small as the accuracy allows."""
+        if self.accurate_threshold is None or self.accurate_terms is None:
+            return self.threshold, self.horner
+        return self.accurate_threshold, self.horner[:self.accurate_terms]
+
+
+@dataclass(frozen=True)
+class Algebraic:
+    expression: sp.Expr
+
+
+@dataclass(frozen=True)
+class ClosedAngle:
+    expression: sp.Expr
+
+
+@dataclass(frozen=True)
+class NewtonAngle:
+    start: tuple[sp.Expr, ...]
+    ratio: Branch
+    slope: Branch
+    iterations: int
+    phi_max: float
+    far: FarStart
+    """The start for s ≥ far.switch (see :mod:`symrot.newton_start`)."""
+
+
+Coefficient = Constant | Algebraic | Branch
+
+
+@dataclass(frozen=True)
+class QuaternionScale:
+    """σ = p(φ)/sin(φ/2), **p** = σ **e**: ``algebraic`` in
+    :data:`~symrot.quaternion_plan.E0` or ``branch`` in t = φ²."""
+
+    algebraic: sp.Expr | None
+    branch: Branch | None
+
+
+@dataclass(frozen=True)
+class PrecisionPlan:
+    dtype: str
+    epsilon: float
+    angle: ClosedAngle | NewtonAngle
+    coefficients: dict[str, Coefficient]
+    quaternion_scale: QuaternionScale
+    """σ with **p** = σ **e** for from_quaternion (see :mod:`symrot.quaternion_plan`)."""
+    x_limit: float = 2.0**600
+    """Edge of the domain for unbounded p: every output is NaN for x = |p|² ≥ x_limit, the largest
+    power of two up to which every printed form is right (:mod:`symrot.domain`)."""
+
+
+@dataclass(frozen=True)
+class EvaluationPlan:
+    name: str
+    p: sp.Expr
+    p_max: float
+    phi_max: float
+    precisions: dict[str, PrecisionPlan]
+    e0_min: float | None
+    """from_quaternion (e₀ ≥ 0) is valid iff e₀ > e0_min; None: every rotation is representable."""
+    complement: sp.Rational | None = None
+    """p_max² when expressions use the symbol ``D`` = p_max² − x, which backends must compute with
+    compensated arithmetic (:func:`symrot.algebraic.fold_complement`)."""
+    p_max_squared_exact: sp.Float | None = None
+    """p_max² at 50 digits (None when p is unbounded): see :meth:`boundary`."""
+
+    def boundary(self, mantissa_bits: int) -> tuple[float, bool]:
+        """(B, inclusive) for a binary type with that many mantissa bits: B = p_max² rounded to the
+        type; inclusive when B lies below the exact p_max², so that x = |p|² ≤ B is inside the range
+        (e.g. p = fl(2π) u for the rotation vector); otherwise inside means x < B."""
+        if self.p_max_squared_exact is None:
+            return float("inf"), False
+        with mpmath.workprec(200):
+            exact = mpmath.mpf(self.p_max_squared_exact._to_mpmath(200))
+            with mpmath.workprec(mantissa_bits):
+                rounded = +exact
+            return float(rounded), bool(rounded < exact)

@@ -1,0 +1,140 @@
+"""Imports run one way: core → plan → backends → API/CLI, with the audit beside plan and backends.
+
+Every module of ``symrot`` is assigned a layer (see docs/architecture.md). The test reads each
+module's source with :mod:`ast`, so it sees every import: at the top, inside functions (lazy) and
+under ``if TYPE_CHECKING:``. It fails when a module imports from a layer its own layer may not
+use, when an import cycle joins modules of different layers and, stricter, on any import cycle.
+Imports by name at run time (``importlib.import_module`` in ``symrot.backends.emitter``) are not
+seen; they stay within the backends.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import symrot
+
+PACKAGE = Path(symrot.__file__).parent
+
+LAYER_OF_PREFIX: dict[str, str] = {
+    # longest prefix wins; a prefix names a module or a package and everything under it
+    "symrot": "app",
+    "symrot.__main__": "app",
+    "symrot.api": "app",
+    "symrot.cli": "app",
+    "symrot.generate": "app",
+    "symrot.audit": "audit",
+    "symrot.backends": "backends",
+    **{f"symrot.{name}": "plan" for name in (
+        "plan", "plan_ir", "algebraic", "newton_start", "quaternion_plan", "sincos_kernel", "evaluation",
+        "domain",
+    )},
+    **{f"symrot.{name}": "core" for name in (
+        "axial", "core", "errors", "functions", "operations", "parsing", "registry", "series",
+        "series_engine", "simplify", "singularities", "solve", "timeouts", "validation",
+    )},
+}
+MAY_IMPORT: dict[str, set[str]] = {
+    "core": {"core"},
+    "plan": {"core", "plan"},
+    "backends": {"core", "plan", "backends"},
+    "audit": {"core", "audit"},
+    "app": {"core", "plan", "backends", "audit", "app"},
+}
+KNOWN_UPWARD: set[tuple[str, str]] = set()
+"""Arrows that run the wrong way and are accepted for now (none)."""
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES: dict[str, Path] = {module_name(path): path for path in sorted(PACKAGE.rglob("*.py"))}
+
+
+def layer(module: str) -> str:
+    prefixes = [p for p in LAYER_OF_PREFIX if module == p or module.startswith(p + ".")]
+    if not prefixes:
+        raise AssertionError(f"{module} has no layer: add it to LAYER_OF_PREFIX")
+    return LAYER_OF_PREFIX[max(prefixes, key=len)]
+
+
+def imports(module: str) -> set[str]:
+    """The ``symrot`` modules ``module`` imports anywhere in its source (``from a import b``
+    counts as importing ``a.b`` when that is a module, else ``a``)."""
+    path = MODULES[module]
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:  # relative: from . import x, from ..plan import y
+                parts = package.split(".")
+                base = ".".join([*parts[:len(parts) - node.level + 1], *filter(None, [node.module])])
+            for alias in node.names:
+                found.add(f"{base}.{alias.name}" if f"{base}.{alias.name}" in MODULES else base)
+    return {name for name in found if name in MODULES and name != module}
+
+
+GRAPH: dict[str, set[str]] = {module: imports(module) for module in MODULES}
+
+
+def test_every_module_has_a_layer() -> None:
+    for module in MODULES:
+        assert layer(module) in MAY_IMPORT
+
+
+def test_no_module_imports_a_layer_above_it() -> None:
+    upward = sorted((module, target) for module, targets in GRAPH.items() for target in targets
+                    if layer(target) not in MAY_IMPORT[layer(module)])
+    unexpected = [f"{m} ({layer(m)}) imports {t} ({layer(t)})" for m, t in upward
+                  if (m, t) not in KNOWN_UPWARD]
+    assert not unexpected, "\n".join(unexpected)
+    stale = KNOWN_UPWARD - set(upward)
+    assert not stale, f"KNOWN_UPWARD lists arrows that are gone, delete them: {sorted(stale)}"
+
+
+def strongly_connected(graph: dict[str, set[str]]) -> list[set[str]]:
+    """Tarjan's algorithm: the import cycles, as sets of modules."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    components: list[set[str]] = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        for target in graph[node]:
+            if target not in index:
+                visit(target)
+                low[node] = min(low[node], low[target])
+            elif target in stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            position = stack.index(node)
+            components.append(set(stack[position:]))
+            del stack[position:]
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return [c for c in components if len(c) > 1]
+
+
+CYCLES = strongly_connected({module: {t for t in targets if (module, t) not in KNOWN_UPWARD}
+                              for module, targets in GRAPH.items()})
+
+
+def test_no_import_cycle_spans_two_layers() -> None:
+    mixed = [sorted(cycle) for cycle in CYCLES if len({layer(m) for m in cycle}) > 1]
+    assert not mixed, f"import cycles across layers: {mixed}"
+
+
+def test_no_import_cycle() -> None:
+    """Stricter than the rule between layers: modules of one layer do not import each other in a
+    circle either (shared code goes into a module below both, as c_writer, plan_ir, audit.records)."""
+    assert not CYCLES, f"import cycles: {[sorted(cycle) for cycle in CYCLES]}"
