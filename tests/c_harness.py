@@ -33,8 +33,11 @@ from symrot.core import Derivation
 from symrot.functions import mpmath_namespace
 from symrot.parsing import PHI
 
-STRICT_C = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror")
-STRICT_CXX = ("-x", "c++", "-std=c++11", "-Wall", "-Wextra", "-Wpedantic", "-Werror")
+EMBEDDED_WARNINGS = ("-Wdouble-promotion", "-Wconversion", "-Wshadow")
+"""What embedded users add (a silent float → double promotion is a software-emulated double
+operation on a single-precision FPU such as Cortex-M4F): the headers compile cleanly with them."""
+STRICT_C = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", *EMBEDDED_WARNINGS, "-Werror")
+STRICT_CXX = ("-x", "c++", "-std=c++11", "-Wall", "-Wextra", "-Wpedantic", *EMBEDDED_WARNINGS, "-Werror")
 SANITIZE = ("-O0", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all")
 CTYPES = {"double": ctypes.c_double, "float": ctypes.c_float}
 DTYPES = {"double": np.float64, "float": np.float32}

@@ -34,6 +34,7 @@ from symrot.backends import c_backend
 from symrot.backends.c_backend import FUNCTIONS
 from symrot.functions import mpmath_namespace
 from symrot.parsing import PHI
+from symrot.plan import evaluation_plan
 from symrot.registry import NAMED
 from symrot.singularities import Validity, validity
 
@@ -78,6 +79,8 @@ def make_grid(name: str, precision: str, seed: int = 5) -> Grid:
     angles = [0.0, *np.geomspace(TINY[precision], 1e-3, 5), *np.geomspace(1e-3, top * 0.9, 11)[1:],
               *(top * (1 - np.geomspace(0.05, 1e-6, 5)))]
     p_max = limits(name).p_max_float
+    label = "float64" if dtype == np.float64 else "float32"
+    x_limit = evaluation_plan(derive(name).derivation, name).precisions[label].x_limit
     rows, vs = [], []
     for angle in angles:
         with mpmath.workdps(40):
@@ -87,6 +90,9 @@ def make_grid(name: str, precision: str, seed: int = 5) -> Grid:
         row = np.array([float(magnitude * mpmath.mpf(float(a))) for a in axis], dtype=dtype)
         # where p′(φ_max) = 0, p(φ_max(1 − 1e-6)) rounds onto p_max: keep to the inside
         if np.linalg.norm(row.astype(np.float64)) >= p_max * (1 - 8 * float(np.finfo(dtype).eps)):
+            continue
+        # unbounded p: the documented domain ends at the plan's x_limit (tests/test_domain.py)
+        if float(np.sum(row.astype(np.float64) ** 2)) >= x_limit:
             continue
         rows.append(row)
         vs.append([rng.uniform(-2, 2) for _ in range(3)])

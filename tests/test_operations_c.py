@@ -29,6 +29,7 @@ import pytest
 
 from symrot.cli import main as symrot_main
 
+from . import c_harness
 from .test_operations_numpy import (
     EXTRA,
     FLIP_ZONE,
@@ -45,7 +46,7 @@ ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated" / "c"
 NAMES = ("rotation_vector", "wiener_milenkovic", "cayley_gibbs_rodrigues", "linear", "det_h_one",
          "euler_rodrigues", "user_eq35")
-FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-O2")
+FLAGS = (*c_harness.STRICT_C, "-O2")
 CTYPE = {"double": "double", "float": "float"}
 DTYPE = {"double": np.float64, "float": np.float32}
 SUFFIX = {"double": "", "float": "_f"}

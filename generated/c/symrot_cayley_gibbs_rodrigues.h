@@ -10,7 +10,7 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
  * Never a silently wrong value: NaN in every output instead.
  *
  * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
@@ -46,14 +46,16 @@ static inline double symrot_cayley_gibbs_rodrigues__phi(double s)
 }
 
 /* symrot_cayley_gibbs_rodrigues_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = 2*atan(s/2) (closed inverse of p(phi))
  * ops: 21 */
 static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        return (double)NAN;
     }
     double s;
     if (x < 2.409919865102884e-181) {
@@ -68,7 +70,9 @@ static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
@@ -76,16 +80,16 @@ static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        R[0] = (double)NAN;
+        R[1] = (double)NAN;
+        R[2] = (double)NAN;
+        R[3] = (double)NAN;
+        R[4] = (double)NAN;
+        R[5] = (double)NAN;
+        R[6] = (double)NAN;
+        R[7] = (double)NAN;
+        R[8] = (double)NAN;
         return;
     }
     const double c_R_1 = 4/(x + 4);
@@ -130,11 +134,11 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -153,7 +157,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
@@ -161,16 +167,16 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
 static inline void symrot_cayley_gibbs_rodrigues_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        H[0] = (double)NAN;
+        H[1] = (double)NAN;
+        H[2] = (double)NAN;
+        H[3] = (double)NAN;
+        H[4] = (double)NAN;
+        H[5] = (double)NAN;
+        H[6] = (double)NAN;
+        H[7] = (double)NAN;
+        H[8] = (double)NAN;
         return;
     }
     const double c_H_0 = 4/(x + 4);
@@ -216,10 +222,10 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_1;
-            c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 0;
+            c_H_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_1;
+            c_H_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -238,7 +244,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 4)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
@@ -246,16 +254,16 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/4.0)*x + 1;
@@ -298,9 +306,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n,
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : -1.0/2.0;
-            c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1.0/4.0;
+            c_H_inverse_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
+            c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1.0/4.0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -319,21 +327,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n,
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H = 16/(x + 4)**2 (algebraic in x)
  * ops: 9 */
 static inline double symrot_cayley_gibbs_rodrigues_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        return (double)NAN;
     }
     const double c_det_H = 16/pow(x + 4, 2);
     return c_det_H;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = 1/sqrt(x + 4) (algebraic in x)
  * G_2 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
@@ -341,16 +353,16 @@ static inline double symrot_cayley_gibbs_rodrigues_tangent_det(const double p[3]
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        G[0] = (double)NAN;
+        G[1] = (double)NAN;
+        G[2] = (double)NAN;
+        G[3] = (double)NAN;
+        G[4] = (double)NAN;
+        G[5] = (double)NAN;
+        G[6] = (double)NAN;
+        G[7] = (double)NAN;
+        G[8] = (double)NAN;
         return;
     }
     const double c_G_1 = 1.0/sqrt(x + 4);
@@ -382,7 +394,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -408,11 +420,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -431,7 +443,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 2/(x + 4) (algebraic in x)
  * K_1 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
  * K_2 = -1/((x + 4)*(sqrt(x + 4) + 2)) (algebraic in x)
@@ -439,16 +453,16 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        K[0] = (double)NAN;
+        K[1] = (double)NAN;
+        K[2] = (double)NAN;
+        K[3] = (double)NAN;
+        K[4] = (double)NAN;
+        K[5] = (double)NAN;
+        K[6] = (double)NAN;
+        K[7] = (double)NAN;
+        K[8] = (double)NAN;
         return;
     }
     const double c_K_0 = 2/(x + 4);
@@ -481,7 +495,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
             } else {
                 const double u0 = sqrt(x + 4);
@@ -506,11 +520,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_1;
+            c_K_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
-            c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_2;
+            c_K_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -529,7 +543,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
 }
 
 /* symrot_cayley_gibbs_rodrigues_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 4)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
@@ -537,10 +553,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
 static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        pdot[0] = NAN;
-        pdot[1] = NAN;
-        pdot[2] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        pdot[0] = (double)NAN;
+        pdot[1] = (double)NAN;
+        pdot[2] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/4.0)*x + 1;
@@ -553,7 +569,9 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const d
 }
 
 /* symrot_cayley_gibbs_rodrigues_omega: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
@@ -561,10 +579,10 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const d
 static inline void symrot_cayley_gibbs_rodrigues_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        omega[0] = NAN;
-        omega[1] = NAN;
-        omega[2] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        omega[0] = (double)NAN;
+        omega[1] = (double)NAN;
+        omega[2] = (double)NAN;
         return;
     }
     const double c_H_0 = 4/(x + 4);
@@ -578,18 +596,20 @@ static inline void symrot_cayley_gibbs_rodrigues_omega(const double p[3], const 
 }
 
 /* symrot_cayley_gibbs_rodrigues_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0 = 2/sqrt(x + 4) (algebraic in x)
  * nu = 2/sqrt(x + 4) (algebraic in x)
  * ops: 18 */
 static inline void symrot_cayley_gibbs_rodrigues_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        e[0] = NAN;
-        e[1] = NAN;
-        e[2] = NAN;
-        e[3] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        e[0] = (double)NAN;
+        e[1] = (double)NAN;
+        e[2] = (double)NAN;
+        e[3] = (double)NAN;
         return;
     }
     const double c_e_0 = 2/sqrt(x + 4);
@@ -608,7 +628,7 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion(double e0, doub
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
     const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
-    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+    if (big > 0 && big < (double)INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
         int k;
         (void)frexp(big, &k);
         e0 = ldexp(e0, -k);
@@ -619,17 +639,17 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion(double e0, doub
     const double y = (e1*e1) + (e2*e2) + (e3*e3);
     const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
     const double c0 = fabs(e0)/n;
     if (!(c0 > 0.0)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double sigma = 2/c0;
@@ -694,9 +714,9 @@ static inline int symrot_cayley_gibbs_rodrigues_rescale(const double p[3], doubl
     double e[4];
     symrot_cayley_gibbs_rodrigues_to_quaternion(p, e);
     if (isnan(e[0])) {
-        q[0] = NAN;
-        q[1] = NAN;
-        q[2] = NAN;
+        q[0] = (double)NAN;
+        q[1] = (double)NAN;
+        q[2] = (double)NAN;
         return 1;
     }
     if (e[0] >= 0) {
@@ -717,13 +737,15 @@ static inline float symrot_cayley_gibbs_rodrigues__phi_f(float s)
 }
 
 /* symrot_cayley_gibbs_rodrigues_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = 2*atan(s/2) (closed inverse of p(phi))
  * ops: 21 */
 static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         return NAN;
     }
     float s;
@@ -739,7 +761,9 @@ static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
@@ -747,7 +771,7 @@ static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -801,11 +825,11 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -824,7 +848,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
@@ -832,7 +858,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
 static inline void symrot_cayley_gibbs_rodrigues_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -887,10 +913,10 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_1;
-            c_H_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 0;
+            c_H_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_1;
+            c_H_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -909,7 +935,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 4)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
@@ -917,7 +945,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -969,9 +997,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : -1.0F/2.0F;
-            c_H_inverse_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1.0F/4.0F;
+            c_H_inverse_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1.0F/4.0F;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -990,13 +1018,15 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t 
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H = 16/(x + 4)**2 (algebraic in x)
  * ops: 9 */
 static inline float symrot_cayley_gibbs_rodrigues_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         return NAN;
     }
     const float c_det_H = 16/powf(x + 4, 2);
@@ -1004,7 +1034,9 @@ static inline float symrot_cayley_gibbs_rodrigues_tangent_det_f(const float p[3]
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = 1/sqrt(x + 4) (algebraic in x)
  * G_2 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
@@ -1012,7 +1044,7 @@ static inline float symrot_cayley_gibbs_rodrigues_tangent_det_f(const float p[3]
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -1053,7 +1085,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -1079,11 +1111,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1102,7 +1134,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 2/(x + 4) (algebraic in x)
  * K_1 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
  * K_2 = -1/((x + 4)*(sqrt(x + 4) + 2)) (algebraic in x)
@@ -1110,7 +1144,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -1152,7 +1186,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
             } else {
                 const float u0 = sqrtf(x + 4);
@@ -1177,11 +1211,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_1;
+            c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
-            c_K_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_2;
+            c_K_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1200,7 +1234,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
 }
 
 /* symrot_cayley_gibbs_rodrigues_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 4)/4 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
@@ -1208,7 +1244,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
 static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -1224,7 +1260,9 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const 
 }
 
 /* symrot_cayley_gibbs_rodrigues_omega_f: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
@@ -1232,7 +1270,7 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const 
 static inline void symrot_cayley_gibbs_rodrigues_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -1249,14 +1287,16 @@ static inline void symrot_cayley_gibbs_rodrigues_omega_f(const float p[3], const
 }
 
 /* symrot_cayley_gibbs_rodrigues_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 3.1415926535897931); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0 = 2/sqrt(x + 4) (algebraic in x)
  * nu = 2/sqrt(x + 4) (algebraic in x)
  * ops: 18 */
 static inline void symrot_cayley_gibbs_rodrigues_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;

@@ -74,7 +74,7 @@ static inline double symrot_linear_angle(const double p[3])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        return NAN;
+        return (double)NAN;
     }
     double s;
     if (x < 2.409919865102884e-181) {
@@ -99,15 +99,15 @@ static inline void symrot_linear_rotation_matrix(const double p[3], double R[9])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        R[0] = (double)NAN;
+        R[1] = (double)NAN;
+        R[2] = (double)NAN;
+        R[3] = (double)NAN;
+        R[4] = (double)NAN;
+        R[5] = (double)NAN;
+        R[6] = (double)NAN;
+        R[7] = (double)NAN;
+        R[8] = (double)NAN;
         return;
     }
     const double c_R_2 = 1.0/(sqrt(d) + 1);
@@ -158,10 +158,10 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 1.0) ? NAN : 1;
-            c_R_1_lanes[k] = !(x < 1.0) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 1.0) ? (double)NAN : 1;
+            c_R_1_lanes[k] = !(x < 1.0) ? (double)NAN : 1;
             const double closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 1.0) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 1.0) ? (double)NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -190,15 +190,15 @@ static inline void symrot_linear_tangent(const double p[3], double H[9])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        H[0] = (double)NAN;
+        H[1] = (double)NAN;
+        H[2] = (double)NAN;
+        H[3] = (double)NAN;
+        H[4] = (double)NAN;
+        H[5] = (double)NAN;
+        H[6] = (double)NAN;
+        H[7] = (double)NAN;
+        H[8] = (double)NAN;
         return;
     }
     const double c_H_0 = 1.0/sqrt(d);
@@ -268,13 +268,13 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 1.0) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 1.0) ? NAN : closed_H_1;
+            c_H_1_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
             const double v_H_2 = x < 9.999999999999965e-15 ? poly_H_2 : closed_H_2;
-            c_H_2_lanes[k] = !(x < 1.0) ? NAN : v_H_2;
+            c_H_2_lanes[k] = !(x < 1.0) ? (double)NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -303,15 +303,15 @@ static inline void symrot_linear_tangent_inverse(const double p[3], double Hinv[
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = sqrt(d);
@@ -365,10 +365,10 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 1.0) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 1.0) ? NAN : -1.0/2.0;
+            c_H_inverse_0_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 1.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
-            c_H_inverse_2_lanes[k] = !(x < 1.0) ? NAN : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -395,7 +395,7 @@ static inline double symrot_linear_tangent_det(const double p[3])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        return NAN;
+        return (double)NAN;
     }
     double c_det_H;
     if (x < 0.005951203046330052) {
@@ -418,15 +418,15 @@ static inline void symrot_linear_root_matrix(const double p[3], double G[9])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        G[0] = (double)NAN;
+        G[1] = (double)NAN;
+        G[2] = (double)NAN;
+        G[3] = (double)NAN;
+        G[4] = (double)NAN;
+        G[5] = (double)NAN;
+        G[6] = (double)NAN;
+        G[7] = (double)NAN;
+        G[8] = (double)NAN;
         return;
     }
     const double c_G_1 = (1.0/2.0)*sqrt(2)/sqrt(sqrt(d) + 1);
@@ -509,13 +509,13 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 1.0) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 1.0) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 1.0) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 1.0) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
             const double v_G_2 = x < 0.0649445220708132 ? poly_G_2 : closed_G_2;
-            c_G_2_lanes[k] = !(x < 1.0) ? NAN : v_G_2;
+            c_G_2_lanes[k] = !(x < 1.0) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -544,15 +544,15 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        K[0] = (double)NAN;
+        K[1] = (double)NAN;
+        K[2] = (double)NAN;
+        K[3] = (double)NAN;
+        K[4] = (double)NAN;
+        K[5] = (double)NAN;
+        K[6] = (double)NAN;
+        K[7] = (double)NAN;
+        K[8] = (double)NAN;
         return;
     }
     const double c_K_0 = (1.0/2.0)/sqrt(d);
@@ -654,15 +654,15 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 1.0) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 1.0) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 0.0649445220708132 ? poly_K_1 : closed_K_1;
-            c_K_1_lanes[k] = !(x < 1.0) ? NAN : v_K_1;
+            c_K_1_lanes[k] = !(x < 1.0) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
             const double v_K_2 = x < 0.116472206314816 ? poly_K_2 : closed_K_2;
-            c_K_2_lanes[k] = !(x < 1.0) ? NAN : v_K_2;
+            c_K_2_lanes[k] = !(x < 1.0) ? (double)NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -691,9 +691,9 @@ static inline void symrot_linear_pdot(const double p[3], const double omega[3], 
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        pdot[0] = NAN;
-        pdot[1] = NAN;
-        pdot[2] = NAN;
+        pdot[0] = (double)NAN;
+        pdot[1] = (double)NAN;
+        pdot[2] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = sqrt(d);
@@ -717,9 +717,9 @@ static inline void symrot_linear_omega(const double p[3], const double pdot[3], 
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        omega[0] = NAN;
-        omega[1] = NAN;
-        omega[2] = NAN;
+        omega[0] = (double)NAN;
+        omega[1] = (double)NAN;
+        omega[2] = (double)NAN;
         return;
     }
     const double c_H_0 = 1.0/sqrt(d);
@@ -749,10 +749,10 @@ static inline void symrot_linear_to_quaternion(const double p[3], double e[4])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_linear__complement(p);
     if (!(x < 1.0)) {
-        e[0] = NAN;
-        e[1] = NAN;
-        e[2] = NAN;
-        e[3] = NAN;
+        e[0] = (double)NAN;
+        e[1] = (double)NAN;
+        e[2] = (double)NAN;
+        e[3] = (double)NAN;
         return;
     }
     const double c_nu = sqrt(2)/sqrt(sqrt(d) + 1);
@@ -777,7 +777,7 @@ static inline int symrot_linear__from_quaternion(double e0, double e1, double e2
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
     const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
-    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+    if (big > 0 && big < (double)INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
         int k;
         (void)frexp(big, &k);
         e0 = ldexp(e0, -k);
@@ -788,17 +788,17 @@ static inline int symrot_linear__from_quaternion(double e0, double e1, double e2
     const double y = (e1*e1) + (e2*e2) + (e3*e3);
     const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
     const double c0 = fabs(e0)/n;
     if (!(c0 > 0.7071067811865476)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double sigma = 2*c0;
@@ -806,9 +806,9 @@ static inline int symrot_linear__from_quaternion(double e0, double e1, double e2
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
     if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 1.0)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     return 0;
@@ -869,9 +869,9 @@ static inline int symrot_linear_rescale(const double p[3], double q[3])
     double e[4];
     symrot_linear_to_quaternion(p, e);
     if (isnan(e[0])) {
-        q[0] = NAN;
-        q[1] = NAN;
-        q[2] = NAN;
+        q[0] = (double)NAN;
+        q[1] = (double)NAN;
+        q[2] = (double)NAN;
         return 1;
     }
     if (e[0] >= 0) {

@@ -53,7 +53,7 @@ static inline double symrot_rotation_vector_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        return NAN;
+        return (double)NAN;
     }
     double s;
     if (x < 2.409919865102884e-181) {
@@ -77,15 +77,15 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        R[0] = (double)NAN;
+        R[1] = (double)NAN;
+        R[2] = (double)NAN;
+        R[3] = (double)NAN;
+        R[4] = (double)NAN;
+        R[5] = (double)NAN;
+        R[6] = (double)NAN;
+        R[7] = (double)NAN;
+        R[8] = (double)NAN;
         return;
     }
     double c_R_1, c_R_2;
@@ -163,15 +163,15 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
+            c_R_0_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
             const double v_R_1 = x < 5.028297529613116e-13 ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_1;
+            c_R_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
             const double v_R_2 = x < 5.028297529613116e-13 ? poly_R_2 : closed_R_2;
-            c_R_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_R_2;
+            c_R_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -199,15 +199,15 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        H[0] = (double)NAN;
+        H[1] = (double)NAN;
+        H[2] = (double)NAN;
+        H[3] = (double)NAN;
+        H[4] = (double)NAN;
+        H[5] = (double)NAN;
+        H[6] = (double)NAN;
+        H[7] = (double)NAN;
+        H[8] = (double)NAN;
         return;
     }
     double c_H_1, c_H_2;
@@ -291,15 +291,15 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_H_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
+            c_H_0_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : 1;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 5.028297529613116e-13 ? poly_H_1 : closed_H_1;
-            c_H_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_1;
+            c_H_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
             const double v_H_2 = x < 0.7851233626304374 ? poly_H_2 : closed_H_2;
-            c_H_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_2;
+            c_H_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -327,15 +327,15 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
         return;
     }
     double c_H_inverse_2;
@@ -408,12 +408,12 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
-            c_H_inverse_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : -1.0/2.0;
+            c_H_inverse_0_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : 1;
+            c_H_inverse_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
             const double v_H_inverse_2 = x < 5.5673482008975155 ? poly_H_inverse_2 : closed_H_inverse_2;
-            c_H_inverse_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -439,7 +439,7 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        return NAN;
+        return (double)NAN;
     }
     double c_det_H;
     if (x < 0.7851233626304374) {
@@ -461,15 +461,15 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        G[0] = (double)NAN;
+        G[1] = (double)NAN;
+        G[2] = (double)NAN;
+        G[3] = (double)NAN;
+        G[4] = (double)NAN;
+        G[5] = (double)NAN;
+        G[6] = (double)NAN;
+        G[7] = (double)NAN;
+        G[8] = (double)NAN;
         return;
     }
     double c_G_1, c_G_2;
@@ -553,15 +553,15 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1;
+            c_G_0_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
             const double v_G_1 = x < 1.8559287093218047e-12 ? poly_G_1 : closed_G_1;
-            c_G_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_1;
+            c_G_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
             const double v_G_2 = x < 1.8559287093218047e-12 ? poly_G_2 : closed_G_2;
-            c_G_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_G_2;
+            c_G_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -589,15 +589,15 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        K[0] = (double)NAN;
+        K[1] = (double)NAN;
+        K[2] = (double)NAN;
+        K[3] = (double)NAN;
+        K[4] = (double)NAN;
+        K[5] = (double)NAN;
+        K[6] = (double)NAN;
+        K[7] = (double)NAN;
+        K[8] = (double)NAN;
         return;
     }
     double c_K_1, c_K_2;
@@ -681,15 +681,15 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_K_0_lanes[k] = !(x <= 39.47841760435743) ? NAN : 1.0/2.0;
+            c_K_0_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : 1.0/2.0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 1.8559287093218047e-12 ? poly_K_1 : closed_K_1;
-            c_K_1_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_K_1;
+            c_K_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
             const double v_K_2 = x < 5.5673482008975155 ? poly_K_2 : closed_K_2;
-            c_K_2_lanes[k] = !(x <= 39.47841760435743) ? NAN : v_K_2;
+            c_K_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -717,9 +717,9 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        pdot[0] = NAN;
-        pdot[1] = NAN;
-        pdot[2] = NAN;
+        pdot[0] = (double)NAN;
+        pdot[1] = (double)NAN;
+        pdot[2] = (double)NAN;
         return;
     }
     double c_H_inverse_2;
@@ -748,9 +748,9 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        omega[0] = NAN;
-        omega[1] = NAN;
-        omega[2] = NAN;
+        omega[0] = (double)NAN;
+        omega[1] = (double)NAN;
+        omega[2] = (double)NAN;
         return;
     }
     double c_H_1, c_H_2;
@@ -779,10 +779,10 @@ static inline void symrot_rotation_vector_to_quaternion(const double p[3], doubl
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        e[0] = NAN;
-        e[1] = NAN;
-        e[2] = NAN;
-        e[3] = NAN;
+        e[0] = (double)NAN;
+        e[1] = (double)NAN;
+        e[2] = (double)NAN;
+        e[3] = (double)NAN;
         return;
     }
     double c_e_0, c_nu;
@@ -809,7 +809,7 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
     const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
-    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+    if (big > 0 && big < (double)INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
         int k;
         (void)frexp(big, &k);
         e0 = ldexp(e0, -k);
@@ -821,9 +821,9 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
     const double e_norm = sqrt(y);
     const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
@@ -839,9 +839,9 @@ static inline int symrot_rotation_vector__from_quaternion(double e0, double e1, 
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
     if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) <= 39.47841760435743)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     return 0;
@@ -902,9 +902,9 @@ static inline int symrot_rotation_vector_rescale(const double p[3], double q[3])
     double e[4];
     symrot_rotation_vector_to_quaternion(p, e);
     if (isnan(e[0])) {
-        q[0] = NAN;
-        q[1] = NAN;
-        q[2] = NAN;
+        q[0] = (double)NAN;
+        q[1] = (double)NAN;
+        q[2] = (double)NAN;
         return 1;
     }
     if (e[0] >= 0) {

@@ -10,7 +10,7 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
  * Never a silently wrong value: NaN in every output instead.
  *
  * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
@@ -46,14 +46,16 @@ static inline double symrot_tangent_m1__phi(double s)
 }
 
 /* symrot_tangent_m1_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = atan(s) (closed inverse of p(phi))
  * ops: 19 */
 static inline double symrot_tangent_m1_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        return (double)NAN;
     }
     double s;
     if (x < 2.409919865102884e-181) {
@@ -68,7 +70,9 @@ static inline double symrot_tangent_m1_angle(const double p[3])
 }
 
 /* symrot_tangent_m1_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 1/sqrt(x + 1) (algebraic in x)
  * R_2 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
@@ -76,16 +80,16 @@ static inline double symrot_tangent_m1_angle(const double p[3])
 static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        R[0] = (double)NAN;
+        R[1] = (double)NAN;
+        R[2] = (double)NAN;
+        R[3] = (double)NAN;
+        R[4] = (double)NAN;
+        R[5] = (double)NAN;
+        R[6] = (double)NAN;
+        R[7] = (double)NAN;
+        R[8] = (double)NAN;
         return;
     }
     const double c_R_1 = 1.0/sqrt(x + 1);
@@ -117,7 +121,7 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -143,11 +147,11 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -166,7 +170,9 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m1_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -174,16 +180,16 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
 static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        H[0] = (double)NAN;
+        H[1] = (double)NAN;
+        H[2] = (double)NAN;
+        H[3] = (double)NAN;
+        H[4] = (double)NAN;
+        H[5] = (double)NAN;
+        H[6] = (double)NAN;
+        H[7] = (double)NAN;
+        H[8] = (double)NAN;
         return;
     }
     const double c_H_0 = 1.0/(x + 1);
@@ -216,7 +222,7 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
             } else {
                 const double u0 = sqrt(x + 1);
@@ -241,11 +247,11 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_1;
+            c_H_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -264,7 +270,9 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
 }
 
 /* symrot_tangent_m1_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -272,16 +280,16 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
 static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = x + 1;
@@ -313,7 +321,7 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
             } else {
                 const double u0 = sqrt(x + 1);
@@ -335,10 +343,10 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : -1.0/2.0;
+            c_H_inverse_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
-            c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -357,21 +365,25 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m1_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H = 2/((x + 1)*(x + sqrt(x + 1) + 1)) (algebraic in x)
  * ops: 14 */
 static inline double symrot_tangent_m1_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        return (double)NAN;
     }
     const double c_det_H = 2/((x + 1)*(x + sqrt(x + 1) + 1));
     return c_det_H;
 }
 
 /* symrot_tangent_m1_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/s**2
@@ -379,16 +391,16 @@ static inline double symrot_tangent_m1_tangent_det(const double p[3])
 static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        G[0] = (double)NAN;
+        G[1] = (double)NAN;
+        G[2] = (double)NAN;
+        G[3] = (double)NAN;
+        G[4] = (double)NAN;
+        G[5] = (double)NAN;
+        G[6] = (double)NAN;
+        G[7] = (double)NAN;
+        G[8] = (double)NAN;
         return;
     }
     const double c_G_1 = (1.0/2.0)*sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
@@ -428,7 +440,7 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
@@ -475,13 +487,13 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
             const double v_G_2 = x < 7.889013259849922e-06 ? poly_G_2 : closed_G_2;
-            c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_2;
+            c_G_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -500,7 +512,9 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
 }
 
 /* symrot_tangent_m1_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 1/(2*(x + 1)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 18 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
@@ -508,16 +522,16 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
 static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        K[0] = (double)NAN;
+        K[1] = (double)NAN;
+        K[2] = (double)NAN;
+        K[3] = (double)NAN;
+        K[4] = (double)NAN;
+        K[5] = (double)NAN;
+        K[6] = (double)NAN;
+        K[7] = (double)NAN;
+        K[8] = (double)NAN;
         return;
     }
     const double c_K_0 = (1.0/2.0)/(x + 1);
@@ -560,7 +574,7 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 7.889013259849922e-06) {
+            if (!(x < 6.703903964971299e+153) || x < 7.889013259849922e-06) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -612,15 +626,15 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 7.889013259849922e-06 ? poly_K_1 : closed_K_1;
-            c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_1;
+            c_K_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
             const double v_K_2 = x < 0.13182630716008584 ? poly_K_2 : closed_K_2;
-            c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_2;
+            c_K_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -639,7 +653,9 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
 }
 
 /* symrot_tangent_m1_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -647,10 +663,10 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
 static inline void symrot_tangent_m1_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        pdot[0] = NAN;
-        pdot[1] = NAN;
-        pdot[2] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        pdot[0] = (double)NAN;
+        pdot[1] = (double)NAN;
+        pdot[2] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = x + 1;
@@ -664,7 +680,9 @@ static inline void symrot_tangent_m1_pdot(const double p[3], const double omega[
 }
 
 /* symrot_tangent_m1_omega: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -672,10 +690,10 @@ static inline void symrot_tangent_m1_pdot(const double p[3], const double omega[
 static inline void symrot_tangent_m1_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        omega[0] = NAN;
-        omega[1] = NAN;
-        omega[2] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        omega[0] = (double)NAN;
+        omega[1] = (double)NAN;
+        omega[2] = (double)NAN;
         return;
     }
     const double c_H_0 = 1.0/(x + 1);
@@ -690,18 +708,20 @@ static inline void symrot_tangent_m1_omega(const double p[3], const double pdot[
 }
 
 /* symrot_tangent_m1_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.0109725, else cos(phi/2)
  * nu = sqrt(2)/((x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * ops: 46 */
 static inline void symrot_tangent_m1_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        e[0] = NAN;
-        e[1] = NAN;
-        e[2] = NAN;
-        e[3] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        e[0] = (double)NAN;
+        e[1] = (double)NAN;
+        e[2] = (double)NAN;
+        e[3] = (double)NAN;
         return;
     }
     const double c_nu = sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
@@ -726,7 +746,7 @@ static inline int symrot_tangent_m1__from_quaternion(double e0, double e1, doubl
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
     const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
-    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+    if (big > 0 && big < (double)INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
         int k;
         (void)frexp(big, &k);
         e0 = ldexp(e0, -k);
@@ -737,17 +757,17 @@ static inline int symrot_tangent_m1__from_quaternion(double e0, double e1, doubl
     const double y = (e1*e1) + (e2*e2) + (e3*e3);
     const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
     const double c0 = fabs(e0)/n;
     if (!(c0 > 0.7071067811865476)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double sigma = 2*c0/(2*(c0*c0) - 1);
@@ -812,9 +832,9 @@ static inline int symrot_tangent_m1_rescale(const double p[3], double q[3])
     double e[4];
     symrot_tangent_m1_to_quaternion(p, e);
     if (isnan(e[0])) {
-        q[0] = NAN;
-        q[1] = NAN;
-        q[2] = NAN;
+        q[0] = (double)NAN;
+        q[1] = (double)NAN;
+        q[2] = (double)NAN;
         return 1;
     }
     if (e[0] >= 0) {
@@ -835,13 +855,15 @@ static inline float symrot_tangent_m1__phi_f(float s)
 }
 
 /* symrot_tangent_m1_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = atan(s) (closed inverse of p(phi))
  * ops: 19 */
 static inline float symrot_tangent_m1_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         return NAN;
     }
     float s;
@@ -857,7 +879,9 @@ static inline float symrot_tangent_m1_angle_f(const float p[3])
 }
 
 /* symrot_tangent_m1_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = 1/sqrt(x + 1) (algebraic in x)
  * R_2 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
@@ -865,7 +889,7 @@ static inline float symrot_tangent_m1_angle_f(const float p[3])
 static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -906,7 +930,7 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -932,11 +956,11 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -955,7 +979,9 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m1_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -963,7 +989,7 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
 static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -1005,7 +1031,7 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
             } else {
                 const float u0 = sqrtf(x + 1);
@@ -1030,11 +1056,11 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_1;
+            c_H_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1053,7 +1079,9 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
 }
 
 /* symrot_tangent_m1_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -1061,7 +1089,7 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
 static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -1102,7 +1130,7 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
             } else {
                 const float u0 = sqrtf(x + 1);
@@ -1124,10 +1152,10 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
-            c_H_inverse_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1146,13 +1174,15 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m1_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H = 2/((x + 1)*(x + sqrt(x + 1) + 1)) (algebraic in x)
  * ops: 14 */
 static inline float symrot_tangent_m1_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         return NAN;
     }
     const float c_det_H = 2/((x + 1)*(x + sqrtf(x + 1) + 1));
@@ -1160,7 +1190,9 @@ static inline float symrot_tangent_m1_tangent_det_f(const float p[3])
 }
 
 /* symrot_tangent_m1_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/s**2
@@ -1168,7 +1200,7 @@ static inline float symrot_tangent_m1_tangent_det_f(const float p[3])
 static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -1217,7 +1249,7 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
@@ -1264,13 +1296,13 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
             const float v_G_2 = x < 0.0017890878F ? poly_G_2 : closed_G_2;
-            c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_2;
+            c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1289,7 +1321,9 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
 }
 
 /* symrot_tangent_m1_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 1/(2*(x + 1)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 13 in x below x = 0.258954, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
@@ -1297,7 +1331,7 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
 static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -1349,7 +1383,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 0.0017890878F) {
+            if (!(x < 9.223372e+18F) || x < 0.0017890878F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1401,15 +1435,15 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.0017890878F ? poly_K_1 : closed_K_1;
-            c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_1;
+            c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
             const float v_K_2 = x < 0.2589544F ? poly_K_2 : closed_K_2;
-            c_K_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_2;
+            c_K_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1428,7 +1462,9 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
 }
 
 /* symrot_tangent_m1_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = x + 1 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -1436,7 +1472,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
 static inline void symrot_tangent_m1_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -1453,7 +1489,9 @@ static inline void symrot_tangent_m1_pdot_f(const float p[3], const float omega[
 }
 
 /* symrot_tangent_m1_omega_f: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 1/(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
@@ -1461,7 +1499,7 @@ static inline void symrot_tangent_m1_pdot_f(const float p[3], const float omega[
 static inline void symrot_tangent_m1_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -1479,14 +1517,16 @@ static inline void symrot_tangent_m1_omega_f(const float p[3], const float pdot[
 }
 
 /* symrot_tangent_m1_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 1.5707963267948966); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.131826, else cos(phi/2)
  * nu = sqrt(2)/((x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * ops: 46 */
 static inline void symrot_tangent_m1_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;

@@ -10,7 +10,7 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * Never a silently wrong value: NaN in every output instead.
  *
  * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
@@ -46,14 +46,16 @@ static inline double symrot_tangent_m3__phi(double s)
 }
 
 /* symrot_tangent_m3_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = 3*atan(s/3) (closed inverse of p(phi))
  * ops: 21 */
 static inline double symrot_tangent_m3_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        return (double)NAN;
     }
     double s;
     if (x < 2.409919865102884e-181) {
@@ -68,7 +70,9 @@ static inline double symrot_tangent_m3_angle(const double p[3])
 }
 
 /* symrot_tangent_m3_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
  * R_2: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
@@ -76,16 +80,16 @@ static inline double symrot_tangent_m3_angle(const double p[3])
 static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        R[0] = (double)NAN;
+        R[1] = (double)NAN;
+        R[2] = (double)NAN;
+        R[3] = (double)NAN;
+        R[4] = (double)NAN;
+        R[5] = (double)NAN;
+        R[6] = (double)NAN;
+        R[7] = (double)NAN;
+        R[8] = (double)NAN;
         return;
     }
     double c_R_1, c_R_2;
@@ -126,7 +130,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 1.0000000000000006e-14) {
+            if (!(x < 6.703903964971299e+153) || x < 1.0000000000000006e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -174,15 +178,15 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
             const double v_R_1 = x < 1.0000000000000006e-14 ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
             const double v_R_2 = x < 0.13136065202211897 ? poly_R_2 : closed_R_2;
-            c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_R_2;
+            c_R_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -201,7 +205,9 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
  * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
@@ -209,16 +215,16 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
 static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        H[0] = (double)NAN;
+        H[1] = (double)NAN;
+        H[2] = (double)NAN;
+        H[3] = (double)NAN;
+        H[4] = (double)NAN;
+        H[5] = (double)NAN;
+        H[6] = (double)NAN;
+        H[7] = (double)NAN;
+        H[8] = (double)NAN;
         return;
     }
     const double c_H_0 = 9/(x + 9);
@@ -259,7 +265,7 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
@@ -308,13 +314,13 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.13136065202211897 ? poly_H_1 : closed_H_1;
-            c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_H_1;
+            c_H_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -333,7 +339,9 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
 }
 
 /* symrot_tangent_m3_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
@@ -341,16 +349,16 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
 static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/9.0)*x + 1;
@@ -382,7 +390,7 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180)) {
+            if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
             } else {
                 const double u0 = sqrt(x + 9);
@@ -405,10 +413,10 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : -1.0/2.0;
+            c_H_inverse_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
-            c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -427,14 +435,16 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
 }
 
 /* symrot_tangent_m3_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H: Horner degree 9 in x below x = 0.131361, else 36*sin(phi/2)**2/(s**2*(x + 9))
  * ops: 35 */
 static inline double symrot_tangent_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        return (double)NAN;
     }
     double c_det_H;
     if (x < 0.13136065202211897) {
@@ -448,7 +458,9 @@ static inline double symrot_tangent_m3_tangent_det(const double p[3])
 }
 
 /* symrot_tangent_m3_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.0687772, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/s**2
@@ -456,16 +468,16 @@ static inline double symrot_tangent_m3_tangent_det(const double p[3])
 static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        G[0] = (double)NAN;
+        G[1] = (double)NAN;
+        G[2] = (double)NAN;
+        G[3] = (double)NAN;
+        G[4] = (double)NAN;
+        G[5] = (double)NAN;
+        G[6] = (double)NAN;
+        G[7] = (double)NAN;
+        G[8] = (double)NAN;
         return;
     }
     double c_G_1, c_G_2;
@@ -506,7 +518,7 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 1.9011961863057328e-14) {
+            if (!(x < 6.703903964971299e+153) || x < 1.9011961863057328e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -554,15 +566,15 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
             const double v_G_1 = x < 1.9011961863057328e-14 ? poly_G_1 : closed_G_1;
-            c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_1;
+            c_G_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
             const double v_G_2 = x < 0.01895808389350374 ? poly_G_2 : closed_G_2;
-            c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_G_2;
+            c_G_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -581,7 +593,9 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
 }
 
 /* symrot_tangent_m3_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 21 in x below x = 1.93909, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
@@ -589,16 +603,16 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
 static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        K[0] = (double)NAN;
+        K[1] = (double)NAN;
+        K[2] = (double)NAN;
+        K[3] = (double)NAN;
+        K[4] = (double)NAN;
+        K[5] = (double)NAN;
+        K[6] = (double)NAN;
+        K[7] = (double)NAN;
+        K[8] = (double)NAN;
         return;
     }
     const double c_K_0 = (9.0/2.0)/(x + 9);
@@ -641,7 +655,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 4.149515568880993e+180) || x < 0.01895808389350374) {
+            if (!(x < 6.703903964971299e+153) || x < 0.01895808389350374) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -693,15 +707,15 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 0.01895808389350374 ? poly_K_1 : closed_K_1;
-            c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_1;
+            c_K_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
             const double v_K_2 = x < 1.9390924142768158 ? poly_K_2 : closed_K_2;
-            c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : v_K_2;
+            c_K_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -720,7 +734,9 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
 }
 
 /* symrot_tangent_m3_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
@@ -728,10 +744,10 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
 static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        pdot[0] = NAN;
-        pdot[1] = NAN;
-        pdot[2] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        pdot[0] = (double)NAN;
+        pdot[1] = (double)NAN;
+        pdot[2] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/9.0)*x + 1;
@@ -745,7 +761,9 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
 }
 
 /* symrot_tangent_m3_omega: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
  * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
@@ -753,10 +771,10 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
 static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        omega[0] = NAN;
-        omega[1] = NAN;
-        omega[2] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        omega[0] = (double)NAN;
+        omega[1] = (double)NAN;
+        omega[2] = (double)NAN;
         return;
     }
     const double c_H_0 = 9/(x + 9);
@@ -778,18 +796,20 @@ static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[
 }
 
 /* symrot_tangent_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0 = -sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/(2*(x + 9)**(3/4)) (algebraic in x)
  * nu: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)/s
  * ops: 53 */
 static inline void symrot_tangent_m3_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        e[0] = NAN;
-        e[1] = NAN;
-        e[2] = NAN;
-        e[3] = NAN;
+    if (!(x < 6.703903964971299e+153)) {
+        e[0] = (double)NAN;
+        e[1] = (double)NAN;
+        e[2] = (double)NAN;
+        e[3] = (double)NAN;
         return;
     }
     const double c_e_0 = -1.0/2.0*sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/pow(x + 9, 3.0/4.0);
@@ -815,7 +835,7 @@ static inline int symrot_tangent_m3__from_quaternion(double e0, double e1, doubl
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
     const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
-    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+    if (big > 0 && big < (double)INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
         int k;
         (void)frexp(big, &k);
         e0 = ldexp(e0, -k);
@@ -827,9 +847,9 @@ static inline int symrot_tangent_m3__from_quaternion(double e0, double e1, doubl
     const double e_norm = sqrt(y);
     const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
@@ -902,9 +922,9 @@ static inline int symrot_tangent_m3_rescale(const double p[3], double q[3])
     double e[4];
     symrot_tangent_m3_to_quaternion(p, e);
     if (isnan(e[0])) {
-        q[0] = NAN;
-        q[1] = NAN;
-        q[2] = NAN;
+        q[0] = (double)NAN;
+        q[1] = (double)NAN;
+        q[2] = (double)NAN;
         return 1;
     }
     if (e[0] >= 0) {
@@ -925,13 +945,15 @@ static inline float symrot_tangent_m3__phi_f(float s)
 }
 
 /* symrot_tangent_m3_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = 3*atan(s/3) (closed inverse of p(phi))
  * ops: 21 */
 static inline float symrot_tangent_m3_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         return NAN;
     }
     float s;
@@ -947,7 +969,9 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
 }
 
 /* symrot_tangent_m3_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
@@ -955,7 +979,7 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
 static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -1006,7 +1030,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 1e-14F) {
+            if (!(x < 9.223372e+18F) || x < 1e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1057,15 +1081,15 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
             const float v_R_1 = x < 1e-14F ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
             const float v_R_2 = x < 0.48711845F ? poly_R_2 : closed_R_2;
-            c_R_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_R_2;
+            c_R_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1084,7 +1108,9 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
  * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
@@ -1092,7 +1118,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
 static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -1142,7 +1168,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
@@ -1192,13 +1218,13 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.48711845F ? poly_H_1 : closed_H_1;
-            c_H_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_H_1;
+            c_H_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1217,7 +1243,9 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
 }
 
 /* symrot_tangent_m3_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
@@ -1225,7 +1253,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
 static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -1266,7 +1294,7 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F)) {
+            if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
             } else {
                 const float u0 = sqrtf(x + 9);
@@ -1289,10 +1317,10 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
-            c_H_inverse_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1311,13 +1339,15 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
 }
 
 /* symrot_tangent_m3_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H: Horner degree 6 in x below x = 0.487118, else 36*sin(phi/2)**2/(s**2*(x + 9))
  * ops: 25 */
 static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         return NAN;
     }
     float c_det_H;
@@ -1332,7 +1362,9 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
 }
 
 /* symrot_tangent_m3_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.956738, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/s**2
@@ -1340,7 +1372,7 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
 static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -1390,7 +1422,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 1.9011963e-14F) {
+            if (!(x < 9.223372e+18F) || x < 1.9011963e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1438,15 +1470,15 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
             const float v_G_1 = x < 1.9011963e-14F ? poly_G_1 : closed_G_1;
-            c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_1;
+            c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
             const float v_G_2 = x < 0.95673823F ? poly_G_2 : closed_G_2;
-            c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_G_2;
+            c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1465,7 +1497,9 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
 }
 
 /* symrot_tangent_m3_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/s**2
  * K_2: Horner degree 21 in x below x = 4.19813, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
@@ -1473,7 +1507,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
 static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -1525,7 +1559,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 1.2676506e+30F) || x < 0.95673823F) {
+            if (!(x < 9.223372e+18F) || x < 0.95673823F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1577,15 +1611,15 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.95673823F ? poly_K_1 : closed_K_1;
-            c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_1;
+            c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
             const float v_K_2 = x < 4.1981263F ? poly_K_2 : closed_K_2;
-            c_K_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : v_K_2;
+            c_K_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1604,7 +1638,9 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
 }
 
 /* symrot_tangent_m3_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 9)/9 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
@@ -1612,7 +1648,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
 static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -1629,7 +1665,9 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
 }
 
 /* symrot_tangent_m3_omega_f: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
  * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
@@ -1637,7 +1675,7 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
 static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -1662,14 +1700,16 @@ static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[
 }
 
 /* symrot_tangent_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 4.7123889803846897); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0 = -sqrt(2)*(sqrt(x + 9) - 6)*sqrt(sqrt(x + 9) + 3)/(2*(x + 9)**(3/4)) (algebraic in x)
  * nu: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/2)/s
  * ops: 53 */
 static inline void symrot_tangent_m3_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 9.223372e+18F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;

@@ -53,7 +53,7 @@ static inline double symrot_tangent_m6_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        return NAN;
+        return (double)NAN;
     }
     double s;
     if (x < 2.409919865102884e-181) {
@@ -77,15 +77,15 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        R[0] = (double)NAN;
+        R[1] = (double)NAN;
+        R[2] = (double)NAN;
+        R[3] = (double)NAN;
+        R[4] = (double)NAN;
+        R[5] = (double)NAN;
+        R[6] = (double)NAN;
+        R[7] = (double)NAN;
+        R[8] = (double)NAN;
         return;
     }
     double c_R_1, c_R_2;
@@ -178,15 +178,15 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 108.0) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 108.0) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
             const double v_R_1 = x < 3.69096836134238e-14 ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 108.0) ? NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 108.0) ? (double)NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
             const double v_R_2 = x < 0.21355546857295174 ? poly_R_2 : closed_R_2;
-            c_R_2_lanes[k] = !(x < 108.0) ? NAN : v_R_2;
+            c_R_2_lanes[k] = !(x < 108.0) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -214,15 +214,15 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        H[0] = (double)NAN;
+        H[1] = (double)NAN;
+        H[2] = (double)NAN;
+        H[3] = (double)NAN;
+        H[4] = (double)NAN;
+        H[5] = (double)NAN;
+        H[6] = (double)NAN;
+        H[7] = (double)NAN;
+        H[8] = (double)NAN;
         return;
     }
     const double c_H_0 = 36/(x + 36);
@@ -304,13 +304,13 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 108.0) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.21355546857295174 ? poly_H_1 : closed_H_1;
-            c_H_1_lanes[k] = !(x < 108.0) ? NAN : v_H_1;
+            c_H_1_lanes[k] = !(x < 108.0) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 108.0) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -338,15 +338,15 @@ static inline void symrot_tangent_m6_tangent_inverse(const double p[3], double H
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/36.0)*x + 1;
@@ -391,10 +391,10 @@ static inline void symrot_tangent_m6_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 108.0) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 108.0) ? NAN : -1.0/2.0;
+            c_H_inverse_0_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 108.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
-            c_H_inverse_2_lanes[k] = !(x < 108.0) ? NAN : closed_H_inverse_2;
+            c_H_inverse_2_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -420,7 +420,7 @@ static inline double symrot_tangent_m6_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        return NAN;
+        return (double)NAN;
     }
     const double c_det_H = 144*pow(x - 108, 2)/pow(x + 36, 4);
     return c_det_H;
@@ -436,15 +436,15 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        G[0] = (double)NAN;
+        G[1] = (double)NAN;
+        G[2] = (double)NAN;
+        G[3] = (double)NAN;
+        G[4] = (double)NAN;
+        G[5] = (double)NAN;
+        G[6] = (double)NAN;
+        G[7] = (double)NAN;
+        G[8] = (double)NAN;
         return;
     }
     double c_G_1, c_G_2;
@@ -526,15 +526,15 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 108.0) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 108.0) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
             const double v_G_1 = x < 3.69096836134238e-14 ? poly_G_1 : closed_G_1;
-            c_G_1_lanes[k] = !(x < 108.0) ? NAN : v_G_1;
+            c_G_1_lanes[k] = !(x < 108.0) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
             const double v_G_2 = x < 1.55152626720702 ? poly_G_2 : closed_G_2;
-            c_G_2_lanes[k] = !(x < 108.0) ? NAN : v_G_2;
+            c_G_2_lanes[k] = !(x < 108.0) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -562,15 +562,15 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        K[0] = (double)NAN;
+        K[1] = (double)NAN;
+        K[2] = (double)NAN;
+        K[3] = (double)NAN;
+        K[4] = (double)NAN;
+        K[5] = (double)NAN;
+        K[6] = (double)NAN;
+        K[7] = (double)NAN;
+        K[8] = (double)NAN;
         return;
     }
     const double c_K_0 = 18/(x + 36);
@@ -661,13 +661,13 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 108.0) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 108.0) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 1.55152626720702 ? poly_K_1 : closed_K_1;
-            c_K_1_lanes[k] = !(x < 108.0) ? NAN : v_K_1;
+            c_K_1_lanes[k] = !(x < 108.0) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
-            c_K_2_lanes[k] = !(x < 108.0) ? NAN : closed_K_2;
+            c_K_2_lanes[k] = !(x < 108.0) ? (double)NAN : closed_K_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -695,9 +695,9 @@ static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        pdot[0] = NAN;
-        pdot[1] = NAN;
-        pdot[2] = NAN;
+        pdot[0] = (double)NAN;
+        pdot[1] = (double)NAN;
+        pdot[2] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/36.0)*x + 1;
@@ -720,9 +720,9 @@ static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        omega[0] = NAN;
-        omega[1] = NAN;
-        omega[2] = NAN;
+        omega[0] = (double)NAN;
+        omega[1] = (double)NAN;
+        omega[2] = (double)NAN;
         return;
     }
     const double c_H_0 = 36/(x + 36);
@@ -752,10 +752,10 @@ static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 108.0)) {
-        e[0] = NAN;
-        e[1] = NAN;
-        e[2] = NAN;
-        e[3] = NAN;
+        e[0] = (double)NAN;
+        e[1] = (double)NAN;
+        e[2] = (double)NAN;
+        e[3] = (double)NAN;
         return;
     }
     const double c_e_0 = -18*(x - 12)/pow(x + 36, 3.0/2.0);
@@ -781,7 +781,7 @@ static inline int symrot_tangent_m6__from_quaternion(double e0, double e1, doubl
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
     const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
-    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+    if (big > 0 && big < (double)INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
         int k;
         (void)frexp(big, &k);
         e0 = ldexp(e0, -k);
@@ -793,9 +793,9 @@ static inline int symrot_tangent_m6__from_quaternion(double e0, double e1, doubl
     const double e_norm = sqrt(y);
     const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
@@ -811,9 +811,9 @@ static inline int symrot_tangent_m6__from_quaternion(double e0, double e1, doubl
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
     if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 108.0)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     return 0;
@@ -874,9 +874,9 @@ static inline int symrot_tangent_m6_rescale(const double p[3], double q[3])
     double e[4];
     symrot_tangent_m6_to_quaternion(p, e);
     if (isnan(e[0])) {
-        q[0] = NAN;
-        q[1] = NAN;
-        q[2] = NAN;
+        q[0] = (double)NAN;
+        q[1] = (double)NAN;
+        q[2] = (double)NAN;
         return 1;
     }
     if (e[0] >= 0) {

@@ -10,7 +10,7 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
  * Never a silently wrong value: NaN in every output instead.
  *
  * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
@@ -46,14 +46,16 @@ static inline double symrot_wiener_milenkovic__phi(double s)
 }
 
 /* symrot_wiener_milenkovic_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = 4*atan(s/4) (closed inverse of p(phi))
  * ops: 21 */
 static inline double symrot_wiener_milenkovic_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        return (double)NAN;
     }
     double s;
     if (x < 2.409919865102884e-181) {
@@ -68,7 +70,9 @@ static inline double symrot_wiener_milenkovic_angle(const double p[3])
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * R_2 = 128/(x + 16)**2 (algebraic in x)
@@ -76,16 +80,16 @@ static inline double symrot_wiener_milenkovic_angle(const double p[3])
 static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        R[0] = (double)NAN;
+        R[1] = (double)NAN;
+        R[2] = (double)NAN;
+        R[3] = (double)NAN;
+        R[4] = (double)NAN;
+        R[5] = (double)NAN;
+        R[6] = (double)NAN;
+        R[7] = (double)NAN;
+        R[8] = (double)NAN;
         return;
     }
     const double c_R_1 = -16*(x - 16)/pow(x + 16, 2);
@@ -130,11 +134,11 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -153,7 +157,9 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
 }
 
 /* symrot_wiener_milenkovic_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -161,16 +167,16 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
 static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        H[0] = (double)NAN;
+        H[1] = (double)NAN;
+        H[2] = (double)NAN;
+        H[3] = (double)NAN;
+        H[4] = (double)NAN;
+        H[5] = (double)NAN;
+        H[6] = (double)NAN;
+        H[7] = (double)NAN;
+        H[8] = (double)NAN;
         return;
     }
     const double c_H_0 = 16/(x + 16);
@@ -219,11 +225,11 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_1;
+            c_H_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -242,7 +248,9 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -250,16 +258,16 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
 static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/16.0)*x + 1;
@@ -302,9 +310,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, cons
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : -1.0/2.0;
-            c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1.0/8.0;
+            c_H_inverse_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : -1.0/2.0;
+            c_H_inverse_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 1.0/8.0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -323,21 +331,25 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, cons
 }
 
 /* symrot_wiener_milenkovic_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H = 4096/(x + 16)**3 (algebraic in x)
  * ops: 9 */
 static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        return NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        return (double)NAN;
     }
     const double c_det_H = 4096/pow(x + 16, 3);
     return c_det_H;
 }
 
 /* symrot_wiener_milenkovic_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = 8/(x + 16) (algebraic in x)
  * G_2 = 2/(x + 16) (algebraic in x)
@@ -345,16 +357,16 @@ static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
 static inline void symrot_wiener_milenkovic_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        G[0] = (double)NAN;
+        G[1] = (double)NAN;
+        G[2] = (double)NAN;
+        G[3] = (double)NAN;
+        G[4] = (double)NAN;
+        G[5] = (double)NAN;
+        G[6] = (double)NAN;
+        G[7] = (double)NAN;
+        G[8] = (double)NAN;
         return;
     }
     const double c_G_1 = 8/(x + 16);
@@ -399,11 +411,11 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -422,7 +434,9 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
 }
 
 /* symrot_wiener_milenkovic_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 8/(x + 16) (algebraic in x)
  * K_1 = 2/(x + 16) (algebraic in x)
  * K_2 = 0 (constant)
@@ -430,16 +444,16 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
 static inline void symrot_wiener_milenkovic_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        K[0] = (double)NAN;
+        K[1] = (double)NAN;
+        K[2] = (double)NAN;
+        K[3] = (double)NAN;
+        K[4] = (double)NAN;
+        K[5] = (double)NAN;
+        K[6] = (double)NAN;
+        K[7] = (double)NAN;
+        K[8] = (double)NAN;
         return;
     }
     const double c_K_0 = 8/(x + 16);
@@ -485,10 +499,10 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : closed_K_1;
-            c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? NAN : 0;
+            c_K_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_K_1;
+            c_K_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -507,7 +521,9 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
 }
 
 /* symrot_wiener_milenkovic_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -515,10 +531,10 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
 static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        pdot[0] = NAN;
-        pdot[1] = NAN;
-        pdot[2] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        pdot[0] = (double)NAN;
+        pdot[1] = (double)NAN;
+        pdot[2] = (double)NAN;
         return;
     }
     const double c_H_inverse_0 = (1.0/16.0)*x + 1;
@@ -531,7 +547,9 @@ static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double
 }
 
 /* symrot_wiener_milenkovic_omega: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -539,10 +557,10 @@ static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double
 static inline void symrot_wiener_milenkovic_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        omega[0] = NAN;
-        omega[1] = NAN;
-        omega[2] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        omega[0] = (double)NAN;
+        omega[1] = (double)NAN;
+        omega[2] = (double)NAN;
         return;
     }
     const double c_H_0 = 16/(x + 16);
@@ -557,18 +575,20 @@ static inline void symrot_wiener_milenkovic_omega(const double p[3], const doubl
 }
 
 /* symrot_wiener_milenkovic_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^600 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0 = -(x - 16)/(x + 16) (algebraic in x)
  * nu = 16/(x + 16) (algebraic in x)
  * ops: 16 */
 static inline void symrot_wiener_milenkovic_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.149515568880993e+180)) {
-        e[0] = NAN;
-        e[1] = NAN;
-        e[2] = NAN;
-        e[3] = NAN;
+    if (!(x < 4.4794894843556084e+102)) {
+        e[0] = (double)NAN;
+        e[1] = (double)NAN;
+        e[2] = (double)NAN;
+        e[3] = (double)NAN;
         return;
     }
     const double c_e_0 = -(x - 16)/(x + 16);
@@ -587,7 +607,7 @@ static inline int symrot_wiener_milenkovic__from_quaternion(double e0, double e1
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
     const double big = fmax(fmax(fabs(e0), fabs(e1)), fmax(fabs(e2), fabs(e3)));
-    if (big > 0 && big < INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
+    if (big > 0 && big < (double)INFINITY && (big < 3.054936363499605e-151 || big > 3.273390607896142e+150)) {
         int k;
         (void)frexp(big, &k);
         e0 = ldexp(e0, -k);
@@ -598,9 +618,9 @@ static inline int symrot_wiener_milenkovic__from_quaternion(double e0, double e1
     const double y = (e1*e1) + (e2*e2) + (e3*e3);
     const double n = sqrt((e0*e0) + y);
     if (!(n > 0) || !(n <= 1.7976931348623157e+308)) {
-        p[0] = NAN;
-        p[1] = NAN;
-        p[2] = NAN;
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
         return 1;
     }
     const double f = (e0 < 0 ? -1 : 1) / n;
@@ -667,9 +687,9 @@ static inline int symrot_wiener_milenkovic_rescale(const double p[3], double q[3
     double e[4];
     symrot_wiener_milenkovic_to_quaternion(p, e);
     if (isnan(e[0])) {
-        q[0] = NAN;
-        q[1] = NAN;
-        q[2] = NAN;
+        q[0] = (double)NAN;
+        q[1] = (double)NAN;
+        q[2] = (double)NAN;
         return 1;
     }
     if (e[0] >= 0) {
@@ -690,13 +710,15 @@ static inline float symrot_wiener_milenkovic__phi_f(float s)
 }
 
 /* symrot_wiener_milenkovic_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * phi = 4*atan(s/4) (closed inverse of p(phi))
  * ops: 21 */
 static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         return NAN;
     }
     float s;
@@ -712,7 +734,9 @@ static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * R_2 = 128/(x + 16)**2 (algebraic in x)
@@ -720,7 +744,7 @@ static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
 static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -774,11 +798,11 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -797,7 +821,9 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
 }
 
 /* symrot_wiener_milenkovic_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -805,7 +831,7 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
 static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -863,11 +889,11 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_0;
+            c_H_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_1;
+            c_H_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -886,7 +912,9 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -894,7 +922,7 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
 static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -946,9 +974,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, co
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_H_inverse_0;
-            c_H_inverse_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : -1.0F/2.0F;
-            c_H_inverse_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1.0F/8.0F;
+            c_H_inverse_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 1.0F/8.0F;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -967,13 +995,15 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, co
 }
 
 /* symrot_wiener_milenkovic_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * det_H = 4096/(x + 16)**3 (algebraic in x)
  * ops: 9 */
 static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         return NAN;
     }
     const float c_det_H = 4096/powf(x + 16, 3);
@@ -981,7 +1011,9 @@ static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 }
 
 /* symrot_wiener_milenkovic_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = 8/(x + 16) (algebraic in x)
  * G_2 = 2/(x + 16) (algebraic in x)
@@ -989,7 +1021,7 @@ static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 static inline void symrot_wiener_milenkovic_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -1043,11 +1075,11 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1066,7 +1098,9 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
 }
 
 /* symrot_wiener_milenkovic_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * K_0 = 8/(x + 16) (algebraic in x)
  * K_1 = 2/(x + 16) (algebraic in x)
  * K_2 = 0 (constant)
@@ -1074,7 +1108,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
 static inline void symrot_wiener_milenkovic_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -1129,10 +1163,10 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_0;
+            c_K_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 1.2676506e+30F) ? NAN : closed_K_1;
-            c_K_2_lanes[k] = !(x < 1.2676506e+30F) ? NAN : 0;
+            c_K_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_K_1;
+            c_K_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1151,7 +1185,9 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
 }
 
 /* symrot_wiener_milenkovic_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_inverse_0 = (x + 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
@@ -1159,7 +1195,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
 static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -1175,7 +1211,9 @@ static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float
 }
 
 /* symrot_wiener_milenkovic_omega_f: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
@@ -1183,7 +1221,7 @@ static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float
 static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -1201,14 +1239,16 @@ static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const floa
 }
 
 /* symrot_wiener_milenkovic_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^100 (|phi| < 6.2831853071795862); otherwise, and for non-finite p, every output is NaN.
+ * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
  * e_0 = -(x - 16)/(x + 16) (algebraic in x)
  * nu = 16/(x + 16) (algebraic in x)
  * ops: 16 */
 static inline void symrot_wiener_milenkovic_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 1.2676506e+30F)) {
+    if (!(x < 4.3980465e+12F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;

@@ -1293,6 +1293,7 @@ _USES_PHI = {
 _BLOCK = 16384
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
+_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 E0_MIN = -numpy.inf
 
 
@@ -1328,9 +1329,9 @@ def _length(p, suffix):
 
 
 def _inside(x, suffix):
-    """The validity test on x = |p|^2 (as in the C header); |p|^2 >= 2^600 (2^100 in float32) is
-    outside even when p is unbounded."""
-    return (x <= P_MAX_SQUARED) & (x < _HUGE[suffix])
+    """The validity test on x = |p|^2 (as in the C header); x >= _X_LIMIT (at most 2^600, 2^100 in
+    float32) is outside even when p is unbounded."""
+    return (x <= P_MAX_SQUARED) & (x < _X_LIMIT[suffix])
 
 
 def _prepare(p, names):

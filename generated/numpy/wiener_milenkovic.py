@@ -3,8 +3,8 @@
 
 Vectorial parameterization (Bauchau & Trainelli 2003): p = p(phi) u, x = |p|^2.  Every function
 takes p of shape (..., 3); float32 input is computed in float32 with the float32 plan, any other
-input in float64.  Validity: every p with |p|^2 < 2^600 (2^100 in float32); outside it every output
-is NaN.
+input in float64.  Validity: every p with |p|^2 < 2^341 (2^42 in float32), the largest
+power of two up to which every printed form was checked; outside it every output is NaN.
 
 angle(p) -> phi; rotation_matrix(p) -> R (eq 16); tangent(p) -> H, omega = H pdot (eq 20);
 tangent_inverse(p) -> H^-1 (eq 26); tangent_det(p) -> det H (eq 24); root_matrix(p) -> G (eq 81);
@@ -282,6 +282,7 @@ _USES_PHI = {
 _BLOCK = 16384
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
+_X_LIMIT = {"64": 4.4794894843556084e+102, "32": numpy.float32(4398046511104.0)}
 E0_MIN = -numpy.inf
 
 
@@ -317,9 +318,9 @@ def _length(p, suffix):
 
 
 def _inside(x, suffix):
-    """The validity test on x = |p|^2 (as in the C header); |p|^2 >= 2^600 (2^100 in float32) is
-    outside even when p is unbounded."""
-    return (x < P_MAX_SQUARED) & (x < _HUGE[suffix])
+    """The validity test on x = |p|^2 (as in the C header); x >= _X_LIMIT (at most 2^600, 2^100 in
+    float32) is outside even when p is unbounded."""
+    return (x < P_MAX_SQUARED) & (x < _X_LIMIT[suffix])
 
 
 def _prepare(p, names):

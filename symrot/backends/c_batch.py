@@ -199,7 +199,8 @@ class BatchWriter:
                 body.append({"kind": "let", "type": self.t, "name": f"v_{name}",
                              "value": f"x < {threshold} ? poly_{name} : {value}"})
                 value = f"v_{name}"
-            body.append({"kind": "set", "name": f"c_{name}_lanes[k]", "value": f"{outside} ? NAN : {value}"})
+            body.append({"kind": "set", "name": f"c_{name}_lanes[k]",
+                         "value": f"{outside} ? {self.writer.nan} : {value}"})
         return body
 
     def assembly(self, spec: CFunction, names: list[str]) -> list[Statement]:

@@ -29,7 +29,6 @@ from ..quaternion_plan import E0
 from .c_writer import LARGEST, PHI_SYMBOL, T_SYMBOL, FunctionWriter, Statement, ops_of
 
 E_SYMBOL = sp.Symbol("c0", real=True)
-NAN = "NAN"
 
 
 class OperationWriter(FunctionWriter):
@@ -43,7 +42,7 @@ class OperationWriter(FunctionWriter):
         return f"symrot_{self.header}_{operation}{self.suffix}"
 
     def nan_out(self, output: str, count: int, status: bool = True) -> list[Statement]:
-        statements: list[Statement] = [self.set(f"{output}[{i}]", NAN) for i in range(count)]
+        statements: list[Statement] = [self.set(f"{output}[{i}]", self.nan) for i in range(count)]
         statements.append({"kind": "return", "value": "1" if status else ""})
         return statements
 
@@ -110,7 +109,8 @@ class OperationWriter(FunctionWriter):
             {"kind": "let", "type": t, "name": "big",
              "value": f"fmax{f}(fmax{f}(fabs{f}(e0), fabs{f}(e1)), fmax{f}(fabs{f}(e2), fabs{f}(e3)))",
              "ops": 7},
-            {"kind": "if", "condition": f"big > 0 && big < INFINITY && (big < {low_lit} || big > {high_lit})",
+            {"kind": "if",
+             "condition": f"big > 0 && big < {self.infinity} && (big < {low_lit} || big > {high_lit})",
              "then": [{"kind": "declare", "type": "int", "names": ["k"]},
                       {"kind": "call", "value": f"(void)frexp{f}(big, &k)"}]
              + [{"kind": "set", "name": v, "value": f"ldexp{f}({v}, -k)", "ops": 1}

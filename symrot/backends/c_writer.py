@@ -5,10 +5,10 @@
 header (:mod:`symrot.backends.c_backend`), the ``_batch`` kernels (:mod:`symrot.backends.c_batch`)
 and the operations (:mod:`symrot.backends.c_operations`) build on it. How a plan becomes C:
 
-* x = |p|² once; outside the validity range (``!(x < p_max²)``, or ``!(x < 2^600)`` (2^100 in
-  float) when p is unbounded, which also catches inf and NaN) every output is NaN; for the sine
-  family also d = p_max² − x with fma-exact products and TwoSum (``__complement``), which the plan's
-  expressions use instead of k² − x;
+* x = |p|² once; outside the validity range (``!(x < p_max²)``, or ``!(x < x_limit)`` (the plan's
+  x_limit, at most 2^600, 2^100 in float) when p is unbounded, which also catches inf and NaN)
+  every output is NaN; for the sine family also d = p_max² − x with fma-exact products and TwoSum
+  (``__complement``), which the plan's expressions use instead of k² − x;
 * coefficients: a :class:`~symrot.plan.Constant` is folded into the output expressions, an
   :class:`~symrot.plan.Algebraic` one is a single expression in x (no branch, no trig); the
   :class:`~symrot.plan.Branch` ones of a function share one ``if (x < smallest threshold)``:
@@ -83,6 +83,17 @@ class FunctionWriter:
         self.precision_plan: PrecisionPlan = plan.precisions[PLAN_LABEL[precision]]
 
     # -- small helpers ---------------------------------------------------------------------------
+    @property
+    def nan(self) -> str:
+        """NaN of this precision: C99's ``NAN`` is a float, so double code casts it (no silent
+        promotion: the header compiles cleanly with -Wdouble-promotion)."""
+        return "NAN" if self.precision == "float" else "(double)NAN"
+
+    @property
+    def infinity(self) -> str:
+        """+∞ of this precision (``INFINITY`` is a float in C99, cast like :attr:`nan`)."""
+        return "INFINITY" if self.precision == "float" else "(double)INFINITY"
+
     def c(self, expr: sp.Expr) -> str:
         return str(self.printer.doprint(expr))
 
@@ -158,7 +169,7 @@ class FunctionWriter:
         """The C condition (as text) under which every output is NaN."""
         if math.isfinite(self.plan.p_max):
             return f"!(x {self.inside_operator} {self.printer.literal(self.bound)})"
-        return f"!(x < {self.printer.literal(TINY_X[self.precision][1])})"
+        return f"!(x < {self.printer.literal(sp.Float(self.precision_plan.x_limit))})"
 
     # -- φ ---------------------------------------------------------------------------------------
     def branch_value(self, branch: Branch, variable: sp.Symbol, target: str) -> Statement:
@@ -299,8 +310,9 @@ class FunctionWriter:
         if math.isfinite(plan.p_max):
             return [f"Valid for |p| < {plan.p_max:.17g} (|phi| < {plan.phi_max:.17g}); outside it, and for "
                     "non-finite p, every output is NaN."]
-        bound = "2^600" if self.precision == "double" else "2^100"
-        return [f"Valid for every p with |p|^2 < {bound} (|phi| < {plan.phi_max:.17g}); otherwise, and for "
+        bound = f"2^{math.frexp(self.precision_plan.x_limit)[1] - 1}"
+        return [f"Valid for every p with |p|^2 < {bound} (|phi| < {plan.phi_max:.17g}), the largest power",
+                "of two up to which every printed form was checked against 50+ digits; otherwise, and for",
                 "non-finite p, every output is NaN."]
 
     def coefficient_notes(self, names: list[str]) -> list[str]:
@@ -324,7 +336,7 @@ class FunctionWriter:
         if spec.kind == "scalar":
             signature = f"{t} {name}(const {t} p[3])"
             statements.append({"kind": "if", "condition": self.out_of_range(),
-                               "then": [{"kind": "return", "value": "NAN"}], "otherwise": []})
+                               "then": [{"kind": "return", "value": self.nan}], "otherwise": []})
             if spec.name == "angle":
                 statements += self.norm()
                 statements.append({"kind": "return", "value": self.angle_call("s"),
@@ -343,13 +355,13 @@ class FunctionWriter:
         if spec.kind == "matrix":
             output = OUTPUT_NAMES[spec.name]
             signature = f"void {name}(const {t} p[3], {t} {output}[9])"
-            nan = [self.set(f"{output}[{i}]", "NAN") for i in range(9)] + [{"kind": "return", "value": ""}]
+            nan = [self.set(f"{output}[{i}]", self.nan) for i in range(9)] + [{"kind": "return", "value": ""}]
             outputs = [self.set(f"{output}[{i}]", entry) for i, entry in enumerate(tensor_entries(a, b, c))]
             batch = f"void {name}_batch(size_t n, const {t} *p, {t} *{output})"
         else:
             given, output = VECTOR_NAMES[spec.name]
             signature = f"void {name}(const {t} p[3], const {t} {given}[3], {t} {output}[3])"
-            nan = [self.set(f"{output}[{i}]", "NAN") for i in range(3)] + [{"kind": "return", "value": ""}]
+            nan = [self.set(f"{output}[{i}]", self.nan) for i in range(3)] + [{"kind": "return", "value": ""}]
             v = tuple(sp.Symbol(f"{given}[{i}]", real=True) for i in range(3))
             w = tuple(sp.Symbol(f"w{i}", real=True) for i in range(3))
             cross, entries = vector_entries(a, b, c, v, w)

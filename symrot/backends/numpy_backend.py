@@ -14,6 +14,7 @@ sin(φ/2), cos(φ/2) once per block for all the coefficients that need them.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -166,6 +167,10 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "complement": str(plan.complement) if plan.complement is not None else None,
             "p_max_squared": repr(squared) if np.isfinite(squared) else "numpy.inf",
             "inclusive": inclusive,
+            "x_limit": {SUFFIX[label]: repr(precision.x_limit)
+                        for label, precision in plan.precisions.items()},
+            "x_limit_power": {SUFFIX[label]: math.frexp(precision.x_limit)[1] - 1
+                              for label, precision in plan.precisions.items()},
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()}}
 
