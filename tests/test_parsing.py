@@ -26,6 +26,11 @@ VALID = {
     "phi**(1/3)": PHI ** sp.Rational(1, 3),
     "sqrt(1+phi**2)*phi": sp.sqrt(1 + PHI**2) * PHI,
     "  phi  ": PHI,
+    "0x10*phi": 16 * PHI,
+    "0b101*phi + 0o7*phi**3": 5 * PHI + 7 * PHI**3,
+    "(1+phi)**64 - 1": (1 + PHI) ** 64 - 1,
+    "sqrt((1+phi**2)**64)*phi": (1 + PHI**2) ** 32 * PHI,
+    "(2**64)**4*phi": 2**256 * PHI,
 }
 
 HOSTILE = [
@@ -113,6 +118,19 @@ HOSTILE = [
     "print(phi)",
     "__builtins__",
     "phi.evalf(10**9)",
+    "(10**30)**64*phi",
+    "phi + (10**30)**64*phi**3",
+    "0x" + "f" * 256 + "*phi",
+    "0o" + "7" * 40 + "*phi",
+    "0b" + "1" * 300 + "*phi",
+    "1" + "_0" * 40 + "*phi",
+    "9.99999e399*phi",
+    "(((1+phi)**64)**64)**64",
+    "((1+phi)**64)**64",
+    "(phi**64)**64",
+    "(1+phi+phi**2+phi**3+phi**4)**64",
+    "phi*(2**200)**3",
+    "phi*(sqrt(2)+sqrt(3)+sqrt(5)+sqrt(7))**64",
 ]
 
 
