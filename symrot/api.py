@@ -11,6 +11,7 @@ from typing import Any
 
 import sympy as sp
 
+from .budget import stage
 from .core import SCALAR_NAMES, TENSOR_NAMES, Derivation, Tensor, derive_expression
 from .errors import SymrotError
 from .parsing import parse_expression
@@ -25,13 +26,17 @@ COEFFICIENT_KEYS = ("I", "px", "px2")
 def resolve(expression: str | sp.Expr) -> tuple[sp.Expr, NamedParameterization | None]:
     """A registry identifier or an expression (parsed safely) → (p(φ), registry entry)."""
     if isinstance(expression, sp.Expr):
-        return expression, find_by_expression(expression)
+        with stage("registry lookup"):
+            return expression, find_by_expression(expression)
     text = expression.strip() if isinstance(expression, str) else expression
     if isinstance(text, str) and is_identifier(text):
-        entry = lookup(text)
+        with stage("registry lookup"):
+            entry = lookup(text)
         return entry.expression, entry
-    expr = parse_expression(text)
-    return expr, find_by_expression(expr)
+    with stage("parse"):
+        expr = parse_expression(text)
+    with stage("registry lookup"):
+        return expr, find_by_expression(expr)
 
 
 @dataclass
@@ -122,7 +127,8 @@ def derive(expression: str | sp.Expr, normalize: bool = False) -> DerivationResu
     with time_limit(DERIVE_TIME_LIMIT, "derivation"):
         derivation = derive_expression(expr, normalize=normalize)
     if normalize and derivation.p != expr:
-        entry = find_by_expression(derivation.p)
+        with stage("registry lookup"):
+            entry = find_by_expression(derivation.p)
     return DerivationResult(derivation, entry, normalized=normalize and derivation.p != expr)
 
 

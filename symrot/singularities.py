@@ -31,6 +31,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from .budget import stage
 from .core import Derivation, derive_expression
 from .functions import mpmath_namespace
 from .parsing import PHI
@@ -76,7 +77,8 @@ SCAN_INTERVAL = sp.Interval.Lopen(0, 4 * sp.pi)
 
 def validity(derivation: Derivation) -> Validity:
     """The validity range of ``derivation``'s parameterization and every singular angle."""
-    return _validity_of(derivation.p)
+    with stage("validity analysis"):
+        return _validity_of(derivation.p)
 
 
 @lru_cache(maxsize=256)

@@ -7,7 +7,9 @@ import json
 from typing import Any
 
 from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
+from ..budget import stage
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
+from .output import output_directory, write_file
 
 SCALAR_LABELS = {
     "p_prime": "p'",
@@ -41,17 +43,27 @@ def register(subparsers: Any) -> None:
 
 
 def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
+    """Plan, print into a scratch directory, then write the files into ``--out``."""
     import re
+    import tempfile
     from pathlib import Path
 
     from ..backends import emitter
     from ..errors import SymrotError
+    from ..plan import evaluation_plan
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
         raise SymrotError(f"--name {name!r} is not a valid identifier")
-    for path in emitter(args.emit)(result.derivation, name, Path(args.out)):
-        print(path)
+    emit = emitter(args.emit)
+    output_directory(Path(args.out))
+    with stage("planning"):
+        evaluation_plan(result.derivation, name)  # cached: the backend reuses it
+    with tempfile.TemporaryDirectory(prefix="symrot-emit-") as scratch:
+        with stage("printing"):
+            printed = emit(result.derivation, name, Path(scratch))
+        for path in printed:
+            write_file(Path(args.out), path.name, path.read_text(encoding="utf-8"))
     return 0
 
 
@@ -60,9 +72,10 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "emit", None):
         return emit_code(result, args)
     if args.json:
-        print(json.dumps(result.to_dict(series_terms=args.terms), indent=2))
+        text = json.dumps(result.to_dict(series_terms=args.terms), indent=2)
     else:
-        print(summary(result, args.terms))
+        text = summary(result, args.terms)
+    print(text)
     return 0
 
 
