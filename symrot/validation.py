@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import mpmath
 import sympy as sp
 
-from .errors import InvalidGeneratingFunction, NonAnalyticError, SymrotError
+from .errors import InvalidGeneratingFunction, NonAnalyticError, SymrotError, SymrotTimeout
 from .parsing import PHI
 from .series import InsufficientOrder, coefficient_list, taylor_series
 
@@ -85,6 +85,8 @@ def _check_numerically(expr: sp.Expr) -> None:
         try:
             plus = evaluate(expr, angle)
             minus = evaluate(expr, "-" + angle)
+        except SymrotTimeout:
+            raise  # running out of time says nothing about p
         except (TypeError, ValueError, ZeroDivisionError, SymrotError):
             raise InvalidGeneratingFunction(f"p cannot be evaluated at phi = ±{angle}") from None
         real_plus = not isinstance(plus, mpmath.mpc) and mpmath.isfinite(plus)
