@@ -13,6 +13,7 @@ import argparse
 import math
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 
 from .. import budget
@@ -26,6 +27,9 @@ EXIT_USAGE = 2
 EXIT_INTERNAL = 70
 DEFAULT_TIMEOUT = 60.0
 """Seconds per command unless the command sets its own ``default_timeout`` (audit)."""
+INT_DIGITS = 20_000
+"""Decimal digits an exact number may print with (Python's default stops at 4300). The parser
+keeps numbers below 2**512, so series coefficients stay far below this, and printing is fast."""
 WORKER_VARIABLE = "SYMROT_WORKER"
 """1 forces the worker process, 0 disables it (default: only for the real command line)."""
 
@@ -112,7 +116,10 @@ def run(args: argparse.Namespace, seconds: float | None) -> int:
     """Run the parsed command in this process under the time budget; the exit status."""
     budget.reset()
     try:
-        with budget.enforce(seconds):
+        with budget.enforce(seconds), warnings.catch_warnings():
+            # overflow in a numeric scan is handled where it happens; it is no message for users
+            warnings.simplefilter("ignore", RuntimeWarning)
+            sys.set_int_max_str_digits(max(sys.get_int_max_str_digits(), INT_DIGITS))
             return int(args.run(args) or 0)
     except budget.BudgetExceeded as exc:
         print(f"symrot: error: {exc} (--timeout changes it)", file=sys.stderr)
