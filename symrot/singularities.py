@@ -212,8 +212,8 @@ def _is_complex(f: Callable[[mpmath.mpf], mpmath.mpf], t: mpmath.mpf) -> bool:
     """True past the edge of the real domain: f(t) has a non-zero imaginary part (or no value)."""
     try:
         value = f(t)
-    except (ValueError, ZeroDivisionError):
-        return False  # a pole, not the end of the domain
+    except (ValueError, ZeroDivisionError, OverflowError):
+        return False  # a pole or an overflow, not the end of the domain
     return isinstance(value, mpmath.mpc) and value.imag != 0
 
 
@@ -290,8 +290,8 @@ def _safe(f: Callable[[mpmath.mpf], mpmath.mpf]) -> Callable[[mpmath.mpf], mpmat
     def safe(t: mpmath.mpf) -> mpmath.mpf:
         try:
             value = f(t)
-        except (ZeroDivisionError, ValueError):
-            return mpmath.inf
+        except (ZeroDivisionError, ValueError, OverflowError, MemoryError):
+            return mpmath.inf  # overflow: an exponent beyond mpmath's range (sinh of sinh...)
         return value.real if isinstance(value, mpmath.mpc) else value
 
     return safe

@@ -38,6 +38,14 @@ def evaluate(expr: sp.Expr, angle: mpmath.mpf | str, digits: int = 50) -> mpmath
         return mpmath.mpc(complex(value)) if not value.is_real else mpmath.mpf(value)
 
 
+def _evaluate_or_inf(expr: sp.Expr, angle: str) -> mpmath.mpf | mpmath.mpc:
+    """``evaluate``, with an exponent beyond mpmath's range (sinh of sinh of ...) read as inf."""
+    try:
+        return evaluate(expr, angle)
+    except OverflowError:
+        return mpmath.inf
+
+
 def validate(expr: sp.Expr) -> ValidatedFunction:
     """Check ``expr`` as a generating function and return it with κ and its Taylor series."""
     if expr.free_symbols - {PHI}:
@@ -83,8 +91,7 @@ def _check_numerically(expr: sp.Expr) -> None:
     """
     for index, angle in enumerate(SAMPLE_ANGLES):
         try:
-            plus = evaluate(expr, angle)
-            minus = evaluate(expr, "-" + angle)
+            plus, minus = (_evaluate_or_inf(expr, a) for a in (angle, "-" + angle))
         except SymrotTimeout:
             raise  # running out of time says nothing about p
         except (TypeError, ValueError, ZeroDivisionError, SymrotError):
