@@ -16,10 +16,10 @@ can name it after killing a worker that no longer reacts to signals (long C-leve
 from __future__ import annotations
 
 import mmap
-import signal
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+
+from .timeouts import alarm
 
 
 class BudgetExceeded(BaseException):
@@ -104,17 +104,5 @@ def enforce(seconds: float | None) -> Iterator[None]:
     Needs the main thread (signals); elsewhere the body runs unbounded, as with
     :func:`symrot.timeouts.time_limit`.
     """
-    if not seconds or threading.current_thread() is not threading.main_thread():
+    with alarm(seconds or 0, lambda: BudgetExceeded(seconds or 0, current())):
         yield
-        return
-
-    def _on_alarm(signum: int, frame: object) -> None:
-        raise BudgetExceeded(seconds, current())
-
-    previous = signal.signal(signal.SIGALRM, _on_alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
