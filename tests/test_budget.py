@@ -116,3 +116,22 @@ def test_a_fifo_in_the_way_is_refused_not_blocked_on(tmp_path: Path,
     os.mkfifo(tmp_path / "rotation_vector.tex")
     assert main(["sheet", "phi", "--out", str(tmp_path)]) == 2
     assert "is not a regular file" in capsys.readouterr().err
+
+
+def test_the_worker_dies_with_a_killed_command() -> None:
+    import subprocess
+    import sys
+
+    command = subprocess.Popen([sys.executable, "-m", "symrot", "derive", TOWER],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    children: list[str] = []
+    deadline = time.monotonic() + 20
+    while not children and time.monotonic() < deadline:
+        time.sleep(0.2)
+        children = Path(f"/proc/{command.pid}/task/{command.pid}/children").read_text().split()
+    command.kill()
+    command.wait()
+    assert children, "no worker was forked"
+    time.sleep(0.5)
+    assert not Path(f"/proc/{children[0]}").exists() or "Z" in Path(
+        f"/proc/{children[0]}/stat").read_text().split()[2]

@@ -29,6 +29,7 @@ CRASH_SIGNALS = (signal.SIGKILL, signal.SIGSEGV, signal.SIGABRT, signal.SIGBUS)
 """Deaths a worker suffers when the address-space limit hits C code that cannot raise."""
 
 EXIT_ERROR = 2
+PR_SET_PDEATHSIG = 1
 
 
 def available() -> bool:
@@ -55,10 +56,12 @@ def run(command: Callable[[], int], seconds: float | None, memory: int = MEMORY_
             os._exit(code)
     try:
         status = _wait(pid, None if not seconds else seconds + GRACE_SECONDS)
-    except KeyboardInterrupt:
-        _kill(pid)
-        print("symrot: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt:  # the worker got the same SIGINT: let it report, briefly
+        status = _wait(pid, GRACE_SECONDS)
+        if status is None:
+            _kill(pid)
+            print("symrot: interrupted", file=sys.stderr)
+            return 130
     if status is None:
         _kill(pid)
         assert seconds is not None
@@ -77,6 +80,7 @@ def run(command: Callable[[], int], seconds: float | None, memory: int = MEMORY_
 def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int) -> int:
     import resource
 
+    _die_with_parent()
     try:
         _, hard = resource.getrlimit(resource.RLIMIT_AS)
         limit = memory if hard == resource.RLIM_INFINITY else min(memory, hard)
@@ -89,6 +93,16 @@ def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int) -> int:
             sys.stderr.flush()
         except (OSError, ValueError):
             pass
+
+
+def _die_with_parent() -> None:
+    """Linux: the worker gets SIGKILL when the parent dies, so none outlives a killed command."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    except (OSError, AttributeError):
+        pass
 
 
 def _wait(pid: int, seconds: float | None) -> int | None:
