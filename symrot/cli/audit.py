@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..budget import stage
 from .output import write_file
 
 EXIT_CHECK_FAILED = 1
@@ -47,7 +48,8 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import SymrotError
 
     only = {key.strip() for key in args.only.split(",")} if args.only else None
-    results = run_all(only=only)
+    with stage("audit checks"):
+        results = run_all(only=only)
     if only is not None and not results:
         raise SymrotError(
             f"no check has the key(s) {args.only!r} (keys: 1-102, 'text after (N): ...', "
