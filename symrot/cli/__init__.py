@@ -48,7 +48,8 @@ def _timeout_option(parser: argparse.ArgumentParser, default: object) -> None:
     parser.add_argument(
         "--timeout", type=_seconds, default=default, metavar="SECONDS",
         help=f"time budget of the whole command, parse to written files (default "
-        f"{DEFAULT_TIMEOUT:g} s; 0: none); on expiry: exit 2 naming the stage",
+        f"{DEFAULT_TIMEOUT:g} s, audit {audit.AUDIT_TIMEOUT:g} s; 0: none); on expiry: exit 2 "
+        "naming the stage",
     )
 
 
