@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 from typing import Any
 
 from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
 from ..budget import stage
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
+from ..errors import SymrotError
 from .output import output_directory, write_file
 
 SCALAR_LABELS = {
@@ -18,6 +20,7 @@ SCALAR_LABELS = {
     "mu": "mu",
     "det_H": "det H",
 }
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 TENSOR_LABELS = {"R": "R", "H": "H", "H_inverse": "H^-1", "G": "G", "K": "K"}
 
 
@@ -42,19 +45,24 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(run=run)
 
 
+def _check_emit_options(args: argparse.Namespace) -> None:
+    """Refuse a bad --name or --emit before any derivation is spent on them."""
+    from ..backends import emitter
+
+    if args.name is not None and not IDENTIFIER.fullmatch(args.name):
+        raise SymrotError(f"--name {args.name!r} is not a valid identifier")
+    emitter(args.emit)
+
+
 def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
     """Plan, print into a scratch directory, then write the files into ``--out``."""
-    import re
     import tempfile
     from pathlib import Path
 
     from ..backends import emitter
-    from ..errors import SymrotError
     from ..plan import evaluation_plan
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
-    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
-        raise SymrotError(f"--name {name!r} is not a valid identifier")
     emit = emitter(args.emit)
     output_directory(Path(args.out))
     with stage("planning"):
@@ -68,6 +76,8 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    if getattr(args, "emit", None):
+        _check_emit_options(args)
     result = derive(args.expression, normalize=args.normalize)
     if getattr(args, "emit", None):
         return emit_code(result, args)
