@@ -11,6 +11,7 @@ from typing import Any
 
 import sympy as sp
 
+from .budget import stage
 from .core import SCALAR_NAMES, TENSOR_NAMES, Derivation, Tensor, derive_expression
 from .errors import SymrotError
 from .parsing import parse_expression
@@ -26,13 +27,17 @@ COEFFICIENT_KEYS = ("I", "px", "px2")
 def resolve(expression: str | sp.Expr) -> tuple[sp.Expr, NamedParameterization | None]:
     """A registry identifier or an expression (parsed safely) → (p(φ), registry entry)."""
     if isinstance(expression, sp.Expr):
-        return expression, find_by_expression(expression)
+        with stage("registry lookup"):
+            return expression, find_by_expression(expression)
     text = expression.strip() if isinstance(expression, str) else expression
     if isinstance(text, str) and (is_identifier(text) or looks_like_a_name(text)):
-        entry = lookup(text)
+        with stage("registry lookup"):
+            entry = lookup(text)
         return entry.expression, entry
-    expr = parse_expression(text)
-    return expr, find_by_expression(expr)
+    with stage("parse"):
+        expr = parse_expression(text)
+    with stage("registry lookup"):
+        return expr, find_by_expression(expr)
 
 
 @dataclass
@@ -128,7 +133,8 @@ def derive(expression: str | sp.Expr, normalize: bool = False) -> DerivationResu
         original_kappa = validate(expr).kappa if normalize else None
     normalized = normalize and derivation.p != expr
     if normalized:
-        entry = find_by_expression(derivation.p)
+        with stage("registry lookup"):
+            entry = find_by_expression(derivation.p)
     return DerivationResult(derivation, entry, normalized=normalized, original_kappa=original_kappa)
 
 

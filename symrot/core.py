@@ -21,6 +21,7 @@ import mpmath
 import sympy as sp
 
 from .axial import AxialTensor
+from .budget import stage
 from .errors import InvalidGeneratingFunction
 from .parsing import PHI
 from .series import Series, coefficient_list, compose_even_in_x, revert, taylor_series
@@ -122,13 +123,17 @@ class Derivation:
         """Exact Taylor coefficients d_j of coefficient ``name`` in x = |p|², j < n_terms."""
         key = (name, n_terms)
         if key not in self._series_cache:
-            order = 2 * n_terms
-            in_phi = self.taylor_in_phi(name, order)
-            odd = [k for k in range(1, order, 2) if in_phi[k] != 0]
-            if odd:
-                raise InvalidGeneratingFunction(f"coefficient {name} is not even in phi")
-            self._series_cache[key] = compose_even_in_x(in_phi, self.phi_of_p(order), n_terms)
+            with stage("series expansion"):
+                self._series_cache[key] = self._series_in_x(name, n_terms)
         return self._series_cache[key]
+
+    def _series_in_x(self, name: str, n_terms: int) -> list[sp.Expr]:
+        order = 2 * n_terms
+        in_phi = self.taylor_in_phi(name, order)
+        odd = [k for k in range(1, order, 2) if in_phi[k] != 0]
+        if odd:
+            raise InvalidGeneratingFunction(f"coefficient {name} is not even in phi")
+        return compose_even_in_x(in_phi, self.phi_of_p(order), n_terms)
 
     def constant_value(self, name: str) -> sp.Expr | None:
         """The constant c if coefficient ``name`` is identically c, else None.
@@ -212,7 +217,9 @@ def derive_function(function: ValidatedFunction) -> Derivation:
 
 def derive_expression(expr: sp.Expr, normalize: bool = False) -> Derivation:
     """Validate ``expr`` as p(φ) and derive everything; ``normalize`` divides p by κ."""
-    function = validate(expr)
-    if normalize and function.kappa != 1:
-        function = validate(sp.expand(expr / function.kappa) if expr.is_Add else expr / function.kappa)
-    return derive_function(function)
+    with stage("validation"):
+        function = validate(expr)
+        if normalize and function.kappa != 1:
+            function = validate(sp.expand(expr / function.kappa) if expr.is_Add else expr / function.kappa)
+    with stage("derivation"):
+        return derive_function(function)

@@ -5,6 +5,12 @@ by :func:`ast.parse` (which only builds a tree), every node is checked against a
 the SymPy expression is built directly from the checked tree. Caps on length, depth, node count,
 literal size and exponents keep both parsing and SymPy's automatic evaluation fast.
 
+Every literal form counts towards the literal caps (decimal, hex, octal, binary, scientific).
+Before SymPy builds a node, the size of that node *fully expanded* is estimated (see
+:class:`Size`): the number of terms ``sympy.expand`` would produce, the combined exponent of
+nested powers and the bit length of the numbers powers and products create. ``((1+phi)**64)**64``
+or ``(10**30)**64`` are rejected here, before SymPy evaluates them or a later ``expand`` does.
+
 Grammar: numbers, ``phi`` (or ``φ``), ``pi`` (or ``π``), ``+ - * / **`` (``^`` is accepted
 as ``**``, with the same precedence), parentheses, and calls of one argument to the
 functions in :data:`FUNCTIONS`.
@@ -15,8 +21,10 @@ from __future__ import annotations
 
 import ast
 import difflib
+import math
 import unicodedata
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from fractions import Fraction
 
 import sympy as sp
@@ -33,6 +41,14 @@ MAX_NODES = 160
 MAX_LITERAL_DIGITS = 30
 MAX_EXPONENT = 64
 MAX_EXPONENT_DENOMINATOR = 64
+MAX_LITERAL_BITS = 256
+"""A literal's numerator and denominator have at most this many bits (about 77 digits)."""
+MAX_NUMBER_BITS = 512
+"""Numbers created by powers and products stay below 2**512 (floats reach 2**1024)."""
+MAX_EXPANDED_TERMS = 5000
+"""Terms ``sympy.expand`` would produce for one node (about 2 s of SymPy at this size)."""
+MAX_DEGREE = 1024
+"""Combined exponent of nested powers, e.g. ``(phi**64)**16``."""
 
 FUNCTIONS: dict[str, Callable[[sp.Expr], sp.Expr]] = {
     "sin": sp.sin,
@@ -89,7 +105,7 @@ def parse_expression(text: object, extra_names: dict[str, sp.Expr] | None = None
     if nodes > MAX_NODES:
         raise ParseError(f"expression is too large ({nodes} syntax nodes, at most {MAX_NODES})")
     builder = _Builder(stripped, extra_names or {})
-    expr = builder.build(tree.body, 0)
+    expr, _ = builder.build(tree.body, 0)
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise ParseError("expression evaluates to an infinity or NaN (division by zero?)")
     if expr.has(sp.I):
@@ -113,6 +129,48 @@ def _did_you_mean(word: str, choices: Iterable[str]) -> str:
     """"; did you mean X?" for the closest of ``choices``, or ""."""
     close = difflib.get_close_matches(word[:40], list(choices), n=1, cutoff=0.6)
     return f"; did you mean {close[0]}?" if close else ""
+@dataclass(frozen=True)
+class Size:
+    """An upper estimate of a node's size once fully expanded, computed before SymPy builds it.
+
+    ``terms``: terms of ``sympy.expand`` (a product multiplies, a power n of t terms gives the
+    multinomial count C(n + t - 1, t - 1)); ``degree``: the combined exponent of nested powers;
+    ``bits``: the bit length of the largest number that products and powers create.
+    """
+
+    terms: int = 1
+    degree: int = 0
+    bits: int = 0
+
+    def plus(self, other: Size) -> Size:
+        return Size(self.terms + other.terms, max(self.degree, other.degree),
+                    max(self.bits, other.bits) + 1)
+
+    def times(self, other: Size) -> Size:
+        return Size(self.terms * other.terms, self.degree + other.degree, self.bits + other.bits)
+
+    def power(self, exponent: sp.Rational) -> Size:
+        magnitude = abs(exponent)
+        whole = int(magnitude)  # expand multiplies out the integer part only
+        terms = math.comb(whole + self.terms - 1, self.terms - 1) if whole else 1
+        multinomial_bits = math.ceil(whole * math.log2(self.terms)) if self.terms > 1 else 0
+        return Size(min(terms, MAX_EXPANDED_TERMS + 1), math.ceil(self.degree * magnitude),
+                    math.ceil(self.bits * magnitude) + multinomial_bits)
+
+    def check(self) -> Size:
+        """Raise :class:`ParseError` when the estimate exceeds a cap; else return self."""
+        if self.terms > MAX_EXPANDED_TERMS:
+            raise ParseError(f"expression expands to too many terms (more than {MAX_EXPANDED_TERMS})")
+        if self.degree > MAX_DEGREE:
+            raise ParseError(f"powers combine to a degree above {MAX_DEGREE} ({self.degree})")
+        if self.bits > MAX_NUMBER_BITS:
+            raise ParseError(f"expression creates a number beyond 2**{MAX_NUMBER_BITS} "
+                             f"(about {self.bits} bits)")
+        return self
+
+
+_ATOM = Size(1, 1, 0)
+
 
 class _Builder:
     """Turns a whitelisted AST into SymPy, rejecting everything else with a clear message."""
@@ -121,44 +179,47 @@ class _Builder:
         self.source = source
         self.extra_names = extra_names
 
-    def build(self, node: ast.AST, depth: int) -> sp.Expr:
+    def build(self, node: ast.AST, depth: int) -> tuple[sp.Expr, Size]:
+        """The SymPy expression of ``node`` and its expanded :class:`Size` (checked)."""
         if depth > MAX_DEPTH:
             raise ParseError(f"expression is nested too deeply (more than {MAX_DEPTH} levels)")
         if isinstance(node, ast.Constant):
             return self._number(node)
         if isinstance(node, ast.Name):
-            return self._name(node)
+            return self._name(node), _ATOM
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.UAdd | ast.USub):
-            operand = self.build(node.operand, depth + 1)
-            return -operand if isinstance(node.op, ast.USub) else operand
+            operand, size = self.build(node.operand, depth + 1)
+            return (-operand if isinstance(node.op, ast.USub) else operand), size
         if isinstance(node, ast.BinOp) and isinstance(node.op, _BINARY):
             return self._binary(node, depth)
         if isinstance(node, ast.Call):
             return self._call(node, depth)
         raise ParseError(f"'{_describe(node)}' is not allowed in an expression")
 
-    def _number(self, node: ast.Constant) -> sp.Expr:
+    def _number(self, node: ast.Constant) -> tuple[sp.Expr, Size]:
         value = node.value
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ParseError(f"literal {value!r} is not a real number")
         literal = ast.get_source_segment(self.source, node) or repr(value)
-        digits = sum(ch.isdigit() for ch in literal)
-        if digits > MAX_LITERAL_DIGITS:
-            raise ParseError(f"number literal has too many digits (at most {MAX_LITERAL_DIGITS})")
-        if isinstance(value, int):
-            return sp.Integer(value)
         if any(ch in literal for ch in "jJ"):
             raise ParseError("complex literals are not allowed")
-        _, _, exponent = literal.lower().replace("_", "").partition("e")
-        if exponent and (not exponent.lstrip("+-").isdigit() or abs(int(exponent)) > 400):
-            raise ParseError(f"number literal {literal[:40]!r} is out of range")
-        try:
-            exact = Fraction(literal.replace("_", ""))
-        except (ValueError, ZeroDivisionError):
-            raise ParseError(f"number literal {literal!r} is not valid") from None
-        if abs(exact.numerator).bit_length() > 256 or exact.denominator.bit_length() > 256:
-            raise ParseError(f"number literal {literal!r} is out of range")
-        return sp.Rational(exact.numerator, exact.denominator)
+        if _literal_digits(literal) > MAX_LITERAL_DIGITS:
+            raise ParseError(f"number literal has too many digits (at most {MAX_LITERAL_DIGITS})")
+        if isinstance(value, int):
+            exact = Fraction(value)
+        else:
+            _, _, exponent = literal.lower().replace("_", "").partition("e")
+            if exponent and (not exponent.lstrip("+-").isdigit() or abs(int(exponent)) > 400):
+                raise ParseError(f"number literal {literal[:40]!r} is out of range")
+            try:
+                exact = Fraction(literal.replace("_", ""))
+            except (ValueError, ZeroDivisionError):
+                raise ParseError(f"number literal {literal[:40]!r} is not valid") from None
+        bits = max(abs(exact.numerator).bit_length(), exact.denominator.bit_length())
+        if bits > MAX_LITERAL_BITS:
+            raise ParseError(f"number literal {literal[:40]!r} is out of range "
+                             f"(at most {MAX_LITERAL_BITS} bits)")
+        return sp.Rational(exact.numerator, exact.denominator), Size(1, 0, bits)
 
     def _name(self, node: ast.Name) -> sp.Expr:
         if node.id in _VARIABLES:
@@ -173,22 +234,23 @@ class _Builder:
         raise ParseError(f"unknown name '{node.id[:40]}'{_did_you_mean(node.id, names)} "
                          f"(allowed names: {', '.join(names)})")
 
-    def _binary(self, node: ast.BinOp, depth: int) -> sp.Expr:
-        left = self.build(node.left, depth + 1)
-        right = self.build(node.right, depth + 1)
-        if isinstance(node.op, ast.Add):
-            return left + right
-        if isinstance(node.op, ast.Sub):
-            return left - right
+    def _binary(self, node: ast.BinOp, depth: int) -> tuple[sp.Expr, Size]:
+        left, left_size = self.build(node.left, depth + 1)
+        right, right_size = self.build(node.right, depth + 1)
+        if isinstance(node.op, ast.Add | ast.Sub):
+            size = left_size.plus(right_size).check()
+            return (left + right if isinstance(node.op, ast.Add) else left - right), size
         if isinstance(node.op, ast.Mult):
-            return left * right
+            return left * right, left_size.times(right_size).check()
         if isinstance(node.op, ast.Div):
             if right.is_zero:
                 raise ParseError("division by zero")
-            return left / right
-        return self._power(left, right)
+            return left / right, left_size.times(right_size).check()
+        exponent = self._exponent(right)
+        return self._power(left, exponent, left_size.power(exponent).check())
 
-    def _power(self, base: sp.Expr, exponent: sp.Expr) -> sp.Expr:
+    @staticmethod
+    def _exponent(exponent: sp.Expr) -> sp.Rational:
         if exponent.has(PHI) or not exponent.is_Rational:
             raise ParseError("exponents must be rational constants such as 2, -1 or 1/3")
         exp_rational = sp.Rational(exponent)
@@ -196,13 +258,17 @@ class _Builder:
             raise ParseError(f"exponent {exp_rational} is too large (|exponent| <= {MAX_EXPONENT})")
         if exp_rational.q > MAX_EXPONENT_DENOMINATOR:
             raise ParseError(f"exponent {exp_rational} has too large a denominator")
+        return exp_rational
+
+    @staticmethod
+    def _power(base: sp.Expr, exp_rational: sp.Rational, size: Size) -> tuple[sp.Expr, Size]:
         if base.is_zero and exp_rational.is_negative:
             raise ParseError("division by zero")
         if base.is_Number and base.is_negative and exp_rational.q != 1:
             raise ParseError("a fractional power of a negative number is not real (use cbrt)")
-        return sp.Pow(base, exp_rational)
+        return sp.Pow(base, exp_rational), size
 
-    def _call(self, node: ast.Call, depth: int) -> sp.Expr:
+    def _call(self, node: ast.Call, depth: int) -> tuple[sp.Expr, Size]:
         if not isinstance(node.func, ast.Name):
             raise ParseError(f"'{_describe(node.func)}' cannot be called")
         name = node.func.id
@@ -212,8 +278,26 @@ class _Builder:
                              f"(allowed: {allowed})")
         if node.keywords or len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
             raise ParseError(f"function '{name}' takes exactly one argument")
-        argument = self.build(node.args[0], depth + 1)
-        return FUNCTIONS[name](argument)
+        argument, size = self.build(node.args[0], depth + 1)
+        if name in _ROOTS:  # a power in SymPy: numbers and polynomials inside keep their size
+            return FUNCTIONS[name](argument), size.power(_ROOTS[name]).check()
+        return FUNCTIONS[name](argument), _ATOM
+
+
+_ROOTS = {"sqrt": sp.Rational(1, 2), "cbrt": sp.Rational(1, 3)}
+
+
+_BASES = {"0x": 16, "0o": 8, "0b": 2}
+
+
+def _literal_digits(literal: str) -> int:
+    """Decimal digits a literal stands for: a hex, octal or binary literal counts its digits
+    times log10 of its base (hex letters included); a decimal one its mantissa digits."""
+    text = literal.lower().replace("_", "")
+    if text[:2] in _BASES:
+        return math.ceil((len(text) - 2) * math.log10(_BASES[text[:2]]))
+    mantissa = text.partition("e")[0]
+    return sum(ch.isdigit() for ch in mantissa)
 
 
 def _describe(node: ast.AST) -> str:

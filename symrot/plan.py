@@ -45,6 +45,7 @@ from .algebraic import (
 from .algebraic import X as X  # re-exported: the symbol of the coefficients' variable x = |p|²
 from .core import Derivation, derive_expression
 from .domain import FIRST_POWER, domain_limit
+from .errors import SymrotError
 from .evaluation import log_grid, model_function
 from .functions import RealCbrt, mpmath_namespace
 from .newton_start import FarStart as FarStart
@@ -242,6 +243,9 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                 best, best_k = worst, k
         elif worst < best:
             best, best_k = worst, k
+    if best_k >= near_zero:  # every error estimate is inf/NaN: e.g. p = 1e-20*phi, the series overflows
+        raise SymrotError(f"cannot plan {closed} in {np.dtype(dtype).name}: neither it nor its series "
+                          "in x = |p|^2 is finite on the grid (p is too small or too large in scale)")
     def terms_at(threshold: float) -> int:
         target = max(0.25, tail(threshold, MAX_TERMS - 2))
         return next((n for n in range(1, MAX_TERMS - 1) if tail(threshold, n) <= target), MAX_TERMS - 2)

@@ -340,13 +340,8 @@ class SeriesEngine:
         one = self._from_element(self.domain.one)
         if isinstance(expr, sp.exp):
             return self.exp(a)
-        if isinstance(expr, sp.sin | sp.cos | sp.tan):
-            sin_f, cos_f = self.sin_cos(a)
-            if isinstance(expr, sp.sin):
-                return sin_f
-            if isinstance(expr, sp.cos):
-                return cos_f
-            return self.mul(sin_f, self._inverse_checked(cos_f, "tan has a pole at phi = 0"))
+        if isinstance(expr, sp.sin | sp.cos | sp.tan | sp.cot | sp.sec | sp.csc):
+            return self._trigonometric(expr, a)
         if isinstance(expr, sp.sinh | sp.cosh | sp.tanh):
             e_plus, e_minus = self.exp(a), self.exp(self.scale(a, -self.domain.one))
             sinh = self.scale(self.add(e_plus, self.scale(e_minus, -self.domain.one)),
@@ -357,6 +352,12 @@ class SeriesEngine:
             if isinstance(expr, sp.cosh):
                 return cosh
             return self.mul(sinh, self.inverse(cosh))
+        if isinstance(expr, sp.coth | sp.csch):  # SymPy writes tanh(x + i pi/2) this way
+            numerator = self.scale(self.add(self.exp(a), self.exp(self.scale(a, -self.domain.one))),
+                                   self.domain.one / 2) if isinstance(expr, sp.coth) else one
+            sinh_f = self.scale(self.add(self.exp(a), self.scale(self.exp(self.scale(
+                a, -self.domain.one)), -self.domain.one)), self.domain.one / 2)
+            return self.mul(numerator, self.inverse(sinh_f))
         if isinstance(expr, sp.log):
             return self.log(a)
         c0, _ = self._split_constant(a)
@@ -386,6 +387,19 @@ class SeriesEngine:
                 a, sp.atanh(c0), self.inverse(self.add(one, self.scale(square, -self.domain.one)))
             )
         raise SymrotError(f"the series engine has no rule for {type(expr).__name__}")
+
+    def _trigonometric(self, expr: sp.Expr, a: Series) -> Series:
+        """sin, cos and their quotients (SymPy turns tan(pi/2 + phi) into -cot(phi)); a pole of
+        cot or csc at 0 is a Laurent term, so that the caller reports the pole of p itself."""
+        sin_f, cos_f = self.sin_cos(a)
+        name = type(expr).__name__
+        if isinstance(expr, sp.sin | sp.cos):
+            return sin_f if isinstance(expr, sp.sin) else cos_f
+        if isinstance(expr, sp.tan | sp.sec):
+            inverse_cos = self._inverse_checked(cos_f, f"{name} has a pole at phi = 0")
+            return self.mul(sin_f, inverse_cos) if isinstance(expr, sp.tan) else inverse_cos
+        inverse_sin = self.inverse(sin_f)  # a Laurent series: phi**2*cot(phi) is analytic
+        return self.mul(cos_f, inverse_sin) if isinstance(expr, sp.cot) else inverse_sin
 
     def _abs_or_sign(self, expr: sp.Expr, a: Series) -> Series:
         c0 = self.domain.to_sympy(a.constant_term())

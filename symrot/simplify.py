@@ -40,7 +40,16 @@ def complexity(expr: sp.Expr) -> tuple[int, int, int]:
     """Ranking key: size, with sums and hidden 0/0 quotients penalised, then printed length."""
     sums = sum(1 for node in sp.preorder_traversal(expr) if isinstance(node, sp.Add))
     size = int(sp.count_ops(expr, visual=False)) + sums + 3 * _vanishing_denominators(expr)
-    return (size, sums, len(str(expr)))
+    return (size, sums, _printed_length(expr))
+
+
+def _printed_length(expr: sp.Expr) -> int:
+    """len(str(expr)); an integer beyond Python's 4300-digit str limit counts by its bits."""
+    try:
+        return len(str(expr))
+    except ValueError:
+        numbers = expr.atoms(sp.Rational)
+        return sum(int(max(abs(n.p), n.q).bit_length() * 0.302) + 2 for n in numbers) + sp.count_ops(expr)
 
 
 def _trig_multiples(expr: sp.Expr) -> list[sp.Rational] | None:

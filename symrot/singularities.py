@@ -16,6 +16,11 @@ preferred as exact angles: the poles of p from ``sympy.calculus.util.singulariti
 SymPy tool that finds poles inside tan) and the zeros of p′ from ``solveset``. When ``solveset``
 returns a ConditionSet or times out, the analysis is numeric and ``numeric_only`` is set.
 Identically constant functions (e.g. ν for 2 sin(φ/2), det H for eq 35) have no singularity.
+
+Past the edge of its real domain (asin(φ) beyond 1) a function is complex: NaN in double
+precision, an ``mpc`` at 50 digits. The first grid point where it is complex ends the scan, the
+edge is bisected at 50 digits, and the edge itself is a singularity: p → ∞ or p′ → ∞ there when
+the one-sided values grow without bound (a pole or a logarithm), else "p is not real beyond".
 Other angles are matched against rational multiples of π (denominators ≤ 24, to 25 digits:
 multiple roots polish to fewer digits than simple ones); an angle matching neither is reported
 as a Float and ``numeric_only`` is set. The validity range is the smallest singular angle.
@@ -31,6 +36,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from .budget import stage
 from .core import Derivation, derive_expression
 from .functions import mpmath_namespace
 from .parsing import PHI
@@ -49,7 +55,12 @@ CAUSES = {
     ("det_H", "0"): "det H -> 0: H is singular",
     ("det_H", "oo"): "det H -> oo: H^-1 is singular",
     ("monotonicity", "0"): "p' changes sign: |p| no longer determines phi",
+    ("p", "edge"): "p is not real beyond this angle (the edge of its real domain)",
 }
+MAX_CANDIDATES = 400
+"""Brackets polished per function, smallest angles first (the validity range is the smallest)."""
+EDGE_STEPS = 200
+"""Bisection steps that locate the edge of the real domain to 50 digits."""
 
 
 @dataclass(frozen=True)
@@ -76,7 +87,8 @@ SCAN_INTERVAL = sp.Interval.Lopen(0, 4 * sp.pi)
 
 def validity(derivation: Derivation) -> Validity:
     """The validity range of ``derivation``'s parameterization and every singular angle."""
-    return _validity_of(derivation.p)
+    with stage("validity analysis"):
+        return _validity_of(derivation.p)
 
 
 @lru_cache(maxsize=256)
@@ -105,9 +117,20 @@ def _validity_of(p: sp.Expr) -> Validity:
     if not found:
         return Validity(sp.oo, float("inf"), float("inf"), (), False)
     edge = found[0]
-    p_at_edge = float("inf") if any(s.quantity == "p" and abs(s.phi_float - edge.phi_float) < 1e-9
-                                    for s in found) else abs(float(p.subs(PHI, edge.phi).evalf(30)))
+    p_at_edge = float("inf") if any(s.quantity == "p" and s.limit == "oo"
+                                    and abs(s.phi_float - edge.phi_float) < 1e-9
+                                    for s in found) else _magnitude_at(p, edge)
     return Validity(edge.phi, edge.phi_float, p_at_edge, tuple(found), numeric_only)
+
+
+def _magnitude_at(p: sp.Expr, edge: Singularity) -> float:
+    """|p| at the edge of the validity range: exact when SymPy can, else from the left side."""
+    value = p.subs(PHI, edge.phi).evalf(30)
+    if value.is_real and value.is_finite:
+        return abs(float(value))
+    with mpmath.workdps(DIGITS):
+        left = _safe(_mp(p))(mpmath.mpf(edge.phi_float) * (1 - mpmath.mpf(10) ** -12))
+    return float(abs(left)) if mpmath.isfinite(left) else float("inf")
 
 
 def _mp(expr: sp.Expr) -> Callable[[mpmath.mpf], mpmath.mpf]:
@@ -146,32 +169,91 @@ def _events(expr: sp.Expr, extra: tuple[float, ...] = ()) -> list[tuple[mpmath.m
     numeric = sp.lambdify(PHI, expr, modules=[{"RealCbrt": np.cbrt}, "numpy"])
     with np.errstate(all="ignore"):
         values = np.asarray(numeric(grid), dtype=float) * np.ones_like(grid)
-    magnitude = np.abs(values)
-    scale = float(np.nanmedian(magnitude[np.isfinite(magnitude)])) or 1.0
     exact = _mp(expr)
     events: list[tuple[mpmath.mpf, str, bool]] = []
-    candidates: list[tuple[float, float]] = []
-    for i in range(1, SCAN_POINTS - 1):
-        a, b, c = magnitude[i - 1], magnitude[i], magnitude[i + 1]
-        sign_change = np.sign(values[i]) != np.sign(values[i + 1])
-        local_min = b <= a and b <= c and b < 1e-3 * max(scale, 1.0)
-        local_max = (b >= a and b >= c and b > 1e3 * max(scale, 1.0)) or not np.isfinite(b)
-        if sign_change or local_min or local_max:
-            candidates.append((grid[i - 1], grid[i + 1]))
-    if magnitude[-1] < 1e-9 * max(scale, 1.0) or magnitude[-1] > 1e9 * max(scale, 1.0):
-        candidates.append((grid[-2], grid[-1]))
     with mpmath.workdps(DIGITS):
-        for low, high in candidates:
+        inside, edge = _real_domain(exact, grid, values)
+        grid, values = grid[:inside], values[:inside]
+        for low, high in _brackets(grid, values, complete=edge is None)[:MAX_CANDIDATES]:
             event = _polish(exact, mpmath.mpf(low), mpmath.mpf(high))
             if event is not None and not any(abs(event[0] - e[0]) < 1e-9 for e in events):
                 events.append(event)
         for candidate in extra:  # exact angles: classify in place, no root search
             angle = mpmath.mpf(sp.N(candidate, DIGITS))
-            if not any(abs(angle - e[0]) < 1e-9 for e in events):
+            if (edge is None or angle < edge) and not any(abs(angle - e[0]) < 1e-9 for e in events):
                 event = _classify(_safe(exact), angle)
                 if event is not None:
                     events.append(event)
+        if edge is not None and not any(abs(edge - e[0]) < 1e-9 for e in events):
+            events.append(_classify_edge(_safe(exact), edge))
     return events
+
+
+def _brackets(grid: np.ndarray, values: np.ndarray, complete: bool) -> list[tuple[float, float]]:
+    """Grid intervals around sign changes, near-zeros and poles (the start of an overflow run);
+    ``complete``: the grid reaches 4π, so a tiny or huge last value is bracketed too."""
+    magnitude = np.abs(values)
+    finite = magnitude[np.isfinite(magnitude)]
+    scale = max(float(np.median(finite)) if finite.size else 1.0, 1.0)
+    candidates: list[tuple[float, float]] = []
+    for i in range(1, len(grid) - 1):
+        a, b, c = magnitude[i - 1], magnitude[i], magnitude[i + 1]
+        sign_change = np.sign(values[i]) != np.sign(values[i + 1])
+        local_min = b <= a and b <= c and b < 1e-3 * scale
+        local_max = (b >= a and b >= c and b > 1e3 * scale) or (not np.isfinite(b) and np.isfinite(a))
+        if sign_change or local_min or local_max:
+            candidates.append((grid[i - 1], grid[i + 1]))
+    if complete and len(grid) > 1 and (magnitude[-1] < 1e-9 * scale or magnitude[-1] > 1e9 * scale):
+        candidates.append((grid[-2], grid[-1]))
+    return candidates
+
+
+def _is_complex(f: Callable[[mpmath.mpf], mpmath.mpf], t: mpmath.mpf) -> bool:
+    """True past the edge of the real domain: f(t) has a non-zero imaginary part (or no value)."""
+    try:
+        value = f(t)
+    except (ValueError, ZeroDivisionError, OverflowError):
+        return False  # a pole or an overflow, not the end of the domain
+    return isinstance(value, mpmath.mpc) and value.imag != 0
+
+
+def _real_domain(f: Callable[[mpmath.mpf], mpmath.mpf], grid: np.ndarray, values: np.ndarray
+                 ) -> tuple[int, mpmath.mpf | None]:
+    """(grid points before the first one where f is complex, the bisected edge or None).
+
+    NaN in double precision is either the complex region or an overflow (inf − inf); only the
+    first few NaN points are checked at 50 digits, the rest of a NaN run belongs to the same.
+    """
+    checked = 0
+    for i in np.flatnonzero(np.isnan(values)):
+        if i and np.isnan(values[i - 1]):
+            continue
+        if _is_complex(f, mpmath.mpf(grid[i])):
+            low = mpmath.mpf(grid[i - 1]) if i else mpmath.mpf(0)
+            high = mpmath.mpf(grid[i])
+            for _ in range(EDGE_STEPS):
+                middle = (low + high) / 2
+                if middle in (low, high):
+                    break
+                low, high = (low, middle) if _is_complex(f, middle) else (middle, high)
+            return int(i), low
+        checked += 1
+        if checked >= 20:
+            break
+    return len(grid), None
+
+
+def _classify_edge(safe: Callable[[mpmath.mpf], mpmath.mpf], edge: mpmath.mpf
+                   ) -> tuple[mpmath.mpf, str, bool]:
+    """Classify the edge of the real domain from the left: a pole (or a logarithm: values that
+    keep growing as the edge nears), a zero, or a plain end of the domain."""
+    near, nearer = safe(edge * (1 - mpmath.mpf(10) ** -15)), safe(edge * (1 - mpmath.mpf(10) ** -30))
+    huge, tiny = mpmath.mpf(10) ** 12, mpmath.mpf(10) ** -12
+    if not mpmath.isfinite(nearer) or abs(nearer) > huge or abs(nearer) > 1.5 * abs(near):
+        return edge, "oo", False
+    if abs(nearer) < tiny or abs(nearer) < abs(near) / 1.5:
+        return edge, "0", False
+    return edge, "edge", False
 
 
 def _polish(f: Callable[[mpmath.mpf], mpmath.mpf], low: mpmath.mpf, high: mpmath.mpf
@@ -208,8 +290,8 @@ def _safe(f: Callable[[mpmath.mpf], mpmath.mpf]) -> Callable[[mpmath.mpf], mpmat
     def safe(t: mpmath.mpf) -> mpmath.mpf:
         try:
             value = f(t)
-        except (ZeroDivisionError, ValueError):
-            return mpmath.inf
+        except (ZeroDivisionError, ValueError, OverflowError, MemoryError):
+            return mpmath.inf  # overflow: an exponent beyond mpmath's range (sinh of sinh...)
         return value.real if isinstance(value, mpmath.mpc) else value
 
     return safe
@@ -230,13 +312,15 @@ def _classify(safe: Callable[[mpmath.mpf], mpmath.mpf], angle: mpmath.mpf
 
 
 def _exact_angle(angle: mpmath.mpf, candidates: tuple[sp.Expr, ...] = ()) -> sp.Expr | None:
-    """The symbolic candidate, or k π / n, that the 50-digit root matches (n ≤ 24), else None."""
+    """The symbolic candidate, k π / n or k / n that the 50-digit root matches (n ≤ 24), else
+    None (k / n: edges of real domains, such as 1 for asin(phi))."""
     with mpmath.workdps(DIGITS):
         for candidate in candidates:
             if abs(angle - mpmath.mpf(sp.N(candidate, DIGITS))) < mpmath.mpf(10) ** -25:
                 return candidate
-        for n in range(1, 25):
-            k = int(mpmath.nint(angle * n / mpmath.pi))
-            if k and abs(angle - k * mpmath.pi / n) < mpmath.mpf(10) ** -25:
-                return sp.Rational(k, n) * sp.pi
+        for unit, exact in ((mpmath.pi, sp.pi), (mpmath.mpf(1), sp.S.One)):
+            for n in range(1, 25):
+                k = int(mpmath.nint(angle * n / unit))
+                if k and abs(angle - k * unit / n) < mpmath.mpf(10) ** -25:
+                    return sp.Rational(k, n) * exact
     return None

@@ -27,8 +27,8 @@ def _can_use_signals() -> bool:
 
 
 @contextmanager
-def time_limit(seconds: float, what: str = "symbolic step", marker: object = None) -> Iterator[None]:
-    """Raise :class:`SymrotTimeout` (with ``.marker``) if the body runs longer than ``seconds``."""
+def alarm(seconds: float, error: Callable[[], BaseException]) -> Iterator[None]:
+    """Raise ``error()`` in the body if it runs longer than ``seconds`` (nests, see above)."""
     if not _can_use_signals() or seconds <= 0:
         yield
         return
@@ -38,9 +38,7 @@ def time_limit(seconds: float, what: str = "symbolic step", marker: object = Non
         return
 
     def _on_alarm(signum: int, frame: object) -> None:
-        error = SymrotTimeout(f"{what} took longer than {seconds:g} s")
-        error.marker = marker  # type: ignore[attr-defined]
-        raise error
+        raise error()
 
     previous = signal.signal(signal.SIGALRM, _on_alarm)
     started = time.monotonic()
@@ -53,6 +51,19 @@ def time_limit(seconds: float, what: str = "symbolic step", marker: object = Non
         if outer_remaining:
             elapsed = time.monotonic() - started
             signal.setitimer(signal.ITIMER_REAL, max(outer_remaining - elapsed, 1e-3))
+
+
+@contextmanager
+def time_limit(seconds: float, what: str = "symbolic step", marker: object = None) -> Iterator[None]:
+    """Raise :class:`SymrotTimeout` (with ``.marker``) if the body runs longer than ``seconds``."""
+
+    def expired() -> SymrotTimeout:
+        error = SymrotTimeout(f"{what} took longer than {seconds:g} s")
+        error.marker = marker  # type: ignore[attr-defined]
+        return error
+
+    with alarm(seconds, expired):
+        yield
 
 
 def bounded(seconds: float, fallback: T, func: Callable[..., T], *args: Any) -> T:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 import pytest
 import sympy as sp
@@ -11,6 +12,10 @@ import sympy as sp
 from symrot.errors import ParseError
 from symrot.functions import RealCbrt
 from symrot.parsing import PHI, parse_expression
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
+
+import hostile_cli  # the CLI corpus: its injections and bombs are parse errors
 
 VALID = {
     "cbrt(6*(phi-sin(phi)))": RealCbrt(6 * PHI - 6 * sp.sin(PHI)),
@@ -26,93 +31,60 @@ VALID = {
     "phi**(1/3)": PHI ** sp.Rational(1, 3),
     "sqrt(1+phi**2)*phi": sp.sqrt(1 + PHI**2) * PHI,
     "  phi  ": PHI,
+    "0x10*phi": 16 * PHI,
+    "0b101*phi + 0o7*phi**3": 5 * PHI + 7 * PHI**3,
+    "(1+phi)**64 - 1": (1 + PHI) ** 64 - 1,
+    "sqrt((1+phi**2)**64)*phi": (1 + PHI**2) ** 32 * PHI,
+    "(2**64)**4*phi": 2**256 * PHI,
 }
 
 HOSTILE = [
+    *hostile_cli.INJECTIONS,
+    *hostile_cli.BOMBS,
     "__import__('os').system('echo pwned')",
-    "__import__('subprocess').call(['true'])",
-    "eval('1+1')",
-    "exec('import os')",
     "open('/etc/passwd')",
-    "compile('1', 'f', 'eval')",
-    "globals()",
     "locals()",
     "vars()",
-    "getattr(phi, 'func')",
-    "phi.func",
     "phi.__class__",
-    "().__class__.__bases__[0].__subclasses__()",
-    "sin.__call__(phi)",
-    "sympy.sin(phi)",
     "Symbol('x')",
-    "lambda: 1",
-    "(lambda x: x)(phi)",
     "[phi]",
     "(phi, phi)",
     "{phi}",
     "{1: phi}",
     "[x for x in range(10**9)]",
-    "phi[0]",
-    "phi if phi else 1",
     "phi < 1",
     "not phi",
     "phi and 1",
     "phi or 1",
     "phi % 2",
-    "phi // 2",
-    "phi @ phi",
     "phi << 2",
     "~phi",
-    "(x := 1)",
-    "f'{phi}'",
-    "'string'",
-    "b'bytes'",
-    "None",
-    "True * phi",
-    "...",
-    "1j * phi",
     "x",
     "e * phi",
     "sin",
     "sin()",
     "sin(phi, 2)",
-    "sin(x=phi)",
-    "sin(*[phi])",
     "sin(**{})",
     "import os",
-    "phi; import os",
-    "phi\nimport os",
-    "await phi",
     "yield phi",
     "",
     "   ",
     "\x00phi",
-    "2**2**2**2**2",
-    "phi**10**100",
-    "phi**(10**6)",
     "phi**phi",
     "phi**sqrt(2)",
-    "9" * 5000,
     "1" * 40 + "*phi",
     "1e999999 * phi",
     "1e99999999999 * phi",
-    "(" * 300 + "phi" + ")" * 300,
     "sin(" * 100 + "phi" + ")" * 100,
-    "-" * 5000 + "phi",
-    "+".join(["phi"] * 500),
     "1/0",
     "phi/0",
     "(-8)**(1/3)",
     "0**-1",
-    "exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(exp(phi))))))))))))))))))))))))))))))))))",
-    "ᵖʰⁱ.__class__",
     "φ.__class__.__mro__",
-    "breakpoint()",
     "help()",
     "quit()",
-    "print(phi)",
-    "__builtins__",
-    "phi.evalf(10**9)",
+    "phi*(2**200)**3",
+    "0o" + "7" * 40 + "*phi",
 ]
 
 

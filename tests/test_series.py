@@ -91,3 +91,15 @@ def test_product_rule_property(a: object, b: object, k: int) -> None:
     gs = coefficient_list(taylor_series(g, 12), 0, 12)
     product = [sum(fs[i] * gs[n - i] for i in range(n + 1)) for n in range(12)]
     assert fg == product
+
+
+@pytest.mark.parametrize("expr", [PHI**2 * sp.cot(PHI), PHI * sp.csc(PHI), sp.sec(PHI),
+                                  PHI * sp.coth(PHI), PHI * sp.csch(PHI), -sp.cot(PHI + 1)])
+def test_reciprocal_trigonometric_functions_match_sympy(expr: sp.Expr) -> None:
+    ours = coefficient_list(taylor_series(expr, 9), 0, 9)
+    reference = sp.series(expr, PHI, 0, 9).removeO()
+    assert all(sp.simplify(ours[k] - reference.coeff(PHI, k)) == 0 for k in range(9))
+
+
+def test_cot_has_a_pole_not_a_missing_rule() -> None:
+    assert taylor_series(parse_expression("tan(pi/2 + phi)"), 4).valuation == -1

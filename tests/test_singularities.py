@@ -94,3 +94,19 @@ def test_transcendental_angle_falls_back_to_numeric() -> None:
     assert result.phi_max_float == pytest.approx(0.8603335890193798, abs=1e-15)
     assert "monotonicity" in {s.quantity for s in result.singularities
                               if s.phi_float == result.phi_max_float}
+
+
+@pytest.mark.parametrize("text, edge, limit", [
+    ("asin(phi)", sp.S.One, "edge"),
+    ("2*asin(phi/2)", sp.Integer(2), "edge"),
+    ("phi/sqrt(1-phi**2)", sp.S.One, "oo"),
+    ("log((1+phi)/(1-phi))/2", sp.S.One, "oo"),
+])
+def test_the_edge_of_the_real_domain_is_a_singularity(text: str, edge: sp.Expr, limit: str) -> None:
+    started = time.monotonic()
+    result = validity(derive_expression(parse_expression(text)))
+    assert result.phi_max == edge
+    p_events = [s for s in result.singularities if s.quantity == "p"]
+    assert p_events and p_events[0].phi == edge and p_events[0].limit == limit
+    assert (result.p_max_float == float("inf")) == (limit == "oo")
+    assert time.monotonic() - started < 20

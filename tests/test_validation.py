@@ -59,3 +59,16 @@ def test_oddness_beyond_the_series_order_is_caught_numerically() -> None:
     # Even part phi**40 is beyond the checked Taylor order; the 50-digit check finds it.
     with pytest.raises(InvalidGeneratingFunction, match="not odd"):
         validate(parse_expression("phi + phi**40"))
+
+
+def test_a_timeout_in_the_numeric_check_is_not_reported_as_a_bad_function(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from symrot import validation
+    from symrot.errors import SymrotTimeout
+
+    def slow(*args: object, **kwargs: object) -> None:
+        raise SymrotTimeout("derivation took longer than 60 s")
+
+    monkeypatch.setattr(validation, "evaluate", slow)
+    with pytest.raises(SymrotTimeout):
+        validate(parse_expression("sin(phi)"))

@@ -9,9 +9,13 @@ from pathlib import Path
 from typing import Any
 
 from .. import strict_json
+from ..budget import stage
+from .output import write_file
 
 EXIT_CHECK_FAILED = 1
 DEFAULT_ERRATA = "docs/errata.md"
+AUDIT_TIMEOUT = 1800.0
+"""The audit runs hundreds of bounded checks: its budget is larger than the other commands'."""
 
 
 def register(subparsers: Any) -> None:
@@ -35,7 +39,7 @@ def register(subparsers: Any) -> None:
         metavar="KEYS",
         help="comma-separated equation keys to run (e.g. 14,22,45); no errata written",
     )
-    parser.set_defaults(run=run)
+    parser.set_defaults(run=run, default_timeout=AUDIT_TIMEOUT)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -46,7 +50,8 @@ def run(args: argparse.Namespace) -> int:
 
     only = {key.strip() for key in args.only.split(",")} if args.only else None
     selected = [c for c in all_checks() if only is None or c.equation in only]
-    results = [result for check in each(selected, "symrot audit") for result in run_all([check])]
+    with stage("audit checks"):
+        results = [result for check in each(selected, "symrot audit") for result in run_all([check])]
     if only is not None and not results:
         raise SymrotError(
             f"no check has the key(s) {args.only!r} (keys: 1-102, 'text after (N): ...', "
@@ -58,10 +63,9 @@ def run(args: argparse.Namespace) -> int:
         text = errata_markdown(results)
         if args.write:
             path = Path(args.write)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(text, encoding="utf-8")
+            write_file(path.parent, path.name, text, announce=False)
         if args.check:
-            current = Path(args.check).read_text(encoding="utf-8") if Path(args.check).exists() else ""
+            current = _read(Path(args.check))
             if current != text:
                 sys.stdout.writelines(
                     difflib.unified_diff(
@@ -71,3 +75,13 @@ def run(args: argparse.Namespace) -> int:
                 print(f"{args.check} is stale: run `{REGENERATE}`", file=sys.stderr)
                 return EXIT_CHECK_FAILED
     return EXIT_CHECK_FAILED if failed else 0
+
+
+def _read(path: Path) -> str:
+    """The text of ``path`` ('' when it does not exist); exit 2 with one line when unreadable."""
+    from ..errors import SymrotError
+
+    try:
+        return path.read_text(encoding="utf-8") if path.exists() else ""
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SymrotError(f"cannot read {path}: {getattr(exc, 'strerror', None) or exc}") from None

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import re
 from typing import Any
 
 from .. import strict_json
 from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
+from ..budget import stage
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
+from ..errors import SymrotError
+from .output import output_directory, write_file
 
 SCALAR_LABELS = {
     "p_prime": "p'",
@@ -16,6 +20,7 @@ SCALAR_LABELS = {
     "mu": "mu",
     "det_H": "det H",
 }
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 TENSOR_LABELS = {"R": "R", "H": "H", "H_inverse": "H^-1", "G": "G", "K": "K"}
 
 
@@ -40,40 +45,55 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(run=run)
 
 
+def _check_emit_options(args: argparse.Namespace) -> None:
+    """Refuse a bad --name or --emit before any derivation is spent on them."""
+    from ..backends import emitter
+
+    if args.name is not None and not IDENTIFIER.fullmatch(args.name):
+        raise SymrotError(f"--name {args.name!r} is not a valid identifier")
+    emitter(args.emit)
+
+
 def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
-    import re
+    """Plan, print into a scratch directory, then write the files into ``--out``."""
+    import tempfile
     from pathlib import Path
 
     from ..backends import emitter
-    from ..errors import SymrotError
     from ..plan import evaluation_plan
     from ..singularities import validity
     from .progress import stages
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
-    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
-        raise SymrotError(f"--name {name!r} is not a valid identifier")
     emit = emitter(args.emit)
+    output_directory(Path(args.out))
     with stages(f"symrot: --emit {args.emit}", 3) as progress:
         progress.start("validity range (Section 3.4)")
-        validity(result.derivation)
+        with stage("validity analysis"):
+            validity(result.derivation)
         progress.start("evaluation plan (float64, float32)")
-        evaluation_plan(result.derivation, name)  # cached: the backend prints this plan
+        with stage("planning"):
+            evaluation_plan(result.derivation, name)  # cached: the backend reuses it
         progress.start("printing")
-        paths = emit(result.derivation, name, Path(args.out))
-    for path in paths:
-        print(path)
+        with tempfile.TemporaryDirectory(prefix="symrot-emit-") as scratch:
+            with stage("printing"):
+                printed = emit(result.derivation, name, Path(scratch))
+            for path in printed:
+                write_file(Path(args.out), path.name, path.read_text(encoding="utf-8"))
     return 0
 
 
 def run(args: argparse.Namespace) -> int:
+    if getattr(args, "emit", None):
+        _check_emit_options(args)
     result = derive(args.expression, normalize=args.normalize)
     if getattr(args, "emit", None):
         return emit_code(result, args)
     if args.json:
-        print(strict_json.dumps(result.to_dict(series_terms=args.terms), indent=2))
+        text = strict_json.dumps(result.to_dict(series_terms=args.terms), indent=2)
     else:
-        print(summary(result, args.terms))
+        text = summary(result, args.terms)
+    print(text)
     return 0
 
 

@@ -8,8 +8,10 @@ from typing import Any
 
 from ..api import derive
 from ..backends.latex import sheet, standalone, table
+from ..budget import stage
 from ..errors import SymrotError
 from ..registry import PAPER_TABLE_1_VALIDITY, TABLE_1
+from .output import write_file
 
 EXTRA_COLUMNS = ("mu", "det_H", "causes")
 
@@ -43,25 +45,15 @@ def _common(parser: argparse.ArgumentParser) -> None:
                         help="a complete document instead of a fragment to \\input")
 
 
-def _write(directory: Path, filename: str, text: str) -> Path:
-    try:
-        directory.mkdir(parents=True, exist_ok=True)
-        path = directory / filename
-        path.write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise SymrotError(f"cannot write {directory / filename}: {exc.strerror}") from None
-    print(path)
-    return path
-
-
 def run_table(args: argparse.Namespace) -> int:
     columns = tuple(c.strip() for c in args.columns.split(",") if c.strip())
     unknown = [c for c in columns if c not in EXTRA_COLUMNS]
     if unknown:
         raise SymrotError(f"unknown column(s) {', '.join(unknown)} (allowed: {', '.join(EXTRA_COLUMNS)})")
     results = [derive(item) for item in (args.items or TABLE_1)]
-    body = table(results, columns, PAPER_TABLE_1_VALIDITY)
-    _write(args.out, "table.tex", standalone(body, landscape=True) if args.standalone else body)
+    with stage("printing"):
+        body = table(results, columns, PAPER_TABLE_1_VALIDITY)
+    write_file(args.out, "table.tex", standalone(body, landscape=True) if args.standalone else body)
     return 0
 
 
@@ -70,6 +62,7 @@ def run_sheet(args: argparse.Namespace) -> int:
     stem = args.name or (result.entry.identifier if result.entry else "sheet")
     if not stem.replace("_", "").isalnum():
         raise SymrotError("--name must contain only letters, digits and underscores")
-    body = sheet(result)
-    _write(args.out, f"{stem}.tex", standalone(body) if args.standalone else body)
+    with stage("printing"):
+        body = sheet(result)
+    write_file(args.out, f"{stem}.tex", standalone(body) if args.standalone else body)
     return 0

@@ -8,8 +8,10 @@ from typing import Any
 
 from ..api import resolve
 from ..backends.figures import FIGURES, render
+from ..budget import stage
 from ..errors import SymrotError
 from ..validation import validate
+from .output import output_directory, write_file
 from .progress import each
 
 
@@ -32,14 +34,15 @@ def run(args: argparse.Namespace) -> int:
     formats = [f.strip() for f in args.format.split(",") if f.strip()]
     if not formats or any(f not in ("pdf", "png") for f in formats):
         raise SymrotError("--format takes pdf, png or pdf,png")
-    extra = tuple(validate(resolve(text)[0]).expression for text in args.add)
-    try:
-        args.out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise SymrotError(f"cannot create {args.out}: {exc.strerror}") from None
+    extra = []
+    for text in args.add:
+        expression = resolve(text)[0]
+        with stage("validation"):
+            extra.append(validate(expression).expression)
+    output_directory(args.out)
     jobs = [(number, fmt) for number in args.figure or sorted(FIGURES) for fmt in formats]
     for number, fmt in each(jobs, "symrot plot"):
-        path = args.out / f"figure{number}.{fmt}"
-        path.write_bytes(render(number, fmt, extra))
-        print(path)
+        with stage("printing"):
+            image = render(number, fmt, tuple(extra))
+        write_file(args.out, f"figure{number}.{fmt}", image)
     return 0

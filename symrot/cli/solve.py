@@ -6,6 +6,7 @@ import argparse
 from typing import Any
 
 from .. import strict_json
+from ..budget import stage
 from ..registry import find_by_expression
 from ..solve import solve_property
 
@@ -27,8 +28,10 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    solution = solve_property(args.property, args.m)
-    entry = find_by_expression(solution.expression) if solution.expression is not None else None
+    with stage("solving"):
+        solution = solve_property(args.property, args.m)
+    with stage("registry lookup"):
+        entry = find_by_expression(solution.expression) if solution.expression is not None else None
     data = {
         "property": solution.property,
         "expression": None if solution.expression is None else str(solution.expression),

@@ -1,0 +1,240 @@
+"""A hostile user at the command line: every input answered in time, exit 0 or 2, no traceback.
+
+The corpus covers every subcommand with code injections (``__import__``, lambda, attribute
+access, f-strings...), resource bombs (nested powers, huge literals in every base, towers of
+exponentials), invalid and borderline-valid generating functions, bad paths for ``--out`` and bad
+options. Each input runs as a subprocess ``python -m symrot --timeout BUDGET ...`` (so through the
+worker process of :mod:`symrot.cli.worker`) in a scratch directory, two at a time, and must:
+
+* exit with status 0 or 2 (never 70, the internal error, nor a signal);
+* finish within BUDGET plus a margin for interpreter start-up;
+* print no "Traceback" and no "internal error" on stderr.
+
+``tests/test_hostile_cli.py`` runs :data:`QUICK` with a small budget and :data:`HEAVY` as a slow
+test; ``python bench/hostile_cli.py [BUDGET]`` runs those and :data:`EXTRA` with the default
+budget of 60 s and prints one line per input (status, seconds, the last line of stderr).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+MARGIN = 12.0
+"""Seconds allowed beyond the budget: interpreter start-up and the worker's grace period on a
+loaded two-core machine."""
+
+INJECTIONS = [
+    "__import__('os').system('touch pwned')",
+    "__import__('subprocess').call(['true'])",
+    "eval('1+1')",
+    "exec('import os')",
+    "open('/etc/passwd').read()",
+    "compile('1', 'f', 'eval')",
+    "globals()",
+    "getattr(phi, 'func')",
+    "phi.func",
+    "phi.__class__.__mro__",
+    "().__class__.__bases__[0].__subclasses__()",
+    "sin.__call__(phi)",
+    "sympy.sin(phi)",
+    "lambda: 1",
+    "(lambda x: x)(phi)",
+    "f'{phi}'",
+    "f'{__import__(\"os\").getcwd()}'",
+    "[phi for phi in range(10**9)]",
+    "phi if phi else 1",
+    "(x := 1)",
+    "phi[0]",
+    "{'a': phi}",
+    "'string'",
+    "b'bytes'",
+    "None",
+    "True * phi",
+    "...",
+    "1j * phi",
+    "breakpoint()",
+    "print(phi)",
+    "__builtins__",
+    "phi.evalf(10**9)",
+    "phi; import os",
+    "phi\nimport os",
+    "await phi",
+    "sin(*[phi])",
+    "sin(x=phi)",
+    "ᵖʰⁱ.__class__",
+    "phi @ phi",
+    "phi // 2",
+]
+
+BOMBS = [
+    "(((1+phi)**64)**64)**64",
+    "((1+phi)**64)**64",
+    "(phi**64)**64",
+    "(1+phi+phi**2+phi**3+phi**4)**64",
+    "phi*(sqrt(2)+sqrt(3)+sqrt(5)+sqrt(7))**64",
+    "(10**30)**64*phi",
+    "phi + (10**30)**64*phi**3",
+    "0x" + "f" * 256 + "*phi",
+    "0o" + "7" * 100 + "*phi",
+    "0b" + "1" * 400 + "*phi",
+    "9" * 5000,
+    "1" + "_0" * 60 + "*phi",
+    "1e999999*phi",
+    "9.9e-400*phi",
+    "2**2**2**2**2",
+    "phi**10**100",
+    "phi**(10**6)",
+    "phi**(1/10**6)",
+    "exp(" * 34 + "phi" + ")" * 34,
+    "(" * 300 + "phi" + ")" * 300,
+    "-" * 5000 + "phi",
+    "+".join(["phi"] * 500),
+    "phi" + "*phi" * 200,
+]
+
+INVALID = [
+    "cos(phi)", "sqrt(phi)", "phi**2", "phi**3", "1/phi", "log(phi)", "exp(phi)", "sin(phi) + 1",
+    "tan(pi/2 + phi)", "acosh(phi)", "phi**(1/3)", "cbrt(phi)**2", "abs(phi)", "sqrt(phi**2)",
+    "x + phi", "phi + y", "sin(phi, 2)", "sin()", "1/0", "phi/0", "(-8)**(1/3)", "0**-1",
+    "phi**phi", "phi**sqrt(2)", "phi**pi", "", " ", "phi +", "((phi)", "phi)", "sin", "φ**2",
+    "phi*sin(1/phi)", "exp(-1/phi**2)", "phi + phi**2", "sin(phi)*cos(phi)**2 + 1e-30",
+    "asin(phi + 2)", "log(-phi**2 - 1)", "sqrt(-1 - phi**2)*phi", "sin(phi)/phi",
+]
+
+VALID = [
+    "-phi", "phi", "sin(phi)", "asin(phi)", "2*asin(phi/2)", "atanh(phi)",
+    "phi/sqrt(1-phi**2)", "log((1+phi)/(1-phi))/2", "1e-20*phi", "2**64*phi", "0x10*phi",
+    "sinh(phi)", "phi + phi**3", "-sin(-phi)", "cbrt(6*(phi-sin(phi)))", "phi*(1+phi**2)**32",
+]
+
+PATHS = ["/proc", "/dev/null/x", "/etc/passwd/x", "/proc/self/x", "/sys/kernel/x", ""]
+
+
+def _derive(expression: str, *options: str) -> list[str]:
+    return ["derive", expression, *options]
+
+
+QUICK: list[list[str]] = (
+    [_derive(text) for text in INJECTIONS]
+    + [["solve", f"mu = {text}"] for text in INJECTIONS[:6]]
+    + [[command, text, "--out", command] for command in ("table", "sheet") for text in INJECTIONS[:3]]
+    + [["plot", "--add", text, "--out", "plots"] for text in INJECTIONS[:3]]
+    + [_derive(text) for text in BOMBS]
+    + [["solve", f"p = {text}"] for text in BOMBS[:4]]
+    + [["table", text, "--out", "tables"] for text in BOMBS[:2]]
+    + [_derive(text) for text in INVALID[:30]]
+    + [_derive(text, "--json") for text in VALID[:3]]
+    + [_derive("phi", "--emit", "numpy", "--out", path) for path in PATHS[1:4]]
+    + [["plot", "--figure", "1", "--format", "png", "--out", path] for path in PATHS[1:4]]
+    + [["table", "phi", "--out", PATHS[1]], ["sheet", "phi", "--out", PATHS[0]]]
+    + [
+        [], ["frobnicate"], ["derive"], ["solve"], ["sheet"], ["--timeout", "-1", "derive", "phi"],
+        ["--timeout", "nan", "derive", "phi"], ["--timeout", "inf", "derive", "phi"],
+        ["--timeout", "abc", "derive", "phi"], ["derive", "phi", "--terms", "0"],
+        ["derive", "phi", "--terms", "99"], ["derive", "phi", "--terms", "abc"],
+        ["derive", "phi", "--emit", "fortran"], ["derive", "phi", "--emit", "c", "--name", "a b"],
+        ["derive", "phi", "--emit", "numpy", "--name", "../escape"], ["derive", "--bogus", "phi"],
+        ["derive", "phi", "extra"], ["plot", "--figure", "9"], ["plot", "--format", "svg"],
+        ["plot", "--format", ","], ["table", "--columns", "nope"], ["sheet", "phi", "--name", "../x"],
+        ["solve", "mu"], ["solve", "a = b = c"], ["solve", "mu == 1"], ["solve", "x = 1"],
+        ["solve", "--m", "0", "mu = 1"], ["solve", "--m", "-3", "mu = 1"], ["solve", "--m", "x", "mu = 1"],
+        ["solve", "c = 1"], ["audit", "--only", "no-such-key"],
+        ["derive", "nonexistent_m0"], ["derive", "sine_m0"], ["derive", "sine_m99999"],
+        ["derive", "cayley_m1001"], ["derive", "\u202ephi"], ["derive", "phi\u200b"],
+        ["derive", "２*phi"], ["derive", "phi 🙂"], ["derive", "-phi", "--timeout", "20"],
+        ["solve", "mu = 1"],
+    ]
+)
+"""Inputs answered in a few seconds: rejected early, or cheap valid functions."""
+
+EXTRA: list[list[str]] = (
+    [["solve", f"mu = {text}"] for text in INJECTIONS[6:]]
+    + [[command, text, "--out", command] for command in ("table", "sheet") for text in INJECTIONS[3:12]]
+    + [["plot", "--add", text, "--out", "plots"] for text in INJECTIONS[3:12]]
+    + [["solve", f"p = {text}"] for text in BOMBS[4:]]
+    + [_derive(text) for text in INVALID[30:]]
+    + [_derive(text, "--json") for text in VALID[3:]]
+    + [["table", "phi", "--out", path] for path in PATHS[2:]]
+    + [["sheet", "phi", "--out", path] for path in PATHS[1:]]
+    + [["derive", "φ", "--json"], ["--timeout", "5", "derive", "wiener_milenkovic"],
+       ["solve", "det_H = const", "--json"], ["solve", "p_prime = p_prime"]]
+)
+"""More of the same for the long run (``python bench/hostile_cli.py``)."""
+
+HEAVY: list[list[str]] = [
+    _derive("tan(" * 31 + "phi" + ")" * 31),
+    _derive("sinh(" * 20 + "phi" + ")" * 20),
+    _derive("asin(" * 8 + "phi" + ")" * 8),
+    ["solve", "mu = exp(-exp(exp(exp(64))))"],
+    ["solve", "det_H = exp(exp(exp(p)))"],
+    ["table", "asin(phi)", "--out", "tables"],
+    ["sheet", "asin(phi)", "--out", "sheets"],
+    _derive("1e-20*phi", "--emit", "c", "--out", "code"),
+    _derive("phi", "--emit", "c", "--out", "/proc"),
+    ["plot", "--add", "asin(phi)", "--figure", "3", "--format", "png", "--out", "plots"],
+    *[_derive(text) for text in VALID[3:9]],
+]
+"""Inputs that run into the budget or do real work (derivation, planning, figures)."""
+
+
+@dataclass(frozen=True)
+class Outcome:
+    args: tuple[str, ...]
+    status: int
+    seconds: float
+    stderr: str
+
+    def problems(self, budget: float, margin: float = MARGIN) -> list[str]:
+        """What this run did wrong (empty when it behaved)."""
+        found = []
+        if self.status not in (0, 2):
+            found.append(f"exit {self.status}")
+        if self.seconds > budget + margin:
+            found.append(f"took {self.seconds:.1f} s (budget {budget:g} s)")
+        if "Traceback" in self.stderr or "internal error" in self.stderr:
+            found.append("traceback or internal error")
+        return found
+
+
+def run_one(args: list[str], budget: float, directory: str) -> Outcome:
+    """``python -m symrot --timeout BUDGET *args`` in ``directory``."""
+    started = time.monotonic()
+    try:
+        result = subprocess.run([sys.executable, "-m", "symrot", "--timeout", f"{budget:g}", *args],
+                                capture_output=True, text=True, cwd=directory, check=False,
+                                timeout=budget + 10 * MARGIN)
+        status, stderr = result.returncode, result.stderr
+    except subprocess.TimeoutExpired as exc:
+        status, stderr = -9, str(exc.stderr or "")
+    return Outcome(tuple(args), status, time.monotonic() - started, stderr)
+
+
+def run_all(corpus: list[list[str]], budget: float, workers: int = 2) -> list[Outcome]:
+    """Every input of ``corpus``, ``workers`` at a time, each in its own scratch directory."""
+    with tempfile.TemporaryDirectory(prefix="symrot-hostile-") as scratch, \
+            ThreadPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(lambda args: run_one(args, budget, scratch), corpus))
+
+
+def main(argv: list[str]) -> int:
+    budget = float(argv[0]) if argv else 60.0
+    started = time.monotonic()
+    outcomes = run_all(QUICK + EXTRA + HEAVY, budget)
+    bad = 0
+    for outcome in outcomes:
+        problems = outcome.problems(budget)
+        bad += bool(problems)
+        last = (outcome.stderr.strip().splitlines() or [""])[-1][:100]
+        print(f"{'FAIL' if problems else 'ok  '} {outcome.status:>3} {outcome.seconds:6.1f} s  "
+              f"{' '.join(outcome.args)[:60]!r:64} {last}")
+    print(f"{len(outcomes)} inputs, {bad} failed, {time.monotonic() - started:.0f} s")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))

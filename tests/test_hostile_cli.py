@@ -1,0 +1,55 @@
+"""Reliability of the command line under hostile input (issue 17): the corpus of
+``bench/hostile_cli.py``, each input a subprocess with a small budget, answered in time with
+exit 0 or 2 and no traceback. The long version: ``python bench/hostile_cli.py``."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "bench"))
+
+import hostile_cli  # noqa: E402
+
+QUICK_BUDGET = 15.0
+HEAVY_BUDGET = 10.0
+
+
+def _report(outcomes: list[hostile_cli.Outcome], budget: float) -> list[str]:
+    return [f"{' '.join(o.args)[:80]!r}: {', '.join(o.problems(budget))}; stderr: {o.stderr[-300:]!r}"
+            for o in outcomes if o.problems(budget)]
+
+
+def test_the_corpus_is_large_and_covers_every_subcommand() -> None:
+    corpus = hostile_cli.QUICK + hostile_cli.HEAVY
+    assert len(corpus) >= 150
+    commands = {word for args in corpus for word in args[:3]}
+    assert {"derive", "solve", "table", "sheet", "plot", "audit"} <= commands
+
+
+def test_outcomes_are_judged() -> None:
+    judge = hostile_cli.Outcome
+    assert judge(("x",), 2, 1.0, "symrot: error: no").problems(10) == []
+    assert judge(("x",), 70, 1.0, "symrot: internal error (X)").problems(10) == [
+        "exit 70", "traceback or internal error"]
+    assert judge(("x",), 0, 30.0, "").problems(10) == ["took 30.0 s (budget 10 s)"]
+    assert judge(("x",), -9, 1.0, "Traceback (most recent call last):").problems(10)[0] == "exit -9"
+
+
+def test_quick_hostile_inputs_exit_0_or_2_in_time_without_traceback() -> None:
+    outcomes = hostile_cli.run_all(hostile_cli.QUICK, QUICK_BUDGET)
+    assert _report(outcomes, QUICK_BUDGET) == []
+    # nothing the injections name was executed: no file appeared in the scratch directories
+    assert not (Path.cwd() / "pwned").exists()
+
+
+@pytest.mark.slow
+def test_heavy_inputs_end_within_the_budget() -> None:
+    outcomes = hostile_cli.run_all(hostile_cli.HEAVY, HEAVY_BUDGET)
+    assert _report(outcomes, HEAVY_BUDGET) == []
+    # the budget is the only thing that stops a tower of 31 tangents: its message names a stage
+    tower = outcomes[0]
+    assert tower.status == 2 and "ran out during" in tower.stderr
