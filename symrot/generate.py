@@ -41,7 +41,7 @@ def latex_documents() -> dict[str, str | bytes]:
     out: dict[str, str | bytes] = {}
     rows = table([derive(name) for name in TABLE_1], (), PAPER_TABLE_1_VALIDITY)
     out["latex/table1.tex"] = rows
-    out["latex/table1_standalone.tex"] = standalone(rows, landscape=True)
+    out["latex/table1_standalone.tex"] = standalone(rows)
     for name in NAMED:
         body = sheet(derive(name))
         out[f"latex/{name}.tex"] = body
