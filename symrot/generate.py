@@ -49,6 +49,21 @@ def latex_documents() -> dict[str, str | bytes]:
     return out
 
 
+def renderings() -> dict[str, str | bytes]:
+    """generated/renderings/: the pages of Table 1 and of every derivation sheet as 100 dpi PNG
+    (pdflatex, then pdftoppm; byte-reproducible), to read them without a TeX installation."""
+    from .backends.typeset import page_pngs
+
+    out: dict[str, str | bytes] = {}
+    for name, source in latex_documents().items():
+        if not name.endswith("_standalone.tex"):
+            continue
+        stem = Path(name).name.removesuffix("_standalone.tex")
+        for number, png in enumerate(page_pngs(source), start=1):
+            out[f"renderings/{stem}-{number}.png"] = png
+    return out
+
+
 def figures() -> dict[str, str | bytes]:
     """generated/figures/: the paper's Figures 1–4, as PDF (for papers) and PNG."""
     from .backends.figures import FIGURES
@@ -75,7 +90,8 @@ def c_headers() -> dict[str, str | bytes]:
 
 def producers() -> list[tuple[str, Producer]]:
     """All producers, by the path prefix they own. Backends add theirs here."""
-    return [("derivations/", derivation_json), ("latex/", latex_documents), ("figures/", figures),
+    return [("derivations/", derivation_json), ("latex/", latex_documents),
+            ("renderings/", renderings), ("figures/", figures),
             ("numpy/", numpy_modules), ("c/", c_headers)]
 
 

@@ -10,8 +10,7 @@ import mpmath
 import numpy as np
 import pytest
 
-from symrot.backends.figures import (DPI, FAMILY_ORDERS, FIGURES, STYLES, build_figure, pi_label,
-                                     render)
+from symrot.backends.figures import DPI, FAMILY_ORDERS, FIGURES, STYLES, build_figure, pi_label, render
 from symrot.cli import main
 from symrot.core import derive_expression
 from symrot.registry import family_member, lookup

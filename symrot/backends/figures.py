@@ -70,10 +70,16 @@ class Style:
 STYLES = {"one-column": Style(3.5, 1.9, 8.0), "two-column": Style(7.0, 2.6, 9.0)}
 DEFAULT_STYLE = "one-column"
 DPI = 300
-RC = {"pdf.fonttype": 42, "ps.fonttype": 42, "font.family": "serif",
+RC: dict[str, Any] = {"pdf.fonttype": 42, "ps.fonttype": 42, "font.family": "serif",
       "font.serif": ["STIXGeneral"], "mathtext.fontset": "stix", "axes.linewidth": 0.6,
       "lines.linewidth": 0.9, "xtick.major.width": 0.6, "ytick.major.width": 0.6,
       "svg.hashsalt": "symrot"}
+"""TrueType (Type 42) fonts, matplotlib's bundled STIX for text and math."""
+
+
+def _rc(style: str) -> Any:
+    """The rcParams of ``style`` (``Any``: matplotlib types its keys as literals)."""
+    return {**RC, "font.size": STYLES[style].font_size}
 
 
 @dataclass(frozen=True)
@@ -236,7 +242,7 @@ def build_figure(number: int, extra: tuple[sp.Expr, ...] = (),
 
     family, quantities = FIGURES[number]
     layout = STYLES[style]
-    with matplotlib.rc_context({**RC, "font.size": layout.font_size}):
+    with matplotlib.rc_context(_rc(style)):
         figure = Figure(figsize=(layout.width, layout.panel_height * len(quantities) + 0.55),
                         layout="constrained")
         axes = figure.subplots(len(quantities), 1, sharex=True, squeeze=False)[:, 0]
@@ -262,6 +268,6 @@ def render(number: int, fmt: str, extra: tuple[sp.Expr, ...] = (),
     metadata: dict[str, Any] = (
         {"CreationDate": None, "ModDate": None, "Producer": "symrot", "Creator": "symrot"}
         if fmt == "pdf" else {"Software": "symrot"})
-    with matplotlib.rc_context({**RC, "font.size": STYLES[style].font_size}):
+    with matplotlib.rc_context(_rc(style)):
         figure.savefig(buffer, format=fmt, dpi=DPI, metadata=metadata)
     return buffer.getvalue()

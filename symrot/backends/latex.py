@@ -296,9 +296,10 @@ def table(results: list[DerivationResult], extra_columns: tuple[str, ...] = (),
 
 
 TIER_COLUMNS = 5
-"""Math columns per line of a row: with more, a row continues on a second line under its own
-header line, so the table keeps the body font size at any ``--columns`` (≤ 15 cm wide at 11 pt
-for every named row)."""
+"""Math columns per line of a row. Up to this many, the table has the paper's layout (a name
+column); with more, each row is a name line followed by lines of at most this many values under
+as many header lines, so the table keeps the body font size at any ``--columns`` (≤ 15 cm wide
+at 11 pt for every named row)."""
 
 
 def _tiers(cells: list[str]) -> list[list[str]]:
