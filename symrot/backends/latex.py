@@ -80,7 +80,7 @@ class PaperLatexPrinter(LatexPrinter):
         """A bracketed matrix with display-style entries (fractions at full size)."""
         rows = [" & ".join(r"\displaystyle " + self._print(expr[i, j]) for j in range(expr.cols))
                 for i in range(expr.rows)]
-        return r"\begin{bmatrix}" + r" \\[1ex] ".join(rows) + r"\end{bmatrix}"
+        return r"\begin{bmatrix}" + r" \\[2ex] ".join(rows) + r"\end{bmatrix}"
 
     def _print_RealCbrt(self, expr: sp.Expr, exp: Any = None) -> str:
         root = r"\sqrt[3]{%s}" % self._print(expr.args[0])
