@@ -56,7 +56,7 @@ def renderings() -> dict[str, str | bytes]:
 
     out: dict[str, str | bytes] = {}
     for name, source in latex_documents().items():
-        if not name.endswith("_standalone.tex"):
+        if not name.endswith("_standalone.tex") or not isinstance(source, str):
             continue
         stem = Path(name).name.removesuffix("_standalone.tex")
         for number, png in enumerate(page_pngs(source), start=1):
