@@ -124,11 +124,17 @@ def test_nested_fractions_are_slashed() -> None:
     assert text.count(r"\frac") == 1
 
 
-def test_fit_options_are_explicit() -> None:
-    results = [symrot.derive("linear")]
-    assert r"\resizebox" in table(results, fit="resize")
-    assert "sidewaystable" in table(results, fit="landscape")
-    assert r"\resizebox" not in table(results) and "sidewaystable" not in table(results)
+@pytest.mark.parametrize("fit", ["resize", "landscape"])
+def test_fit_options_are_explicit_and_compile(fit: str, tmp_path: Path) -> None:
+    results = [symrot.derive("linear"), symrot.derive("det_h_one")]
+    body = table(results, ("mu", "det_H", "causes"), fit=fit)
+    assert (r"\resizebox" in body) == (fit == "resize")
+    assert ("sidewaystable" in body) == (fit == "landscape")
+    plain = table(results)
+    assert r"\resizebox" not in plain and "sidewaystable" not in plain
+    document = tmp_path / "table.tex"
+    document.write_text(standalone(body))
+    assert "Linear parameters" in compile_pdf(document)
 
 
 def test_cli_sheet_fragment_inputs_into_a_document(tmp_path: Path) -> None:

@@ -336,10 +336,10 @@ def sheet(result: DerivationResult, series_terms: int = 4) -> str:
     )
 
 
-def standalone(body: str, landscape: bool = False) -> str:
+def standalone(body: str) -> str:
     """A complete article (11 pt, 2 cm margins) around ``body``, with every package the
     fragments need; PDF output carries no date or trailer ID, so it is reproducible."""
-    return render("latex/standalone.tex.j2", body=body, landscape=landscape)
+    return render("latex/standalone.tex.j2", body=body)
 
 
 def derivation_display(result: DerivationResult) -> str:
