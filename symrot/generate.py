@@ -41,11 +41,26 @@ def latex_documents() -> dict[str, str | bytes]:
     out: dict[str, str | bytes] = {}
     rows = table([derive(name) for name in TABLE_1], (), PAPER_TABLE_1_VALIDITY)
     out["latex/table1.tex"] = rows
-    out["latex/table1_standalone.tex"] = standalone(rows, landscape=True)
+    out["latex/table1_standalone.tex"] = standalone(rows)
     for name in NAMED:
         body = sheet(derive(name))
         out[f"latex/{name}.tex"] = body
         out[f"latex/{name}_standalone.tex"] = standalone(body)
+    return out
+
+
+def renderings() -> dict[str, str | bytes]:
+    """generated/renderings/: the pages of Table 1 and of every derivation sheet as 100 dpi PNG
+    (pdflatex, then pdftoppm; byte-reproducible), to read them without a TeX installation."""
+    from .backends.typeset import page_pngs
+
+    out: dict[str, str | bytes] = {}
+    for name, source in latex_documents().items():
+        if not name.endswith("_standalone.tex") or not isinstance(source, str):
+            continue
+        stem = Path(name).name.removesuffix("_standalone.tex")
+        for number, png in enumerate(page_pngs(source), start=1):
+            out[f"renderings/{stem}-{number}.png"] = png
     return out
 
 
@@ -75,7 +90,8 @@ def c_headers() -> dict[str, str | bytes]:
 
 def producers() -> list[tuple[str, Producer]]:
     """All producers, by the path prefix they own. Backends add theirs here."""
-    return [("derivations/", derivation_json), ("latex/", latex_documents), ("figures/", figures),
+    return [("derivations/", derivation_json), ("latex/", latex_documents),
+            ("renderings/", renderings), ("figures/", figures),
             ("numpy/", numpy_modules), ("c/", c_headers)]
 
 

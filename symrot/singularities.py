@@ -80,6 +80,11 @@ class Validity:
     singularities: tuple[Singularity, ...]
     numeric_only: bool
 
+    def listed(self) -> tuple[Singularity, ...]:
+        """The singular angles up to twice the validity bound: what ``symrot derive`` prints and
+        what the table's causes column and the derivation sheets show."""
+        return tuple(s for s in self.singularities if s.phi_float <= 2 * self.phi_max_float)
+
 
 SYMBOLIC_TIME_LIMIT = 0.5
 SCAN_INTERVAL = sp.Interval.Lopen(0, 4 * sp.pi)

@@ -116,9 +116,7 @@ def validity_lines(derivation: Any) -> list[str]:
     p_max = "oo" if result.p_max_float == float("inf") else f"{result.p_max_float:.15g}"
     lines = [f"Validity (Section 3.4): |phi| < {result.phi_max} = {result.phi_max_float:.15g}, "
              f"|p| < {p_max}" + ("  (located numerically)" if result.numeric_only else "")]
-    for s in result.singularities:
-        if s.phi_float <= 2 * result.phi_max_float:
-            lines.append(f"  phi = {s.phi}: {s.cause}")
+    lines.extend(f"  phi = {s.phi}: {s.cause}" for s in result.listed())
     return lines
 
 

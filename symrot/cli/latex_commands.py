@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..api import derive
-from ..backends.latex import sheet, standalone, table
+from ..backends.latex import FITS, sheet, standalone, table
 from ..budget import stage
 from ..errors import SymrotError
 from ..registry import PAPER_TABLE_1_VALIDITY, TABLE_1
@@ -20,12 +20,16 @@ def register(subparsers: Any) -> None:
     table_parser = subparsers.add_parser(
         "table", help="write table.tex: the paper's Table 1, derived (booktabs)",
         description="Write Table 1 of the paper (name, p, p', nu, epsilon, validity) for the "
-        "six rows of the paper, or for the given names/expressions, as table.tex.",
+        "six rows of the paper, or for the given names/expressions, as table.tex. The table keeps "
+        "the body font size; --fit resize or landscape are explicit choices for wide tables.",
     )
     table_parser.add_argument("items", nargs="*", metavar="NAME_OR_EXPR",
                               help="registry names or expressions (default: the paper's six rows)")
     table_parser.add_argument("--columns", default="", metavar="LIST",
                               help="extra columns, comma separated: mu, det_H, causes")
+    table_parser.add_argument("--fit", choices=FITS, default="none",
+                              help="none: natural width at body size (default); resize: scale to "
+                              "the line width; landscape: a sidewaystable")
     _common(table_parser)
     table_parser.set_defaults(run=run_table)
 
@@ -52,8 +56,8 @@ def run_table(args: argparse.Namespace) -> int:
         raise SymrotError(f"unknown column(s) {', '.join(unknown)} (allowed: {', '.join(EXTRA_COLUMNS)})")
     results = [derive(item) for item in (args.items or TABLE_1)]
     with stage("printing"):
-        body = table(results, columns, PAPER_TABLE_1_VALIDITY)
-    write_file(args.out, "table.tex", standalone(body, landscape=True) if args.standalone else body)
+        body = table(results, columns, PAPER_TABLE_1_VALIDITY, fit=args.fit)
+    write_file(args.out, "table.tex", standalone(body) if args.standalone else body)
     return 0
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..api import resolve
-from ..backends.figures import FIGURES, render
+from ..backends.figures import DEFAULT_STYLE, FIGURES, STYLES, render
 from ..budget import stage
 from ..errors import SymrotError
 from ..validation import validate
@@ -19,13 +19,16 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "plot", help="write Figures 1-4 of the paper (p, nu, p', det H for the families)",
         description="Reproduce Figures 1-4: p(phi) for the sine and tangent families m = 1..5 "
-        "(Figs 1-2) and nu, p', det H versus phi (Figs 3-4), as PDF and PNG.",
+        "(Figs 1-2) and nu, p', det H versus phi (Figs 3-4), as PDF (TrueType fonts) and 300 dpi "
+        "PNG, without titles (captions belong to the document).",
     )
     parser.add_argument("--figure", type=int, action="append", choices=sorted(FIGURES),
                         help="figure number (repeatable; default: all four)")
     parser.add_argument("--add", action="append", default=[], metavar="EXPR",
                         help="an extra generating function drawn on every figure (repeatable)")
     parser.add_argument("--format", default="pdf,png", help="comma separated: pdf, png")
+    parser.add_argument("--style", choices=sorted(STYLES), default=DEFAULT_STYLE,
+                        help="journal width: one-column (3.5 in) or two-column (7 in)")
     parser.add_argument("--out", type=Path, default=Path("."), help="output directory")
     parser.set_defaults(run=run)
 
@@ -43,6 +46,6 @@ def run(args: argparse.Namespace) -> int:
     jobs = [(number, fmt) for number in args.figure or sorted(FIGURES) for fmt in formats]
     for number, fmt in each(jobs, "symrot plot"):
         with stage("printing"):
-            image = render(number, fmt, tuple(extra))
+            image = render(number, fmt, tuple(extra), args.style)
         write_file(args.out, f"figure{number}.{fmt}", image)
     return 0
