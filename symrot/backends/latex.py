@@ -147,6 +147,7 @@ CAUSE_MEANINGS = {
     ("det_H", "oo"): r"$\mathbf{H}^{-1}$ is singular, eq.~(24)",
     ("monotonicity", "0"): r"$p'$ changes sign, so $\|\mathbf{p}\|$ no longer determines"
                            r" $\varphi$",
+    ("p", "edge"): r"$p$ is not real beyond this angle (the edge of its real domain)",
 }
 """What each kind of singularity of :data:`symrot.singularities.CAUSES` means, as LaTeX."""
 SERIES = (("nu", r"\nu"), ("mu", r"\mu"), ("det_H", r"\det\mathbf{H}"),
@@ -171,6 +172,8 @@ def cause_latex(quantity: str, limit: str) -> str:
     """The short math for a singularity: ``\\nu \\to 0``, ``p' \\gtrless 0`` (sign change)."""
     if quantity == "monotonicity":
         return r"p' \gtrless 0"
+    if limit == "edge":
+        return r"p \notin \mathbb{R}\ \text{beyond}"
     return rf"{QUANTITY_SYMBOLS[quantity]} \to {LIMITS[limit]}"
 
 
