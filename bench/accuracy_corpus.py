@@ -50,6 +50,7 @@ OPERATIONS = ("from_quaternion", "rescale", "compose")
 FUNCTIONS = (*KINEMATIC, *OPERATIONS)
 FIXED_ANGLES = (1e-30, 1e-8, 1e-3, 0.1, 1.0)
 WORKER_TIMEOUT = 1800
+COLUMNS = (("numpy", "float64"), ("numpy", "float32"), ("c", "float64"), ("c", "float32"))
 
 
 def angles(phi_max: float, points: int) -> np.ndarray:
@@ -190,7 +191,7 @@ class Measurement:
             warnings.simplefilter("ignore")
             try:
                 values = module_values(self.module, p, p2, w, e)
-            except Exception as error:  # noqa: BLE001 - a raising kernel is a measured failure
+            except Exception as error:  # a raising kernel is a measured failure
                 values = {f: np.full(9, np.inf) for f in FUNCTIONS}
                 self.errors.append(f"{label} φ={angle:.3g}: {type(error).__name__}: {error}")
         for function in FUNCTIONS:
@@ -205,9 +206,9 @@ class Measurement:
                 ulp, nonfinite = _error(got, refs[spec.name], spec.name, epsilon, tiny)
                 self.record(spec.name, label, "c", ulp, nonfinite, angle, kappa(spec.name))
 
-    def condition(self, function: str, refs: dict[str, Any], kinematic_at: Callable[[list[Any]], dict[str, Any]],
-                  p: list[Any], p2: list[Any], e: list[Any], guess: float | None, tiny: float
-                  ) -> dict[str, float]:
+    def condition(self, function: str, refs: dict[str, Any],
+                  kinematic_at: Callable[[list[Any]], dict[str, Any]], p: list[Any], p2: list[Any],
+                  e: list[Any], guess: float | None, tiny: float) -> dict[str, float]:
         """κ of ``function`` (and, for the kinematic ones, of all of them at once)."""
         def scale(ref: Any, matrix: bool) -> float:
             values = [ref[i, j] for i in range(ref.rows) for j in range(ref.cols)] \
@@ -255,7 +256,7 @@ def worker(index: int, points: int, with_c: bool) -> dict[str, Any]:
     result["phi_max_reference"] = float(function.phi_max)
     try:
         plan, _source, seconds = emit(entry.expression, name)
-    except Exception as error:  # noqa: BLE001 - any exception of the emit is the measurement
+    except Exception as error:  # any exception of the emit is the measurement
         result["emit_error"] = f"{type(error).__name__}: {str(error).splitlines()[0][:300]}"
         result["traceback"] = traceback.format_exc()[-2000:]
         return result
@@ -290,7 +291,7 @@ def _c_library(plan: Any, name: str, directory: Path) -> tuple[Any, str | None, 
         config = [c for c in build_configs() if c.label == "gcc-O2-nofma"]
         build = compile_all(config, [name], directory, directory)["gcc-O2-nofma"]
         return build.load(), name, info
-    except Exception as error:  # noqa: BLE001 - recorded, the NumPy measurement goes on
+    except Exception as error:  # recorded, the NumPy measurement goes on
         info["error"] = f"{type(error).__name__}: {str(error).splitlines()[0][:300]}"
         return None, None, info
 
@@ -314,6 +315,16 @@ def _cell(e: dict[str, Any] | None) -> str:
     return f"{e['ulp']:.3g} ({e['at']:.3g}; κ {e['kappa']:.2g}{nan})"
 
 
+def _verdicts(result: dict[str, Any]) -> dict[tuple[str, str], str]:
+    """{(backend, precision): verdict} of one measured corpus function (empty if not emitted)."""
+    out = {}
+    for backend, label in COLUMNS:
+        mine = [t for t in result.get("tallies", []) if t["backend"] == backend and t["precision"] == label]
+        if mine:
+            out[(backend, label)] = verdict(mine)
+    return out
+
+
 def report(results: list[dict[str, Any]], command: str, points: int) -> str:
     lines = ["# Accuracy of the generated code for user generating functions (issue 16)", "",
              f"Produced by `{command}`. Reference: tests/reference.py (φ from |p| by safeguarded "
@@ -325,8 +336,8 @@ def report(results: list[dict[str, Any]], command: str, points: int) -> str:
              "*miss* otherwise, **NaN/Inf** when any output is not finite inside the validity range. "
              "C: the header compiled with gcc -O2 -ffp-contract=off (kinematic functions only).", "",
              "## Summary", "",
-             "| # | p(φ) | category | edge | closed φ(p) | emit s (NumPy / C) | angle (f64) | φ_max ref / plan "
-             "| NumPy f64 | NumPy f32 | C double | C float | NaN/Inf |",
+             "| # | p(φ) | category | edge | closed φ(p) | emit s (NumPy / C) | angle (f64) "
+             "| φ_max ref / plan | NumPy f64 | NumPy f32 | C double | C float | NaN/Inf |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     counts: dict[str, int] = {}
     for r in results:
@@ -340,19 +351,24 @@ def report(results: list[dict[str, Any]], command: str, points: int) -> str:
             continue
         c = r.get("c", {})
         c_time = f"{c['emit_seconds']:.1f}" if "emit_seconds" in c else ("fail" if c else "—")
-        cells = []
-        for backend, label in (("numpy", "float64"), ("numpy", "float32"), ("c", "float64"), ("c", "float32")):
-            mine = [t for t in r["tallies"] if t["backend"] == backend and t["precision"] == label]
-            cells.append(verdict(mine) if mine else "—")
-            if mine:
-                counts[f"{backend} {label} {cells[-1]}"] = counts.get(f"{backend} {label} {cells[-1]}", 0) + 1
+        found = _verdicts(r)
+        cells = [found.get(key, "—") for key in COLUMNS]
+        for (backend, label), cell in found.items():
+            counts[f"{backend} {label} {cell}"] = counts.get(f"{backend} {label} {cell}", 0) + 1
         nonfinite = sum(t["nonfinite"] for t in r["tallies"])
         mismatch = "" if abs(r["phi_max_plan"] - r["phi_max_reference"]) <= 1e-9 * r["phi_max_reference"] \
             else " **≠**"
         lines.append(head + f"{r['emit_seconds']:.1f} / {c_time} | {r['angle_kind']['float64']} | "
                      f"{r['phi_max_reference']:.6g} / {r['phi_max_plan']:.6g}{mismatch} | "
                      + " | ".join(cells) + f" | {nonfinite} |")
-    lines += ["", "Counts (corpus functions): " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())),
+    good = ("meets", "conditioned")
+    verdicts = [_verdicts(r) for r in results]
+    numpy_ok = sum(all(v.get(k) in good for k in COLUMNS[:2]) for v in verdicts)
+    all_ok = sum(all(v.get(k) in good for k in COLUMNS) for v in verdicts)
+    lines += ["", f"**Target met** (meets or conditioned, no NaN/Inf) in NumPy float64 and float32: "
+              f"{numpy_ok} of {len(results)} corpus functions; in NumPy and C, both precisions: {all_ok} of "
+              f"{len(results)}.", "",
+              "Counts (corpus functions): " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())),
               "", "## Per function", ""]
     for r in results:
         if "tallies" not in r:
@@ -366,12 +382,11 @@ def report(results: list[dict[str, Any]], command: str, points: int) -> str:
                   "|---|---|---|---|---|---|"]
         by_key = {(t["function"], t["precision"], t["backend"]): t for t in r["tallies"]}
         for function in FUNCTIONS:
-            keys = [(function, "float64", "numpy"), (function, "float32", "numpy"), (function, "float64", "c"),
-                    (function, "float32", "c")]
-            entries = [by_key.get(k) for k in keys]
+            entries = [by_key.get((function, label, backend)) for backend, label in COLUMNS]
             present = [e for e in entries if e is not None]
             if present:
-                lines.append(f"| {function} | " + " | ".join(_cell(e) for e in entries) + f" | {verdict(present)} |")
+                cells = " | ".join(_cell(e) for e in entries)
+                lines.append(f"| {function} | {cells} | {verdict(present)} |")
         lines.append("")
     return "\n".join(lines)
 
@@ -383,19 +398,27 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-c", action="store_true")
     parser.add_argument("--out", default="docs/accuracy_corpus.md")
     parser.add_argument("--json", help="also write the raw results here")
+    parser.add_argument("--reuse", help="results JSON of an earlier run (--json): entries not in --only "
+                                        "are taken from it instead of being measured again")
     parser.add_argument("--worker", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker is not None:
         print(json.dumps(worker(args.worker, args.points, not args.no_c)))
         return 0
     indices = args.only if args.only else list(range(len(CORPUS)))
+    reused = {r["index"]: r for r in json.loads(Path(args.reuse).read_text(encoding="utf-8"))} \
+        if args.reuse else {}
     results = []
-    for index in indices:
+    for index in sorted(set(indices) | set(reused)):
+        if index in reused and index not in indices:
+            results.append(reused[index])
+            continue
         command = [sys.executable, __file__, "--worker", str(index), "--points", str(args.points)]
         command += ["--no-c"] if args.no_c else []
         start = time.perf_counter()
         try:
-            done = subprocess.run(command, capture_output=True, text=True, timeout=WORKER_TIMEOUT, check=False)
+            done = subprocess.run(command, capture_output=True, text=True, timeout=WORKER_TIMEOUT,
+                                  check=False)
             result = json.loads(done.stdout.strip().splitlines()[-1]) if done.returncode == 0 else {
                 "index": index, "expression": CORPUS[index].expression,
                 "worker_error": f"worker exit {done.returncode}: {done.stderr.strip().splitlines()[-1:]}"}

@@ -135,7 +135,9 @@ class GeneratingFunction:
         return 10 + 2 * int(-mpmath.log10(s) + 1)
 
     def value(self, phi: Any) -> Any:
-        """p(φ), with the guard digits of its size."""
+        """p(φ), with the guard digits of its size (p(0) = 0: p is odd, even if written as 0/0)."""
+        if phi == 0:
+            return mpmath.mpf(0)
         with mpmath.workdps(mpmath.mp.dps + self.guard(abs(phi))):
             value = self.p(phi)
         return +value
@@ -172,7 +174,8 @@ class GeneratingFunction:
         raise ValueError(f"no angle found for |p| = {mpmath.nstr(s, 20)}")
 
 
-def _skew(v: Sequence[Any]) -> mpmath.matrix:
+def skew(v: Sequence[Any]) -> mpmath.matrix:
+    """(v×), the skew-symmetric matrix of v."""
     return mpmath.matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
 
 
@@ -182,7 +185,7 @@ def _axial(w: mpmath.matrix) -> list[Any]:
 
 def rodrigues(phi: Any, axis: Sequence[Any]) -> mpmath.matrix:
     """Eq (1): R = I + sin φ (u×) + 2 sin²(φ/2) (u×)² for a unit axis u."""
-    u = _skew(axis)
+    u = skew(axis)
     return mpmath.eye(3) + mpmath.sin(phi) * u + 2 * mpmath.sin(phi / 2) ** 2 * (u * u)
 
 
