@@ -342,8 +342,20 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser()
     parser.add_argument("--points", type=int, default=60)
     parser.add_argument("--only", nargs="*")
-    parser.add_argument("--out", default="docs/accuracy.md")
-    args = parser.parse_args(argv)
+    parser.add_argument("--out", help="default docs/accuracy.md (--corpus: docs/accuracy_corpus.md)")
+    parser.add_argument("--corpus", action="store_true",
+                        help="measure the user generating functions of tests/corpus.py instead "
+                             "(bench/accuracy_corpus.py; its other options follow)")
+    args, rest = parser.parse_known_args(argv)
+    if args.corpus:
+        from accuracy_corpus import main as corpus_main
+
+        points = ["--points", str(args.points)] if args.points != parser.get_default("points") else []
+        only = ["--only", *args.only] if args.only else []
+        return corpus_main([*rest, *points, *only, "--out", args.out or "docs/accuracy_corpus.md"])
+    if rest:
+        parser.error(f"unrecognized arguments: {' '.join(rest)}")
+    args.out = args.out or "docs/accuracy.md"
     names = args.only or default_parameterizations()
     results, operations = {}, {}
     for name in names:
