@@ -12,7 +12,9 @@ converges only linearly. So beyond a switch s₀ the start is a polynomial in a 
 * ``ratio`` (p unbounded): v = s/(s + c), c = p(φ_max/2).
 
 φ(v) is interpolated at Chebyshev nodes (values from a 30-digit bisection) by a polynomial in
-y = 2v − 1, stored in monomial (Horner) form; the degree is the smallest whose start is within
+y = 2v − 1, stored as Chebyshev coefficients and evaluated by Clenshaw's recurrence (its monomial
+form has alternating coefficients up to ~10⁹ for degree 40, which lose every digit in float32:
+sinh's float32 angle at φ = 1 came out as 1.15); the degree is the smallest whose start is within
 ``START_TOLERANCE`` (relative to φ_max) at the midpoints. s₀ is where the reverted series' own
 relative error reaches ``SERIES_TOLERANCE``. Plan-time numerics only (mpmath, and NumPy arithmetic
 that is the same on every CPU); no SymPy call that can hang.
@@ -21,7 +23,7 @@ that is the same on every CPU); no SymPy call that can hang.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -42,14 +44,15 @@ FOLD_DERIVATIVE = mpmath.mpf(10) ** -12
 
 @dataclass(frozen=True)
 class FarStart:
-    """φ ≈ Σ coefficients[j] y^j, y = 2v(s) − 1, used for s ≥ switch (see the module docstring)."""
+    """φ ≈ Σ chebyshev[j] T_j(y), y = 2v(s) − 1, used for s ≥ switch (see the module docstring);
+    backends evaluate it with Clenshaw's recurrence (:func:`clenshaw`)."""
 
     kind: Literal["fold", "linear", "ratio"]
     scale: float
     """p_max for ``fold`` and ``linear``, c for ``ratio``."""
     order: int
     """k for ``fold`` (v = 1 − (1 − s/p_max)^(1/k)); 1 otherwise."""
-    coefficients: tuple[float, ...]
+    chebyshev: tuple[float, ...]
     switch: float
     measured: float
     """Worst relative start error (of φ_max) at the check points."""
@@ -120,11 +123,11 @@ def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, .
         check_values = np.array([phi_at_v(v) for v in checks])
         best: tuple[float, tuple[float, ...]] = (math.inf, ())
         for degree in DEGREES:
-            monomial = np.array(chebyshev_interpolant(lambda y: phi_at_v((y + 1) / 2), degree))
-            estimate = np.polynomial.polynomial.polyval(2 * checks - 1, monomial)
+            chebyshev = np.array(chebyshev_interpolant(lambda y: phi_at_v((y + 1) / 2), degree))
+            estimate = clenshaw(chebyshev, 2 * checks - 1)
             error = float(np.max(np.abs(estimate - check_values))) / phi_max
             if error < best[0]:
-                best = (error, tuple(float(c) for c in monomial))
+                best = (error, tuple(float(c) for c in chebyshev))
             if error <= START_TOLERANCE:
                 break
         switch = _series_switch(f, series, phi_max)
@@ -132,37 +135,34 @@ def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, .
 
 
 def chebyshev_interpolant(function: Callable[[mpmath.mpf], float], degree: int) -> list[float]:
-    """Monomial coefficients (in y, constant first) of the polynomial of ``degree`` interpolating
+    """Chebyshev coefficients c_j (Σ c_j T_j(y)) of the polynomial of ``degree`` interpolating
     ``function`` at the Chebyshev nodes y_k = cos(π(k + ½)/(n + 1)) of [−1, 1].
 
     Computed in mpmath (DIGITS) from the discrete orthogonality of T_j at those nodes,
-    c_j = (2 − δ_j0)/(n + 1) Σ_k f(y_k) T_j(y_k), and the exact integer recurrence of T_j's
-    monomial coefficients; rounded to float64 only at the end. No BLAS/LAPACK least squares (whose
-    results depend on the CPU kernel OpenBLAS picks) and no NumPy transcendental function (whose
-    results depend on the SIMD extensions): every machine prints the same coefficients."""
+    c_j = (2 − δ_j0)/(n + 1) Σ_k f(y_k) T_j(y_k), and rounded to float64 only at the end. No
+    BLAS/LAPACK least squares (whose results depend on the CPU kernel OpenBLAS picks) and no NumPy
+    transcendental function (whose results depend on the SIMD extensions): every machine prints
+    the same coefficients."""
     with mpmath.workdps(DIGITS):
-        return _chebyshev_interpolant(function, degree + 1)
+        n = degree + 1
+        angles = [mpmath.pi * (k + mpmath.mpf(1) / 2) / n for k in range(n)]
+        values = [mpmath.mpf(function(mpmath.cos(a))) for a in angles]
+        pairs = list(zip(values, angles, strict=True))
+        weights = [mpmath.mpf(1 if j == 0 else 2) / n for j in range(n)]
+        return [float(w * mpmath.fsum(v * mpmath.cos(j * a) for v, a in pairs))
+                for j, w in enumerate(weights)]
 
 
-def _chebyshev_interpolant(function: Callable[[mpmath.mpf], float], n: int) -> list[float]:
-    angles = [mpmath.pi * (k + mpmath.mpf(1) / 2) / n for k in range(n)]
-    values = [mpmath.mpf(function(mpmath.cos(a))) for a in angles]
-    pairs = list(zip(values, angles, strict=True))
-    chebyshev = [mpmath.mpf(1 if j == 0 else 2) / n * mpmath.fsum(v * mpmath.cos(j * a) for v, a in pairs)
-                 for j in range(n)]
-    # T_0 = 1, T_1 = y, T_{j+1} = 2y T_j − T_{j−1}: integer monomial coefficients
-    basis: list[list[int]] = [[1], [0, 1]]
-    while len(basis) < n:
-        previous, current = basis[-2], basis[-1]
-        following = [0, *(2 * c for c in current)]
-        for i, c in enumerate(previous):
-            following[i] -= c
-        basis.append(following)
-    monomial = [mpmath.mpf(0)] * n
-    for c, polynomial in zip(chebyshev, basis, strict=False):
-        for i, b in enumerate(polynomial):
-            monomial[i] += c * b
-    return [float(m) for m in monomial]
+def clenshaw(chebyshev: Sequence[float] | np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Σ c_j T_j(y) by Clenshaw's recurrence b_k = c_k + 2y b_{k+1} − b_{k+2}, result
+    c_0 + y b_1 − b_2: stable (error ~ n ε max|f|) where the monomial form is not. The backends
+    print the same recurrence."""
+    y = np.asarray(y)
+    following = np.zeros_like(y)
+    current = np.zeros_like(y)
+    for c in list(chebyshev)[:0:-1]:
+        following, current = current, c + 2 * y * current - following
+    return chebyshev[0] + y * current - following
 
 
 def _series_switch(f: object, series: tuple[sp.Expr, ...], phi_max: float) -> float:

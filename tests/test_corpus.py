@@ -184,13 +184,12 @@ SAMPLE: dict[str, str | None] = {
     # expression: None when it meets the target, else the measured miss (xfail, strict);
     # one per category where the emit is fast (the whole corpus: bench/accuracy_corpus.py)
     "phi - phi**3/50": None,
-    "phi + phi**5/120": "float32 near phi_max = 2 pi: rotation_matrix 7.6e5 ulp, tangent_inverse 8.4e6 ulp "
-                        "(Newton angle, no closed inverse)",
-    "sinh(phi)": "angle 4.5e15 ulp (returns 0) at |p| = 1e-300 in float64, 8.4e6 ulp at 1e-30 in float32 "
-                 "(asinh printed as log(s + sqrt(s**2 + 1))); float32 omega 55 ulp near 2 pi",
+    "phi + phi**5/120": "float32 root_matrix 9.2 ulp at phi = 6.28 (Newton angle, no closed inverse)",
+    "sinh(phi)": "float32 root_matrix 8.2 ulp and omega 55 ulp at phi = 6.28",
     "atan(phi)": None,
-    "phi*cos(phi/4)": "emit fails: NotImplementedError: multiple generators [cos(phi/4), phi]",
-    "sin(phi)/2 + sinh(phi)/2": "emit fails: NotImplementedError: multiple generators [exp(phi), sin(phi)]",
+    "phi*cos(phi/4)": None,
+    "sin(phi)/2 + sinh(phi)/2": "root_matrix 6 ulp (float64) and 8.2 ulp (float32), float32 omega 61 ulp, "
+                                "at phi = 6.27-6.28",
 }
 
 

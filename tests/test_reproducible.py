@@ -23,7 +23,7 @@ import pytest
 import sympy as sp
 
 from symrot.evaluation import log_grid, model_function
-from symrot.newton_start import chebyshev_interpolant
+from symrot.newton_start import chebyshev_interpolant, clenshaw
 from symrot.parsing import PHI
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -94,5 +94,8 @@ def test_log_grid_is_exact_at_the_ends_and_monotone() -> None:
 
 
 def test_chebyshev_interpolant_reproduces_a_polynomial_exactly() -> None:
+    # 1 − 2y + 3y³ = T₀ + T₁/4 + 3T₃/4
     coefficients = chebyshev_interpolant(lambda y: 1 - 2 * y + 3 * y**3, 5)
-    assert np.allclose(coefficients, [1, -2, 0, 3, 0, 0], atol=1e-15)
+    assert np.allclose(coefficients, [1, 0.25, 0, 0.75, 0, 0], atol=1e-15)
+    y = np.linspace(-1, 1, 7)
+    assert np.allclose(clenshaw(coefficients, y), 1 - 2 * y + 3 * y**3, atol=1e-15)

@@ -39,13 +39,21 @@ extern "C" {
 
 /* symrot_det_h_one__phi: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 405 */
+ * ops: 475 */
 static inline double symrot_det_h_one__phi(double s)
 {
     const double s2 = (s*s);
     const double v = 1 - cbrt(fmax(1 - s / 3.3530783864394875, 0));
     const double y = 2*v - 1;
-    double phi = s < 0.6986294588918609 ? s*(s2*(s2*(s2*(s2*(s2*(s2*((33227.0/38118080000000.0)*s2 + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) + 1.0/60.0) + 1) : y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(3.845923283356135e-05 + (-1.979456946368366e-05)*y) + 6.940558049065732e-05) - 0.0001467069417704233) - 0.00014361441577429634) + 0.0003115583333528588) + 0.00012847745214711797) - 0.0003099684923909368) - 0.0001678436288606955) + 0.00035785075169448037) - 0.00011506234184706436) + 0.00015590021809761445) - 0.000491505148100637) + 0.0008726182091765766) - 0.0014078962528680332) + 0.0025640522715133797) - 0.004414898527649544) + 0.008868914263147634) - 0.014103056706279935) + 0.03740130220064722) - 0.05443155197308994) + 0.1723557897410232) - 0.47218492314335037) + 2.919122883842834) + 3.6888749173071784, low = 0, high = 6.283185307179586;
+    const double far_chebyshev[25] = {3.4262488119907286, 3.078435146612714, -0.27270647771411743, 0.058935024871047986, -0.01092341396124625, 0.003881973729847049, -0.0009251648317959207, 0.00030749343680560177, -9.057404840855562e-05, 2.9515258898711766e-05, -9.371131981585395e-06, 3.1093060613898743e-06, -1.0246803513530182e-06, 3.452715616234165e-07, -1.1650659674300742e-07, 3.978329879961088e-08, -1.3631401940270963e-08, 4.7095346659018245e-09, -1.6292939581260258e-09, 5.702343301346788e-10, -1.971054960712895e-10, 7.098545744185871e-11, -2.3537557740900345e-11, 9.169395645513856e-12, -2.3596965627293182e-12};
+    double b0, b1 = 0, b2 = 0;
+    int j;
+    for (j = 24; j >= 1; --j) {
+        b0 = 2*b1*y - b2 + far_chebyshev[j];
+        b2 = b1;
+        b1 = b0;
+    }
+    double phi = s < 0.6986294588918609 ? s*(s2*(s2*(s2*(s2*(s2*(s2*((33227.0/38118080000000.0)*s2 + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) + 1.0/60.0) + 1) : b1*y - b2 + 3.4262488119907286, low = 0, high = 6.283185307179586;
     int k;
     if (phi > 6.283185307179586) {
         phi = high;
@@ -82,7 +90,7 @@ static inline double symrot_det_h_one__phi(double s)
 /* symrot_det_h_one_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 423 */
+ * ops: 493 */
 static inline double symrot_det_h_one_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -106,7 +114,7 @@ static inline double symrot_det_h_one_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * R_2: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
- * ops: 507 */
+ * ops: 577 */
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -233,7 +241,7 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * H_0: Horner degree 13 in x below x = 0.764824, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
  * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 579 */
+ * ops: 649 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -394,7 +402,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
  * H_inverse_0: Horner degree 15 in x below x = 1.43428, else 2*(1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 533 */
+ * ops: 603 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -554,7 +562,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 12 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * G_2: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
- * ops: 507 */
+ * ops: 577 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -688,7 +696,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
  * K_0: Horner degree 13 in x below x = 0.764824, else cbrt(6*(phi - sin(phi)))**2/(8*sin(phi/2)**2)
  * K_1: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
  * K_2: Horner degree 21 in x below x = 2.63022, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 583 */
+ * ops: 653 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -842,7 +850,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
  * H_inverse_0: Horner degree 15 in x below x = 1.43428, else 2*(1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 527 */
+ * ops: 597 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -879,7 +887,7 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * H_0: Horner degree 13 in x below x = 0.764824, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
  * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 573 */
+ * ops: 643 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -917,7 +925,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
  * nu: Horner degree 12 in x below x = 0.764824, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * ops: 458 */
+ * ops: 528 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1063,13 +1071,21 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
 
 /* symrot_det_h_one__phi_f: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 309 */
+ * ops: 379 */
 static inline float symrot_det_h_one__phi_f(float s)
 {
     const float s2 = (s*s);
     const float v = 1 - cbrtf(fmaxf(1 - s / 3.3530784F, 0));
     const float y = 2*v - 1;
-    float phi = s < 0.69862944F ? s*(s2*(s2*(s2*(s2*(s2*(s2*((8.716861e-10F)*s2 + 1.1911668e-08F) + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) + 1.0F/60.0F) + 1) : y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(y*(3.845923e-05F + (-1.979457e-05F)*y) + 6.940558e-05F) - 0.00014670694F) - 0.00014361442F) + 0.00031155834F) + 0.00012847745F) - 0.00030996848F) - 0.00016784362F) + 0.00035785075F) - 0.00011506234F) + 0.00015590021F) - 0.00049150514F) + 0.0008726182F) - 0.0014078963F) + 0.0025640524F) - 0.0044148983F) + 0.008868914F) - 0.014103057F) + 0.037401304F) - 0.05443155F) + 0.17235579F) - 0.47218493F) + 2.919123F) + 3.688875F, low = 0, high = 6.2831855F;
+    const float far_chebyshev[25] = {3.4262488F, 3.0784352F, -0.27270648F, 0.058935024F, -0.010923414F, 0.0038819737F, -0.00092516484F, 0.00030749344F, -9.0574045e-05F, 2.9515259e-05F, -9.371132e-06F, 3.1093061e-06F, -1.0246804e-06F, 3.4527156e-07F, -1.165066e-07F, 3.97833e-08F, -1.3631402e-08F, 4.7095345e-09F, -1.6292939e-09F, 5.702343e-10F, -1.971055e-10F, 7.098546e-11F, -2.3537557e-11F, 9.169395e-12F, -2.3596966e-12F};
+    float b0, b1 = 0, b2 = 0;
+    int j;
+    for (j = 24; j >= 1; --j) {
+        b0 = 2*b1*y - b2 + far_chebyshev[j];
+        b2 = b1;
+        b1 = b0;
+    }
+    float phi = s < 0.69862944F ? s*(s2*(s2*(s2*(s2*(s2*(s2*((8.716861e-10F)*s2 + 1.1911668e-08F) + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) + 1.0F/60.0F) + 1) : b1*y - b2 + 3.4262488F, low = 0, high = 6.2831855F;
     int k;
     if (phi > 6.2831855F) {
         phi = high;
@@ -1109,7 +1125,7 @@ static inline float symrot_det_h_one__phi_f(float s)
 /* symrot_det_h_one_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 327 */
+ * ops: 397 */
 static inline float symrot_det_h_one_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1133,7 +1149,7 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * R_2: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 392 */
+ * ops: 462 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1274,7 +1290,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
  * H_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
  * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 478 */
+ * ops: 548 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1429,7 +1445,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
  * H_inverse_0: Horner degree 8 in x below x = 2.63022, else 4*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 422 */
+ * ops: 492 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1574,7 +1590,7 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))
  * G_2: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
- * ops: 392 */
+ * ops: 462 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1707,7 +1723,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
  * K_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*(phi - sin(phi)))**2/(8*sin(phi/2)**2)
  * K_1: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 487 */
+ * ops: 557 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1854,7 +1870,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
  * H_inverse_0: Horner degree 8 in x below x = 2.63022, else 4*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 416 */
+ * ops: 486 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1892,7 +1908,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
  * H_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
  * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 472 */
+ * ops: 542 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1930,7 +1946,7 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
  * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))
- * ops: 332 */
+ * ops: 402 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);

@@ -217,12 +217,25 @@ class FunctionWriter:
         ]
         phi_max = self.printer.literal(angle.phi_max)
         far = angle.far
-        y = sp.Symbol("y", real=True)
-        far_value = horner(tuple(sp.Float(c, 17) for c in far.coefficients), y)
+        y, b1, b2 = (sp.Symbol(n, real=True) for n in ("y", "b1", "b2"))
+        degree = len(far.chebyshev) - 1
+        literals = ", ".join(self.printer.literal(sp.Float(c, 17)) for c in far.chebyshev)
+        # Σ c_j T_j(y) by Clenshaw's recurrence (the monomial form is unstable in float)
+        clenshaw: list[Statement] = [
+            {"kind": "let", "type": self.ctype, "name": f"far_chebyshev[{degree + 1}]",
+             "value": f"{{{literals}}}"},
+            {"kind": "declare", "type": self.ctype, "names": ["b0", "b1 = 0", "b2 = 0"]},
+            {"kind": "declare", "type": "int", "names": ["j"]},
+            {"kind": "loop", "header": f"j = {degree}; j >= 1; --j", "times": degree,
+             "body": [self.set("b0", sp.Symbol("far_chebyshev[j]", real=True) + 2 * y * b1 - b2),
+                      self.set("b2", "b1"), self.set("b1", "b0")]},
+        ]
+        far_value = sp.Float(far.chebyshev[0], 17) + y * b1 - b2
         return [
             self.let("s2", S_SYMBOL**2),
             {"kind": "let", "type": self.ctype, "name": "v", "value": self.far_variable(far), "ops": 4},
             self.let("y", 2 * sp.Symbol("v", real=True) - 1),
+            *clenshaw,
             {"kind": "declare", "type": self.ctype,
              "names": [f"phi = s < {self.printer.literal(far.switch)} ? {self.c(start)} : "
                        f"{self.c(far_value)}",

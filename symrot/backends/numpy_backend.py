@@ -120,8 +120,11 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
     start_lines = [f"start = {_literal(angle.start[-1])}"]
     start_lines += [f"start = {_literal(c)} + s2 * start" for c in reversed(angle.start[:-1])]
     far = angle.far
-    far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", f"far = {far.coefficients[-1]!r}"]
-    far_lines += [f"far = {c!r} + y * far" for c in reversed(far.coefficients[:-1])]
+    # Clenshaw's recurrence for Σ c_j T_j(y) (the monomial form loses every digit in float32)
+    far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", "b1 = numpy.zeros_like(y)",
+                 "b2 = numpy.zeros_like(y)"]
+    far_lines += [f"b1, b2 = {c!r} + 2.0 * y * b1 - b2, b1" for c in far.chebyshev[:0:-1]]
+    far_lines.append(f"far = {far.chebyshev[0]!r} + y * b1 - b2")
     return [
         "s2 = s * s",
         *start_lines,
