@@ -36,7 +36,7 @@ from ..plan import (
     S,
     evaluation_plan,
 )
-from ..quaternion_plan import E0, QuaternionScale
+from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 from .templating import render
 
 TENSORS = ("R", "H", "H_inverse", "G", "K")
@@ -171,6 +171,8 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
                         for label, precision in plan.precisions.items()},
             "x_limit_power": {SUFFIX[label]: math.frexp(precision.x_limit)[1] - 1
                               for label, precision in plan.precisions.items()},
+            "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
+                                         for label in plan.precisions},
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()}}
 
