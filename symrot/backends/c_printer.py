@@ -35,7 +35,8 @@ from ..errors import NonFiniteLiteral
 Precision = Literal["double", "float"]
 PRECISIONS: tuple[Precision, ...] = ("double", "float")
 MANTISSA_BITS = {"double": 53, "float": 24}
-LARGEST = {"double": mpmath.mpf(np.finfo(np.float64).max), "float": mpmath.mpf(float(np.finfo(np.float32).max))}
+LARGEST = {"double": mpmath.mpf(float(np.finfo(np.float64).max)),
+           "float": mpmath.mpf(float(np.finfo(np.float32).max))}
 """The largest finite value of each type: a literal rounded beyond it would be ``inf``."""
 MAX_EXPANDED_POWER = 4
 """x**n with a symbol x and 2 ≤ |n| ≤ this prints as a product instead of ``pow``."""
@@ -91,6 +92,12 @@ class SymrotCPrinter(C99CodePrinter):
 
     def _print_Float(self, flt: sp.Float) -> str:
         return self.literal(flt)
+
+    def _refuse(self, expr: sp.Expr) -> str:
+        raise NonFiniteLiteral(f"the constant {expr} is not finite in C {self.precision}: "
+                               "it cannot be printed")
+
+    _print_Infinity = _print_NegativeInfinity = _print_ComplexInfinity = _print_NaN = _refuse
 
     def _print_NumberSymbol(self, expr: sp.Expr) -> str:
         return self.literal(expr)

@@ -103,7 +103,8 @@ class FunctionWriter:
         try:
             return self.c(value)
         except NonFiniteLiteral as error:
-            raise NonFiniteLiteral(f"cannot emit {name} of {self.header} in {self.precision}: {error}") from None
+            message = f"cannot emit {name} of {self.header} in {self.precision}: {error}"
+            raise NonFiniteLiteral(message) from None
 
     def let(self, name: str, value: sp.Expr) -> Statement:
         return {"kind": "let", "type": self.ctype, "name": name, "value": self.named(name, value),

@@ -1,0 +1,73 @@
+"""Emitted C is checked before it is written (issue 17): every literal finite.
+
+``symrot derive cayley_m1000 --emit c`` (also ``cayley_m800``, ``'1e-8*phi'``) used to write
+``(inf.0F)*x + 1.1106829e+37F``: a float32 Horner coefficient beyond 3.4e38. The plan now keeps
+only the leading Horner terms that are finite in the format (symrot.plan._branch_for, ``top``),
+and the printer refuses any non-finite constant with a one-line SymrotError (exit 2). Each
+``--emit c`` here must exit 0 with a header that gcc compiles with -std=c99 -Wall -Wextra
+-Wpedantic -Werror (and the embedded warnings), or exit 2 with one line.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from symrot.api import derive
+from symrot.backends.c_printer import MANTISSA_BITS
+from symrot.cli import main as symrot_main
+from symrot.plan import evaluation_plan
+from symrot.plan_ir import Branch
+
+from .c_harness import STRICT_C
+
+LARGEST = {"float64": 1.7976931348623157e308, "float32": 3.4028234663852886e38}
+
+
+def emit(expression: str, out: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    code = symrot_main(["derive", expression, "--name", "t", "--emit", "c", "--out", str(out)])
+    return code, capsys.readouterr().err
+
+
+def check_header(code: int, err: str, out: Path) -> None:
+    assert code in (0, 2), err
+    if code == 2:
+        assert err.count("\n") == 1 and "Traceback" not in err, err
+        return
+    header = out / "symrot_t.h"
+    literals = re.findall(r"\b(?:inf|nan)\b", header.read_text(encoding="utf-8"))  # as in inf.0F
+    assert not literals, literals
+    source = out / "use.c"
+    source.write_text('#include "symrot_t.h"\nint main(void) { double p[3] = {0.1, 0.2, 0.3};\n'
+                      "    return symrot_t_angle(p) > 1 ? 1 : 0; }\n", encoding="utf-8")
+    result = subprocess.run(["gcc", *STRICT_C, f"-I{out}", str(source), "-o", str(out / "use"), "-lm"],
+                            capture_output=True, text=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr[-4000:]
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+@pytest.mark.parametrize("expression", ["1e-8*phi", pytest.param("cayley_m800", marks=pytest.mark.slow)])
+def test_emitted_c_compiles_or_is_refused(expression: str, tmp_path: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    code, err = emit(expression, tmp_path, capsys)
+    check_header(code, err, tmp_path)
+    assert code == 0, err  # these plans are printable: the overflowing Horner terms are dropped
+
+
+def test_plan_horner_coefficients_are_finite_in_their_format() -> None:
+    """1e-8*phi: the coefficients of x grow like 1e16^j; in float32 every printed one is finite."""
+    plan = evaluation_plan(derive("1e-8*phi").derivation, "t")
+    truncated = 0
+    for label, precision in plan.precisions.items():
+        for name, coefficient in precision.coefficients.items():
+            if isinstance(coefficient, Branch):
+                values = [abs(float(c)) for c in coefficient.horner]
+                assert all(v <= LARGEST[label] for v in values), (label, name, values)
+                truncated += label == "float32" and len(values) < 22
+    assert truncated > 0  # the case this guards is exercised
+    assert MANTISSA_BITS["float"] == 24 and math.isfinite(LARGEST["float32"])
