@@ -246,7 +246,8 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
 
     def tail(t: float, n: int) -> float:
         rest = floats[n:n + 2]
-        return sum(c * t ** (n + j) for j, c in enumerate(rest)) / (scale0 * epsilon)
+        with np.errstate(all="ignore"):  # coefficients beyond float64 are inf here: inf or NaN expected
+            return sum(c * t ** (n + j) for j, c in enumerate(rest)) / (scale0 * epsilon)
 
     best, best_k = np.inf, len(angles) - 1
     near_zero = int(np.searchsorted(angles, 0.5 * min(phi_max, 4 * np.pi)))
