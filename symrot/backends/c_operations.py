@@ -14,7 +14,9 @@ A status 0 therefore promises that every function of the header accepts the resu
   rescaling, eqs 40–47) and returns **p** = σ **e** with σ = p(φ)/sin(φ/2) from the plan (trig-free
   in e₀ when possible, otherwise φ = 2 atan2(|**e**|, e₀) and a Taylor-safe branch in φ²);
 * ``from_rotation_matrix``: Shepperd's largest pivot (eqs 61–65); the selected row is 4 e_k e, so
-  no square root is needed before the normalization of ``from_quaternion``;
+  no square root is needed before the normalization of ``from_quaternion``. Eqs 61–65 hold for
+  rotations only, so R is first checked: max |RᵀR − I| ≤ 2⁻²⁶ (2⁻¹¹ in float) and det R > 0
+  (:data:`~symrot.quaternion_plan.ROTATION_TOLERANCE_POWER`), otherwise status 1;
 * ``compose`` (eqs 18–19, 67): p₃ with R(p₃) = R(p₂) R(p₁), p₁ applied first: e₃ = e₂ ∘ e₁;
 * ``rescale``: **p** itself when e₀ ≥ 0, otherwise ``from_quaternion`` of −e.
 """
