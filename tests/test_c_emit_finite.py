@@ -97,3 +97,33 @@ def test_numpy_float32_tangent_of_a_small_scale_is_finite_inside_the_range(tmp_p
         assert np.isfinite(single).all(), (name, phi[~np.isfinite(single).all(-1)])
         error = np.abs(single - double).max(-1) / np.abs(double).max(-1)
         assert (error <= 64 * float(np.finfo(np.float32).eps)).all(), (name, error.max())
+
+
+@pytest.mark.slow
+def test_numpy_closed_form_in_x_on_mixed_batches(tmp_path: Path) -> None:
+    """tan(phi/20): some branches' closed forms are algebraic in x (e.g. 20/(x + 1)); in a batch with
+    lanes on both sides of the switch the closed form must see x of its own lanes only (it raised
+    "cannot assign 400 input values to the 134 output values" for cayley_m1000)."""
+    import importlib.util
+
+    import numpy as np
+
+    from symrot.backends.numpy_backend import module_source
+
+    path = tmp_path / "t20.py"
+    path.write_text(module_source(evaluation_plan(derive("tan(phi/20)").derivation, "t20")), encoding="utf-8")
+    assert "x = x[big]" in path.read_text(encoding="utf-8")
+    spec = importlib.util.spec_from_file_location("symrot_t20", path)
+    assert spec and spec.loader
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    phi = np.geomspace(1e-6, 3.0, 300)
+    p = np.tan(phi / 20)[:, None] * np.array([0.6, 0.8, 0.0])
+    for dtype in (np.float64, np.float32):
+        for name in ("rotation_matrix", "tangent", "tangent_inverse", "root_matrix", "root_tangent"):
+            batch = getattr(module, name)(p.astype(dtype))
+            assert np.isfinite(batch).all(), (name, dtype)
+            for k in (0, 150, 299):
+                single = getattr(module, name)(p[k].astype(dtype))
+                scale = 16 * float(np.finfo(dtype).eps) * float(np.abs(single).max())
+                np.testing.assert_allclose(batch[k], single, rtol=0, atol=scale)

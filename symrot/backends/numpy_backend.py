@@ -101,7 +101,7 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
         closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
     if closed.has(PHI):
         lines.append(f"    phi = {phi}[big]")
-    for symbol in (S, D, SIN_HALF, COS_HALF):
+    for symbol in (X, S, D, SIN_HALF, COS_HALF):  # a closed form in x too (e.g. 2000/(x + 1))
         if closed.has(symbol):
             lines.append(f"    {symbol} = {symbol}[big]")
     closed = closed.subs(PHI, sp.Symbol("phi"))
