@@ -26,3 +26,7 @@ class SymrotTimeout(SymrotError):
 
 class UnknownName(SymrotError):
     """A registry identifier that does not exist."""
+
+
+class NonFiniteLiteral(SymrotError):
+    """A constant of a plan is not finite in the target precision (it would print as ``inf``)."""

@@ -201,6 +201,14 @@ def _error_class(ulp: float) -> float:
     return float(exponent if mantissa > 0.5 else exponent - 1)
 
 
+def _magnitude(coefficient: sp.Expr) -> float:
+    """|coefficient| as a float64, inf when it exceeds the largest double."""
+    try:
+        return abs(float(coefficient))
+    except OverflowError:
+        return math.inf
+
+
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type) -> Branch:
     epsilon = float(np.finfo(dtype).eps)
@@ -226,20 +234,29 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                 error = abs(value - reference) / (scale * epsilon) if np.isfinite(value) else np.inf
                 worst = max(worst, error)
             closed_error[k] = worst
-    floats = [abs(float(c)) for c in series]
+    floats = [_magnitude(c) for c in series]
+    # every Horner coefficient must be finite in the format (e.g. 1000 tan(φ/1000) has a
+    # coefficient 1.1e42 of x in H⁻¹, beyond float32): the polynomial keeps only the leading terms
+    # that are, and the switch moves down until those truncate below the tolerance
+    largest = float(np.finfo(dtype).max)
+    top = min(MAX_TERMS - 2, next((n for n, c in enumerate(floats) if not c <= largest), len(floats)))
+    if top == 0:
+        raise SymrotError(f"cannot plan {closed} in {np.dtype(dtype).name}: its value at p = 0 "
+                          f"({float(series[0]):.3g}) is not finite in that format")
 
     def tail(t: float, n: int) -> float:
         rest = floats[n:n + 2]
-        return sum(c * t ** (n + j) for j, c in enumerate(rest)) / (scale0 * epsilon)
+        with np.errstate(all="ignore"):  # coefficients beyond float64 are inf here: inf or NaN expected
+            return sum(c * t ** (n + j) for j, c in enumerate(rest)) / (scale0 * epsilon)
 
     best, best_k = np.inf, len(angles) - 1
     near_zero = int(np.searchsorted(angles, 0.5 * min(phi_max, 4 * np.pi)))
     for k in range(near_zero):
         worst_closed = float(np.max(closed_error[k:near_zero]))
-        worst = max(worst_closed, tail(t_values[k], MAX_TERMS - 2))
+        worst = max(worst_closed, tail(t_values[k], top))
         if worst <= CLOSED_TOLERANCE_ULP and best <= CLOSED_TOLERANCE_ULP:
             # both acceptable: prefer the smaller switch (fewer terms)
-            if tail(t_values[k], MAX_TERMS - 2) <= tail(t_values[best_k], MAX_TERMS - 2):
+            if tail(t_values[k], top) <= tail(t_values[best_k], top):
                 best, best_k = worst, k
         elif worst < best:
             best, best_k = worst, k
@@ -247,17 +264,17 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         raise SymrotError(f"cannot plan {closed} in {np.dtype(dtype).name}: neither it nor its series "
                           "in x = |p|^2 is finite on the grid (p is too small or too large in scale)")
     def terms_at(threshold: float) -> int:
-        target = max(0.25, tail(threshold, MAX_TERMS - 2))
-        return next((n for n in range(1, MAX_TERMS - 1) if tail(threshold, n) <= target), MAX_TERMS - 2)
+        target = max(0.25, tail(threshold, top))
+        return next((n for n in range(1, top + 1) if tail(threshold, n) <= target), top)
 
     accurate_threshold = float(t_values[best_k])
     # speed: a polynomial of up to CHEAP_TERMS terms costs less than the closed form's library
     # calls, so the switch moves up while such a polynomial still truncates below a quarter ulp
     # (the closed form then serves a smaller range, where its error can only be smaller)
-    while best_k + 1 < near_zero and tail(t_values[best_k + 1], CHEAP_TERMS) <= 0.25:
+    while best_k + 1 < near_zero and tail(t_values[best_k + 1], min(CHEAP_TERMS, top)) <= 0.25:
         best_k += 1
     best = min(best, max(float(np.max(closed_error[best_k:near_zero])),
-                         tail(t_values[best_k], MAX_TERMS - 2)))
+                         tail(t_values[best_k], top)))
     threshold = float(t_values[best_k])
     accurate_terms = terms_at(accurate_threshold)
     degree = max(terms_at(threshold), accurate_terms)

@@ -32,6 +32,11 @@ E0 = sp.Symbol("e0", positive=True)
 """The scalar part e₀ of the unit quaternion on the hemisphere e₀ ≥ 0."""
 QUATERNION_SCALAR = "e_0"
 """Name of the plan coefficient e₀ = cos(φ/2) (eq 74) among the coefficients of x."""
+ROTATION_TOLERANCE_POWER = {"float64": -26, "float32": -11}
+"""``from_rotation_matrix`` accepts R only when max |RᵀR − I| ≤ 2^power and det R > 0 (eqs 61–65
+hold for rotations only; anything else, e.g. 0, −I, 2 Rz, a rank-1 matrix or a reflection, would be
+mapped to some rotation): 2⁻²⁶ ≈ 1.5e-8 in float64, 2⁻¹¹ ≈ 4.9e-4 in float32, about √ε, so that
+a rotation rounded to the format, or computed by a few products of rotations, is accepted."""
 
 
 def quaternion_scalar() -> sp.Expr:

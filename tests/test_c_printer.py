@@ -106,3 +106,22 @@ def test_float_variant_calls_only_float_functions_and_float_literals() -> None:
 def test_unknown_precision_is_rejected() -> None:
     with pytest.raises(ValueError, match="precision"):
         SymrotCPrinter("half")  # type: ignore[arg-type]
+
+
+NON_FINITE = [(sp.Float("1.1253368e42"), "float"), (sp.Integer(10) ** 39, "float"),
+              (sp.Float("1e309"), "double"),
+              (-sp.Integer(2) ** 1024, "double"), (sp.oo, "double"), (sp.nan, "float")]
+
+
+@pytest.mark.parametrize(("value", "precision"), NON_FINITE)
+def test_non_finite_literal_is_refused_in_one_line(value: sp.Expr, precision: str) -> None:
+    """A constant that is ±inf or NaN in the type would print as ``inf.0F`` (gcc: 'inf' undeclared):
+    a SymrotError (exit 2 at the CLI) naming the constant and the type instead."""
+    from symrot.errors import NonFiniteLiteral, SymrotError
+
+    with pytest.raises(NonFiniteLiteral) as caught:
+        print_c(value * X, precision)  # type: ignore[arg-type]
+    assert isinstance(caught.value, SymrotError)
+    message = str(caught.value)
+    assert "\n" not in message and precision in message and "not finite" in message
+    assert print_c(sp.Float("3.4028234e38") * X, "float").startswith("3.4028235e+38F")  # largest float

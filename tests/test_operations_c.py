@@ -259,3 +259,81 @@ def test_zero_and_tiny(library: ctypes.CDLL, case: tuple[str, ModuleType], preci
     assert status[0] == 0
     error = np.abs(back[0].astype(np.float64) / tiny - p1[0] / tiny).max()
     assert error <= 4 * eps * np.abs(p1[0] / tiny).max(), (name, back)
+
+
+# -- issue 17: statuses agree with the domain; non-rotations refused ------------------------------
+def _rz(angle: float, dtype: type) -> np.ndarray:
+    c, s = np.cos(dtype(angle)), np.sin(dtype(angle))  # in the format: Rz(π) has sin(π) ≠ 0
+    return np.array([c, -s, 0, s, c, 0, 0, 0, 1], dtype=dtype)
+
+
+@pytest.mark.parametrize("precision", ["double", "float"])
+@pytest.mark.parametrize("name", ["cayley_gibbs_rodrigues", "wiener_milenkovic"])
+def test_status_agrees_with_the_domain_near_half_turns(library: ctypes.CDLL, name: str, precision: str,
+                                                       tmp_path: Path) -> None:
+    """e = (e0, 1, 0, 0) with e0 → 0, Rz(π) in the format, compose and rescale of near half turns:
+    status 0 exactly when the returned p is accepted by the header's own rotation_matrix (finite R),
+    status 1 with NaN otherwise, and NaN rows where the NumPy module is NaN."""
+    dtype = DTYPE[precision]
+    module = get_module(name, tmp_path)
+    e0 = [1e-300, 1e-100, 1e-30, 1e-17, 1e-10, 1e-5, 0.1, 0.0]
+    with np.errstate(under="ignore"):
+        e = np.array([(v, 1.0, 0.0, 0.0) for v in e0]).astype(dtype)
+    results = {"from_quaternion": call(library, name, "from_quaternion", precision, e),
+               "from_rotation_matrix": call(library, name, "from_rotation_matrix", precision,
+                                            np.stack([_rz(np.pi, dtype), _rz(np.pi - 1e-7, dtype)]))}
+    near = np.array([[np.pi - 1e-7, 0, 0], [0, 0, np.pi - 1e-3]])
+    turns = np.stack([module.from_quaternion(np.array([np.cos(a / 2), 0, 0, np.sin(a / 2)]))
+                      for a in near[:, 0] + near[:, 2]]).astype(dtype)
+    results["compose"] = call(library, name, "compose", precision, turns, turns[::-1])
+    results["rescale"] = call(library, name, "rescale", precision, turns)
+    for function, (got, status) in results.items():
+        what = f"{name} {function} ({precision})"
+        matrices, _ = call(library, name, "rotation_matrix", precision, np.where(np.isnan(got), 0, got))
+        accepted = np.isfinite(matrices).all(-1)
+        assert np.array_equal(status == 0, accepted & np.isfinite(got).all(-1)), (what, got, status)
+        assert np.isnan(got[status != 0]).all(), what
+    got, status = results["from_quaternion"]
+    assert np.array_equal(status != 0, np.isnan(module.from_quaternion(e)).any(-1)), (name, precision, got)
+    if name == "cayley_gibbs_rodrigues":  # 2/e0 leaves the domain: e0 = 1e-100 (1e-17 in float)
+        assert status[1] == 1 and status[3] == (1 if precision == "float" else 0) and status[5] == 0
+    else:  # 4 tan(φ/4) → 4: every half turn is inside
+        assert not status.any()
+
+
+NOT_ROTATIONS = {"zeros": np.zeros(9), "ones": np.ones(9), "diag(1,1,-1)": np.diag([1.0, 1.0, -1.0]).ravel(),
+                 "-I": -np.eye(3).ravel(), "2 Rz(1)": 2 * _rz(1.0, np.float64),
+                 "rank 1": np.outer([0.6, 0.8, 0.0], [0.0, 0.6, 0.8]).ravel(),
+                 "e0 e0^T": np.outer([1.0, 0, 0], [1.0, 0, 0]).ravel(),
+                 "NaN entry": _rz(0.3, np.float64) + np.where(np.arange(9) == 7, np.nan, 0.0),
+                 "inf entry": _rz(0.3, np.float64) + np.where(np.arange(9) == 5, np.inf, 0.0),
+                 "1e30 I": 1e30 * np.eye(3).ravel()}
+
+
+@pytest.mark.parametrize("precision", ["double", "float"])
+def test_from_rotation_matrix_refuses_non_rotations(library: ctypes.CDLL, case: tuple[str, ModuleType],
+                                                    precision: str) -> None:
+    """Status 1 and NaN unless max |RᵀR − I| ≤ tol and det R > 0 (tol = 2^-26, 2^-11 in float);
+    rotations perturbed by up to tol/8 per entry are accepted, scaled by 1 + 4 tol refused."""
+    from symrot.quaternion_plan import ROTATION_TOLERANCE_POWER
+
+    name, module = case
+    dtype = DTYPE[precision]
+    tol = 2.0 ** ROTATION_TOLERANCE_POWER["float64" if precision == "double" else "float32"]
+    refused = np.stack([*NOT_ROTATIONS.values(), (1 + 4 * tol) * _rz(1.0, np.float64),
+                        _rz(1.0, np.float64) + 4 * tol * (np.arange(9) == 1)])
+    with np.errstate(over="ignore"):
+        refused = refused.astype(dtype)
+    got, status = call(library, name, "from_rotation_matrix", precision, refused)
+    assert (status == 1).all() and np.isnan(got).all(), (name, precision, status)
+    with np.errstate(invalid="ignore", over="ignore"):
+        assert np.isnan(module.from_rotation_matrix(refused.reshape(-1, 3, 3))).all(), name
+    rng = np.random.default_rng(5)
+    angles = rng.uniform(-1.5, 1.5, 30)
+    perturbed = np.stack([_rz(a, np.float64) for a in angles]) + rng.uniform(-tol / 8, tol / 8, (30, 9))
+    perturbed = perturbed.astype(dtype)
+    got, status = call(library, name, "from_rotation_matrix", precision, perturbed)
+    expected = module.from_rotation_matrix(perturbed.reshape(-1, 3, 3))
+    assert not status.any() and np.isfinite(expected).all(), (name, precision, status)
+    scale = 16 * float(np.finfo(dtype).eps) * (1 + np.abs(expected.astype(np.float64)).max())
+    assert np.abs(got.astype(np.float64) - expected).max() <= scale, (name, precision)

@@ -713,12 +713,26 @@ static inline int symrot_euler_rodrigues_from_quaternion(const double e[4], doub
 
 /* symrot_euler_rodrigues_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
  * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
- * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
- * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
- * non-finite R gives status 1 and NaN.
- * ops: 27 */
+ * quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:
+ * max |R^T R - I| <= 2^-26 and det R > 0, otherwise (non-finite, singular, scaled, a
+ * reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation
+ * the result differs from Q's parameters by O(|D|).
+ * ops: 75 */
 static inline int symrot_euler_rodrigues_from_rotation_matrix(const double R[9], double p[3])
 {
+    const double g00 = R[0] * R[0] + R[3] * R[3] + R[6] * R[6] - 1;
+    const double g01 = R[0] * R[1] + R[3] * R[4] + R[6] * R[7];
+    const double g02 = R[0] * R[2] + R[3] * R[5] + R[6] * R[8];
+    const double g11 = R[1] * R[1] + R[4] * R[4] + R[7] * R[7] - 1;
+    const double g12 = R[1] * R[2] + R[4] * R[5] + R[7] * R[8];
+    const double g22 = R[2] * R[2] + R[5] * R[5] + R[8] * R[8] - 1;
+    const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+    if (!(fabs(g00) <= 1.4901161193847656e-08 && fabs(g01) <= 1.4901161193847656e-08 && fabs(g02) <= 1.4901161193847656e-08 && fabs(g11) <= 1.4901161193847656e-08 && fabs(g12) <= 1.4901161193847656e-08 && fabs(g22) <= 1.4901161193847656e-08 && det > 0)) {
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
+        return 1;
+    }
     const double tr = R[0] + R[4] + R[8];
     if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
         return symrot_euler_rodrigues__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
@@ -1445,12 +1459,26 @@ static inline int symrot_euler_rodrigues_from_quaternion_f(const float e[4], flo
 
 /* symrot_euler_rodrigues_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
  * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
- * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
- * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
- * non-finite R gives status 1 and NaN.
- * ops: 27 */
+ * quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:
+ * max |R^T R - I| <= 2^-11 and det R > 0, otherwise (non-finite, singular, scaled, a
+ * reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation
+ * the result differs from Q's parameters by O(|D|).
+ * ops: 75 */
 static inline int symrot_euler_rodrigues_from_rotation_matrix_f(const float R[9], float p[3])
 {
+    const float g00 = R[0] * R[0] + R[3] * R[3] + R[6] * R[6] - 1;
+    const float g01 = R[0] * R[1] + R[3] * R[4] + R[6] * R[7];
+    const float g02 = R[0] * R[2] + R[3] * R[5] + R[6] * R[8];
+    const float g11 = R[1] * R[1] + R[4] * R[4] + R[7] * R[7] - 1;
+    const float g12 = R[1] * R[2] + R[4] * R[5] + R[7] * R[8];
+    const float g22 = R[2] * R[2] + R[5] * R[5] + R[8] * R[8] - 1;
+    const float det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+    if (!(fabsf(g00) <= 0.00048828125F && fabsf(g01) <= 0.00048828125F && fabsf(g02) <= 0.00048828125F && fabsf(g11) <= 0.00048828125F && fabsf(g12) <= 0.00048828125F && fabsf(g22) <= 0.00048828125F && det > 0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
     const float tr = R[0] + R[4] + R[8];
     if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
         return symrot_euler_rodrigues__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);

@@ -741,7 +741,7 @@ static inline void symrot_tangent_m1_to_quaternion(const double p[3], double e[4
 
 /* symrot_tangent_m1__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma = 2*e0/(2*e0**2 - 1) (trig-free in e0)
- * ops: 38 */
+ * ops: 39 */
 static inline int symrot_tangent_m1__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -774,6 +774,12 @@ static inline int symrot_tangent_m1__from_quaternion(double e0, double e1, doubl
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 6.703903964971299e+153)) {
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
+        return 1;
+    }
     return 0;
 }
 
@@ -789,12 +795,26 @@ static inline int symrot_tangent_m1_from_quaternion(const double e[4], double p[
 
 /* symrot_tangent_m1_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
  * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
- * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
- * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
- * non-finite R gives status 1 and NaN.
- * ops: 27 */
+ * quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:
+ * max |R^T R - I| <= 2^-26 and det R > 0, otherwise (non-finite, singular, scaled, a
+ * reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation
+ * the result differs from Q's parameters by O(|D|).
+ * ops: 75 */
 static inline int symrot_tangent_m1_from_rotation_matrix(const double R[9], double p[3])
 {
+    const double g00 = R[0] * R[0] + R[3] * R[3] + R[6] * R[6] - 1;
+    const double g01 = R[0] * R[1] + R[3] * R[4] + R[6] * R[7];
+    const double g02 = R[0] * R[2] + R[3] * R[5] + R[6] * R[8];
+    const double g11 = R[1] * R[1] + R[4] * R[4] + R[7] * R[7] - 1;
+    const double g12 = R[1] * R[2] + R[4] * R[5] + R[7] * R[8];
+    const double g22 = R[2] * R[2] + R[5] * R[5] + R[8] * R[8] - 1;
+    const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+    if (!(fabs(g00) <= 1.4901161193847656e-08 && fabs(g01) <= 1.4901161193847656e-08 && fabs(g02) <= 1.4901161193847656e-08 && fabs(g11) <= 1.4901161193847656e-08 && fabs(g12) <= 1.4901161193847656e-08 && fabs(g22) <= 1.4901161193847656e-08 && det > 0)) {
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
+        return 1;
+    }
     const double tr = R[0] + R[4] + R[8];
     if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
         return symrot_tangent_m1__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
@@ -1550,7 +1570,7 @@ static inline void symrot_tangent_m1_to_quaternion_f(const float p[3], float e[4
 
 /* symrot_tangent_m1__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma = 2*e0/(2*e0**2 - 1) (trig-free in e0)
- * ops: 38 */
+ * ops: 39 */
 static inline int symrot_tangent_m1__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1583,6 +1603,12 @@ static inline int symrot_tangent_m1__from_quaternion_f(float e0, float e1, float
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 9.223372e+18F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
     return 0;
 }
 
@@ -1598,12 +1624,26 @@ static inline int symrot_tangent_m1_from_quaternion_f(const float e[4], float p[
 
 /* symrot_tangent_m1_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
  * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
- * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
- * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
- * non-finite R gives status 1 and NaN.
- * ops: 27 */
+ * quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:
+ * max |R^T R - I| <= 2^-11 and det R > 0, otherwise (non-finite, singular, scaled, a
+ * reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation
+ * the result differs from Q's parameters by O(|D|).
+ * ops: 75 */
 static inline int symrot_tangent_m1_from_rotation_matrix_f(const float R[9], float p[3])
 {
+    const float g00 = R[0] * R[0] + R[3] * R[3] + R[6] * R[6] - 1;
+    const float g01 = R[0] * R[1] + R[3] * R[4] + R[6] * R[7];
+    const float g02 = R[0] * R[2] + R[3] * R[5] + R[6] * R[8];
+    const float g11 = R[1] * R[1] + R[4] * R[4] + R[7] * R[7] - 1;
+    const float g12 = R[1] * R[2] + R[4] * R[5] + R[7] * R[8];
+    const float g22 = R[2] * R[2] + R[5] * R[5] + R[8] * R[8] - 1;
+    const float det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+    if (!(fabsf(g00) <= 0.00048828125F && fabsf(g01) <= 0.00048828125F && fabsf(g02) <= 0.00048828125F && fabsf(g11) <= 0.00048828125F && fabsf(g12) <= 0.00048828125F && fabsf(g22) <= 0.00048828125F && det > 0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
     const float tr = R[0] + R[4] + R[8];
     if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
         return symrot_tangent_m1__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);

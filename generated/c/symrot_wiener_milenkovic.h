@@ -602,7 +602,7 @@ static inline void symrot_wiener_milenkovic_to_quaternion(const double p[3], dou
 
 /* symrot_wiener_milenkovic__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma = 4/(e0 + 1) (trig-free in e0)
- * ops: 34 */
+ * ops: 35 */
 static inline int symrot_wiener_milenkovic__from_quaternion(double e0, double e1, double e2, double e3, double p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-500, 2^500] */
@@ -629,6 +629,12 @@ static inline int symrot_wiener_milenkovic__from_quaternion(double e0, double e1
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 4.4794894843556084e+102)) {
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
+        return 1;
+    }
     return 0;
 }
 
@@ -644,12 +650,26 @@ static inline int symrot_wiener_milenkovic_from_quaternion(const double e[4], do
 
 /* symrot_wiener_milenkovic_from_rotation_matrix: parameter vector from a rotation matrix (eq 61-65).
  * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
- * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
- * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
- * non-finite R gives status 1 and NaN.
- * ops: 27 */
+ * quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:
+ * max |R^T R - I| <= 2^-26 and det R > 0, otherwise (non-finite, singular, scaled, a
+ * reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation
+ * the result differs from Q's parameters by O(|D|).
+ * ops: 75 */
 static inline int symrot_wiener_milenkovic_from_rotation_matrix(const double R[9], double p[3])
 {
+    const double g00 = R[0] * R[0] + R[3] * R[3] + R[6] * R[6] - 1;
+    const double g01 = R[0] * R[1] + R[3] * R[4] + R[6] * R[7];
+    const double g02 = R[0] * R[2] + R[3] * R[5] + R[6] * R[8];
+    const double g11 = R[1] * R[1] + R[4] * R[4] + R[7] * R[7] - 1;
+    const double g12 = R[1] * R[2] + R[4] * R[5] + R[7] * R[8];
+    const double g22 = R[2] * R[2] + R[5] * R[5] + R[8] * R[8] - 1;
+    const double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+    if (!(fabs(g00) <= 1.4901161193847656e-08 && fabs(g01) <= 1.4901161193847656e-08 && fabs(g02) <= 1.4901161193847656e-08 && fabs(g11) <= 1.4901161193847656e-08 && fabs(g12) <= 1.4901161193847656e-08 && fabs(g22) <= 1.4901161193847656e-08 && det > 0)) {
+        p[0] = (double)NAN;
+        p[1] = (double)NAN;
+        p[2] = (double)NAN;
+        return 1;
+    }
     const double tr = R[0] + R[4] + R[8];
     if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
         return symrot_wiener_milenkovic__from_quaternion(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);
@@ -1266,7 +1286,7 @@ static inline void symrot_wiener_milenkovic_to_quaternion_f(const float p[3], fl
 
 /* symrot_wiener_milenkovic__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
  * sigma = 4/(e0 + 1) (trig-free in e0)
- * ops: 34 */
+ * ops: 35 */
 static inline int symrot_wiener_milenkovic__from_quaternion_f(float e0, float e1, float e2, float e3, float p[3])
 {
     /* exact power-of-two scaling when max |e_i| is outside [2^-60, 2^60] */
@@ -1293,6 +1313,12 @@ static inline int symrot_wiener_milenkovic__from_quaternion_f(float e0, float e1
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 4.3980465e+12F)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
     return 0;
 }
 
@@ -1308,12 +1334,26 @@ static inline int symrot_wiener_milenkovic_from_quaternion_f(const float e[4], f
 
 /* symrot_wiener_milenkovic_from_rotation_matrix_f: parameter vector from a rotation matrix (eq 61-65).
  * Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the
- * quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for
- * R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a
- * non-finite R gives status 1 and NaN.
- * ops: 27 */
+ * quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:
+ * max |R^T R - I| <= 2^-11 and det R > 0, otherwise (non-finite, singular, scaled, a
+ * reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation
+ * the result differs from Q's parameters by O(|D|).
+ * ops: 75 */
 static inline int symrot_wiener_milenkovic_from_rotation_matrix_f(const float R[9], float p[3])
 {
+    const float g00 = R[0] * R[0] + R[3] * R[3] + R[6] * R[6] - 1;
+    const float g01 = R[0] * R[1] + R[3] * R[4] + R[6] * R[7];
+    const float g02 = R[0] * R[2] + R[3] * R[5] + R[6] * R[8];
+    const float g11 = R[1] * R[1] + R[4] * R[4] + R[7] * R[7] - 1;
+    const float g12 = R[1] * R[2] + R[4] * R[5] + R[7] * R[8];
+    const float g22 = R[2] * R[2] + R[5] * R[5] + R[8] * R[8] - 1;
+    const float det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+    if (!(fabsf(g00) <= 0.00048828125F && fabsf(g01) <= 0.00048828125F && fabsf(g02) <= 0.00048828125F && fabsf(g11) <= 0.00048828125F && fabsf(g12) <= 0.00048828125F && fabsf(g22) <= 0.00048828125F && det > 0)) {
+        p[0] = NAN;
+        p[1] = NAN;
+        p[2] = NAN;
+        return 1;
+    }
     const float tr = R[0] + R[4] + R[8];
     if (tr >= R[0] && tr >= R[4] && tr >= R[8]) {
         return symrot_wiener_milenkovic__from_quaternion_f(1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1], p);

@@ -12,10 +12,13 @@ root_tangent(p) -> K (eq 83); pdot(p, omega) -> H^-1 omega (eq 25); omega(p, pdo
 
 Rotations of any size (Euler-Rodrigues parameters e = (e0, e1, e2, e3), scalar first, eqs 74-75):
 to_quaternion(p) -> e (..., 4); from_quaternion(e) -> p (normalizes e, takes the hemisphere
-e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65);
+e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65;
+NaN unless R is a rotation: max |R^T R - I| <= 2^-26 (2^-11 in float32) and det R > 0);
 compose(p1, p2) -> p3 with R(p3) = R(p2) R(p1), p1 applied first (eqs 18-19, 67);
 rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).  Rotations with
 |phi| >= 1.5707963267948966 cannot be represented: those results are NaN."""
+
+import functools
 
 import numpy
 
@@ -481,6 +484,18 @@ _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 E0_MIN = 0.7071067811865476
+_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
+
+
+def _quiet(function):
+    """Run a public function with every floating-point warning off: overflow, underflow and invalid
+    operations inside are expected (e.g. x = |p|^2 overflowing for huge p) and their results are
+    already NaN by the validity tests, so no RuntimeWarning reaches the caller."""
+    @functools.wraps(function)
+    def quiet(*args):
+        with numpy.errstate(all="ignore"):
+            return function(*args)
+    return quiet
 
 
 def _as_float(value, name, shape):
@@ -627,6 +642,7 @@ def _apply(p, v, name):
     return numpy.where(valid[..., None], result, numpy.nan).astype(p.dtype)
 
 
+@_quiet
 def angle(p):
     """phi = |phi| from p (..., 3); NaN outside the validity range."""
     p, state, valid, suffix = _prepare(p, [])
@@ -634,41 +650,49 @@ def angle(p):
     return numpy.where(valid, phi, numpy.nan).astype(p.dtype)
 
 
+@_quiet
 def rotation_matrix(p):
     """R = R_0 I + R_1 (p x) + R_2 (p x)^2 (eq 16)."""
     return _tensor(p, "R")
 
 
+@_quiet
 def tangent(p):
     """H with omega = H pdot (eq 20)."""
     return _tensor(p, "H")
 
 
+@_quiet
 def tangent_inverse(p):
     """H^-1 (eq 26)."""
     return _tensor(p, "H_inverse")
 
 
+@_quiet
 def tangent_det(p):
     """det H (eq 24)."""
     return _scalar(p, "det_H")
 
 
+@_quiet
 def root_matrix(p):
     """G, the square root of R (eq 81)."""
     return _tensor(p, "G")
 
 
+@_quiet
 def root_tangent(p):
     """K, the tangent tensor of G (eq 83)."""
     return _tensor(p, "K")
 
 
+@_quiet
 def pdot(p, omega):
     """pdot = H^-1 omega (eq 25)."""
     return _apply(p, omega, "H_inverse")
 
 
+@_quiet
 def omega(p, pdot):
     """omega = H pdot (eq 20)."""
     return _apply(p, pdot, "H")
@@ -706,6 +730,7 @@ def _from_quaternion(e0, e, valid, suffix):
     return numpy.where(valid[..., None], p, numpy.nan).astype(dtype)
 
 
+@_quiet
 def to_quaternion(p):
     """e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon (eq 74), (e1, e2, e3) = (nu/2) p (eq 75)."""
     e0, e, valid, _suffix = _quaternion(p)
@@ -713,6 +738,7 @@ def to_quaternion(p):
     return numpy.where(valid[..., None], q, numpy.nan).astype(e.dtype)
 
 
+@_quiet
 def from_quaternion(e):
     """p from e = (e0, e1, e2, e3) (scalar first; normalized here; e and -e give the same p).
 
@@ -726,15 +752,21 @@ def from_quaternion(e):
     return _from_quaternion(e[..., 0], e[..., 1:], finite, suffix)
 
 
+@_quiet
 def from_rotation_matrix(R):
     """p from a rotation matrix (..., 3, 3): Shepperd's largest pivot (eqs 61-65), then from_quaternion.
 
-    No orthogonalization: for R = Q + D with Q a rotation the result differs from Q's parameter
-    vector by O(|D|); non-finite R gives NaN.
+    R must be a rotation within the documented tolerance: max |R^T R - I| <= _ROTATION_TOLERANCE
+    (2^-26, 2^-11 in float32) and det R > 0; anything else (non-finite, singular,
+    scaled, a reflection) gives NaN.  No orthogonalization: for R = Q + D with Q a rotation the
+    result differs from Q's parameter vector by O(|D|).
     """
     r = _as_float(R, "R", (3, 3))
     suffix = "32" if r.dtype == numpy.float32 else "64"
-    finite = numpy.all(numpy.isfinite(r), axis=(-2, -1))
+    gram = numpy.einsum("...ki,...kj->...ij", r, r) - numpy.eye(3, dtype=r.dtype)
+    det = numpy.einsum("...i,...i->...", r[..., 0, :], numpy.cross(r[..., 1, :], r[..., 2, :]))
+    # NaN compares false: non-finite R (and R whose products overflow) is refused here too
+    finite = numpy.all(numpy.abs(gram) <= _ROTATION_TOLERANCE[suffix], axis=(-2, -1)) & (det > 0)
     r = numpy.where(finite[..., None, None], r, 0.0).astype(r.dtype)
     r00, r01, r02 = r[..., 0, 0], r[..., 0, 1], r[..., 0, 2]
     r10, r11, r12 = r[..., 1, 0], r[..., 1, 1], r[..., 1, 2]
@@ -752,6 +784,7 @@ def from_rotation_matrix(R):
     return _from_quaternion(q[..., 0], q[..., 1:], finite, suffix)
 
 
+@_quiet
 def compose(p1, p2):
     """p3 with R(p3) = R(p2) R(p1): p1 applied first, then p2 (eqs 18-19; e3 = e2 o e1, eq 67).
 
@@ -770,6 +803,7 @@ def compose(p1, p2):
     return _from_quaternion(e0, e, valid, suffix)
 
 
+@_quiet
 def rescale(p):
     """The equivalent parameter vector with |phi| <= pi (eqs 40-47); p itself when |phi| <= pi."""
     p = _as_float(p, "p", (3,))

@@ -4,29 +4,33 @@ Printed from the same evaluation plan as the rest of the header (:mod:`symrot.pl
 quaternion entries of :mod:`symrot.quaternion_plan`); quaternions are scalar first, matrices
 row-major. Every function that can fail returns an ``int`` status: 0 on success, 1 when an input
 is outside the validity range or not finite, or when the resulting rotation cannot be represented
-by this parameterization (|φ| ≥ φ_max with φ_max ≤ π); the output is then NaN.
+by this parameterization (|φ| ≥ φ_max with φ_max ≤ π), or when the computed **p** fails the validity
+test of ``angle``/``rotation_matrix`` (|p|² against p_max², or against the plan's x_limit when p is
+unbounded, e.g. Cayley–Gibbs–Rodrigues p = tan(φ/2) e/|e| for e₀ → 0); the output is then NaN.
+A status 0 therefore promises that every function of the header accepts the result.
 
 * ``to_quaternion`` (eqs 74–75): e₀ = cos(φ/2) (the plan coefficient ``e_0``), **e** = (ν/2) **p**;
 * ``from_quaternion``: normalizes e (``hypot``), takes the hemisphere e₀ ≥ 0 (|φ| ≤ π: this is
   rescaling, eqs 40–47) and returns **p** = σ **e** with σ = p(φ)/sin(φ/2) from the plan (trig-free
   in e₀ when possible, otherwise φ = 2 atan2(|**e**|, e₀) and a Taylor-safe branch in φ²);
 * ``from_rotation_matrix``: Shepperd's largest pivot (eqs 61–65); the selected row is 4 e_k e, so
-  no square root is needed before the normalization of ``from_quaternion``;
+  no square root is needed before the normalization of ``from_quaternion``. Eqs 61–65 hold for
+  rotations only, so R is first checked: max |RᵀR − I| ≤ 2⁻²⁶ (2⁻¹¹ in float) and det R > 0
+  (:data:`~symrot.quaternion_plan.ROTATION_TOLERANCE_POWER`), otherwise status 1;
 * ``compose`` (eqs 18–19, 67): p₃ with R(p₃) = R(p₂) R(p₁), p₁ applied first: e₃ = e₂ ∘ e₁;
 * ``rescale``: **p** itself when e₀ ≥ 0, otherwise ``from_quaternion`` of −e.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import sympy as sp
 
 from ..parsing import PHI
 from ..plan_ir import Branch
-from ..quaternion_plan import E0
-from .c_writer import LARGEST, PHI_SYMBOL, T_SYMBOL, FunctionWriter, Statement, ops_of
+from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER
+from .c_writer import LARGEST, PHI_SYMBOL, PLAN_LABEL, T_SYMBOL, FunctionWriter, Statement, ops_of
 
 E_SYMBOL = sp.Symbol("c0", real=True)
 
@@ -133,12 +137,11 @@ class OperationWriter(FunctionWriter):
         statements += scale
         statements += [self.set(f"p[{i}]", sp.Symbol("sigma") * (sp.Symbol(f"e{i + 1}") * sp.Symbol("f")))
                        for i in range(3)]
-        if math.isfinite(self.plan.p_max):
-            bound = self.printer.literal(self.bound)
-            squared = "(p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2])"  # as x in every function
-            statements.append({"kind": "if",
-                               "condition": f"!({squared} {self.inside_operator} {bound})",
-                               "then": self.nan_out("p", 3), "otherwise": []})
+        # the result must pass the validity test of angle/rotation_matrix (p_max or x_limit): a
+        # status 0 promises that every function of the header accepts p
+        squared = "(p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2])"  # as x in every function
+        statements.append({"kind": "if", "condition": self.out_of_range(squared),
+                           "then": self.nan_out("p", 3), "otherwise": []})
         statements.append({"kind": "return", "value": "0"})
         signature = f"int {self.helper}({t} e0, {t} e1, {t} e2, {t} e3, {t} p[3])"
         return self.entry(self.helper, "internal: p from a quaternion of any norm and sign",
@@ -171,7 +174,7 @@ class OperationWriter(FunctionWriter):
             "R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7]",
             "R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8]",
         ]
-        statements: list[Statement] = [
+        statements: list[Statement] = [*self.rotation_check(),
             {"kind": "let", "type": t, "name": "tr", "value": "R[0] + R[4] + R[8]", "ops": 2},
             {"kind": "if", "condition": "tr >= R[0] && tr >= R[4] && tr >= R[8]",
              "then": [{"kind": "return", "value": f"{h}({rows[0]}, p)", "ops": 4}], "otherwise": []},
@@ -181,13 +184,40 @@ class OperationWriter(FunctionWriter):
              "then": [{"kind": "return", "value": f"{h}({rows[2]}, p)", "ops": 6}], "otherwise": []},
             {"kind": "return", "value": f"{h}({rows[3]}, p)", "ops": 6},
         ]
+        power = ROTATION_TOLERANCE_POWER[PLAN_LABEL[self.precision]]
         notes = ["Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the",
-                 "quaternion (eqs 62-65), which from_quaternion normalizes. No orthogonalization: for",
-                 "R = Q + D with Q a rotation the result differs from Q's parameters by O(|D|); a",
-                 "non-finite R gives status 1 and NaN."]
+                 "quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:",
+                 f"max |R^T R - I| <= 2^{power} and det R > 0, otherwise (non-finite, singular, scaled, a",
+                 "reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation",
+                 "the result differs from Q's parameters by O(|D|)."]
         return self.entry(self.name("from_rotation_matrix"), "parameter vector from a rotation matrix",
                           "61-65", f"int {self.name('from_rotation_matrix')}(const {t} R[9], {t} p[3])",
                           statements, notes)
+
+    def rotation_check(self) -> list[Statement]:
+        """Status 1 and NaN unless max |RᵀR − I| ≤ 2^power and det R > 0
+        (:data:`~symrot.quaternion_plan.ROTATION_TOLERANCE_POWER`); NaN fails every comparison, so
+        non-finite R and R whose products overflow are refused too."""
+        t = self.ctype
+        f = "" if t == "double" else "f"
+        power = ROTATION_TOLERANCE_POWER[PLAN_LABEL[self.precision]]
+        tolerance = self.printer.literal(sp.Integer(2) ** power)
+        statements: list[Statement] = []
+        checks = []
+        for i in range(3):
+            for j in range(i, 3):
+                column = " + ".join(f"R[{3 * k + i}] * R[{3 * k + j}]" for k in range(3))  # (RᵀR)_ij
+                value = f"{column} - 1" if i == j else column
+                statements.append({"kind": "let", "type": t, "name": f"g{i}{j}", "value": value,
+                                   "ops": 6 if i == j else 5})
+                checks.append(f"fabs{f}(g{i}{j}) <= {tolerance}")
+        statements.append({"kind": "let", "type": t, "name": "det",
+                           "value": "R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6])"
+                                    " + R[2] * (R[3] * R[7] - R[4] * R[6])", "ops": 14})
+        checks.append("det > 0")
+        statements.append({"kind": "if", "condition": "!(" + " && ".join(checks) + ")",
+                           "then": self.nan_out("p", 3), "otherwise": []})
+        return statements
 
     # -- compose and rescale ---------------------------------------------------------------------
     def compose(self) -> dict[str, Any]:

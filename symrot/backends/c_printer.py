@@ -13,7 +13,10 @@ from what the C backend needs:
   are exact in the type stays a quotient of two literals (IEEE division rounds it once), a larger
   one and every float constant print as the shortest literal that reads back as the correctly
   rounded value (SymPy's default prints 17 or 9 decimal digits, which rounds twice);
-* no ``M_PI``-style macros: they are POSIX, not C99, and ``-std=c99 -Wpedantic`` rejects them.
+* no ``M_PI``-style macros: they are POSIX, not C99, and ``-std=c99 -Wpedantic`` rejects them;
+* **every literal finite**: a number that rounds to ±inf or NaN in the type (e.g. a Horner
+  coefficient 1e39 in float) raises :class:`~symrot.errors.NonFiniteLiteral` (a one-line
+  :class:`~symrot.errors.SymrotError`) instead of printing ``inf.0F``, which no compiler accepts.
 """
 
 from __future__ import annotations
@@ -27,9 +30,14 @@ from mpmath.libmp import from_rational
 from sympy.codegen.ast import float32, float64, real
 from sympy.printing.c import C99CodePrinter
 
+from ..errors import NonFiniteLiteral
+
 Precision = Literal["double", "float"]
 PRECISIONS: tuple[Precision, ...] = ("double", "float")
 MANTISSA_BITS = {"double": 53, "float": 24}
+LARGEST = {"double": mpmath.mpf(float(np.finfo(np.float64).max)),
+           "float": mpmath.mpf(float(np.finfo(np.float32).max))}
+"""The largest finite value of each type: a literal rounded beyond it would be ``inf``."""
 MAX_EXPANDED_POWER = 4
 """x**n with a symbol x and 2 ≤ |n| ≤ this prints as a product instead of ``pow``."""
 
@@ -58,6 +66,9 @@ class SymrotCPrinter(C99CodePrinter):
         else:
             with mpmath.workprec(bits):
                 rounded = +sp.Float(number, 70)._to_mpmath(240)
+        if not mpmath.isfinite(rounded) or abs(rounded) > LARGEST[self.precision]:
+            raise NonFiniteLiteral(f"the constant {sp.Float(number, 8)} is not finite in C {self.precision} "
+                                   f"(largest {float(LARGEST[self.precision]):.8g}): it cannot be printed")
         if self.precision == "float":
             text, suffix = str(np.float32(float(rounded))), self._get_literal_suffix(real)
         else:
@@ -81,6 +92,12 @@ class SymrotCPrinter(C99CodePrinter):
 
     def _print_Float(self, flt: sp.Float) -> str:
         return self.literal(flt)
+
+    def _refuse(self, expr: sp.Expr) -> str:
+        raise NonFiniteLiteral(f"the constant {expr} is not finite in C {self.precision}: "
+                               "it cannot be printed")
+
+    _print_Infinity = _print_NegativeInfinity = _print_ComplexInfinity = _print_NaN = _refuse
 
     def _print_NumberSymbol(self, expr: sp.Expr) -> str:
         return self.literal(expr)

@@ -37,6 +37,7 @@ from typing import Any
 import sympy as sp
 
 from ..algebraic import S, X
+from ..errors import NonFiniteLiteral
 from ..newton_start import FarStart
 from ..parsing import PHI
 from ..plan_ir import Algebraic, Branch, ClosedAngle, Constant, EvaluationPlan, NewtonAngle, PrecisionPlan
@@ -97,12 +98,20 @@ class FunctionWriter:
     def c(self, expr: sp.Expr) -> str:
         return str(self.printer.doprint(expr))
 
+    def named(self, name: str, value: sp.Expr) -> str:
+        """``value`` as C; a non-finite constant is refused naming the variable it was for."""
+        try:
+            return self.c(value)
+        except NonFiniteLiteral as error:
+            message = f"cannot emit {name} of {self.header} in {self.precision}: {error}"
+            raise NonFiniteLiteral(message) from None
+
     def let(self, name: str, value: sp.Expr) -> Statement:
-        return {"kind": "let", "type": self.ctype, "name": name, "value": self.c(value),
+        return {"kind": "let", "type": self.ctype, "name": name, "value": self.named(name, value),
                 "ops": sp.count_ops(value)}
 
     def set(self, name: str, value: sp.Expr | str, ops: int | None = None) -> Statement:
-        text = value if isinstance(value, str) else self.c(value)
+        text = value if isinstance(value, str) else self.named(name, value)
         count = ops if ops is not None else (0 if isinstance(value, str) else sp.count_ops(value))
         return {"kind": "set", "name": name, "value": text, "ops": count}
 
@@ -165,11 +174,12 @@ class FunctionWriter:
                 "signature": f"{t} {self.complement_helper}(const {t} p[3])", "statements": statements,
                 "batch_signature": None, "output": None}
 
-    def out_of_range(self) -> sp.Expr:
-        """The C condition (as text) under which every output is NaN."""
+    def out_of_range(self, x: str = "x") -> str:
+        """The C condition (as text) on the squared norm ``x`` under which every output is NaN: the
+        one validity test of every function, also applied to the results of the operations."""
         if math.isfinite(self.plan.p_max):
-            return f"!(x {self.inside_operator} {self.printer.literal(self.bound)})"
-        return f"!(x < {self.printer.literal(sp.Float(self.precision_plan.x_limit))})"
+            return f"!({x} {self.inside_operator} {self.printer.literal(self.bound)})"
+        return f"!({x} < {self.printer.literal(sp.Float(self.precision_plan.x_limit))})"
 
     # -- φ ---------------------------------------------------------------------------------------
     def branch_value(self, branch: Branch, variable: sp.Symbol, target: str) -> Statement:

@@ -36,7 +36,7 @@ from ..plan import (
     S,
     evaluation_plan,
 )
-from ..quaternion_plan import E0, QuaternionScale
+from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 from .templating import render
 
 TENSORS = ("R", "H", "H_inverse", "G", "K")
@@ -101,7 +101,7 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
         closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
     if closed.has(PHI):
         lines.append(f"    phi = {phi}[big]")
-    for symbol in (S, D, SIN_HALF, COS_HALF):
+    for symbol in (X, S, D, SIN_HALF, COS_HALF):  # a closed form in x too (e.g. 2000/(x + 1))
         if closed.has(symbol):
             lines.append(f"    {symbol} = {symbol}[big]")
     closed = closed.subs(PHI, sp.Symbol("phi"))
@@ -174,6 +174,8 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
                         for label, precision in plan.precisions.items()},
             "x_limit_power": {SUFFIX[label]: math.frexp(precision.x_limit)[1] - 1
                               for label, precision in plan.precisions.items()},
+            "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
+                                         for label in plan.precisions},
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()}}
 
