@@ -64,8 +64,13 @@ def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mappin
         digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
         with mpmath.workdps(digits):
             s_exact = mpmath.sqrt(mpmath.mpf(x))
-            phi = angle_of(s_exact)
-            values = {name: function(phi) for name, function in exact.items()}
+            try:
+                phi = angle_of(s_exact)
+                values = {name: function(phi) for name, function in exact.items()}
+            except (ZeroDivisionError, ValueError, OverflowError):
+                # φ is indistinguishable from the pole at this precision (p ~ e^(1/(φ_max − φ)),
+                # e.g. atanh): nothing beyond can be verified, so the domain ends here
+                return 2.0 ** (k - 1) if k > FIRST_POWER else 2.0**FIRST_POWER
             arguments = (dtype(x), dtype(float(phi)), dtype(float(s_exact)),
                          dtype(complement - x if math.isfinite(complement) else 0.0))
             for name, model in models.items():

@@ -40,3 +40,11 @@ def test_user_function_angle_keeps_relative_accuracy_down_to_1e_300() -> None:
     assert np.all(np.abs(got - exact) <= 2 * np.finfo(float).eps * np.abs(exact))
     # SymPy's inverse of sinh cancels for small s: the measured plan takes the Newton angle
     assert all(isinstance(p.angle, NewtonAngle) for p in plan.precisions.values())
+
+
+def test_a_pole_where_p_grows_exponentially_ends_the_domain_instead_of_failing() -> None:
+    """p = 4 atanh(φ/4) → ∞ at φ = 4 like e^(1/(4 − φ)): the domain sweep cannot resolve φ next to
+    the pole at any fixed precision and must end the domain there (it raised ZeroDivisionError)."""
+    plan = evaluation_plan(derive("4*atanh(phi/4)").derivation, "atanh_user")
+    for precision in plan.precisions.values():
+        assert 2.0**32 <= precision.x_limit <= 2.0**600
