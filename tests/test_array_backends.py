@@ -149,7 +149,10 @@ def _sample(dtype: type) -> np.ndarray:
 def test_values_equal_the_numpy_module(adapter: Adapter, dtype: type) -> None:
     p = _sample(dtype)
     worst = {}
-    for name in NAMED:
+    # JAX runs eagerly here (a jit per module costs more than it saves): float32 on a sample
+    sampled = (adapter.kind, dtype) == ("jax", np.float32)
+    names = ("det_h_one", "sine_m4", "wiener_milenkovic") if sampled else NAMED
+    for name in names:
         reference, module = generated("numpy", name), generated(adapter.kind, name)
         values = adapter.values(module, p)
         for function in FUNCTIONS:
@@ -163,14 +166,14 @@ def test_values_equal_the_numpy_module(adapter: Adapter, dtype: type) -> None:
             scale = np.maximum(np.nan_to_num(scale), np.finfo(dtype).tiny)
             error = np.nan_to_num(np.abs(value.astype(np.float64) - expected) / (scale * np.finfo(dtype).eps))
             worst[name, function] = float(np.max(error))
-    print(adapter.kind, dtype, sorted(worst.items(), key=lambda kv: -kv[1])[:6])
     assert max(worst.values()) <= 6.0, {k: v for k, v in worst.items() if v > 6.0}
 
 
 def test_outside_the_range_is_nan(adapter: Adapter) -> None:
     module = generated(adapter.kind, "euler_rodrigues")  # |p| < 2
     p = np.array([[2.5, 0.0, 0.0], [np.nan, 0.0, 0.0], [0.1, 0.2, 0.3]])
-    for function in ("angle", "rotation_matrix", "tangent", "rotation_derivative"):
+    functions = ("angle", "rotation_matrix", "tangent", "rotation_derivative")
+    for function in functions[:2] if adapter.kind == "jax" else functions:  # JAX: eager op compiles
         args = (adapter.array(p), adapter.array(np.ones_like(p))) if function.endswith("derivative") else (
             adapter.array(p),)
         value = adapter.numpy(getattr(module, function)(*args))
@@ -251,9 +254,10 @@ def _bundle(adapter: Adapter, module: ModuleType) -> Callable[[Any], dict[str, A
     return adapter._compiled[key]
 
 
-JAX_SAMPLE = ("det_h_one", "sine_m4")
-"""JAX compiles each module for seconds: it is checked on a sample (eq 35's Newton angle, the fold
-complement of the sine family), PyTorch on every case."""
+JAX_SAMPLE = ("sine_m4",)
+"""JAX compiles each module for seconds (eq 35's, with its unrolled Newton iterations, ~30 s under
+forward-over-reverse): it is checked on the sine family (fold complement), its Newton angle's
+implicit derivative by test_newton_angle_derivative_is_implicit; PyTorch on every case."""
 
 
 @pytest.mark.parametrize(("source", "key"), _cases())
@@ -309,11 +313,12 @@ def test_identity_gradient_is_the_exact_cross_form(adapter: Adapter, name: str) 
 
 
 def test_every_function_has_finite_gradients_at_the_identity(adapter: Adapter) -> None:
-    module = generated(adapter.kind, "det_h_one")
     names = ("angle", "tangent", "tangent_inverse", "tangent_det", "root_matrix", "root_tangent",
              "to_quaternion", "rescale")
+    module = generated(adapter.kind, "det_h_one")
     if adapter.kind == "jax":  # compile time: the functions with their own safe-where code paths
         names = ("angle", "tangent_det", "to_quaternion", "rescale")
+        module = generated(adapter.kind, "sine_m4")
     jacobian = adapter.fw.jacrev if adapter.kind == "jax" else adapter.fw.func.jacrev
 
     def every(p: Any) -> tuple[Any, ...]:
