@@ -9,7 +9,7 @@ Validity: |p| < 3.3530783864394875 (|phi| < 6.283185307179586); outside it every
 Branch-free and traceable: every branch of the plan is evaluated on all lanes and selected with
 where, each side on safe arguments, so values and derivatives of every order are finite inside the
 validity range, p = 0 included (the Taylor side is exact there); no shape depends on data and
-nothing synchronizes with the host, so the functions work under torch.compile and torch.func.vmap, grad, jacrev and jacfwd.
+nothing synchronizes with the host, so the functions work under torch.func.vmap, grad, jacrev and jacfwd.
 The angle has no closed inverse: a safeguarded Newton iteration with a fixed count gives phi, and
 its derivative is the implicit one, dphi/d|p| = 1/p'(phi) (a torch.autograd.Function).
 

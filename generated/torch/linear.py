@@ -9,7 +9,7 @@ Validity: |p| < 1.0 (|phi| < 1.5707963267948966); outside it every output is NaN
 Branch-free and traceable: every branch of the plan is evaluated on all lanes and selected with
 where, each side on safe arguments, so values and derivatives of every order are finite inside the
 validity range, p = 0 included (the Taylor side is exact there); no shape depends on data and
-nothing synchronizes with the host, so the functions work under torch.compile and torch.func.vmap, grad, jacrev and jacfwd.
+nothing synchronizes with the host, so the functions work under torch.func.vmap, grad, jacrev and jacfwd.
 
 angle(p) -> phi; rotation_matrix(p) -> R (eq 16); tangent(p) -> H, omega = H pdot (eq 20);
 tangent_inverse(p) -> H^-1 (eq 26); tangent_det(p) -> det H (eq 24); root_matrix(p) -> G (eq 81);
