@@ -5,8 +5,8 @@ a safeguarded mpmath Newton iteration) and the definitions of Bauchau & Trainell
 
 * R from eq (1), R = I + sin φ (n×) + 2 sin²(φ/2) (n×)², and ∂R/∂p_k by the chain rule, with
   ∂φ/∂p = n / p′(φ) (implicit function theorem) and ∂n/∂p_k = (e_k − n n_k)/|p|;
-* H from its definition (eq 20 with eq 9): column i = axial((∂R/∂p_i) Rᵀ);
-* second derivatives (of R) and first derivatives of H by a central difference of those analytic
+* H from its definition (eq 20 with eq 9): column i = axial((∂R/∂p_i) Rᵀ), H⁻¹ by mpmath;
+* second derivatives (of R) and first derivatives of H and H⁻¹ by a central difference of those analytic
   first derivatives, with a step 10⁻⁽ᵈ⁺¹⁰⁾ max(|p|, 1) at 2d + 30 digits (they are smooth in p);
 * ∂φ/∂p = φ′ n and ∂²φ/∂p² = φ″ n nᵀ + (φ′/|p|)(I − n nᵀ), φ′ = 1/p′(φ), φ″ = −p″(φ) φ′³.
 
@@ -103,6 +103,11 @@ class AutodiffReference:
     def tangent_jacobian(self, p: Sequence[float]) -> np.ndarray:
         """∂H_ab/∂p_j as an array (3, 3, 3) indexed [a, b, j]."""
         blocks = self._difference(self._tangent, p)
+        return np.array([[[float(blocks[j][a, b]) for j in range(3)] for b in range(3)] for a in range(3)])
+
+    def tangent_inverse_jacobian(self, p: Sequence[float]) -> np.ndarray:
+        """∂(H⁻¹)_ab/∂p_j as an array (3, 3, 3) indexed [a, b, j]."""
+        blocks = self._difference(lambda q: mpmath.inverse(self._tangent(q)), p)
         return np.array([[[float(blocks[j][a, b]) for j in range(3)] for b in range(3)] for a in range(3)])
 
     def angle_derivatives(self, p: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
