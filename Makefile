@@ -33,8 +33,10 @@ setup-bench: ## Install the benchmark peer SymForce in a venv (SYMFORCE_VENV, de
 	test -x $(SYMFORCE_VENV)/bin/python || $(PYTHON) -m venv $(SYMFORCE_VENV)
 	$(SYMFORCE_VENV)/bin/pip install -q symforce
 
-setup-python: ## pip install symrot in editable mode with its dev extras
+setup-python: ## pip install symrot in editable mode with its dev extras, CPU PyTorch and JAX
 	$(PIP) install -q -e '.[dev]'
+	$(PIP) install -q torch==2.13.0
+	$(PIP) install -q -e '.[dev,jax,torch]'
 
 test: lint typecheck pytest check-generated ## ruff, mypy, the test suite and the generated-code check
 

@@ -81,6 +81,24 @@ def numpy_modules() -> dict[str, str | bytes]:
             for name in NAMED}
 
 
+def _array_modules(framework: str) -> dict[str, str | bytes]:
+    from .backends.array_backend import module_source
+    from .plan import evaluation_plan
+
+    return {f"{framework}/{name}.py": module_source(evaluation_plan(derive(name).derivation, name), framework)
+            for name in NAMED}
+
+
+def jax_modules() -> dict[str, str | bytes]:
+    """generated/jax/NAME.py: the JAX kernels of every named parameterization."""
+    return _array_modules("jax")
+
+
+def torch_modules() -> dict[str, str | bytes]:
+    """generated/torch/NAME.py: the PyTorch kernels of every named parameterization."""
+    return _array_modules("torch")
+
+
 def c_headers() -> dict[str, str | bytes]:
     """generated/c/symrot_NAME.h: the C99 headers (Table 1, eq 35, sine/tangent m <= 6)."""
     from .backends.c_backend import generated_headers
@@ -92,7 +110,8 @@ def producers() -> list[tuple[str, Producer]]:
     """All producers, by the path prefix they own. Backends add theirs here."""
     return [("derivations/", derivation_json), ("latex/", latex_documents),
             ("renderings/", renderings), ("figures/", figures),
-            ("numpy/", numpy_modules), ("c/", c_headers)]
+            ("numpy/", numpy_modules), ("c/", c_headers),
+            ("jax/", jax_modules), ("torch/", torch_modules)]
 
 
 def render(only: str | None = None) -> dict[str, Content]:

@@ -16,7 +16,9 @@ from ..errors import SymrotError
 
 Emitter = Callable[[Any, str, Path], list[Path]]
 EMITTERS: dict[str, str] = {"numpy": "symrot.backends.numpy_backend:emit",
-                            "c": "symrot.backends.c_backend:emit"}
+                            "c": "symrot.backends.c_backend:emit",
+                            "jax": "symrot.backends.jax_backend:emit",
+                            "torch": "symrot.backends.torch_backend:emit"}
 """name → "module:function"; backends append here (e.g. "c": "symrot.backends.c_backend:emit")."""
 
 

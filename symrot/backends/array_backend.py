@@ -1,0 +1,260 @@
+"""Array-framework backends (JAX, PyTorch): print an ``EvaluationPlan`` as a branch-free module.
+
+One printer and one template (``symrot/templates/array_module.py.j2``) serve both frameworks; the
+thin adapters :mod:`symrot.backends.jax_backend` and :mod:`symrot.backends.torch_backend` only
+choose the framework's prelude.  Unlike the NumPy module, which evaluates each branch on its own
+lanes, every ``Branch`` here is evaluated on all lanes and selected with ``where``, each side on
+*safe* arguments (the "double where"): the Horner polynomial sees t = 0 where the closed form
+applies, the closed form sees the branch's own switch (``safe_phi`` and the t at it) where the
+polynomial applies, so that neither the value nor any derivative of the unused side is NaN or
+infinite.  Shapes never depend on data, nothing is synchronized with the host, and the Newton
+angle has a fixed iteration count whose derivative comes from the implicit function theorem
+(dφ/ds = 1/p′(φ)), not from differentiating through the iterations.
+
+The switch of every branch is ``Branch.threshold`` (the C backend's, with its longer polynomial):
+both sides are evaluated anyway, so the polynomial costs next to nothing, and it keeps the closed
+form away from small φ, where the derivatives of its cancelling terms lose digits (R″ at φ = 1e-3
+was 1200 ulp off with NumPy's smaller switch).  The closed form's safe arguments are its values at
+that switch (``safe_phi``), where it is accurate and finite.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import mpmath
+import sympy as sp
+
+from ..algebraic import D, X
+from ..newton_start import FarStart
+from ..parsing import PHI
+from ..plan import (
+    Algebraic,
+    Branch,
+    ClosedAngle,
+    Constant,
+    EvaluationPlan,
+    NewtonAngle,
+    S,
+    evaluation_plan,
+)
+from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
+from .numpy_backend import SUFFIX, print_expression, uses_phi
+from .templating import render
+
+FRAMEWORKS = ("jax", "torch")
+
+# NumPy names of the printed functions → the module's own (defined per framework in the prelude)
+_FUNCTIONS = {
+    "sin": "_xp.sin", "cos": "_xp.cos", "tan": "_xp.tan", "sqrt": "_xp.sqrt", "exp": "_xp.exp",
+    "log": "_xp.log", "sinh": "_xp.sinh", "cosh": "_xp.cosh", "tanh": "_xp.tanh",
+    "arcsin": "_xp.asin", "arccos": "_xp.acos", "arctan": "_xp.atan", "arcsinh": "_xp.asinh",
+    "arccosh": "_xp.acosh", "arctanh": "_xp.atanh", "log1p": "_xp.log1p", "expm1": "_xp.expm1",
+    "arctan2": "_atan2", "cbrt": "_cbrt", "sign": "_xp.sign",
+}
+
+SIN_HALF = sp.Symbol("sin_half")
+COS_HALF = sp.Symbol("cos_half")
+
+
+class UnsupportedExpression(ValueError):
+    """A plan expression uses a function the array backends cannot print."""
+
+
+def _numeric_constants(expr: sp.Expr) -> sp.Expr:
+    """Every constant subexpression (sqrt(2), pi, …) as a 20-digit float: the printed code applies
+    framework functions only to arrays (torch.sqrt(2) is an error)."""
+    def is_constant(e: Any) -> bool:
+        return bool(isinstance(e, sp.Expr) and not e.is_Rational and not e.free_symbols and e.is_number)
+    return expr.replace(is_constant, lambda e: sp.Float(sp.N(e, 20), 20))
+
+
+def print_array(expr: sp.Expr) -> str:
+    """``expr`` as code for the array module: NumPy's printing with framework-neutral names."""
+    text = print_expression(_numeric_constants(expr))
+
+    def rename(match: re.Match[str]) -> str:
+        name = match.group(1)
+        if name not in _FUNCTIONS:
+            raise UnsupportedExpression(f"numpy.{name} has no JAX/PyTorch counterpart here")
+        return _FUNCTIONS[name]
+
+    return re.sub(r"numpy\.(\w+)", rename, text)
+
+
+def _literal(value: Any) -> str:
+    return repr(float(value))
+
+
+def _mp_float(expression: Any) -> str:
+    """A constant computed with mpmath (deterministic on every machine, unlike libm)."""
+    with mpmath.workdps(40):
+        return repr(float(expression))
+
+
+def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
+                 half_angles: bool = False) -> list[str]:
+    """Statements returning the Branch value from ``variable`` (t) and the state, branch-free.
+
+    Polynomial below ``branch.threshold`` on t (t replaced by 0 above it), closed form above it on
+    the state with the switch's own values substituted below it (double where)."""
+    switch, horner = branch.threshold, branch.horner
+    threshold = switch
+    lines = [f"small = {variable} < {switch!r}"]
+    if len(horner) > 1:
+        lines.append(f"t = _where(small, {variable}, 0.0)")
+    lines.append(f"series = {_literal(horner[-1])} + 0.0 * {variable}")
+    for c in reversed(horner[:-1]):
+        lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
+    closed = branch.closed
+    if half_angles:
+        closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
+    safe_phi = mpmath.mpf(branch.safe_phi)
+    safe = {PHI: _literal(safe_phi), S: _mp_float(mpmath.sqrt(threshold)), X: _literal(threshold),
+            SIN_HALF: _mp_float(mpmath.sin(safe_phi / 2)), COS_HALF: _mp_float(mpmath.cos(safe_phi / 2))}
+    if complement is not None:
+        safe[D] = _mp_float(mpmath.mpf(sp.Float(complement, 40)._to_mpmath(140)) - threshold)
+    names = {PHI: "phi", S: "s", X: "x", D: "d", SIN_HALF: "sin_half", COS_HALF: "cos_half"}
+    if variable != "x" and closed.has(X, S, D):
+        raise UnsupportedExpression(f"a branch in {variable} has a closed form in x: {closed}")
+    for symbol, value in safe.items():
+        if closed.has(symbol):
+            lines.append(f"{names[symbol]} = _where(small, {value}, {names[symbol]})")
+    closed = closed.subs(PHI, sp.Symbol("phi"))
+    replacements, (reduced,) = sp.cse([closed], symbols=sp.numbered_symbols("w"))
+    for symbol, value in replacements:
+        lines.append(f"{symbol} = {print_array(value)}")
+    lines.append(f"closed = {print_array(reduced)}")
+    lines.append("return _where(small, series, closed)")
+    return lines
+
+
+def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
+    """The fixed-count safeguarded Newton iteration φ(s) (its derivative is the module's)."""
+    start_lines = [f"start = {_literal(angle.start[-1])} + 0.0 * s"]
+    start_lines += [f"start = {_literal(c)} + s2 * start" for c in reversed(angle.start[:-1])]
+    far = angle.far
+    far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", "b1 = 0.0 * y", "b2 = 0.0 * y"]
+    far_lines += [f"b1, b2 = {c!r} + 2.0 * y * b1 - b2, b1" for c in far.chebyshev[:0:-1]]
+    far_lines.append(f"far = {far.chebyshev[0]!r} + y * b1 - b2")
+    return [
+        "s2 = s * s",
+        *start_lines,
+        *far_lines,
+        f"phi = _where(s < {far.switch!r}, s * start, far)",
+        f"phi = _xp.clip(phi, 0.0, {angle.phi_max!r})",
+        "low = 0.0 * s",
+        f"high = low + {angle.phi_max!r}",
+        f"for _ in range({angle.iterations}):",
+        f"    residual = phi * _ratio_{suffix}(phi * phi, phi) - s",
+        "    high = _where(residual > 0, phi, high)",
+        "    low = _where(residual <= 0, phi, low)",
+        f"    slope = _slope_{suffix}(phi * phi, phi)",
+        "    safe = slope > 0",
+        "    step = phi - residual / _where(safe, slope, 1.0)",
+        "    inside = safe & (step >= low) & (step <= high)",
+        "    phi = _where(inside, step, 0.5 * (low + high))",
+        "return phi",
+    ]
+
+
+def _far_variable(far: FarStart) -> str:
+    if far.kind == "fold":
+        inner = f"_xp.clip(1.0 - s / {far.scale!r}, 0.0, None)"
+        root = {2: f"_xp.sqrt({inner})", 3: f"_cbrt({inner})"}.get(
+            far.order, f"{inner} ** {1 / far.order!r}")
+        return f"1.0 - {root}"
+    if far.kind == "linear":
+        return f"_xp.clip(s / {far.scale!r}, None, 1.0)"
+    return f"s / (s + {far.scale!r})"
+
+
+def _coefficient_lines(coefficient: Any, suffix: str, complement: sp.Rational | None) -> list[str]:
+    if isinstance(coefficient, Constant):
+        return [f"return _xp.full_like(x, {_literal(coefficient.value)})"]
+    if isinstance(coefficient, Algebraic):
+        expression = coefficient.expression.subs(X, sp.Symbol("x"))
+        # float32: float64 intermediates where the framework has them ((x + 16)**4 overflows)
+        body = ["x = _wide(x)"] if suffix == "32" else []
+        if expression.has(D) and suffix == "32":
+            body.append("d = _wide(d)")
+        value = print_array(expression)
+        if not expression.has(X):
+            value = f"({value}) + 0.0 * x"
+        body.append(f"return _narrow({value}, s)" if suffix == "32" else f"return {value}")
+        return body
+    return branch_lines(coefficient, "x", complement, half_angles=True)
+
+
+def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
+    """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.quaternion_plan)."""
+    if scale.algebraic is not None:
+        expression = scale.algebraic.subs(E0, sp.Symbol("e0"))
+        lines = ["e0 = _wide(e0)"] if suffix == "32" else []
+        value = f"({print_array(expression)}) + 0.0 * e0"
+        return [*lines, f"return _narrow({value}, e_norm)" if suffix == "32" else f"return {value}"]
+    assert isinstance(scale.branch, Branch)
+    return ["phi = 2.0 * _atan2(e_norm, e0)", "t = phi * phi", *branch_lines(scale.branch, "t", None)]
+
+
+def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
+    if framework not in FRAMEWORKS:
+        raise ValueError(f"unknown framework {framework!r}")
+    functions: list[dict[str, Any]] = []
+    newton: list[str] = []
+    closed_angles: dict[str, list[str]] = {}
+    for label, precision in plan.precisions.items():
+        suffix = SUFFIX[label]
+        for name, coefficient in precision.coefficients.items():
+            functions.append({"name": f"_{name}_{suffix}", "args": "x, phi, s, d, sin_half, cos_half",
+                              "body": _coefficient_lines(coefficient, suffix, plan.complement)})
+        angle = precision.angle
+        if isinstance(angle, NewtonAngle):
+            for helper, branch in (("_ratio", angle.ratio), ("_slope", angle.slope)):
+                functions.append({"name": f"{helper}_{suffix}", "args": "t, phi",
+                                  "body": branch_lines(branch, "t", None)})
+            functions.append({"name": f"_newton_{suffix}", "args": "s",
+                              "body": newton_lines(angle, suffix)})
+            newton.append(suffix)
+        else:
+            assert isinstance(angle, ClosedAngle)
+            expression = angle.expression.subs(S, sp.Symbol("s"))
+            closed_angles[suffix] = [f"return {print_array(expression)} + 0.0 * s"]
+        functions.append({"name": f"_scale_{suffix}", "args": "e0, e_norm",
+                          "body": _scale_lines(precision.quaternion_scale, suffix)})
+    squared, inclusive = plan.boundary(53)
+    finite_p_max = math.isfinite(plan.p_max)
+    return {"framework": framework, "name": plan.name, "p_text": str(plan.p), "functions": functions,
+            "newton": newton, "closed_angles": closed_angles,
+            "names": list(plan.precisions["float64"].coefficients),
+            "e0_min": repr(plan.e0_min) if plan.e0_min is not None else None,
+            "p_max": repr(plan.p_max) if finite_p_max else None, "phi_max": repr(plan.phi_max),
+            "complement": str(plan.complement) if plan.complement is not None else None,
+            "p_max_squared": repr(squared) if math.isfinite(squared) else "math.inf",
+            "inclusive": inclusive,
+            "x_limit": {SUFFIX[label]: repr(precision.x_limit)
+                        for label, precision in plan.precisions.items()},
+            "x_limit_power": {SUFFIX[label]: math.frexp(precision.x_limit)[1] - 1
+                              for label, precision in plan.precisions.items()},
+            "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
+                                         for label in plan.precisions},
+            "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
+                         for label, precision in plan.precisions.items()}}
+
+
+def module_source(plan: EvaluationPlan, framework: str) -> str:
+    source = render("array_module.py.j2", **module_context(plan, framework))
+    if any(len(line) > 110 for line in source.splitlines()):
+        source = "# ruff: noqa: E501  (printed closed forms exceed the line length)\n" + source
+    return source
+
+
+def emit_framework(derivation: Any, name: str, out: Path, framework: str) -> list[Path]:
+    """Write ``out/NAME.py`` for ``framework``; return the written paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{name}.py"
+    path.write_text(module_source(evaluation_plan(derivation, name), framework), encoding="utf-8")
+    return [path]
