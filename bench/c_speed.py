@@ -40,7 +40,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from symrot.api import derive
+from symrot.api import derive, validity_dict
 from symrot.functions import mpmath_namespace
 from symrot.parsing import PHI
 
@@ -99,8 +99,11 @@ def c_source(names: list[str]) -> tuple[str, list[tuple[str, str, str, str]]]:
     """The C benchmark translation unit and its timers (symbol, parameterization, label, precision)."""
     lines = ["#define _POSIX_C_SOURCE 199309L", "#include <time.h>", "#include <stddef.h>",
              f'#include "{TEXTBOOK}"',
-             "void batch_floor(size_t n, const double *p, double *out) { size_t i, k; "
-             "for (i = 0; i < n; ++i) for (k = 0; k < 9; ++k) out[9*i + k] = p[3*i + k % 3]; }"]
+             # the memory floor: read p and write the 9 outputs, nothing computed
+             "void batch_floor(size_t n, const double *p, double *out) { size_t i; "
+             "for (i = 0; i < n; ++i) { const double a = p[3*i], b = p[3*i+1], c = p[3*i+2]; "
+             "double *o = out + 9*i; o[0] = a; o[1] = b; o[2] = c; o[3] = a; o[4] = b; o[5] = c; "
+             "o[6] = a; o[7] = b; o[8] = c; } }"]
     lines += [f'#include "symrot_{name}.h"' for name in names]
     timers = []
     for name in names:
@@ -205,7 +208,7 @@ def random_pool(name: str, n: int, rng: np.random.Generator, mix: str) -> np.nda
     (capped at 2π), shrunk by 1e-9 relative so that p(φ) stays inside the range when rounded."""
     result = derive(name)
     p_of_phi = sp.lambdify(PHI, result.derivation.p, modules=[mpmath_namespace(), "mpmath"])
-    limit = min(float(result.phi_max_float), 2 * np.pi) * (1 - 1e-9)
+    limit = min(float(validity_dict(result.derivation)["phi_max_float"]), 2 * np.pi) * (1 - 1e-9)
     angles = rng.uniform(0.0, limit, n) if mix == "uniform" else \
         np.exp(rng.uniform(np.log(1e-6), np.log(limit), n))
     magnitudes = np.array([float(p_of_phi(mpmath.mpf(float(a)))) for a in angles])
@@ -443,7 +446,7 @@ def write_section(text: str) -> None:
     if SECTION in old:
         start = old.index(SECTION)
         following = old.find("\n## ", start + len(SECTION))
-        new = old[:start] + text + (old[following + 1:] if following >= 0 else "")
+        new = old[:start] + text + ("\n" + old[following + 1:] if following >= 0 else "")
     else:
         new = old.rstrip("\n") + "\n\n" + text
     DOC.write_text(new, encoding="utf-8")
