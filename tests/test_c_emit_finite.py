@@ -102,8 +102,10 @@ def test_numpy_float32_tangent_of_a_small_scale_is_finite_inside_the_range(tmp_p
 @pytest.mark.slow
 def test_numpy_closed_form_in_x_on_mixed_batches(tmp_path: Path) -> None:
     """tan(phi/20): some branches' closed forms are algebraic in x (e.g. 20/(x + 1)); in a batch with
-    lanes on both sides of the switch the closed form must see x of its own lanes only (it raised
-    "cannot assign 400 input values to the 134 output values" for cayley_m1000)."""
+    lanes on both sides of the switch the closed form must see x of the lanes it is assigned to (it
+    raised "cannot assign 400 input values to the 134 output values" for cayley_m1000). The closed
+    form now runs on every lane of the block and the polynomial overwrites the lanes below the
+    switch (issue 21), so both see whole arrays."""
     import importlib.util
 
     import numpy as np
@@ -112,7 +114,7 @@ def test_numpy_closed_form_in_x_on_mixed_batches(tmp_path: Path) -> None:
 
     path = tmp_path / "t20.py"
     path.write_text(module_source(evaluation_plan(derive("tan(phi/20)").derivation, "t20")), encoding="utf-8")
-    assert "x = x[big]" in path.read_text(encoding="utf-8")
+    assert "out[small] = series" in path.read_text(encoding="utf-8")
     spec = importlib.util.spec_from_file_location("symrot_t20", path)
     assert spec and spec.loader
     module = importlib.util.module_from_spec(spec)

@@ -40,10 +40,14 @@ extern "C" {
 /* symrot_euler_rodrigues__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline double symrot_euler_rodrigues__complement(const double p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline double symrot_euler_rodrigues__complement(const double p[3], double x)
 {
+    if (x <= 1.0) {
+        return 4.0 - x;
+    }
     double high = 4.0, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -72,7 +76,7 @@ static inline double symrot_euler_rodrigues__phi(double s, double d)
 static inline double symrot_euler_rodrigues_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         return (double)NAN;
     }
@@ -97,7 +101,7 @@ static inline double symrot_euler_rodrigues_angle(const double p[3])
 static inline void symrot_euler_rodrigues_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         R[0] = (double)NAN;
         R[1] = (double)NAN;
@@ -141,7 +145,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
             if (!(x < 4.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_euler_rodrigues__complement(pk);
+                const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -188,7 +192,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
 static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         H[0] = (double)NAN;
         H[1] = (double)NAN;
@@ -233,7 +237,7 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
             if (!(x < 4.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_euler_rodrigues__complement(pk);
+                const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -282,7 +286,7 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
 static inline void symrot_euler_rodrigues_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         Hinv[0] = (double)NAN;
         Hinv[1] = (double)NAN;
@@ -326,7 +330,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const 
             if (!(x < 4.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_euler_rodrigues__complement(pk);
+                const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -371,7 +375,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const 
 static inline double symrot_euler_rodrigues_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         return (double)NAN;
     }
@@ -388,7 +392,7 @@ static inline double symrot_euler_rodrigues_tangent_det(const double p[3])
 static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         G[0] = (double)NAN;
         G[1] = (double)NAN;
@@ -432,7 +436,7 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
             if (!(x < 4.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_euler_rodrigues__complement(pk);
+                const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -479,7 +483,7 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
 static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         K[0] = (double)NAN;
         K[1] = (double)NAN;
@@ -532,7 +536,7 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
-                const double d = symrot_euler_rodrigues__complement(pk);
+                const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = 1.0/sqrt(d);
                 const double u1 = sqrt(d);
                 u0_lanes[k] = u0;
@@ -591,7 +595,7 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
 static inline void symrot_euler_rodrigues_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         pdot[0] = (double)NAN;
         pdot[1] = (double)NAN;
@@ -616,7 +620,7 @@ static inline void symrot_euler_rodrigues_pdot(const double p[3], const double o
 static inline void symrot_euler_rodrigues_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         omega[0] = (double)NAN;
         omega[1] = (double)NAN;
@@ -641,7 +645,7 @@ static inline void symrot_euler_rodrigues_omega(const double p[3], const double 
 static inline void symrot_euler_rodrigues_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         e[0] = (double)NAN;
         e[1] = (double)NAN;
@@ -787,10 +791,14 @@ static inline int symrot_euler_rodrigues_rescale(const double p[3], double q[3])
 /* symrot_euler_rodrigues__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline float symrot_euler_rodrigues__complement_f(const float p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline float symrot_euler_rodrigues__complement_f(const float p[3], float x)
 {
+    if (x <= 1.0F) {
+        return 4.0F - x;
+    }
     float high = 4.0F, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -819,7 +827,7 @@ static inline float symrot_euler_rodrigues__phi_f(float s, float d)
 static inline float symrot_euler_rodrigues_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         return NAN;
     }
@@ -844,7 +852,7 @@ static inline float symrot_euler_rodrigues_angle_f(const float p[3])
 static inline void symrot_euler_rodrigues_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -888,7 +896,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
             if (!(x < 4.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -935,7 +943,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
 static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -980,7 +988,7 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
             if (!(x < 4.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1029,7 +1037,7 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
 static inline void symrot_euler_rodrigues_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -1073,7 +1081,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, cons
             if (!(x < 4.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1118,7 +1126,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, cons
 static inline float symrot_euler_rodrigues_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         return NAN;
     }
@@ -1135,7 +1143,7 @@ static inline float symrot_euler_rodrigues_tangent_det_f(const float p[3])
 static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -1179,7 +1187,7 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
             if (!(x < 4.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1226,7 +1234,7 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
 static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -1279,7 +1287,7 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
-                const float d = symrot_euler_rodrigues__complement_f(pk);
+                const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = 1.0F/sqrtf(d);
                 const float u1 = sqrtf(d);
                 u0_lanes[k] = u0;
@@ -1337,7 +1345,7 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
 static inline void symrot_euler_rodrigues_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
@@ -1362,7 +1370,7 @@ static inline void symrot_euler_rodrigues_pdot_f(const float p[3], const float o
 static inline void symrot_euler_rodrigues_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         omega[0] = NAN;
         omega[1] = NAN;
@@ -1387,7 +1395,7 @@ static inline void symrot_euler_rodrigues_omega_f(const float p[3], const float 
 static inline void symrot_euler_rodrigues_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         e[0] = NAN;
         e[1] = NAN;

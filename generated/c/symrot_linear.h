@@ -40,10 +40,14 @@ extern "C" {
 /* symrot_linear__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline double symrot_linear__complement(const double p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline double symrot_linear__complement(const double p[3], double x)
 {
+    if (x <= 0.25) {
+        return 1.0 - x;
+    }
     double high = 1.0, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -72,7 +76,7 @@ static inline double symrot_linear__phi(double s, double d)
 static inline double symrot_linear_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         return (double)NAN;
     }
@@ -97,7 +101,7 @@ static inline double symrot_linear_angle(const double p[3])
 static inline void symrot_linear_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         R[0] = (double)NAN;
         R[1] = (double)NAN;
@@ -141,7 +145,7 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
             if (!(x < 1.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_linear__complement(pk);
+                const double d = symrot_linear__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -188,7 +192,7 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
 static inline void symrot_linear_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         H[0] = (double)NAN;
         H[1] = (double)NAN;
@@ -241,7 +245,7 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
-                const double d = symrot_linear__complement(pk);
+                const double d = symrot_linear__complement(pk, x);
                 const double u0 = 1.0/sqrt(d);
                 const double u1 = sqrt(d);
                 u0_lanes[k] = u0;
@@ -301,7 +305,7 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
 static inline void symrot_linear_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         Hinv[0] = (double)NAN;
         Hinv[1] = (double)NAN;
@@ -346,7 +350,7 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
             if (!(x < 1.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_linear__complement(pk);
+                const double d = symrot_linear__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -393,7 +397,7 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
 static inline double symrot_linear_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         return (double)NAN;
     }
@@ -416,7 +420,7 @@ static inline double symrot_linear_tangent_det(const double p[3])
 static inline void symrot_linear_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         G[0] = (double)NAN;
         G[1] = (double)NAN;
@@ -471,7 +475,7 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_linear__complement(pk);
+                const double d = symrot_linear__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_linear__phi(s, d);
                 const double u0 = 1.0/sqrt(sqrt(d) + 1);
@@ -542,7 +546,7 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
 static inline void symrot_linear_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         K[0] = (double)NAN;
         K[1] = (double)NAN;
@@ -600,7 +604,7 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_linear__complement(pk);
+                const double d = symrot_linear__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_linear__phi(s, d);
                 const double u0 = 1.0/sqrt(d);
@@ -689,7 +693,7 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
 static inline void symrot_linear_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         pdot[0] = (double)NAN;
         pdot[1] = (double)NAN;
@@ -715,7 +719,7 @@ static inline void symrot_linear_pdot(const double p[3], const double omega[3], 
 static inline void symrot_linear_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         omega[0] = (double)NAN;
         omega[1] = (double)NAN;
@@ -747,7 +751,7 @@ static inline void symrot_linear_omega(const double p[3], const double pdot[3], 
 static inline void symrot_linear_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         e[0] = (double)NAN;
         e[1] = (double)NAN;
@@ -900,10 +904,14 @@ static inline int symrot_linear_rescale(const double p[3], double q[3])
 /* symrot_linear__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline float symrot_linear__complement_f(const float p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline float symrot_linear__complement_f(const float p[3], float x)
 {
+    if (x <= 0.25F) {
+        return 1.0F - x;
+    }
     float high = 1.0F, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -932,7 +940,7 @@ static inline float symrot_linear__phi_f(float s, float d)
 static inline float symrot_linear_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         return NAN;
     }
@@ -957,7 +965,7 @@ static inline float symrot_linear_angle_f(const float p[3])
 static inline void symrot_linear_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -1001,7 +1009,7 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
             if (!(x < 1.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_linear__complement_f(pk);
+                const float d = symrot_linear__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1048,7 +1056,7 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
 static inline void symrot_linear_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -1101,7 +1109,7 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
-                const float d = symrot_linear__complement_f(pk);
+                const float d = symrot_linear__complement_f(pk, x);
                 const float u0 = 1.0F/sqrtf(d);
                 const float u1 = sqrtf(d);
                 u0_lanes[k] = u0;
@@ -1160,7 +1168,7 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
 static inline void symrot_linear_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -1205,7 +1213,7 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
             if (!(x < 1.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_linear__complement_f(pk);
+                const float d = symrot_linear__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1252,7 +1260,7 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
 static inline float symrot_linear_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         return NAN;
     }
@@ -1275,7 +1283,7 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
 static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -1330,7 +1338,7 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_linear__complement_f(pk);
+                const float d = symrot_linear__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_linear__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(sqrtf(d) + 1);
@@ -1401,7 +1409,7 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
 static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -1459,7 +1467,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_linear__complement_f(pk);
+                const float d = symrot_linear__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_linear__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(d);
@@ -1548,7 +1556,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
 static inline void symrot_linear_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
@@ -1574,7 +1582,7 @@ static inline void symrot_linear_pdot_f(const float p[3], const float omega[3], 
 static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         omega[0] = NAN;
         omega[1] = NAN;
@@ -1606,7 +1614,7 @@ static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], 
 static inline void symrot_linear_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         e[0] = NAN;
         e[1] = NAN;

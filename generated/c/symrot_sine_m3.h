@@ -40,10 +40,14 @@ extern "C" {
 /* symrot_sine_m3__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline double symrot_sine_m3__complement(const double p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline double symrot_sine_m3__complement(const double p[3], double x)
 {
+    if (x <= 2.25) {
+        return 9.0 - x;
+    }
     double high = 9.0, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -72,7 +76,7 @@ static inline double symrot_sine_m3__phi(double s, double d)
 static inline double symrot_sine_m3_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         return (double)NAN;
     }
@@ -97,7 +101,7 @@ static inline double symrot_sine_m3_angle(const double p[3])
 static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         R[0] = (double)NAN;
         R[1] = (double)NAN;
@@ -151,7 +155,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m3__complement(pk);
+                const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
                 s_lanes[k] = s;
@@ -219,7 +223,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
 static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         H[0] = (double)NAN;
         H[1] = (double)NAN;
@@ -279,7 +283,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m3__complement(pk);
+                const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
                 const double u0 = 1.0/sqrt(d);
@@ -371,7 +375,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
 static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         Hinv[0] = (double)NAN;
         Hinv[1] = (double)NAN;
@@ -416,7 +420,7 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
             if (!(x < 9.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m3__complement(pk);
+                const double d = symrot_sine_m3__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -464,7 +468,7 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
 static inline double symrot_sine_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         return (double)NAN;
     }
@@ -488,7 +492,7 @@ static inline double symrot_sine_m3_tangent_det(const double p[3])
 static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         G[0] = (double)NAN;
         G[1] = (double)NAN;
@@ -543,7 +547,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m3__complement(pk);
+                const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
                 s_lanes[k] = s;
@@ -623,7 +627,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
 static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         K[0] = (double)NAN;
         K[1] = (double)NAN;
@@ -681,7 +685,7 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m3__complement(pk);
+                const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
                 const double u0 = 1.0/sqrt(d);
@@ -768,7 +772,7 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
 static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         pdot[0] = (double)NAN;
         pdot[1] = (double)NAN;
@@ -794,7 +798,7 @@ static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3],
 static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         omega[0] = (double)NAN;
         omega[1] = (double)NAN;
@@ -830,7 +834,7 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
 static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         e[0] = (double)NAN;
         e[1] = (double)NAN;
@@ -987,10 +991,14 @@ static inline int symrot_sine_m3_rescale(const double p[3], double q[3])
 /* symrot_sine_m3__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline float symrot_sine_m3__complement_f(const float p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline float symrot_sine_m3__complement_f(const float p[3], float x)
 {
+    if (x <= 2.25F) {
+        return 9.0F - x;
+    }
     float high = 9.0F, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -1019,7 +1027,7 @@ static inline float symrot_sine_m3__phi_f(float s, float d)
 static inline float symrot_sine_m3_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         return NAN;
     }
@@ -1044,7 +1052,7 @@ static inline float symrot_sine_m3_angle_f(const float p[3])
 static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -1098,7 +1106,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m3__complement_f(pk);
+                const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
                 s_lanes[k] = s;
@@ -1166,7 +1174,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
 static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -1224,7 +1232,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m3__complement_f(pk);
+                const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(d);
@@ -1322,7 +1330,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
 static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -1367,7 +1375,7 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
             if (!(x < 9.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m3__complement_f(pk);
+                const float d = symrot_sine_m3__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1415,7 +1423,7 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
 static inline float symrot_sine_m3_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         return NAN;
     }
@@ -1439,7 +1447,7 @@ static inline float symrot_sine_m3_tangent_det_f(const float p[3])
 static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -1495,7 +1503,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m3__complement_f(pk);
+                const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
                 s_lanes[k] = s;
@@ -1567,7 +1575,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
 static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -1626,7 +1634,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m3__complement_f(pk);
+                const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(d);
@@ -1705,7 +1713,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
 static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
@@ -1731,7 +1739,7 @@ static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3],
 static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         omega[0] = NAN;
         omega[1] = NAN;
@@ -1766,7 +1774,7 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
 static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         e[0] = NAN;
         e[1] = NAN;

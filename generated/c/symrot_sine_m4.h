@@ -40,10 +40,14 @@ extern "C" {
 /* symrot_sine_m4__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline double symrot_sine_m4__complement(const double p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline double symrot_sine_m4__complement(const double p[3], double x)
 {
+    if (x <= 4.0) {
+        return 16.0 - x;
+    }
     double high = 16.0, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -72,7 +76,7 @@ static inline double symrot_sine_m4__phi(double s, double d)
 static inline double symrot_sine_m4_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         return (double)NAN;
     }
@@ -97,7 +101,7 @@ static inline double symrot_sine_m4_angle(const double p[3])
 static inline void symrot_sine_m4_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         R[0] = (double)NAN;
         R[1] = (double)NAN;
@@ -143,7 +147,7 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
                 d_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m4__complement(pk);
+                const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = sqrt(d);
                 d_lanes[k] = d;
                 u0_lanes[k] = u0;
@@ -196,7 +200,7 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
 static inline void symrot_sine_m4_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         H[0] = (double)NAN;
         H[1] = (double)NAN;
@@ -243,7 +247,7 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
                 d_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m4__complement(pk);
+                const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = 1.0/sqrt(d);
                 d_lanes[k] = d;
                 u0_lanes[k] = u0;
@@ -298,7 +302,7 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
 static inline void symrot_sine_m4_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         Hinv[0] = (double)NAN;
         Hinv[1] = (double)NAN;
@@ -344,7 +348,7 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m4__complement(pk);
+                const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = sqrt(d);
                 const double u1 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
@@ -395,7 +399,7 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
 static inline double symrot_sine_m4_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         return (double)NAN;
     }
@@ -412,7 +416,7 @@ static inline double symrot_sine_m4_tangent_det(const double p[3])
 static inline void symrot_sine_m4_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         G[0] = (double)NAN;
         G[1] = (double)NAN;
@@ -456,7 +460,7 @@ static inline void symrot_sine_m4_root_matrix_batch(size_t n, const double *p, d
             if (!(x < 16.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m4__complement(pk);
+                const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -503,7 +507,7 @@ static inline void symrot_sine_m4_root_matrix_batch(size_t n, const double *p, d
 static inline void symrot_sine_m4_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         K[0] = (double)NAN;
         K[1] = (double)NAN;
@@ -548,7 +552,7 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
             if (!(x < 16.0)) {
                 u0_lanes[k] = 0;
             } else {
-                const double d = symrot_sine_m4__complement(pk);
+                const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
             }
@@ -597,7 +601,7 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
 static inline void symrot_sine_m4_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         pdot[0] = (double)NAN;
         pdot[1] = (double)NAN;
@@ -623,7 +627,7 @@ static inline void symrot_sine_m4_pdot(const double p[3], const double omega[3],
 static inline void symrot_sine_m4_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         omega[0] = (double)NAN;
         omega[1] = (double)NAN;
@@ -649,7 +653,7 @@ static inline void symrot_sine_m4_omega(const double p[3], const double pdot[3],
 static inline void symrot_sine_m4_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         e[0] = (double)NAN;
         e[1] = (double)NAN;
@@ -790,10 +794,14 @@ static inline int symrot_sine_m4_rescale(const double p[3], double q[3])
 /* symrot_sine_m4__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum).
- * ops: 31 */
-static inline float symrot_sine_m4__complement_f(const float p[3])
+ * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
+ * error from the rounding of x stays below one ulp of d.
+ * ops: 33 */
+static inline float symrot_sine_m4__complement_f(const float p[3], float x)
 {
+    if (x <= 4.0F) {
+        return 16.0F - x;
+    }
     float high = 16.0F, low = 0;
     int i;
     for (i = 0; i < 3; ++i) {
@@ -822,7 +830,7 @@ static inline float symrot_sine_m4__phi_f(float s, float d)
 static inline float symrot_sine_m4_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         return NAN;
     }
@@ -847,7 +855,7 @@ static inline float symrot_sine_m4_angle_f(const float p[3])
 static inline void symrot_sine_m4_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         R[0] = NAN;
         R[1] = NAN;
@@ -893,7 +901,7 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
                 d_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m4__complement_f(pk);
+                const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 d_lanes[k] = d;
                 u0_lanes[k] = u0;
@@ -946,7 +954,7 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
 static inline void symrot_sine_m4_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         H[0] = NAN;
         H[1] = NAN;
@@ -993,7 +1001,7 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
                 d_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m4__complement_f(pk);
+                const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = 1.0F/sqrtf(d);
                 d_lanes[k] = d;
                 u0_lanes[k] = u0;
@@ -1048,7 +1056,7 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
 static inline void symrot_sine_m4_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
@@ -1094,7 +1102,7 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m4__complement_f(pk);
+                const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 const float u1 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
@@ -1145,7 +1153,7 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
 static inline float symrot_sine_m4_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         return NAN;
     }
@@ -1162,7 +1170,7 @@ static inline float symrot_sine_m4_tangent_det_f(const float p[3])
 static inline void symrot_sine_m4_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         G[0] = NAN;
         G[1] = NAN;
@@ -1206,7 +1214,7 @@ static inline void symrot_sine_m4_root_matrix_f_batch(size_t n, const float *p, 
             if (!(x < 16.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m4__complement_f(pk);
+                const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1253,7 +1261,7 @@ static inline void symrot_sine_m4_root_matrix_f_batch(size_t n, const float *p, 
 static inline void symrot_sine_m4_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         K[0] = NAN;
         K[1] = NAN;
@@ -1298,7 +1306,7 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
             if (!(x < 16.0F)) {
                 u0_lanes[k] = 0;
             } else {
-                const float d = symrot_sine_m4__complement_f(pk);
+                const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
             }
@@ -1347,7 +1355,7 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
 static inline void symrot_sine_m4_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
@@ -1373,7 +1381,7 @@ static inline void symrot_sine_m4_pdot_f(const float p[3], const float omega[3],
 static inline void symrot_sine_m4_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         omega[0] = NAN;
         omega[1] = NAN;
@@ -1399,7 +1407,7 @@ static inline void symrot_sine_m4_omega_f(const float p[3], const float pdot[3],
 static inline void symrot_sine_m4_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         e[0] = NAN;
         e[1] = NAN;

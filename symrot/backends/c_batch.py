@@ -240,7 +240,7 @@ class BatchWriter:
         inside: list[Statement] = []
         if D in needs:
             inside.append({"kind": "let", "type": self.t, "name": "d",
-                           "value": f"{writer.complement_helper}(pk)"})
+                           "value": f"{writer.complement_helper}(pk, x)"})
         if S in needs:
             inside.append({"kind": "let", "type": self.t, "name": "s", "value": f"sqrt{self.f}(x)"})
         if PHI_SYMBOL in needs:

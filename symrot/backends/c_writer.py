@@ -137,7 +137,7 @@ class FunctionWriter:
         statements = [self.squared_norm()]
         if self.plan.complement is not None:
             statements.append({"kind": "let", "type": self.ctype, "name": "d",
-                               "value": f"{self.complement_helper}(p)", "ops": 20})
+                               "value": f"{self.complement_helper}(p, x)", "ops": 20})
         return statements
 
     @property
@@ -149,11 +149,17 @@ class FunctionWriter:
         return f"{self.angle_helper}({s_text}{extra})"
 
     def complement_function(self) -> dict[str, Any]:
-        """d = p_max² − |p|²: exact products (fma) and error-free sums (TwoSum), then one rounding."""
+        """d = p_max² − |p|²: for x ≤ p_max²/4 plainly (then x ≤ d/3, and the rounding error of x,
+        at most 3 units of roundoff of x, stays below one ulp of d), else with exact products (fma)
+        and error-free sums (TwoSum), then one rounding."""
         t = self.ctype
         fma = "fma" if t == "double" else "fmaf"
-        k2 = self.printer.literal(sp.Integer(self.plan.complement) if self.plan.complement is not None else 0)
-        statements: list[Statement] = [{"kind": "declare", "type": t, "names": [f"high = {k2}", "low = 0"]},
+        complement = sp.Integer(self.plan.complement) if self.plan.complement is not None else sp.Integer(0)
+        k2 = self.printer.literal(complement)
+        near = {"kind": "if", "condition": f"x <= {self.printer.literal(complement / 4)}",
+                "then": [{"kind": "return", "value": f"{k2} - x", "ops": 1}], "otherwise": [], "ops": 0}
+        statements: list[Statement] = [near,
+                                       {"kind": "declare", "type": t, "names": [f"high = {k2}", "low = 0"]},
                                        {"kind": "declare", "type": "int", "names": ["i"]}]
         body: list[Statement] = [
             {"kind": "let", "type": t, "name": "square", "value": "p[i] * p[i]", "ops": 1},
@@ -170,8 +176,9 @@ class FunctionWriter:
                 "equation": "31-32, 36", "ops": ops_of(statements),
                 "notes": ["Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2",
                           "rounded would leave no correct digit of p_max^2 - x (error-free products by",
-                          "fma, TwoSum)."],
-                "signature": f"{t} {self.complement_helper}(const {t} p[3])", "statements": statements,
+                          "fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose",
+                          "error from the rounding of x stays below one ulp of d."],
+                "signature": f"{t} {self.complement_helper}(const {t} p[3], {t} x)", "statements": statements,
                 "batch_signature": None, "output": None}
 
     def out_of_range(self, x: str = "x") -> str:

@@ -7,9 +7,12 @@ eq 24), ``root_matrix`` (G, eq 81), ``root_tangent`` (K, eq 83), ``pdot`` (ṗ =
 ``from_quaternion``, ``from_rotation_matrix``, ``compose`` (R(p3) = R(p2) R(p1)) and ``rescale``
 (eqs 18–19, 40–47, 61–65, 74–75).  float32 input is evaluated with the float32 plan, anything else
 as float64.  Outside the validity range |p| < p_max (|p|² < 2⁶⁰⁰ when p is unbounded) every output
-is NaN.  Tensors are evaluated in blocks of 16384 vectors (entry-major, then transposed), each
-coefficient's Horner polynomial and closed form only on the lanes where it applies, and
-sin(φ/2), cos(φ/2) once per block for all the coefficients that need them.
+is NaN.  Tensors are written in place into the (..., 3, 3) result: up to 64 vectors in one pass
+(entries gathered by index), more in blocks of 4096 (temporaries of 32 KiB, under glibc's mmap
+threshold).  A block whose lanes are all inside the range on one side of a coefficient's switch
+takes that branch on every lane; otherwise each coefficient's Horner polynomial and closed form
+run only on the lanes where they apply.  sin(φ/2), cos(φ/2) are computed once per block for all
+the coefficients that need them, and only when some lane needs them.
 """
 
 from __future__ import annotations
@@ -80,34 +83,70 @@ SIN_HALF = sp.Symbol("sin_half")
 COS_HALF = sp.Symbol("cos_half")
 
 
+def branch_switch(coefficient: Any) -> float:
+    """The x (or t) at which the NumPy module leaves a Branch's polynomial for its closed form
+    (0 for the other coefficients: no polynomial)."""
+    return coefficient.smallest_switch[0] if isinstance(coefficient, Branch) else 0.0
+
+
 def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = False) -> list[str]:
     """Statements returning the Branch value from ``variable`` (t) and ``phi``: the Horner
     polynomial on the lanes with t < threshold, the closed form on the others (each computed on
     its own lanes only, so neither can divide by zero and no work is wasted). The switch is the
     smallest the accuracy allows: a second branch costs a masked pass over the arrays, more than
-    a longer polynomial saves here (unlike in C, which uses ``branch.threshold``)."""
+    a longer polynomial saves here (unlike in C, which uses ``branch.threshold``).
+
+    With ``half_angles`` (the coefficient functions) the argument ``span`` = (min t, max t) of a
+    block whose lanes are all inside the range (None otherwise, see the template's _span) lets a
+    block on one side of the switch take its branch on all lanes, without masks or indexing."""
     threshold, horner = branch.smallest_switch
-    lines = [f"small = {variable} < {threshold!r}", f"out = numpy.empty_like({variable})",
-             "if small.any():"]
-    if len(horner) > 1:
-        lines.append(f"    t = {variable}[small]")
-    lines.append(f"    series = {_literal(horner[-1])}")
-    for c in reversed(horner[:-1]):
-        lines.append(f"    series = {_literal(c)} + t * series" if c != 0 else "    series = t * series")
-    lines.append("    out[small] = series")
-    lines += ["if not small.all():", "    big = ~small"]
     closed = branch.closed
     if half_angles:  # sin(φ/2), cos(φ/2) come precomputed, shared by the coefficients of a tensor
         closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
-    if closed.has(PHI):
-        lines.append(f"    phi = {phi}[big]")
-    for symbol in (X, S, D, SIN_HALF, COS_HALF):  # a closed form in x too (e.g. 2000/(x + 1))
-        if closed.has(symbol):
-            lines.append(f"    {symbol} = {symbol}[big]")
+    symbols = [symbol for symbol in (X, S, D, SIN_HALF, COS_HALF) if closed.has(symbol)]
     closed = closed.subs(PHI, sp.Symbol("phi"))
     replacements, (reduced,) = sp.cse([closed], symbols=sp.numbered_symbols("w"))
-    for symbol, value in replacements:
-        lines.append(f"    {symbol} = {print_expression(value)}")
+    closed_lines = [f"{symbol} = {print_expression(value)}" for symbol, value in replacements]
+    series_lines = [f"series = {_literal(horner[-1])}"]
+    for c in reversed(horner[:-1]):
+        series_lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
+    lines: list[str] = []
+    if half_angles:
+        lines += [f"if span is not None and span[1] < {threshold!r}:  # every lane on the polynomial"]
+        if len(horner) > 1:
+            lines += [f"    t = {variable}", *("    " + line for line in series_lines),
+                      f"    return numpy.asarray(series, dtype={variable}.dtype)"]
+        else:
+            lines.append(f"    return numpy.full_like({variable}, {_literal(horner[0])})")
+        # the closed form on every lane (phi, sin and cos are there for the whole block), then the
+        # polynomial on the lanes below the switch, where the closed form may be 0/0
+        lines += closed_lines
+        if not reduced.free_symbols:
+            lines.append(f"out = numpy.full_like({variable}, {print_expression(reduced)})")
+        else:
+            copy = "array" if reduced.is_Symbol else "asarray"  # never write into an argument
+            lines.append(f"out = numpy.{copy}({print_expression(reduced)}, dtype={variable}.dtype)")
+        lines.append(f"if span is not None and span[0] >= {threshold!r}:  # every lane on the closed form")
+        lines.append("    return out")
+        lines.append(f"small = {variable} < {threshold!r}")
+        lines.append("if small.any():")
+        if len(horner) > 1:
+            lines.append(f"    t = {variable}[small]")
+        lines += ["    " + line for line in series_lines]
+        lines += ["    out[small] = series", "return out"]
+        return lines
+    lines += [f"small = {variable} < {threshold!r}", f"out = numpy.empty_like({variable})",
+              "if small.any():"]
+    if len(horner) > 1:
+        lines.append(f"    t = {variable}[small]")
+    lines += ["    " + line for line in series_lines]
+    lines.append("    out[small] = series")
+    lines += ["if not small.all():", "    big = ~small"]
+    if closed.has(sp.Symbol("phi")):
+        lines.append(f"    phi = {phi}[big]")
+    for symbol in symbols:  # a closed form in x too (e.g. 2000/(x + 1))
+        lines.append(f"    {symbol} = {symbol}[big]")
+    lines += ["    " + line for line in closed_lines]
     lines.append(f"    out[big] = {print_expression(reduced)}")
     lines.append("return out")
     return lines
@@ -177,7 +216,10 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
                                          for label in plan.precisions},
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
-                         for label, precision in plan.precisions.items()}}
+                         for label, precision in plan.precisions.items()},
+            "switch": {SUFFIX[label]: {n: branch_switch(c) for n, c in precision.coefficients.items()
+                                       if uses_phi(c)}
+                       for label, precision in plan.precisions.items()}}
 
 
 def uses_phi(coefficient: Any) -> bool:
@@ -197,13 +239,13 @@ def module_context_functions(precision: Any, suffix: str) -> list[dict[str, Any]
             if expression.has(D) and suffix == "32":
                 body.append("d = d.astype(numpy.float64)")
             value = print_expression(expression)
-            if not expression.has(X):
+            if not coefficient.expression.has(X):
                 value = f"({value}) + 0.0 * x"
             body.append(f"return numpy.asarray({value}).astype(numpy.float{suffix}, copy=False)")
         else:
             body = _branch_lines(coefficient, "x", "phi", half_angles=True)
-        functions.append({"name": f"_{name}_{suffix}", "args": "x, phi, s, d, sin_half, cos_half",
-                          "body": body})
+        functions.append({"name": f"_{name}_{suffix}",
+                          "args": "x, phi, s, d, sin_half, cos_half, span=None", "body": body})
     angle = precision.angle
     if isinstance(angle, NewtonAngle):
         for helper, branch in (("_ratio", angle.ratio), ("_slope", angle.slope)):
