@@ -34,9 +34,6 @@ TENSOR_NAMES = ("R", "H", "H_inverse", "G", "K")
 TENSOR_EQUATIONS = {"R": "14", "H": "22", "H_inverse": "26", "G": "81", "K": "83"}
 CONSTANT_ORDER = 24
 CONSTANT_CHECK_ANGLES = ("0.213", "0.577", "0.911", "1.307")
-SLOPE_SIMPLIFY_SECONDS = 5.0
-"""Bound of each step simplifying a slope (longer than the default 0.5 s: the derivatives are larger
-expressions, and a step cut short by a loaded machine would change the printed form)."""
 SCALAR_EQUATIONS = {"p_prime": "21", "nu": "15", "epsilon": "16", "mu": "21", "det_H": "24"}
 
 
@@ -120,13 +117,14 @@ class Derivation:
 
     def simplified_form(self, name: str) -> sp.Expr:
         """The simplified form of one planned expression; a slope is the derivative of its parent's
-        simplified form over dx/dφ = 2 p p′, simplified when first asked for (bounded) and cached."""
+        simplified form over dx/dφ = 2 p p′ with common factors pulled out (``factor_terms``): no
+        time-bounded step, so that the printed form cannot depend on how loaded the machine is."""
         if name not in self.slopes:
             return self.simplified_coefficients()[name]
         if name not in self._slopes_simplified:
             parent = self.simplified_coefficients()[self.slopes[name][0]]
             quotient = sp.diff(parent, PHI) / (2 * self.p * self.scalars["p_prime"])
-            self._slopes_simplified[name] = simplest(quotient, SLOPE_SIMPLIFY_SECONDS)
+            self._slopes_simplified[name] = sp.factor_terms(quotient)
         return self._slopes_simplified[name]
 
     # -- series -----------------------------------------------------------------------------

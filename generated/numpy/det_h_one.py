@@ -15,7 +15,17 @@ to_quaternion(p) -> e (..., 4); from_quaternion(e) -> p (normalizes e, takes the
 e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65;
 NaN unless R is a rotation: max |R^T R - I| <= 2^-26 (2^-11 in float32) and det R > 0);
 compose(p1, p2) -> p3 with R(p3) = R(p2) R(p1), p1 applied first (eqs 18-19, 67);
-rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).  Every rotation has
+rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).
+
+Derivatives for implicit solvers (docs/derivatives.md): with a fixed vector a, the (..., 3, 3)
+matrices rotation_derivative(p, a) = d(R a)/dp, rotation_transpose_derivative(p, a) = d(R^T a)/dp,
+tangent_derivative(p, a) = d(H a)/dp, tangent_transpose_derivative(p, a) = d(H^T a)/dp and
+tangent_inverse_derivative(p, a) = d(H^-1 a)/dp (column j is the derivative by p_j);
+angular_acceleration(p, pdot, pddot) -> alpha = H pddot + Hdot pdot; compose_jacobians(p1, p2) ->
+(dp3/dp1, dp3/dp2) of p3 = compose(p1, p2), i.e. H(p3)^-1 R(p2) H(p1) and H(p3)^-1 H(p2), rescaling
+of p3 included; rescale_jacobian(p) -> d rescale(p)/dp = H(rescale(p))^-1 H(p) (I where p is kept).
+The derivatives of R, H and H^-1 and angular_acceleration are NaN from |p|^2 >= _DERIVATIVE_X_LIMIT
+on (at most the edge of the other functions; smaller where a derivative's printed form overflows first).  Every rotation has
 such a representation, so these results are NaN only for non-finite input."""
 
 import functools
@@ -525,6 +535,287 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
         w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
         w1 = w0**2
         out[big] = (sin_half/w0 + (0.125)*w1/sin_half**2)/w1
+    return out
+
+
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283275
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 1.4590852718839616e-19
+        series = 1.6712992943913682e-18 + t * series
+        series = 1.9164647128732757e-17 + t * series
+        series = 2.2002829132536273e-16 + t * series
+        series = 2.5296275904133537e-15 + t * series
+        series = 2.912852457999748e-14 + t * series
+        series = 3.360206298123931e-13 + t * series
+        series = 3.884404382527373e-12 + t * series
+        series = 4.5014331338784364e-11 + t * series
+        series = 5.231710865271535e-10 + t * series
+        series = 6.10180260915555e-09 + t * series
+        series = 7.14700076944975e-08 + t * series
+        series = 8.415195915195915e-07 + t * series
+        series = 9.9721706864564e-06 + t * series
+        series = 0.00011904761904761905 + t * series
+        series = 0.0014285714285714286 + t * series
+        series = -0.15 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = sin_half**2
+        out[big] = (0.125)*(-1.3333333333333333*cos_half*sin_half**3/(-2*cos_half*sin_half + phi) - 2*w0 + 1)/w0
+    return out
+
+
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -1.713507963984835e-25
+        series = -1.9911676878064524e-24 + t * series
+        series = -2.3176419769991988e-23 + t * series
+        series = -2.70256607423881e-22 + t * series
+        series = -3.1578003265100976e-21 + t * series
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
+    return out
+
+
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283275
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 4.002447216098616e-21
+        series = 4.349386634459199e-20 + t * series
+        series = 4.717726508806865e-19 + t * series
+        series = 5.106798451593866e-18 + t * series
+        series = 5.515287671491515e-17 + t * series
+        series = 5.941040609907155e-16 + t * series
+        series = 6.3808204484355186e-15 + t * series
+        series = 6.829994494116056e-14 + t * series
+        series = 7.28213114499937e-13 + t * series
+        series = 7.72847448568504e-12 + t * series
+        series = 8.157249203307483e-11 + t * series
+        series = 8.552722954369029e-10 + t * series
+        series = 8.893908470961609e-09 + t * series
+        series = 9.152703913733326e-08 + t * series
+        series = 9.291101000284673e-07 + t * series
+        series = 9.256715506715507e-06 + t * series
+        series = 8.974953617810761e-05 + t * series
+        series = 0.0008333333333333334 + t * series
+        series = 0.007142857142857143 + t * series
+        series = 0.05 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        out[big] = (0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2
+    return out
+
+
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -1.713507963984835e-25
+        series = -1.9911676878064524e-24 + t * series
+        series = -2.3176419769991988e-23 + t * series
+        series = -2.70256607423881e-22 + t * series
+        series = -3.1578003265100976e-21 + t * series
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
+    return out
+
+
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 2.892762495883202e-24
+        series = 3.1482187281713954e-23 + t * series
+        series = 3.420541589612275e-22 + t * series
+        series = 3.7095852246767656e-21 + t * series
+        series = 4.0148184318084914e-20 + t * series
+        series = 4.33520814322793e-19 + t * series
+        series = 4.669072870028677e-18 + t * series
+        series = 5.0138978831741045e-17 + t * series
+        series = 5.366101196045172e-16 + t * series
+        series = 5.720735574459431e-15 + t * series
+        series = 6.07110621699205e-14 + t * series
+        series = 6.408275407599445e-13 + t * series
+        series = 6.7204125962478614e-12 + t * series
+        series = 6.991927888549271e-11 + t * series
+        series = 7.202293014205498e-10 + t * series
+        series = 7.324395211380149e-09 + t * series
+        series = 7.32216313098666e-08 + t * series
+        series = 7.147000769449749e-07 + t * series
+        series = 6.732156732156732e-06 + t * series
+        series = 5.983302411873841e-05 + t * series
+        series = 0.0004761904761904762 + t * series
+        series = 0.002857142857142857 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = sin_half**2
+        w1 = w0**(-1.0)
+        w2 = cos_half*sin_half
+        w3 = (phi - 2*w2)**(-1.0)
+        w4 = 6*phi
+        w5 = 2*phi
+        w6 = -16*w2 + w4 + numpy.sin(w5)
+        out[big] = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4)
+    return out
+
+
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -3.42701592796967e-25
+        series = -3.982335375612905e-24 + t * series
+        series = -4.6352839539983977e-23 + t * series
+        series = -5.40513214847762e-22 + t * series
+        series = -6.315600653020195e-21 + t * series
+        series = -7.396110286959959e-20 + t * series
+        series = -8.683469103988305e-19 + t * series
+        series = -1.0224187860604788e-17 + t * series
+        series = -1.207771859033198e-16 + t * series
+        series = -1.4321083368003567e-15 + t * series
+        series = -1.7055656901807745e-14 + t * series
+        series = -2.0417396933193335e-13 + t * series
+        series = -2.4592808133854965e-12 + t * series
+        series = -2.9844879309052296e-11 + t * series
+        series = -3.65573324363898e-10 + t * series
+        series = -4.531479857547785e-09 + t * series
+        series = -5.705962593717696e-08 + t * series
+        series = -7.343103325246182e-07 + t * series
+        series = -9.760874046588332e-06 + t * series
+        series = -0.0001369047619047619 + t * series
+        series = -0.002142857142857143 + t * series
+        series = -0.05 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out[big] = (0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
+    return out
+
+
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 6.497844255354877e-25
+        series = 7.196733448736306e-24 + t * series
+        series = 7.96467075122581e-23 + t * series
+        series = 8.807039512596957e-22 + t * series
+        series = 9.729237867259716e-21 + t * series
+        series = 1.0736521110134332e-19 + t * series
+        series = 1.1833776459135935e-18 + t * series
+        series = 1.3025203655982459e-17 + t * series
+        series = 1.4313863004846702e-16 + t * series
+        series = 1.5701034167431574e-15 + t * series
+        series = 1.718530004160428e-14 + t * series
+        series = 1.8761222591988522e-13 + t * series
+        series = 2.0417396933193335e-12 + t * series
+        series = 2.213352732046947e-11 + t * series
+        series = 2.3875903447241837e-10 + t * series
+        series = 2.559013270547286e-09 + t * series
+        series = 2.7188879145286708e-08 + t * series
+        series = 2.852981296858848e-07 + t * series
+        series = 2.937241330098473e-06 + t * series
+        series = 2.9282622139764997e-05 + t * series
+        series = 0.0002738095238095238 + t * series
+        series = 0.002142857142857143 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        w2 = (phi - w1)**(-1.0)
+        w3 = sin_half**2
+        w4 = 1 - 2*w3
+        w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+        out[big] = -0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4
     return out
 
 
@@ -1117,6 +1408,271 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return out
 
 
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.630222574480542
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 3.360206298123931e-13
+        series = 3.884404382527373e-12 + t * series
+        series = 4.5014331338784364e-11 + t * series
+        series = 5.231710865271535e-10 + t * series
+        series = 6.10180260915555e-09 + t * series
+        series = 7.14700076944975e-08 + t * series
+        series = 8.415195915195915e-07 + t * series
+        series = 9.9721706864564e-06 + t * series
+        series = 0.00011904761904761905 + t * series
+        series = 0.0014285714285714286 + t * series
+        series = -0.15 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        w0 = sin_half**2
+        w1 = numpy.sin(phi)
+        out[big] = (0.125)*(-0.6666666666666666*w0*w1/(phi - w1) - 2*w0 + 1)/w0
+    return out
+
+
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -3.1578003265100976e-21
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
+    return out
+
+
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 3.373091494469352e-23
+        series = 3.6770822088331955e-22 + t * series
+        series = 4.002447216098616e-21 + t * series
+        series = 4.349386634459199e-20 + t * series
+        series = 4.717726508806865e-19 + t * series
+        series = 5.106798451593866e-18 + t * series
+        series = 5.515287671491515e-17 + t * series
+        series = 5.941040609907155e-16 + t * series
+        series = 6.3808204484355186e-15 + t * series
+        series = 6.829994494116056e-14 + t * series
+        series = 7.28213114499937e-13 + t * series
+        series = 7.72847448568504e-12 + t * series
+        series = 8.157249203307483e-11 + t * series
+        series = 8.552722954369029e-10 + t * series
+        series = 8.893908470961609e-09 + t * series
+        series = 9.152703913733326e-08 + t * series
+        series = 9.291101000284673e-07 + t * series
+        series = 9.256715506715507e-06 + t * series
+        series = 8.974953617810761e-05 + t * series
+        series = 0.0008333333333333334 + t * series
+        series = 0.007142857142857143 + t * series
+        series = 0.05 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        out[big] = (0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2
+    return out
+
+
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -3.1578003265100976e-21
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
+    return out
+
+
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 2.892762495883202e-24
+        series = 3.1482187281713954e-23 + t * series
+        series = 3.420541589612275e-22 + t * series
+        series = 3.7095852246767656e-21 + t * series
+        series = 4.0148184318084914e-20 + t * series
+        series = 4.33520814322793e-19 + t * series
+        series = 4.669072870028677e-18 + t * series
+        series = 5.0138978831741045e-17 + t * series
+        series = 5.366101196045172e-16 + t * series
+        series = 5.720735574459431e-15 + t * series
+        series = 6.07110621699205e-14 + t * series
+        series = 6.408275407599445e-13 + t * series
+        series = 6.7204125962478614e-12 + t * series
+        series = 6.991927888549271e-11 + t * series
+        series = 7.202293014205498e-10 + t * series
+        series = 7.324395211380149e-09 + t * series
+        series = 7.32216313098666e-08 + t * series
+        series = 7.147000769449749e-07 + t * series
+        series = 6.732156732156732e-06 + t * series
+        series = 5.983302411873841e-05 + t * series
+        series = 0.0004761904761904762 + t * series
+        series = 0.002857142857142857 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = sin_half**2
+        w1 = w0**(-1.0)
+        w2 = cos_half*sin_half
+        w3 = (phi - 2*w2)**(-1.0)
+        w4 = 6*phi
+        w5 = 2*phi
+        w6 = -16*w2 + w4 + numpy.sin(w5)
+        out[big] = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4)
+    return out
+
+
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = -6.315600653020195e-21
+        series = -7.396110286959959e-20 + t * series
+        series = -8.683469103988305e-19 + t * series
+        series = -1.0224187860604788e-17 + t * series
+        series = -1.207771859033198e-16 + t * series
+        series = -1.4321083368003567e-15 + t * series
+        series = -1.7055656901807745e-14 + t * series
+        series = -2.0417396933193335e-13 + t * series
+        series = -2.4592808133854965e-12 + t * series
+        series = -2.9844879309052296e-11 + t * series
+        series = -3.65573324363898e-10 + t * series
+        series = -4.531479857547785e-09 + t * series
+        series = -5.705962593717696e-08 + t * series
+        series = -7.343103325246182e-07 + t * series
+        series = -9.760874046588332e-06 + t * series
+        series = -0.0001369047619047619 + t * series
+        series = -0.002142857142857143 + t * series
+        series = -0.05 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out[big] = (0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
+    return out
+
+
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    out = numpy.empty_like(x)
+    if small.any():
+        t = x[small]
+        series = 6.497844255354877e-25
+        series = 7.196733448736306e-24 + t * series
+        series = 7.96467075122581e-23 + t * series
+        series = 8.807039512596957e-22 + t * series
+        series = 9.729237867259716e-21 + t * series
+        series = 1.0736521110134332e-19 + t * series
+        series = 1.1833776459135935e-18 + t * series
+        series = 1.3025203655982459e-17 + t * series
+        series = 1.4313863004846702e-16 + t * series
+        series = 1.5701034167431574e-15 + t * series
+        series = 1.718530004160428e-14 + t * series
+        series = 1.8761222591988522e-13 + t * series
+        series = 2.0417396933193335e-12 + t * series
+        series = 2.213352732046947e-11 + t * series
+        series = 2.3875903447241837e-10 + t * series
+        series = 2.559013270547286e-09 + t * series
+        series = 2.7188879145286708e-08 + t * series
+        series = 2.852981296858848e-07 + t * series
+        series = 2.937241330098473e-06 + t * series
+        series = 2.9282622139764997e-05 + t * series
+        series = 0.0002738095238095238 + t * series
+        series = 0.002142857142857143 + t * series
+        out[small] = series
+    if not small.all():
+        big = ~small
+        phi = phi[big]
+        sin_half = sin_half[big]
+        cos_half = cos_half[big]
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        w2 = (phi - w1)**(-1.0)
+        w3 = sin_half**2
+        w4 = 1 - 2*w3
+        w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+        out[big] = -0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4
+    return out
+
+
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.921189444436213e-14
     out = numpy.empty_like(x)
@@ -1265,6 +1821,15 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "R_0_x": _R_0_x_64,
+        "R_1_x": _R_1_x_64,
+        "R_2_x": _R_2_x_64,
+        "H_0_x": _H_0_x_64,
+        "H_1_x": _H_1_x_64,
+        "H_2_x": _H_2_x_64,
+        "H_inverse_0_x": _H_inverse_0_x_64,
+        "H_inverse_1_x": _H_inverse_1_x_64,
+        "H_inverse_2_x": _H_inverse_2_x_64,
         "e_0": _e_0_64,
     },
     "32": {
@@ -1288,19 +1853,29 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "R_0_x": _R_0_x_32,
+        "R_1_x": _R_1_x_32,
+        "R_2_x": _R_2_x_32,
+        "H_0_x": _H_0_x_32,
+        "H_1_x": _H_1_x_32,
+        "H_2_x": _H_2_x_32,
+        "H_inverse_0_x": _H_inverse_0_x_32,
+        "H_inverse_1_x": _H_inverse_1_x_32,
+        "H_inverse_2_x": _H_inverse_2_x_32,
         "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'e_0': True},
-    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'e_0': True},
+    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
+    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _BLOCK = 16384
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 E0_MIN = -numpy.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 
@@ -1435,6 +2010,53 @@ def _apply(p, v, name):
     return numpy.where(valid[..., None], result, numpy.nan).astype(p.dtype)
 
 
+def _skew(v):
+    """(v x) of shape (..., 3, 3)."""
+    out = numpy.zeros((*v.shape, 3), dtype=v.dtype)
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.derivatives)."""
+    pa = numpy.cross(p, a)
+    ppa = numpy.cross(p, pa)
+    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
+    out = u[..., :, None] * p[..., None, :]
+    out = out + (-c1)[..., None, None] * (_skew(a))
+    out = out + (-c2)[..., None, None] * (_skew(pa))
+    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
+    return out
+
+
+def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.derivatives)."""
+    pa = numpy.cross(p, a)
+    ppa = numpy.cross(p, pa)
+    pta = numpy.einsum('...i,...i->...', p, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * numpy.cross(pa, a)
+
+
+def _with_slopes(p, a, name, sign):
+    """p, a, (c0, c1, c2, d0, d1, d2) of T = ``name`` (sign -1: of its transpose), valid."""
+    a = _as_float(a, "the second argument", (3,))
+    names = [name + "_0", name + "_1", name + "_2", name + "_0_x", name + "_1_x", name + "_2_x"]
+    p, state, valid, suffix = _prepare(p, names)
+    valid = valid & (state[0] < _DERIVATIVE_X_LIMIT[suffix])  # the slopes' own edge of the domain
+    a = a.astype(p.dtype)
+    table = _COEFFICIENTS[suffix]
+    c0, c1, c2, d0, d1, d2 = (table[n](*state) for n in names)
+    return p, a, (c0, sign * c1, c2, d0, sign * d1, d2), valid
+
+
+def _derivative(p, a, name, sign):
+    p, a, scalars, valid = _with_slopes(p, a, name, sign)
+    out = _derivative_matrix(*scalars, p, a)
+    return numpy.where(valid[..., None, None], out, numpy.nan).astype(p.dtype)
+
+
 @_quiet
 def angle(p):
     """phi = |phi| from p (..., 3); NaN outside the validity range."""
@@ -1489,6 +2111,49 @@ def pdot(p, omega):
 def omega(p, pdot):
     """omega = H pdot (eq 20)."""
     return _apply(p, pdot, "H")
+
+
+@_quiet
+def rotation_derivative(p, a):
+    """d(R a)/dp for a fixed vector a (..., 3, 3); column j is d(R a)/dp_j (R of eq 16)."""
+    return _derivative(p, a, "R", 1)
+
+
+@_quiet
+def rotation_transpose_derivative(p, a):
+    """d(R^T a)/dp for a fixed vector a (..., 3, 3)."""
+    return _derivative(p, a, "R", -1)
+
+
+@_quiet
+def tangent_derivative(p, a):
+    """d(H a)/dp for a fixed vector a (..., 3, 3) (H of eq 20); Hdot = d(H a)/dp at a = pdot, times pdot."""
+    return _derivative(p, a, "H", 1)
+
+
+@_quiet
+def tangent_transpose_derivative(p, a):
+    """d(H^T a)/dp for a fixed vector a (..., 3, 3)."""
+    return _derivative(p, a, "H", -1)
+
+
+@_quiet
+def tangent_inverse_derivative(p, a):
+    """d(H^-1 a)/dp for a fixed vector a (..., 3, 3) (H^-1 of eq 26)."""
+    return _derivative(p, a, "H_inverse", 1)
+
+
+@_quiet
+def angular_acceleration(p, pdot, pddot):
+    """alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20)."""
+    pddot = _as_float(pddot, "pddot", (3,))
+    p, v, scalars, valid = _with_slopes(p, pdot, "H", 1)
+    w = pddot.astype(p.dtype)
+    c0, c1, c2 = scalars[:3]
+    pw = numpy.cross(p, w)
+    first = c0[..., None] * w + c1[..., None] * pw + c2[..., None] * numpy.cross(p, pw)
+    out = first + _rate_vector(*scalars, p, v)
+    return numpy.where(valid[..., None], out, numpy.nan).astype(p.dtype)
 
 
 def _quaternion(p):
@@ -1594,6 +2259,31 @@ def compose(p1, p2):
     e0 = numpy.where(valid, e0, 1.0).astype(a.dtype)
     e = numpy.where(valid[..., None], e, 0.0).astype(a.dtype)
     return _from_quaternion(e0, e, valid, suffix)
+
+
+@_quiet
+def compose_jacobians(p1, p2):
+    """(dp3/dp1, dp3/dp2) of p3 = compose(p1, p2), each (..., 3, 3): H(p3)^-1 R(p2) H(p1) and
+    H(p3)^-1 H(p2) (the rotation increments add as d theta3 = R(p2) d theta1 + d theta2, omega = H pdot).
+
+    p3 is the rescaled result of compose, so the rescaling is included; NaN where compose is NaN.
+    """
+    p3 = compose(p1, p2)
+    h3_inverse = _tensor(p3, "H_inverse")
+    return h3_inverse @ (_tensor(p2, "R") @ _tensor(p1, "H")), h3_inverse @ _tensor(p2, "H")
+
+
+@_quiet
+def rescale_jacobian(p):
+    """d rescale(p)/dp (..., 3, 3): H(rescale(p))^-1 H(p) where p is rescaled (the same rotation, so
+    the same increment d theta), the identity where p is kept; NaN outside the validity range."""
+    p = _as_float(p, "p", (3,))
+    e0, _e, valid, _suffix = _quaternion(p)
+    flip = valid & (e0 < 0)
+    jacobian = _tensor(rescale(p), "H_inverse") @ _tensor(p, "H")
+    identity = numpy.broadcast_to(numpy.eye(3, dtype=p.dtype), jacobian.shape)
+    out = numpy.where(flip[..., None, None], jacobian, identity)
+    return numpy.where(valid[..., None, None], out, numpy.nan).astype(p.dtype)
 
 
 @_quiet

@@ -15,7 +15,17 @@ to_quaternion(p) -> e (..., 4); from_quaternion(e) -> p (normalizes e, takes the
 e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65;
 NaN unless R is a rotation: max |R^T R - I| <= 2^-26 (2^-11 in float32) and det R > 0);
 compose(p1, p2) -> p3 with R(p3) = R(p2) R(p1), p1 applied first (eqs 18-19, 67);
-rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).  Rotations with
+rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).
+
+Derivatives for implicit solvers (docs/derivatives.md): with a fixed vector a, the (..., 3, 3)
+matrices rotation_derivative(p, a) = d(R a)/dp, rotation_transpose_derivative(p, a) = d(R^T a)/dp,
+tangent_derivative(p, a) = d(H a)/dp, tangent_transpose_derivative(p, a) = d(H^T a)/dp and
+tangent_inverse_derivative(p, a) = d(H^-1 a)/dp (column j is the derivative by p_j);
+angular_acceleration(p, pdot, pddot) -> alpha = H pddot + Hdot pdot; compose_jacobians(p1, p2) ->
+(dp3/dp1, dp3/dp2) of p3 = compose(p1, p2), i.e. H(p3)^-1 R(p2) H(p1) and H(p3)^-1 H(p2), rescaling
+of p3 included; rescale_jacobian(p) -> d rescale(p)/dp = H(rescale(p))^-1 H(p) (I where p is kept).
+The derivatives of R, H and H^-1 and angular_acceleration are NaN from |p|^2 >= _DERIVATIVE_X_LIMIT
+on (at most the edge of the other functions; smaller where a derivative's printed form overflows first).  Rotations with
 |phi| >= 3.141592653589793 cannot be represented: those results are NaN."""
 
 import functools
@@ -116,6 +126,42 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
         w0 = numpy.sqrt(d)
         out[big] = (0.25)/(w0*((0.5)*w0 + 1))
     return out
+
+
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((d**(-1.5)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.25)/d**(1.5)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
@@ -243,6 +289,50 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return out
 
 
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((d**(-1.5)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.25)/d**(1.5)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
@@ -280,6 +370,15 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "R_0_x": _R_0_x_64,
+        "R_1_x": _R_1_x_64,
+        "R_2_x": _R_2_x_64,
+        "H_0_x": _H_0_x_64,
+        "H_1_x": _H_1_x_64,
+        "H_2_x": _H_2_x_64,
+        "H_inverse_0_x": _H_inverse_0_x_64,
+        "H_inverse_1_x": _H_inverse_1_x_64,
+        "H_inverse_2_x": _H_inverse_2_x_64,
         "e_0": _e_0_64,
     },
     "32": {
@@ -303,19 +402,29 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "R_0_x": _R_0_x_32,
+        "R_1_x": _R_1_x_32,
+        "R_2_x": _R_2_x_32,
+        "H_0_x": _H_0_x_32,
+        "H_1_x": _H_1_x_32,
+        "H_2_x": _H_2_x_32,
+        "H_inverse_0_x": _H_inverse_0_x_32,
+        "H_inverse_1_x": _H_inverse_1_x_32,
+        "H_inverse_2_x": _H_inverse_2_x_32,
         "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
-    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
+    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
+    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
 }
 _BLOCK = 16384
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 E0_MIN = 0.0
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 
@@ -475,6 +584,53 @@ def _apply(p, v, name):
     return numpy.where(valid[..., None], result, numpy.nan).astype(p.dtype)
 
 
+def _skew(v):
+    """(v x) of shape (..., 3, 3)."""
+    out = numpy.zeros((*v.shape, 3), dtype=v.dtype)
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.derivatives)."""
+    pa = numpy.cross(p, a)
+    ppa = numpy.cross(p, pa)
+    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
+    out = u[..., :, None] * p[..., None, :]
+    out = out + (-c1)[..., None, None] * (_skew(a))
+    out = out + (-c2)[..., None, None] * (_skew(pa))
+    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
+    return out
+
+
+def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.derivatives)."""
+    pa = numpy.cross(p, a)
+    ppa = numpy.cross(p, pa)
+    pta = numpy.einsum('...i,...i->...', p, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * numpy.cross(pa, a)
+
+
+def _with_slopes(p, a, name, sign):
+    """p, a, (c0, c1, c2, d0, d1, d2) of T = ``name`` (sign -1: of its transpose), valid."""
+    a = _as_float(a, "the second argument", (3,))
+    names = [name + "_0", name + "_1", name + "_2", name + "_0_x", name + "_1_x", name + "_2_x"]
+    p, state, valid, suffix = _prepare(p, names)
+    valid = valid & (state[0] < _DERIVATIVE_X_LIMIT[suffix])  # the slopes' own edge of the domain
+    a = a.astype(p.dtype)
+    table = _COEFFICIENTS[suffix]
+    c0, c1, c2, d0, d1, d2 = (table[n](*state) for n in names)
+    return p, a, (c0, sign * c1, c2, d0, sign * d1, d2), valid
+
+
+def _derivative(p, a, name, sign):
+    p, a, scalars, valid = _with_slopes(p, a, name, sign)
+    out = _derivative_matrix(*scalars, p, a)
+    return numpy.where(valid[..., None, None], out, numpy.nan).astype(p.dtype)
+
+
 @_quiet
 def angle(p):
     """phi = |phi| from p (..., 3); NaN outside the validity range."""
@@ -529,6 +685,49 @@ def pdot(p, omega):
 def omega(p, pdot):
     """omega = H pdot (eq 20)."""
     return _apply(p, pdot, "H")
+
+
+@_quiet
+def rotation_derivative(p, a):
+    """d(R a)/dp for a fixed vector a (..., 3, 3); column j is d(R a)/dp_j (R of eq 16)."""
+    return _derivative(p, a, "R", 1)
+
+
+@_quiet
+def rotation_transpose_derivative(p, a):
+    """d(R^T a)/dp for a fixed vector a (..., 3, 3)."""
+    return _derivative(p, a, "R", -1)
+
+
+@_quiet
+def tangent_derivative(p, a):
+    """d(H a)/dp for a fixed vector a (..., 3, 3) (H of eq 20); Hdot = d(H a)/dp at a = pdot, times pdot."""
+    return _derivative(p, a, "H", 1)
+
+
+@_quiet
+def tangent_transpose_derivative(p, a):
+    """d(H^T a)/dp for a fixed vector a (..., 3, 3)."""
+    return _derivative(p, a, "H", -1)
+
+
+@_quiet
+def tangent_inverse_derivative(p, a):
+    """d(H^-1 a)/dp for a fixed vector a (..., 3, 3) (H^-1 of eq 26)."""
+    return _derivative(p, a, "H_inverse", 1)
+
+
+@_quiet
+def angular_acceleration(p, pdot, pddot):
+    """alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20)."""
+    pddot = _as_float(pddot, "pddot", (3,))
+    p, v, scalars, valid = _with_slopes(p, pdot, "H", 1)
+    w = pddot.astype(p.dtype)
+    c0, c1, c2 = scalars[:3]
+    pw = numpy.cross(p, w)
+    first = c0[..., None] * w + c1[..., None] * pw + c2[..., None] * numpy.cross(p, pw)
+    out = first + _rate_vector(*scalars, p, v)
+    return numpy.where(valid[..., None], out, numpy.nan).astype(p.dtype)
 
 
 def _quaternion(p):
@@ -634,6 +833,31 @@ def compose(p1, p2):
     e0 = numpy.where(valid, e0, 1.0).astype(a.dtype)
     e = numpy.where(valid[..., None], e, 0.0).astype(a.dtype)
     return _from_quaternion(e0, e, valid, suffix)
+
+
+@_quiet
+def compose_jacobians(p1, p2):
+    """(dp3/dp1, dp3/dp2) of p3 = compose(p1, p2), each (..., 3, 3): H(p3)^-1 R(p2) H(p1) and
+    H(p3)^-1 H(p2) (the rotation increments add as d theta3 = R(p2) d theta1 + d theta2, omega = H pdot).
+
+    p3 is the rescaled result of compose, so the rescaling is included; NaN where compose is NaN.
+    """
+    p3 = compose(p1, p2)
+    h3_inverse = _tensor(p3, "H_inverse")
+    return h3_inverse @ (_tensor(p2, "R") @ _tensor(p1, "H")), h3_inverse @ _tensor(p2, "H")
+
+
+@_quiet
+def rescale_jacobian(p):
+    """d rescale(p)/dp (..., 3, 3): H(rescale(p))^-1 H(p) where p is rescaled (the same rotation, so
+    the same increment d theta), the identity where p is kept; NaN outside the validity range."""
+    p = _as_float(p, "p", (3,))
+    e0, _e, valid, _suffix = _quaternion(p)
+    flip = valid & (e0 < 0)
+    jacobian = _tensor(rescale(p), "H_inverse") @ _tensor(p, "H")
+    identity = numpy.broadcast_to(numpy.eye(3, dtype=p.dtype), jacobian.shape)
+    out = numpy.where(flip[..., None, None], jacobian, identity)
+    return numpy.where(valid[..., None, None], out, numpy.nan).astype(p.dtype)
 
 
 @_quiet
