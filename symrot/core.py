@@ -22,6 +22,7 @@ import sympy as sp
 
 from .axial import AxialTensor
 from .budget import stage
+from .derivatives import slope_definitions, slope_series
 from .errors import InvalidGeneratingFunction
 from .parsing import PHI
 from .series import Series, coefficient_list, compose_even_in_x, revert, taylor_series
@@ -79,8 +80,11 @@ class Derivation:
     scalars_raw: dict[str, sp.Expr]
     scalars: dict[str, sp.Expr]
     tensors: dict[str, Tensor]
+    slopes: dict[str, tuple[str, sp.Expr]] = field(default_factory=dict)
+    """Slopes dc/dx of R, H, H⁻¹'s coefficients (:mod:`symrot.derivatives`): name → (parent, raw)."""
     _series_cache: dict[tuple[str, int], list[sp.Expr]] = field(default_factory=dict, repr=False)
     _constants: dict[str, sp.Expr | None] = field(default_factory=dict, repr=False)
+    _slopes_simplified: dict[str, sp.Expr] = field(default_factory=dict, repr=False)
 
     @property
     def p(self) -> sp.Expr:
@@ -103,10 +107,30 @@ class Derivation:
             out.update(zip(tensor.coefficient_names(), tensor.simplified, strict=True))
         return out
 
+    def planned_expressions(self) -> dict[str, sp.Expr]:
+        """The coefficients and the slopes of :mod:`symrot.derivatives`: everything a plan evaluates."""
+        return {**self.coefficient_expressions(), **{n: raw for n, (_, raw) in self.slopes.items()}}
+
+    def simplified_planned(self) -> dict[str, sp.Expr]:
+        """Simplified forms of :meth:`planned_expressions` (see :meth:`simplified_form`)."""
+        return {name: self.simplified_form(name) for name in self.planned_expressions()}
+
+    def simplified_form(self, name: str) -> sp.Expr:
+        """The simplified form of one planned expression; a slope is the derivative of its parent's
+        simplified form over dx/dφ = 2 p p′ with common factors pulled out (``factor_terms``): no
+        time-bounded step, so that the printed form cannot depend on how loaded the machine is."""
+        if name not in self.slopes:
+            return self.simplified_coefficients()[name]
+        if name not in self._slopes_simplified:
+            parent = self.simplified_coefficients()[self.slopes[name][0]]
+            quotient = sp.diff(parent, PHI) / (2 * self.p * self.scalars["p_prime"])
+            self._slopes_simplified[name] = sp.factor_terms(quotient)
+        return self._slopes_simplified[name]
+
     # -- series -----------------------------------------------------------------------------
     def taylor_in_phi(self, name: str, order: int) -> list[sp.Expr]:
         """Exact Taylor coefficients of coefficient ``name`` in φ (index k ↔ φ^k)."""
-        series: Series = taylor_series(self.coefficient_expressions()[name], order)
+        series: Series = taylor_series(self.planned_expressions()[name], order)
         if not series.is_zero and series.shift < 0:
             raise InvalidGeneratingFunction(f"coefficient {name} has a pole at phi = 0")
         return coefficient_list(series, 0, order)
@@ -128,6 +152,8 @@ class Derivation:
         return self._series_cache[key]
 
     def _series_in_x(self, name: str, n_terms: int) -> list[sp.Expr]:
+        if name in self.slopes:  # exact, term by term from the parent's series
+            return slope_series(self.series_in_x(self.slopes[name][0], n_terms + 1), n_terms)
         order = 2 * n_terms
         in_phi = self.taylor_in_phi(name, order)
         odd = [k for k in range(1, order, 2) if in_phi[k] != 0]
@@ -148,7 +174,9 @@ class Derivation:
         return self._constants[name]
 
     def _find_constant(self, name: str) -> sp.Expr | None:
-        simplified = self.simplified_coefficients()[name]
+        if name in self.slopes and self.constant_value(self.slopes[name][0]) is not None:
+            return sp.S.Zero
+        simplified = self.simplified_form(name)
         if simplified.is_Number:
             return simplified
         in_phi = self.taylor_in_phi(name, CONSTANT_ORDER)
@@ -165,7 +193,7 @@ class Derivation:
     # -- numeric evaluation -------------------------------------------------------------------
     def evaluate(self, name: str, angle: mpmath.mpf | str, digits: int = 50) -> mpmath.mpf:
         """Coefficient ``name`` at φ = angle to ``digits`` digits (raw closed form)."""
-        return evaluate(self.coefficient_expressions()[name], angle, digits)
+        return evaluate(self.planned_expressions()[name], angle, digits)
 
 
 def scalar_definitions(p: sp.Expr) -> dict[str, sp.Expr]:
@@ -212,7 +240,9 @@ def derive_function(function: ValidatedFunction) -> Derivation:
     tensors = {
         name: _build_tensor(name, u_basis, p) for name, u_basis in tensor_definitions(p).items()
     }
-    return Derivation(function, raw, scalars, tensors)
+    coefficients = {n: c for t in tensors.values() for n, c in zip(t.coefficient_names(), t.coefficients,
+                                                                  strict=True)}
+    return Derivation(function, raw, scalars, tensors, slope_definitions(coefficients, p))
 
 
 def derive_expression(expr: sp.Expr, normalize: bool = False) -> Derivation:

@@ -2,7 +2,8 @@
 
 Generated code takes the parameter vector p, never φ. Every quantity is a scalar coefficient of
 x = |p|²: ν, ε, μ, p′, det H (eqs 17–24), the coefficients on I, (p×), (p×)² of R (16), H (20),
-H⁻¹ (26), G (81) and K (83) (names as in ``Derivation.coefficient_expressions``), e₀ = cos(φ/2)
+H⁻¹ (26), G (81) and K (83) (names as in ``Derivation.coefficient_expressions``), the slopes dc/dx
+of R's, H's and H⁻¹'s coefficients (``R_1_x`` …, :mod:`symrot.derivatives`), e₀ = cos(φ/2)
 (``e_0``, eq 74) and φ itself. The plan decides this once per coefficient and per precision;
 backends only print it.
 
@@ -34,6 +35,7 @@ import numpy as np
 import sympy as sp
 
 from .algebraic import (
+    D,
     S,
     algebraic_in_x,
     angle_with_complement,
@@ -184,7 +186,15 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     """Choose the switch t₀ and Horner degree for one coefficient in one precision."""
     candidates = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
     candidates += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
-    branches = [_branch_for(form, series, variable_of_phi, phi_max, dtype) for form in candidates]
+    branches = []
+    for form in candidates:
+        try:
+            branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype))
+        except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
+            continue
+    if not branches:
+        raise SymrotError(f"cannot plan {closed} in {np.dtype(dtype).name}: every form divides by zero "
+                          "on the grid")
     return min(branches, key=lambda b: (max(_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
                                         len(b.smallest_switch[1]), trig_arguments(b.closed), b.edge_ulp,
                                         b.measured_ulp))
@@ -301,14 +311,17 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     precisions = {}
     for label, dtype in PRECISIONS.items():
         coefficients: dict[str, Coefficient] = {}
-        for coefficient, closed in derivation.coefficient_expressions().items():
+        for coefficient, closed in derivation.planned_expressions().items():
             constant = derivation.constant_value(coefficient)
             if constant is not None:
                 coefficients[coefficient] = Constant(constant)
                 continue
+            if coefficient in derivation.slopes:  # after every parent: its parent's plan is known
+                coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max, dtype)
+                continue
             if inverse is not None:
                 if coefficient not in algebraic_forms:  # the first precision searches, both use it
-                    simplest_form = derivation.simplified_coefficients()[coefficient]
+                    simplest_form = derivation.simplified_form(coefficient)
                     found = None
                     if time.monotonic() < algebraic_deadline:
                         found = (algebraic_in_x(simplest_form, inverse, p_max)
@@ -319,7 +332,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                     coefficients[coefficient] = Algebraic(algebraic)
                     continue
             series = derivation.series_in_x(coefficient, MAX_TERMS)
-            simplest_form = derivation.simplified_coefficients()[coefficient]
+            simplest_form = derivation.simplified_form(coefficient)
             coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype)
         coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, phi_max, p_max, dtype)
         scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
@@ -333,11 +346,26 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
         elif inverse is not None:
             coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
                             if isinstance(c, Branch) else c for n, c in coefficients.items()}
-        limit = _domain_limit(derivation, coefficients, angle, inverse, phi_max, p_max, dtype)
+        slopes = {n: c for n, c in coefficients.items() if n in derivation.slopes}
+        kinematic = {n: c for n, c in coefficients.items() if n not in derivation.slopes}
+        limit = _domain_limit(derivation, kinematic, angle, inverse, phi_max, p_max, dtype)
+        slope_limit = min(limit, _domain_limit(derivation, slopes, angle, inverse, phi_max, p_max, dtype))
         precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale,
-                                          limit)
+                                          limit, slope_limit)
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
                           _p_max_squared(p, limits.phi_max, p_max))
+
+
+def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coefficient], phi_max: float,
+                dtype: type) -> Coefficient:
+    """A slope dc/dx (:mod:`symrot.derivatives`): the derivative in x of its parent's algebraic form when
+    the parent has one (d(D)/dx = −1), else a Branch of its closed form and exact series. Never a search
+    of its own under the algebraic time budget, so that the plan is the same on a loaded machine."""
+    parent = coefficients[derivation.slopes[name][0]]
+    if isinstance(parent, Algebraic):
+        return Algebraic(sp.diff(parent.expression, X) - sp.diff(parent.expression, D))
+    series = derivation.series_in_x(name, MAX_TERMS)
+    return plan_branch(derivation.simplified_form(name), series, derivation.p ** 2, phi_max, dtype)
 
 
 def _domain_limit(derivation: Derivation, coefficients: dict[str, Coefficient],
@@ -346,7 +374,7 @@ def _domain_limit(derivation: Derivation, coefficients: dict[str, Coefficient],
     """x_limit of :class:`PrecisionPlan`: the printed forms as the backends evaluate them above
     x = 2^32 (algebraic forms, the closed side of branches, the closed angle), swept by
     :func:`symrot.domain.domain_limit`."""
-    raw = {**derivation.coefficient_expressions(), QUATERNION_SCALAR: quaternion_scalar()}
+    raw = {**derivation.planned_expressions(), QUATERNION_SCALAR: quaternion_scalar()}
     printed: dict[str, tuple[str, sp.Expr]] = {}
     for name, coefficient in coefficients.items():
         if isinstance(coefficient, Algebraic):

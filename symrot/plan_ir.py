@@ -125,6 +125,10 @@ class PrecisionPlan:
     x_limit: float = 2.0**600
     """Edge of the domain for unbounded p: every output is NaN for x = |p|² ≥ x_limit, the largest
     power of two up to which every printed form is right (:mod:`symrot.domain`)."""
+    derivative_x_limit: float = 2.0**600
+    """The same edge for the derivatives of :mod:`symrot.derivatives` (≤ ``x_limit``): their slopes
+    dc/dx may overflow earlier (Wiener–Milenkovic's −256/(x + 16)³ beyond 2^341), and must not move
+    the domain of the other functions."""
 
 
 @dataclass(frozen=True)

@@ -266,6 +266,46 @@ class Reference:
             quaternion = [mpmath.cos(phi / 2)] + [mpmath.sin(phi / 2) * v / s for v in p]
         return State(phi, rotation, root, tangent, root_tangent, quaternion)
 
+    # -- derivatives (issue 19) ------------------------------------------------------------------
+    def tensor(self, p: Sequence[Any], name: str) -> mpmath.matrix:
+        """R, R_T (Rᵀ), H, H_T (Hᵀ) or H_inverse at p, from the definitions above."""
+        state = self.state(p)
+        if name.endswith("_T"):
+            return getattr(state, name[:-2]).T
+        return getattr(state, name)
+
+    def derivative(self, p: Sequence[Any], a: Sequence[Any], name: str) -> mpmath.matrix:
+        """∂(T a)/∂p for a fixed a, column j = d(T a)/dp_j, T = :meth:`tensor` ``name``: a central
+        difference of T itself with step 10⁻³⁰ max(1, |p|) (truncation ~10⁻⁶⁰; T is exact to ~10⁻⁸⁰,
+        so rounding ~10⁻⁵⁰)."""
+        with mpmath.workdps(2 * self.digits + 30):
+            p = [mpmath.mpf(v) for v in p]
+            a_vector = mpmath.matrix([mpmath.mpf(v) for v in a])
+            step = mpmath.mpf(10) ** -30 * max(1, mpmath.sqrt(sum(v * v for v in p)))
+            columns = []
+            for j in range(3):
+                plus, minus = list(p), list(p)
+                plus[j] += step
+                minus[j] -= step
+                columns.append((self.tensor(plus, name) - self.tensor(minus, name)) * a_vector / (2 * step))
+            return mpmath.matrix([[columns[j][i] for j in range(3)] for i in range(3)])
+
+    def along(self, p: Sequence[Any], pdot: Sequence[Any], pddot: Sequence[Any]
+              ) -> tuple[mpmath.matrix, mpmath.matrix]:
+        """(Ḣ ṗ, α) on the trajectory p(t) = p + t ṗ + t² p̈/2 at t = 0: d/dt of H(p(t)) applied to ṗ,
+        and α = dω/dt of ω(t) = H(p(t)) ṗ(t) (eq 20), by central differences in t (step as above)."""
+        with mpmath.workdps(2 * self.digits + 30):
+            p, v, w = ([mpmath.mpf(c) for c in u] for u in (p, pdot, pddot))
+            step = mpmath.mpf(10) ** -30
+            values = {}
+            for t in (step, -step):
+                point = [p[i] + t * v[i] + t * t * w[i] / 2 for i in range(3)]
+                values[t] = (self.state(point).H, mpmath.matrix([v[i] + t * w[i] for i in range(3)]))
+            (h_plus, v_plus), (h_minus, v_minus) = values[step], values[-step]
+            rate = (h_plus - h_minus) * mpmath.matrix(v) / (2 * step)
+            acceleration = (h_plus * v_plus - h_minus * v_minus) / (2 * step)
+            return rate, acceleration
+
     # -- operations on rotations of any size ------------------------------------------------
     def from_quaternion(self, e: Sequence[Any]) -> list[Any]:
         """p of the rotation e (either sign); NaN when its angle is ≥ φ_max."""

@@ -18,6 +18,11 @@
  * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
  * the output is NaN (input out of range or not finite, or rotation not representable).
  *
+ * Derivatives (docs/derivatives.md): rotation_derivative, rotation_transpose_derivative,
+ * tangent_derivative, tangent_transpose_derivative, tangent_inverse_derivative (D = d(T a)/dp for a
+ * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
+ * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, safeguarded Newton iteration for phi
  */
@@ -1083,6 +1088,639 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
     return symrot_det_h_one__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_det_h_one_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * R_2: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 16 in x below x = 1.43428, else (-2*sin(phi/2)**2 + 1 - 4*sin(phi/2)**3*cos(phi/2)/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2)
+ * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * ops: 784 */
+static inline void symrot_det_h_one_rotation_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.243134665607636)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.764824235244299) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
+    } else {
+        const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double w0 = sin(phi);
+        const double w1 = cbrt(6*phi - 6*w0);
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = (w3*w3);
+        const double w5 = cos(w2);
+        const double w6 = w3*w5;
+        const double w7 = 2*w6;
+        const double w8 = 1.0/(phi - w7);
+        const double w9 = (1.0/8.0)/w4;
+        c_R_1 = w0/w1;
+        c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
+        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w9*(-4.0/3.0*(w3*w3*w3)*w5*w8 - 2*w4 + 1);
+        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w9*(-8.0/3.0*(w3*w3*w3*w3)*w8 + w7)/cbrt(6*phi - 12*w6);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_R_2_x*dw13;
+    const double dw15 = a[2]*c_R_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_R_1_x;
+    const double dw18 = a[1]*c_R_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_R_2_x*dw20;
+    const double dw23 = a[0]*c_R_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_det_h_one_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * R_2: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 16 in x below x = 1.43428, else (-2*sin(phi/2)**2 + 1 - 4*sin(phi/2)**3*cos(phi/2)/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2)
+ * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * ops: 785 */
+static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.243134665607636)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.764824235244299) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
+    } else {
+        const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double w0 = sin(phi);
+        const double w1 = cbrt(6*phi - 6*w0);
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = (w3*w3);
+        const double w5 = cos(w2);
+        const double w6 = w3*w5;
+        const double w7 = 2*w6;
+        const double w8 = 1.0/(phi - w7);
+        const double w9 = (1.0/8.0)/w4;
+        c_R_1 = w0/w1;
+        c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
+        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w9*(-4.0/3.0*(w3*w3*w3)*w5*w8 - 2*w4 + 1);
+        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w9*(-8.0/3.0*(w3*w3*w3*w3)*w8 + w7)/cbrt(6*phi - 12*w6);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = a[0]*p[1];
+    const double dw6 = -a[1]*p[0] + dw5;
+    const double dw7 = -dw6;
+    const double dw8 = dw7*p[1];
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8;
+    const double dw14 = a[2]*c_R_1;
+    const double dw15 = dw4*p[1];
+    const double dw16 = 2*c_R_1_x;
+    const double dw17 = a[1]*c_R_1;
+    const double dw18 = dw11*p[0];
+    const double dw19 = dw7*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = a[0]*c_R_1;
+    const double dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_det_h_one_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
+ * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 850 */
+static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.243134665607636)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
+    if (x < 1.4342812090283275) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
+    } else {
+        const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double w0 = 2*phi;
+        const double w1 = sin(w0);
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = cos(w2);
+        const double w4 = sin(w2);
+        const double w5 = w3*w4;
+        const double w6 = 2*w5;
+        const double w7 = 1.0/(phi - w6);
+        const double w8 = (w4*w4);
+        const double w9 = 1.0/w8;
+        const double w10 = w7*w9;
+        const double w11 = 6*phi;
+        const double w12 = w11 - 12*w5;
+        const double w13 = w3/(w4*w4*w4);
+        const double w14 = cbrt(w12);
+        const double w15 = w1 + w11 - 16*w5;
+        c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w1 - 8*w5);
+        c_H_0_x = (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w7);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w4*w4*w4*w4)*w7 + w6)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w7 - 1.0/2.0*w9*(8*w8 + cos(w0) - 1));
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = a[0]*p[2];
+    const double dw12 = a[2]*p[0];
+    const double dw13 = dw11 - dw12;
+    const double dw14 = dw13*p[2];
+    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const double dw16 = a[2]*c_H_1;
+    const double dw17 = dw6*p[1];
+    const double dw18 = 2*c_H_1_x;
+    const double dw19 = 2*dw15;
+    const double dw20 = a[1]*c_H_1;
+    const double dw21 = a[1]*p[0];
+    const double dw22 = dw13*p[0];
+    const double dw23 = dw10*p[0];
+    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const double dw25 = 2*dw24;
+    const double dw26 = a[0]*c_H_1;
+    const double dw27 = -dw17 + dw22;
+    const double dw28 = c_H_2_x*dw27;
+    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+}
+
+/* symrot_det_h_one_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
+ * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 856 */
+static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.243134665607636)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
+    if (x < 1.4342812090283275) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
+    } else {
+        const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double w0 = 2*phi;
+        const double w1 = sin(w0);
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = cos(w2);
+        const double w4 = sin(w2);
+        const double w5 = w3*w4;
+        const double w6 = 2*w5;
+        const double w7 = 1.0/(phi - w6);
+        const double w8 = (w4*w4);
+        const double w9 = 1.0/w8;
+        const double w10 = w7*w9;
+        const double w11 = 6*phi;
+        const double w12 = w11 - 12*w5;
+        const double w13 = w3/(w4*w4*w4);
+        const double w14 = cbrt(w12);
+        const double w15 = w1 + w11 - 16*w5;
+        c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w1 - 8*w5);
+        c_H_0_x = (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w7);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w4*w4*w4*w4)*w7 + w6)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w7 - 1.0/2.0*w9*(8*w8 + cos(w0) - 1));
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = dw10*p[1];
+    const double dw12 = a[0]*p[2];
+    const double dw13 = a[2]*p[0];
+    const double dw14 = dw12 - dw13;
+    const double dw15 = dw14*p[2];
+    const double dw16 = dw11 - dw15;
+    const double dw17 = c_H_2_x*dw16;
+    const double dw18 = a[2]*c_H_1;
+    const double dw19 = dw6*p[1];
+    const double dw20 = 2*c_H_1_x;
+    const double dw21 = a[1]*c_H_1;
+    const double dw22 = a[1]*p[0];
+    const double dw23 = dw14*p[0];
+    const double dw24 = dw10*p[0];
+    const double dw25 = -dw24 + dw6*p[2];
+    const double dw26 = c_H_2_x*dw25;
+    const double dw27 = a[0]*c_H_1;
+    const double dw28 = -dw19 + dw23;
+    const double dw29 = a[2]*p[1];
+    const double dw30 = 2*c_H_2_x*dw28;
+    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+}
+
+/* symrot_det_h_one_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
+ * H_inverse_0_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x: Horner degree 21 in x below x = 2.63022, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
+ * ops: 648 */
+static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.243134665607636)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_H_inverse_2, c_H_inverse_0_x, c_H_inverse_2_x;
+    if (x < 2.6302227241416043) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
+        c_H_inverse_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.42701592796967e-25)*x - 3.982335375612905e-24) - 4.6352839539983977e-23) - 5.40513214847762e-22) - 6.315600653020195e-21) - 7.396110286959959e-20) - 8.683469103988305e-19) - 1.0224187860604788e-17) - 1.207771859033198e-16) - 1.4321083368003567e-15) - 1.7055656901807745e-14) - 2.0417396933193335e-13) - 2.4592808133854965e-12) - 2.9844879309052296e-11) - 3.65573324363898e-10) - 11192989.0/2470051584000000.0) - 604523.0/10594584000000.0) - 3293.0/4484480000.0) - 947.0/97020000.0) - 23.0/168000.0) - 3.0/1400.0) - 1.0/20.0;
+        c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.497844255354877e-25)*x + 7.196733448736306e-24) + 7.96467075122581e-23) + 8.807039512596957e-22) + 9.729237867259716e-21) + 1.0736521110134332e-19) + 1.1833776459135935e-18) + 1.3025203655982459e-17) + 1.4313863004846702e-16) + 1.5701034167431574e-15) + 1.718530004160428e-14) + 1.8761222591988522e-13) + 2.0417396933193335e-12) + 2.213352732046947e-11) + 2.3875903447241837e-10) + 2.559013270547286e-09) + 11192989.0/411675264000000.0) + 604523.0/2118916800000.0) + 3293.0/1121120000.0) + 947.0/32340000.0) + 23.0/84000.0) + 3.0/1400.0;
+    } else {
+        const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/w2;
+        const double w4 = 6*phi;
+        const double w5 = cos(w0);
+        const double w6 = w1*w5;
+        const double w7 = cbrt(w4 - 12*w6);
+        const double w8 = 1 - 2*w2;
+        const double w9 = -8*w2 + w4*w6 + (w8*w8) - 1;
+        const double w10 = 2*w6;
+        const double w11 = (w1*w1*w1*w1);
+        const double w12 = 1.0/(phi - w10);
+        const double w13 = (8.0/3.0)*w12;
+        c_H_inverse_2 = -1.0/2.0*w3*w9/(w7*w7*w7*w7);
+        c_H_inverse_0_x = (1.0/4.0)*w3*(w10 - w11*w13)/w7;
+        c_H_inverse_2_x = -1.0/96.0*w12*(3*phi*w8 - w10 - w13*w2*w9 - 4*w6*w8 - w5*w9/w1)/w11;
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_inverse_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[0]*p[1];
+    const double dw5 = -a[1]*p[0] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = a[0]*p[2];
+    const double dw8 = a[2]*p[0];
+    const double dw9 = dw7 - dw8;
+    const double dw10 = dw6*p[1] - dw9*p[2];
+    const double dw11 = 2*c_H_inverse_2_x;
+    const double dw12 = dw10*dw11;
+    const double dw13 = (1.0/2.0)*a[2];
+    const double dw14 = (1.0/2.0)*a[1];
+    const double dw15 = a[1]*p[0];
+    const double dw16 = a[1]*p[2];
+    const double dw17 = -a[2]*p[1] + dw16;
+    const double dw18 = -dw17;
+    const double dw19 = dw18*p[2] - dw6*p[0];
+    const double dw20 = dw11*dw19;
+    const double dw21 = (1.0/2.0)*a[0];
+    const double dw22 = -dw18*p[1] + dw9*p[0];
+    const double dw23 = a[2]*p[1];
+    const double dw24 = dw11*dw22;
+    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+}
+
+/* symrot_det_h_one_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_0: Horner degree 13 in x below x = 0.764824, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
+ * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
+ * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 910 */
+static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.243134665607636)) {
+        alpha[0] = (double)NAN;
+        alpha[1] = (double)NAN;
+        alpha[2] = (double)NAN;
+        return;
+    }
+    double c_H_0, c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
+    if (x < 0.764824235244299) {
+        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.253841918550812e-15)*x + 6.068442620832808e-14) + 7.02588589607731e-13) + 8.157249203307483e-12) + 9.503025504854477e-11) + 1.111738558870201e-09) + 99681.0/7623616000000.0) + 151439.0/977961600000.0) + 1213.0/655200000.0) + 387.0/17248000.0) + 1.0/3600.0) + 1.0/280.0) + 1.0/20.0) + 1;
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
+    } else {
+        const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/w2;
+        const double w4 = pow(cbrt(6*(phi - sin(phi))), 2);
+        const double w5 = 2*phi;
+        const double w6 = sin(w5);
+        const double w7 = cos(w0);
+        const double w8 = w1*w7;
+        const double w9 = 2*w8;
+        const double w10 = 1.0/(phi - w9);
+        const double w11 = w10*w3;
+        const double w12 = 6*phi;
+        const double w13 = w12 - 12*w8;
+        const double w14 = w7/(w1*w1*w1);
+        const double w15 = cbrt(w13);
+        const double w16 = w12 + w6 - 16*w8;
+        c_H_0 = (1.0/4.0)*w3*w4;
+        c_H_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/w4;
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w11*(3*phi + (1.0/2.0)*w6 - 8*w8);
+        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w13*w3*(2*w10 - 3.0/2.0*w14);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w3*(-8.0/3.0*(w1*w1*w1*w1)*w10 + w9)/w15;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w11*w15*((1.0/2.0)*w10*w16 + (1.0/4.0)*w14*w16 - 1.0/2.0*w3*(8*w2 + cos(w5) - 1));
+    }
+    const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const double w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const double dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const double dw1 = c_H_0_x*dw0;
+    const double dw2 = p[1]*pdot[2] - p[2]*pdot[1];
+    const double dw3 = c_H_1_x*dw0;
+    const double dw4 = p[0]*pdot[1] - p[1]*pdot[0];
+    const double dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const double dw6 = c_H_2_x*dw0;
+    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+}
+
+/* symrot_det_h_one_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_det_h_one_compose_jacobians(const double p1[3], const double p2[3], double J1[9], double J2[9])
+{
+    double p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_det_h_one_compose(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = (double)NAN;
+        J1[1] = (double)NAN;
+        J1[2] = (double)NAN;
+        J1[3] = (double)NAN;
+        J1[4] = (double)NAN;
+        J1[5] = (double)NAN;
+        J1[6] = (double)NAN;
+        J1[7] = (double)NAN;
+        J1[8] = (double)NAN;
+        J2[0] = (double)NAN;
+        J2[1] = (double)NAN;
+        J2[2] = (double)NAN;
+        J2[3] = (double)NAN;
+        J2[4] = (double)NAN;
+        J2[5] = (double)NAN;
+        J2[6] = (double)NAN;
+        J2[7] = (double)NAN;
+        J2[8] = (double)NAN;
+        return 1;
+    }
+    symrot_det_h_one_tangent_inverse(p3, Hinv3);
+    symrot_det_h_one_rotation_matrix(p2, R2);
+    symrot_det_h_one_tangent(p1, H1);
+    symrot_det_h_one_tangent(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_det_h_one_rescale_jacobian: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_det_h_one_rescale_jacobian(const double p[3], double J[9])
+{
+    double e[4], q[3], Hinv[9], H[9];
+    symrot_det_h_one_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_det_h_one_rescale(p, q) != 0) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    symrot_det_h_one_tangent_inverse(q, Hinv);
+    symrot_det_h_one_tangent(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
+}
+
 /* symrot_det_h_one__phi_f: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
  * ops: 379 */
@@ -2116,6 +2754,638 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
         return 0;
     }
     return symrot_det_h_one__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_det_h_one_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * R_2: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
+ * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * ops: 639 */
+static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.2431345F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 1.4342812F) {
+        c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
+    } else {
+        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float w0 = sinf(phi);
+        const float w1 = phi - w0;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = w3*cosf(w2);
+        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w6 = (w3*w3);
+        const float w7 = 2*w6;
+        const float w8 = (1.0F/8.0F)/w6;
+        const float w9 = 2*w4;
+        c_R_1 = w0/cbrtf(6*w1);
+        c_R_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_R_2_x*dw13;
+    const float dw15 = a[2]*c_R_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_R_1_x;
+    const float dw18 = a[1]*c_R_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_R_2_x*dw20;
+    const float dw23 = a[0]*c_R_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_det_h_one_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * R_2: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
+ * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * ops: 640 */
+static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.2431345F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 1.4342812F) {
+        c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
+    } else {
+        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float w0 = sinf(phi);
+        const float w1 = phi - w0;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = w3*cosf(w2);
+        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w6 = (w3*w3);
+        const float w7 = 2*w6;
+        const float w8 = (1.0F/8.0F)/w6;
+        const float w9 = 2*w4;
+        c_R_1 = w0/cbrtf(6*w1);
+        c_R_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = a[0]*p[1];
+    const float dw6 = -a[1]*p[0] + dw5;
+    const float dw7 = -dw6;
+    const float dw8 = dw7*p[1];
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8;
+    const float dw14 = a[2]*c_R_1;
+    const float dw15 = dw4*p[1];
+    const float dw16 = 2*c_R_1_x;
+    const float dw17 = a[1]*c_R_1;
+    const float dw18 = dw11*p[0];
+    const float dw19 = dw7*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = a[0]*c_R_1;
+    const float dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_det_h_one_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
+ * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 783 */
+static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.2431345F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
+    if (x < 2.6302226F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
+        c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
+    } else {
+        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 6*phi;
+        const float w4 = cosf(w0);
+        const float w5 = w1*w4;
+        const float w6 = w3 - 12*w5;
+        const float w7 = cbrtf(w6);
+        const float w8 = 2*phi;
+        const float w9 = sinf(w8);
+        const float w10 = 2*w5;
+        const float w11 = 1.0F/(phi - w10);
+        const float w12 = 1.0F/w2;
+        const float w13 = w11*w12;
+        const float w14 = w4/(w1*w1*w1);
+        const float w15 = w3 - 16*w5 + w9;
+        c_H_1 = 2*w2/(w7*w7);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w13*(3*phi - 8*w5 + (1.0F/2.0F)*w9);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w6*(2*w11 - 3.0F/2.0F*w14);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w12*(-8.0F/3.0F*(w1*w1*w1*w1)*w11 + w10)/w7;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w13*w7*((1.0F/2.0F)*w11*w15 - 1.0F/2.0F*w12*(8*w2 + cosf(w8) - 1) + (1.0F/4.0F)*w14*w15);
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = a[0]*p[2];
+    const float dw12 = a[2]*p[0];
+    const float dw13 = dw11 - dw12;
+    const float dw14 = dw13*p[2];
+    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const float dw16 = a[2]*c_H_1;
+    const float dw17 = dw6*p[1];
+    const float dw18 = 2*c_H_1_x;
+    const float dw19 = 2*dw15;
+    const float dw20 = a[1]*c_H_1;
+    const float dw21 = a[1]*p[0];
+    const float dw22 = dw13*p[0];
+    const float dw23 = dw10*p[0];
+    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const float dw25 = 2*dw24;
+    const float dw26 = a[0]*c_H_1;
+    const float dw27 = -dw17 + dw22;
+    const float dw28 = c_H_2_x*dw27;
+    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+}
+
+/* symrot_det_h_one_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
+ * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 789 */
+static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.2431345F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
+    if (x < 2.6302226F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
+        c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
+    } else {
+        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 6*phi;
+        const float w4 = cosf(w0);
+        const float w5 = w1*w4;
+        const float w6 = w3 - 12*w5;
+        const float w7 = cbrtf(w6);
+        const float w8 = 2*phi;
+        const float w9 = sinf(w8);
+        const float w10 = 2*w5;
+        const float w11 = 1.0F/(phi - w10);
+        const float w12 = 1.0F/w2;
+        const float w13 = w11*w12;
+        const float w14 = w4/(w1*w1*w1);
+        const float w15 = w3 - 16*w5 + w9;
+        c_H_1 = 2*w2/(w7*w7);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w13*(3*phi - 8*w5 + (1.0F/2.0F)*w9);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w6*(2*w11 - 3.0F/2.0F*w14);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w12*(-8.0F/3.0F*(w1*w1*w1*w1)*w11 + w10)/w7;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w13*w7*((1.0F/2.0F)*w11*w15 - 1.0F/2.0F*w12*(8*w2 + cosf(w8) - 1) + (1.0F/4.0F)*w14*w15);
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = dw10*p[1];
+    const float dw12 = a[0]*p[2];
+    const float dw13 = a[2]*p[0];
+    const float dw14 = dw12 - dw13;
+    const float dw15 = dw14*p[2];
+    const float dw16 = dw11 - dw15;
+    const float dw17 = c_H_2_x*dw16;
+    const float dw18 = a[2]*c_H_1;
+    const float dw19 = dw6*p[1];
+    const float dw20 = 2*c_H_1_x;
+    const float dw21 = a[1]*c_H_1;
+    const float dw22 = a[1]*p[0];
+    const float dw23 = dw14*p[0];
+    const float dw24 = dw10*p[0];
+    const float dw25 = -dw24 + dw6*p[2];
+    const float dw26 = c_H_2_x*dw25;
+    const float dw27 = a[0]*c_H_1;
+    const float dw28 = -dw19 + dw23;
+    const float dw29 = a[2]*p[1];
+    const float dw30 = 2*c_H_2_x*dw28;
+    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+}
+
+/* symrot_det_h_one_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
+ * H_inverse_0_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x: Horner degree 21 in x below x = 4.61948, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
+ * ops: 552 */
+static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.2431345F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_H_inverse_2, c_H_inverse_0_x, c_H_inverse_2_x;
+    if (x < 4.619481F) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
+        c_H_inverse_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-6.3156007e-21F)*x - 7.39611e-20F) - 8.683469e-19F) - 1.0224188e-17F) - 1.2077718e-16F) - 1.4321084e-15F) - 1.7055657e-14F) - 2.0417397e-13F) - 2.4592808e-12F) - 2.984488e-11F) - 3.6557332e-10F) - 4.5314796e-09F) - 5.7059626e-08F) - 7.3431033e-07F) - 9.7608745e-06F) - 23.0F/168000.0F) - 3.0F/1400.0F) - 1.0F/20.0F;
+        c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4978443e-25F)*x + 7.196733e-24F) + 7.964671e-23F) + 8.807039e-22F) + 9.729238e-21F) + 1.0736521e-19F) + 1.1833776e-18F) + 1.3025204e-17F) + 1.4313863e-16F) + 1.5701034e-15F) + 1.71853e-14F) + 1.8761223e-13F) + 2.0417396e-12F) + 2.2133528e-11F) + 2.3875904e-10F) + 2.5590132e-09F) + 2.7188879e-08F) + 2.8529814e-07F) + 2.9372413e-06F) + 2.9282623e-05F) + 23.0F/84000.0F) + 3.0F/1400.0F;
+    } else {
+        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 1.0F/w2;
+        const float w4 = 6*phi;
+        const float w5 = cosf(w0);
+        const float w6 = w1*w5;
+        const float w7 = cbrtf(w4 - 12*w6);
+        const float w8 = 1 - 2*w2;
+        const float w9 = -8*w2 + w4*w6 + (w8*w8) - 1;
+        const float w10 = 2*w6;
+        const float w11 = (w1*w1*w1*w1);
+        const float w12 = 1.0F/(phi - w10);
+        const float w13 = (8.0F/3.0F)*w12;
+        c_H_inverse_2 = -1.0F/2.0F*w3*w9/(w7*w7*w7*w7);
+        c_H_inverse_0_x = (1.0F/4.0F)*w3*(w10 - w11*w13)/w7;
+        c_H_inverse_2_x = -1.0F/96.0F*w12*(3*phi*w8 - w10 - w13*w2*w9 - 4*w6*w8 - w5*w9/w1)/w11;
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_inverse_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[0]*p[1];
+    const float dw5 = -a[1]*p[0] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = a[0]*p[2];
+    const float dw8 = a[2]*p[0];
+    const float dw9 = dw7 - dw8;
+    const float dw10 = dw6*p[1] - dw9*p[2];
+    const float dw11 = 2*c_H_inverse_2_x;
+    const float dw12 = dw10*dw11;
+    const float dw13 = (1.0F/2.0F)*a[2];
+    const float dw14 = (1.0F/2.0F)*a[1];
+    const float dw15 = a[1]*p[0];
+    const float dw16 = a[1]*p[2];
+    const float dw17 = -a[2]*p[1] + dw16;
+    const float dw18 = -dw17;
+    const float dw19 = dw18*p[2] - dw6*p[0];
+    const float dw20 = dw11*dw19;
+    const float dw21 = (1.0F/2.0F)*a[0];
+    const float dw22 = -dw18*p[1] + dw9*p[0];
+    const float dw23 = a[2]*p[1];
+    const float dw24 = dw11*dw22;
+    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+}
+
+/* symrot_det_h_one_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*(phi - sin(phi)))**2/(4*sin(phi/2)**2)
+ * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
+ * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
+ * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 799 */
+static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.2431345F)) {
+        alpha[0] = NAN;
+        alpha[1] = NAN;
+        alpha[2] = NAN;
+        return;
+    }
+    float c_H_0, c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
+    if (x < 2.6302226F) {
+        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
+        c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
+    } else {
+        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 1.0F/w2;
+        const float w4 = 6*phi;
+        const float w5 = cosf(w0);
+        const float w6 = w1*w5;
+        const float w7 = w4 - 12*w6;
+        const float w8 = cbrtf(w7);
+        const float w9 = 2*phi;
+        const float w10 = sinf(w9);
+        const float w11 = 2*w6;
+        const float w12 = 1.0F/(phi - w11);
+        const float w13 = w12*w3;
+        const float w14 = w5/(w1*w1*w1);
+        const float w15 = w10 + w4 - 16*w6;
+        c_H_0 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1 : (1.0F/4.0F)*w3*powf(cbrtf(6*(phi - sinf(phi))), 2);
+        c_H_1 = 2*w2/(w8*w8);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w13*(3*phi + (1.0F/2.0F)*w10 - 8*w6);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w3*w7*(2*w12 - 3.0F/2.0F*w14);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w3*(-8.0F/3.0F*(w1*w1*w1*w1)*w12 + w11)/w8;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w13*w8*((1.0F/2.0F)*w12*w15 + (1.0F/4.0F)*w14*w15 - 1.0F/2.0F*w3*(8*w2 + cosf(w9) - 1));
+    }
+    const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const float w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const float dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const float dw1 = c_H_0_x*dw0;
+    const float dw2 = p[1]*pdot[2] - p[2]*pdot[1];
+    const float dw3 = c_H_1_x*dw0;
+    const float dw4 = p[0]*pdot[1] - p[1]*pdot[0];
+    const float dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const float dw6 = c_H_2_x*dw0;
+    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+}
+
+/* symrot_det_h_one_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_det_h_one_compose_jacobians_f(const float p1[3], const float p2[3], float J1[9], float J2[9])
+{
+    float p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_det_h_one_compose_f(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = NAN;
+        J1[1] = NAN;
+        J1[2] = NAN;
+        J1[3] = NAN;
+        J1[4] = NAN;
+        J1[5] = NAN;
+        J1[6] = NAN;
+        J1[7] = NAN;
+        J1[8] = NAN;
+        J2[0] = NAN;
+        J2[1] = NAN;
+        J2[2] = NAN;
+        J2[3] = NAN;
+        J2[4] = NAN;
+        J2[5] = NAN;
+        J2[6] = NAN;
+        J2[7] = NAN;
+        J2[8] = NAN;
+        return 1;
+    }
+    symrot_det_h_one_tangent_inverse_f(p3, Hinv3);
+    symrot_det_h_one_rotation_matrix_f(p2, R2);
+    symrot_det_h_one_tangent_f(p1, H1);
+    symrot_det_h_one_tangent_f(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_det_h_one_rescale_jacobian_f: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_det_h_one_rescale_jacobian_f(const float p[3], float J[9])
+{
+    float e[4], q[3], Hinv[9], H[9];
+    symrot_det_h_one_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_det_h_one_rescale_f(p, q) != 0) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    symrot_det_h_one_tangent_inverse_f(q, Hinv);
+    symrot_det_h_one_tangent_f(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
 }
 
 #ifdef __cplusplus

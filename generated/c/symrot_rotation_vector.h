@@ -18,6 +18,11 @@
  * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
  * the output is NaN (input out of range or not finite, or rotation not representable).
  *
+ * Derivatives (docs/derivatives.md): rotation_derivative, rotation_transpose_derivative,
+ * tangent_derivative, tangent_transpose_derivative, tangent_inverse_derivative (D = d(T a)/dp for a
+ * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
+ * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -930,6 +935,563 @@ static inline int symrot_rotation_vector_rescale(const double p[3], double q[3])
     return symrot_rotation_vector__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_rotation_vector_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 0.408665, else 2*sin(phi/2)*cos(phi/2)/phi
+ * R_2: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 8 in x below x = 0.785123, else (cos(phi) - sin(phi)/phi)/(2*phi**2)
+ * R_2_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * ops: 228 */
+static inline void symrot_rotation_vector_rotation_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.47841760435743)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.4086652777619188) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = 1.0/phi;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = 2*w2*cos(w1);
+        const double w4 = 1.0/(phi*phi);
+        const double w5 = (w2*w2);
+        c_R_1 = w0*w3;
+        c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*w4*w5;
+        c_R_1_x = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0 : (1.0/2.0)*w4*(-w0*sin(phi) + cos(phi));
+        c_R_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*(-4*w0*w5 + w3)/(phi*phi*phi);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_R_2_x*dw13;
+    const double dw15 = a[2]*c_R_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_R_1_x;
+    const double dw18 = a[1]*c_R_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_R_2_x*dw20;
+    const double dw23 = a[0]*c_R_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_rotation_vector_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 0.408665, else 2*sin(phi/2)*cos(phi/2)/phi
+ * R_2: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 8 in x below x = 0.785123, else (cos(phi) - sin(phi)/phi)/(2*phi**2)
+ * R_2_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * ops: 229 */
+static inline void symrot_rotation_vector_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.47841760435743)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.4086652777619188) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = 1.0/phi;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = 2*w2*cos(w1);
+        const double w4 = 1.0/(phi*phi);
+        const double w5 = (w2*w2);
+        c_R_1 = w0*w3;
+        c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*w4*w5;
+        c_R_1_x = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0 : (1.0/2.0)*w4*(-w0*sin(phi) + cos(phi));
+        c_R_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*(-4*w0*w5 + w3)/(phi*phi*phi);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = a[0]*p[1];
+    const double dw6 = -a[1]*p[0] + dw5;
+    const double dw7 = -dw6;
+    const double dw8 = dw7*p[1];
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8;
+    const double dw14 = a[2]*c_R_1;
+    const double dw15 = dw4*p[1];
+    const double dw16 = 2*c_R_1_x;
+    const double dw17 = a[1]*c_R_1;
+    const double dw18 = dw11*p[0];
+    const double dw19 = dw7*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = a[0]*c_R_1;
+    const double dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_rotation_vector_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_0_x = 0 (constant)
+ * H_1_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 + 3*(-phi + sin(phi))/phi)/(2*phi**4)
+ * ops: 235 */
+static inline void symrot_rotation_vector_tangent_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.47841760435743)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 0.7851233626304374) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/(phi*phi*phi);
+        const double w4 = -phi + sin(phi);
+        const double w5 = 1.0/phi;
+        c_H_1 = 2*w2/(phi*phi);
+        c_H_2 = -w3*w4;
+        c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
+        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_H_2_x*dw13;
+    const double dw15 = a[2]*c_H_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_H_1_x;
+    const double dw18 = a[1]*c_H_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_H_2_x*dw20;
+    const double dw23 = a[0]*c_H_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_H_2_x*dw24;
+    D[0] = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
+    D[4] = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
+    D[8] = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_rotation_vector_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_0_x = 0 (constant)
+ * H_1_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 + 3*(-phi + sin(phi))/phi)/(2*phi**4)
+ * ops: 236 */
+static inline void symrot_rotation_vector_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.47841760435743)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 0.7851233626304374) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/(phi*phi*phi);
+        const double w4 = -phi + sin(phi);
+        const double w5 = 1.0/phi;
+        c_H_1 = 2*w2/(phi*phi);
+        c_H_2 = -w3*w4;
+        c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
+        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = a[0]*p[1];
+    const double dw6 = -a[1]*p[0] + dw5;
+    const double dw7 = -dw6;
+    const double dw8 = dw7*p[1];
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8;
+    const double dw14 = a[2]*c_H_1;
+    const double dw15 = dw4*p[1];
+    const double dw16 = 2*c_H_1_x;
+    const double dw17 = a[1]*c_H_1;
+    const double dw18 = dw11*p[0];
+    const double dw19 = dw7*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = a[0]*c_H_1;
+    const double dw23 = -dw15 + dw18;
+    D[0] = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
+    D[1] = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_rotation_vector_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2: Horner degree 18 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
+ * H_inverse_0_x = 0 (constant)
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x: Horner degree 20 in x below x = 5.56735, else ((-phi*(1 - 2*sin(phi/2)**2) + 2*phi*cos(phi/2)**2 - 2*sin(phi/2)*cos(phi/2))/(4*sin(phi/2)**2) - (-phi*cos(phi/2)/sin(phi/2) + 2)/phi)/(2*phi**3)
+ * ops: 220 */
+static inline void symrot_rotation_vector_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.47841760435743)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_H_inverse_2, c_H_inverse_2_x;
+    if (x < 5.5673482008975155) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.336734257095045e-31)*x + 3.6859949406653103e-29) + 1.455172475614865e-27) + 5.744790668872202e-26) + 2.267952452337683e-24) + 8.953517427037546e-23) + 3.534707039629467e-21) + 1.3954464685812522e-19) + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
+        c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.1866552573834097e-34)*x + 1.1981343524964268e-32) + 4.4935425898311966e-31) + 1.6806121662771081e-29) + 6.266191399131027e-28) + 2.328275960983784e-26) + 8.617186003308303e-25) + 3.1751334332727565e-23) + 1.163957265514881e-21) + 4.241648447555361e-20) + 1.5349911154393775e-18) + 5.5090028283602297e-17) + 1.9573818287022555e-15) + 6.868849645022276e-14) + 3617.0/1524374691840000.0) + 1.0/12454041600.0) + 691.0/261534873600.0) + 1.0/11975040.0) + 1.0/403200.0) + 1.0/15120.0) + 1.0/720.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = cos(w0);
+        const double w3 = w2/w1;
+        const double w4 = (w1*w1);
+        c_H_inverse_2 = (-w0*w3 + 1)/(phi*phi);
+        c_H_inverse_2_x = (1.0/2.0)*((1.0/4.0)*(2*phi*(w2*w2) - phi*(1 - 2*w4) - 2*w1*w2)/w4 - (-phi*w3 + 2)/phi)/(phi*phi*phi);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[0]*p[1];
+    const double dw3 = -a[1]*p[0] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = a[0]*p[2];
+    const double dw6 = a[2]*p[0];
+    const double dw7 = dw5 - dw6;
+    const double dw8 = dw4*p[1] - dw7*p[2];
+    const double dw9 = (1.0/2.0)*a[2];
+    const double dw10 = (1.0/2.0)*a[1];
+    const double dw11 = a[1]*p[2];
+    const double dw12 = -a[2]*p[1] + dw11;
+    const double dw13 = -dw12;
+    const double dw14 = dw13*p[2] - dw4*p[0];
+    const double dw15 = a[0]*p[0];
+    const double dw16 = (1.0/2.0)*a[0];
+    const double dw17 = -dw13*p[1] + dw7*p[0];
+    D[0] = -c_H_inverse_2*(-dw0 - dw1) + 2*c_H_inverse_2_x*dw8*p[0];
+    D[1] = -c_H_inverse_2*dw2 - c_H_inverse_2*dw3 + 2*c_H_inverse_2_x*dw8*p[1] - dw9;
+    D[2] = -c_H_inverse_2*dw5 - c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw8*p[2] + dw10;
+    D[3] = -a[1]*c_H_inverse_2*p[0] - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw14*p[0] + dw9;
+    D[4] = -c_H_inverse_2*(-dw1 - dw15) + 2*c_H_inverse_2_x*dw14*p[1];
+    D[5] = -c_H_inverse_2*dw11 - c_H_inverse_2*dw12 + 2*c_H_inverse_2_x*dw14*p[2] - dw16;
+    D[6] = -c_H_inverse_2*dw6 + c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw17*p[0] - dw10;
+    D[7] = -a[2]*c_H_inverse_2*p[1] - c_H_inverse_2*dw13 + 2*c_H_inverse_2_x*dw17*p[1] + dw16;
+    D[8] = -c_H_inverse_2*(-dw0 - dw15) + 2*c_H_inverse_2_x*dw17*p[2];
+}
+
+/* symrot_rotation_vector_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_0 = 1 (constant)
+ * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_0_x = 0 (constant)
+ * H_1_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 + 3*(-phi + sin(phi))/phi)/(2*phi**4)
+ * ops: 200 */
+static inline void symrot_rotation_vector_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.47841760435743)) {
+        alpha[0] = (double)NAN;
+        alpha[1] = (double)NAN;
+        alpha[2] = (double)NAN;
+        return;
+    }
+    double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 0.7851233626304374) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/(phi*phi*phi);
+        const double w4 = -phi + sin(phi);
+        const double w5 = 1.0/phi;
+        c_H_1 = 2*w2/(phi*phi);
+        c_H_2 = -w3*w4;
+        c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
+        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
+    }
+    const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const double w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const double dw0 = p[1]*pdot[2] - p[2]*pdot[1];
+    const double dw1 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const double dw2 = c_H_1_x*dw1;
+    const double dw3 = p[0]*pdot[1] - p[1]*pdot[0];
+    const double dw4 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const double dw5 = c_H_2_x*dw1;
+    alpha[0] = c_H_1*w0 - c_H_2*(-dw3*pdot[1] + dw4*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw0*dw2 + dw5*(dw3*p[1] - dw4*p[2]) + pddot[0];
+    alpha[1] = c_H_1*w1 - c_H_2*(-dw0*pdot[2] + dw3*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw2*dw4 + dw5*(dw0*p[2] - dw3*p[0]) + pddot[1];
+    alpha[2] = c_H_1*w2 - c_H_2*(dw0*pdot[1] - dw4*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw2*dw3 + dw5*(-dw0*p[1] + dw4*p[0]) + pddot[2];
+}
+
+/* symrot_rotation_vector_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_rotation_vector_compose_jacobians(const double p1[3], const double p2[3], double J1[9], double J2[9])
+{
+    double p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_rotation_vector_compose(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = (double)NAN;
+        J1[1] = (double)NAN;
+        J1[2] = (double)NAN;
+        J1[3] = (double)NAN;
+        J1[4] = (double)NAN;
+        J1[5] = (double)NAN;
+        J1[6] = (double)NAN;
+        J1[7] = (double)NAN;
+        J1[8] = (double)NAN;
+        J2[0] = (double)NAN;
+        J2[1] = (double)NAN;
+        J2[2] = (double)NAN;
+        J2[3] = (double)NAN;
+        J2[4] = (double)NAN;
+        J2[5] = (double)NAN;
+        J2[6] = (double)NAN;
+        J2[7] = (double)NAN;
+        J2[8] = (double)NAN;
+        return 1;
+    }
+    symrot_rotation_vector_tangent_inverse(p3, Hinv3);
+    symrot_rotation_vector_rotation_matrix(p2, R2);
+    symrot_rotation_vector_tangent(p1, H1);
+    symrot_rotation_vector_tangent(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_rotation_vector_rescale_jacobian: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_rotation_vector_rescale_jacobian(const double p[3], double J[9])
+{
+    double e[4], q[3], Hinv[9], H[9];
+    symrot_rotation_vector_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_rotation_vector_rescale(p, q) != 0) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    symrot_rotation_vector_tangent_inverse(q, Hinv);
+    symrot_rotation_vector_tangent(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
+}
+
 /* symrot_rotation_vector__phi_f: internal: phi from s = |p| (eq 11).
  * phi = s (closed inverse of p(phi))
  * ops: 0 */
@@ -1819,6 +2381,570 @@ static inline int symrot_rotation_vector_rescale_f(const float p[3], float q[3])
         return 0;
     }
     return symrot_rotation_vector__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_rotation_vector_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 5.56735, else 2*sin(phi/2)*cos(phi/2)/phi
+ * R_2: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 6 in x below x = 5.56735, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)*cos(phi/2)/phi)/(2*phi**2)
+ * R_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * ops: 204 */
+static inline void symrot_rotation_vector_rotation_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.478416F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 5.567348F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(9.635426e-10F + (-5.3530145e-12F)*x) - 1.0F/7983360.0F) + 1.0F/90720.0F) - 1.0F/1680.0F) + 1.0F/60.0F) - 1.0F/6.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = 1.0F/phi;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = 2*w2*cosf(w1);
+        const float w4 = w0*w3;
+        const float w5 = 1.0F/(phi*phi);
+        const float w6 = (w2*w2);
+        const float w7 = 2*w6;
+        c_R_1 = w4;
+        c_R_2 = w5*w7;
+        c_R_1_x = (1.0F/2.0F)*w5*(-w4 - w7 + 1);
+        c_R_2_x = (1.0F/2.0F)*(-4*w0*w6 + w3)/(phi*phi*phi);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_R_2_x*dw13;
+    const float dw15 = a[2]*c_R_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_R_1_x;
+    const float dw18 = a[1]*c_R_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_R_2_x*dw20;
+    const float dw23 = a[0]*c_R_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_rotation_vector_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 5.56735, else 2*sin(phi/2)*cos(phi/2)/phi
+ * R_2: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 6 in x below x = 5.56735, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)*cos(phi/2)/phi)/(2*phi**2)
+ * R_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * ops: 205 */
+static inline void symrot_rotation_vector_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.478416F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 5.567348F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(9.635426e-10F + (-5.3530145e-12F)*x) - 1.0F/7983360.0F) + 1.0F/90720.0F) - 1.0F/1680.0F) + 1.0F/60.0F) - 1.0F/6.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = 1.0F/phi;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = 2*w2*cosf(w1);
+        const float w4 = w0*w3;
+        const float w5 = 1.0F/(phi*phi);
+        const float w6 = (w2*w2);
+        const float w7 = 2*w6;
+        c_R_1 = w4;
+        c_R_2 = w5*w7;
+        c_R_1_x = (1.0F/2.0F)*w5*(-w4 - w7 + 1);
+        c_R_2_x = (1.0F/2.0F)*(-4*w0*w6 + w3)/(phi*phi*phi);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = a[0]*p[1];
+    const float dw6 = -a[1]*p[0] + dw5;
+    const float dw7 = -dw6;
+    const float dw8 = dw7*p[1];
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8;
+    const float dw14 = a[2]*c_R_1;
+    const float dw15 = dw4*p[1];
+    const float dw16 = 2*c_R_1_x;
+    const float dw17 = a[1]*c_R_1;
+    const float dw18 = dw11*p[0];
+    const float dw19 = dw7*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = a[0]*c_R_1;
+    const float dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_rotation_vector_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_0_x = 0 (constant)
+ * H_1_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 + 3*(-phi + 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
+ * ops: 201 */
+static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.478416F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 5.567348F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(4.588298e-12F + (-1.96802e-14F)*x) - 8.029522e-10F) + 1.0F/9979200.0F) - 1.0F/120960.0F) + 1.0F/2520.0F) - 1.0F/120.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 2*w2;
+        const float w4 = 1.0F/(phi*phi*phi);
+        const float w5 = cosf(w0);
+        const float w6 = 1.0F/phi;
+        c_H_1 = w3/(phi*phi);
+        c_H_2 = -w4*(-phi + sinf(phi));
+        c_H_1_x = (1.0F/2.0F)*w4*(2*w1*w5 - 4*w2*w6);
+        c_H_2_x = (1.0F/2.0F)*(w3 + 3*w6*(-phi + 2*w1*w5))/(phi*phi*phi*phi);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_H_2_x*dw13;
+    const float dw15 = a[2]*c_H_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_H_1_x;
+    const float dw18 = a[1]*c_H_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_H_2_x*dw20;
+    const float dw23 = a[0]*c_H_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_H_2_x*dw24;
+    D[0] = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
+    D[4] = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
+    D[8] = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_rotation_vector_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_0_x = 0 (constant)
+ * H_1_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 + 3*(-phi + 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
+ * ops: 202 */
+static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.478416F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 5.567348F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(4.588298e-12F + (-1.96802e-14F)*x) - 8.029522e-10F) + 1.0F/9979200.0F) - 1.0F/120960.0F) + 1.0F/2520.0F) - 1.0F/120.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 2*w2;
+        const float w4 = 1.0F/(phi*phi*phi);
+        const float w5 = cosf(w0);
+        const float w6 = 1.0F/phi;
+        c_H_1 = w3/(phi*phi);
+        c_H_2 = -w4*(-phi + sinf(phi));
+        c_H_1_x = (1.0F/2.0F)*w4*(2*w1*w5 - 4*w2*w6);
+        c_H_2_x = (1.0F/2.0F)*(w3 + 3*w6*(-phi + 2*w1*w5))/(phi*phi*phi*phi);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = a[0]*p[1];
+    const float dw6 = -a[1]*p[0] + dw5;
+    const float dw7 = -dw6;
+    const float dw8 = dw7*p[1];
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8;
+    const float dw14 = a[2]*c_H_1;
+    const float dw15 = dw4*p[1];
+    const float dw16 = 2*c_H_1_x;
+    const float dw17 = a[1]*c_H_1;
+    const float dw18 = dw11*p[0];
+    const float dw19 = dw7*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = a[0]*c_H_1;
+    const float dw23 = -dw15 + dw18;
+    D[0] = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
+    D[1] = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_rotation_vector_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2: Horner degree 8 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
+ * H_inverse_0_x = 0 (constant)
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x: Horner degree 10 in x below x = 5.56735, else ((-phi*(1 - 2*sin(phi/2)**2) + 2*phi*cos(phi/2)**2 - 2*sin(phi/2)*cos(phi/2))/(4*sin(phi/2)**2) - (-phi*cos(phi/2)/sin(phi/2) + 2)/phi)/(2*phi**3)
+ * ops: 160 */
+static inline void symrot_rotation_vector_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.478416F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_H_inverse_2, c_H_inverse_2_x;
+    if (x < 5.567348F) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*((8.586062e-15F)*x + 3.3896803e-13F) + 1.3382536e-11F) + 5.2841903e-10F) + 2.0876756e-08F) + 1.0F/1209600.0F) + 1.0F/30240.0F) + 1.0F/720.0F) + 1.0F/12.0F;
+        c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5349911e-18F)*x + 5.5090027e-17F) + 1.9573818e-15F) + 6.86885e-14F) + 2.3727762e-12F) + 8.029522e-11F) + 2.642095e-09F) + 1.0F/11975040.0F) + 1.0F/403200.0F) + 1.0F/15120.0F) + 1.0F/720.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = cosf(w0);
+        const float w3 = w2/w1;
+        const float w4 = (w1*w1);
+        c_H_inverse_2 = (-w0*w3 + 1)/(phi*phi);
+        c_H_inverse_2_x = (1.0F/2.0F)*((1.0F/4.0F)*(2*phi*(w2*w2) - phi*(1 - 2*w4) - 2*w1*w2)/w4 - (-phi*w3 + 2)/phi)/(phi*phi*phi);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[0]*p[1];
+    const float dw3 = -a[1]*p[0] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = a[0]*p[2];
+    const float dw6 = a[2]*p[0];
+    const float dw7 = dw5 - dw6;
+    const float dw8 = dw4*p[1] - dw7*p[2];
+    const float dw9 = (1.0F/2.0F)*a[2];
+    const float dw10 = (1.0F/2.0F)*a[1];
+    const float dw11 = a[1]*p[2];
+    const float dw12 = -a[2]*p[1] + dw11;
+    const float dw13 = -dw12;
+    const float dw14 = dw13*p[2] - dw4*p[0];
+    const float dw15 = a[0]*p[0];
+    const float dw16 = (1.0F/2.0F)*a[0];
+    const float dw17 = -dw13*p[1] + dw7*p[0];
+    D[0] = -c_H_inverse_2*(-dw0 - dw1) + 2*c_H_inverse_2_x*dw8*p[0];
+    D[1] = -c_H_inverse_2*dw2 - c_H_inverse_2*dw3 + 2*c_H_inverse_2_x*dw8*p[1] - dw9;
+    D[2] = -c_H_inverse_2*dw5 - c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw8*p[2] + dw10;
+    D[3] = -a[1]*c_H_inverse_2*p[0] - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw14*p[0] + dw9;
+    D[4] = -c_H_inverse_2*(-dw1 - dw15) + 2*c_H_inverse_2_x*dw14*p[1];
+    D[5] = -c_H_inverse_2*dw11 - c_H_inverse_2*dw12 + 2*c_H_inverse_2_x*dw14*p[2] - dw16;
+    D[6] = -c_H_inverse_2*dw6 + c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw17*p[0] - dw10;
+    D[7] = -a[2]*c_H_inverse_2*p[1] - c_H_inverse_2*dw13 + 2*c_H_inverse_2_x*dw17*p[1] + dw16;
+    D[8] = -c_H_inverse_2*(-dw0 - dw15) + 2*c_H_inverse_2_x*dw17*p[2];
+}
+
+/* symrot_rotation_vector_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_0 = 1 (constant)
+ * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
+ * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_0_x = 0 (constant)
+ * H_1_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
+ * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 + 3*(-phi + 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
+ * ops: 166 */
+static inline void symrot_rotation_vector_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 39.478416F)) {
+        alpha[0] = NAN;
+        alpha[1] = NAN;
+        alpha[2] = NAN;
+        return;
+    }
+    float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 5.567348F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(4.588298e-12F + (-1.96802e-14F)*x) - 8.029522e-10F) + 1.0F/9979200.0F) - 1.0F/120960.0F) + 1.0F/2520.0F) - 1.0F/120.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 2*w2;
+        const float w4 = 1.0F/(phi*phi*phi);
+        const float w5 = cosf(w0);
+        const float w6 = 1.0F/phi;
+        c_H_1 = w3/(phi*phi);
+        c_H_2 = -w4*(-phi + sinf(phi));
+        c_H_1_x = (1.0F/2.0F)*w4*(2*w1*w5 - 4*w2*w6);
+        c_H_2_x = (1.0F/2.0F)*(w3 + 3*w6*(-phi + 2*w1*w5))/(phi*phi*phi*phi);
+    }
+    const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const float w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const float dw0 = p[1]*pdot[2] - p[2]*pdot[1];
+    const float dw1 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const float dw2 = c_H_1_x*dw1;
+    const float dw3 = p[0]*pdot[1] - p[1]*pdot[0];
+    const float dw4 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const float dw5 = c_H_2_x*dw1;
+    alpha[0] = c_H_1*w0 - c_H_2*(-dw3*pdot[1] + dw4*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw0*dw2 + dw5*(dw3*p[1] - dw4*p[2]) + pddot[0];
+    alpha[1] = c_H_1*w1 - c_H_2*(-dw0*pdot[2] + dw3*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw2*dw4 + dw5*(dw0*p[2] - dw3*p[0]) + pddot[1];
+    alpha[2] = c_H_1*w2 - c_H_2*(dw0*pdot[1] - dw4*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw2*dw3 + dw5*(-dw0*p[1] + dw4*p[0]) + pddot[2];
+}
+
+/* symrot_rotation_vector_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_rotation_vector_compose_jacobians_f(const float p1[3], const float p2[3], float J1[9], float J2[9])
+{
+    float p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_rotation_vector_compose_f(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = NAN;
+        J1[1] = NAN;
+        J1[2] = NAN;
+        J1[3] = NAN;
+        J1[4] = NAN;
+        J1[5] = NAN;
+        J1[6] = NAN;
+        J1[7] = NAN;
+        J1[8] = NAN;
+        J2[0] = NAN;
+        J2[1] = NAN;
+        J2[2] = NAN;
+        J2[3] = NAN;
+        J2[4] = NAN;
+        J2[5] = NAN;
+        J2[6] = NAN;
+        J2[7] = NAN;
+        J2[8] = NAN;
+        return 1;
+    }
+    symrot_rotation_vector_tangent_inverse_f(p3, Hinv3);
+    symrot_rotation_vector_rotation_matrix_f(p2, R2);
+    symrot_rotation_vector_tangent_f(p1, H1);
+    symrot_rotation_vector_tangent_f(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_rotation_vector_rescale_jacobian_f: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_rotation_vector_rescale_jacobian_f(const float p[3], float J[9])
+{
+    float e[4], q[3], Hinv[9], H[9];
+    symrot_rotation_vector_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_rotation_vector_rescale_f(p, q) != 0) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    symrot_rotation_vector_tangent_inverse_f(q, Hinv);
+    symrot_rotation_vector_tangent_f(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
 }
 
 #ifdef __cplusplus

@@ -18,6 +18,11 @@
  * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
  * the output is NaN (input out of range or not finite, or rotation not representable).
  *
+ * Derivatives (docs/derivatives.md): rotation_derivative, rotation_transpose_derivative,
+ * tangent_derivative, tangent_transpose_derivative, tangent_inverse_derivative (D = d(T a)/dp for a
+ * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
+ * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -956,6 +961,585 @@ static inline int symrot_tangent_m3_rescale(const double p[3], double q[3])
     return symrot_tangent_m3__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_tangent_m3_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * R_2: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 6*(s**2/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 9))
+ * R_2_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
+ * ops: 295 */
+static inline void symrot_tangent_m3_rotation_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4294967296.0)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.06877716192024325) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
+    } else {
+        const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = 1.0/s;
+        const double w1 = (s*s);
+        const double w2 = 1.0/w1;
+        const double w3 = (1.0/2.0)*phi;
+        const double w4 = sin(w3);
+        const double w5 = (w4*w4);
+        const double w6 = 6*w4*cos(w3);
+        const double w7 = w0*((1.0/9.0)*w1 + 1);
+        const double w8 = (3.0/2.0)/(x + 9);
+        c_R_1 = w0*sin(phi);
+        c_R_2 = x < 0.13136065202211897 ? x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : 2*w2*w5;
+        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w2*w8*(-6*w5 - w6*w7 + 3);
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w5*w7 + w6)/(s*s*s);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_R_2_x*dw13;
+    const double dw15 = a[2]*c_R_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_R_1_x;
+    const double dw18 = a[1]*c_R_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_R_2_x*dw20;
+    const double dw23 = a[0]*c_R_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_tangent_m3_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * R_2: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 6*(s**2/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 9))
+ * R_2_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
+ * ops: 296 */
+static inline void symrot_tangent_m3_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4294967296.0)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.06877716192024325) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
+    } else {
+        const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = 1.0/s;
+        const double w1 = (s*s);
+        const double w2 = 1.0/w1;
+        const double w3 = (1.0/2.0)*phi;
+        const double w4 = sin(w3);
+        const double w5 = (w4*w4);
+        const double w6 = 6*w4*cos(w3);
+        const double w7 = w0*((1.0/9.0)*w1 + 1);
+        const double w8 = (3.0/2.0)/(x + 9);
+        c_R_1 = w0*sin(phi);
+        c_R_2 = x < 0.13136065202211897 ? x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : 2*w2*w5;
+        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w2*w8*(-6*w5 - w6*w7 + 3);
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w5*w7 + w6)/(s*s*s);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = a[0]*p[1];
+    const double dw6 = -a[1]*p[0] + dw5;
+    const double dw7 = -dw6;
+    const double dw8 = dw7*p[1];
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8;
+    const double dw14 = a[2]*c_R_1;
+    const double dw15 = dw4*p[1];
+    const double dw16 = 2*c_R_1_x;
+    const double dw17 = a[1]*c_R_1;
+    const double dw18 = dw11*p[0];
+    const double dw19 = dw7*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = a[0]*c_R_1;
+    const double dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_tangent_m3_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
+ * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 283 */
+static inline void symrot_tangent_m3_tangent_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4294967296.0)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
+    const double c_H_0_x = -9/pow(x + 9, 2);
+    const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
+    double c_H_1, c_H_1_x;
+    if (x < 0.13136065202211897) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
+    } else {
+        const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        c_H_1 = 2*w3/w0;
+        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w2*cos(w1) - 12*w3*((1.0/9.0)*w0 + 1)/s)/((s*s*s)*(x + 9));
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = a[0]*p[2];
+    const double dw12 = a[2]*p[0];
+    const double dw13 = dw11 - dw12;
+    const double dw14 = dw13*p[2];
+    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const double dw16 = a[2]*c_H_1;
+    const double dw17 = dw6*p[1];
+    const double dw18 = 2*c_H_1_x;
+    const double dw19 = 2*dw15;
+    const double dw20 = a[1]*c_H_1;
+    const double dw21 = a[1]*p[0];
+    const double dw22 = dw13*p[0];
+    const double dw23 = dw10*p[0];
+    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const double dw25 = 2*dw24;
+    const double dw26 = a[0]*c_H_1;
+    const double dw27 = -dw17 + dw22;
+    const double dw28 = c_H_2_x*dw27;
+    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+}
+
+/* symrot_tangent_m3_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
+ * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 289 */
+static inline void symrot_tangent_m3_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4294967296.0)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
+    const double c_H_0_x = -9/pow(x + 9, 2);
+    const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
+    double c_H_1, c_H_1_x;
+    if (x < 0.13136065202211897) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
+    } else {
+        const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        c_H_1 = 2*w3/w0;
+        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w2*cos(w1) - 12*w3*((1.0/9.0)*w0 + 1)/s)/((s*s*s)*(x + 9));
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = dw10*p[1];
+    const double dw12 = a[0]*p[2];
+    const double dw13 = a[2]*p[0];
+    const double dw14 = dw12 - dw13;
+    const double dw15 = dw14*p[2];
+    const double dw16 = dw11 - dw15;
+    const double dw17 = c_H_2_x*dw16;
+    const double dw18 = a[2]*c_H_1;
+    const double dw19 = dw6*p[1];
+    const double dw20 = 2*c_H_1_x;
+    const double dw21 = a[1]*c_H_1;
+    const double dw22 = a[1]*p[0];
+    const double dw23 = dw14*p[0];
+    const double dw24 = dw10*p[0];
+    const double dw25 = -dw24 + dw6*p[2];
+    const double dw26 = c_H_2_x*dw25;
+    const double dw27 = a[0]*c_H_1;
+    const double dw28 = -dw19 + dw23;
+    const double dw29 = a[2]*p[1];
+    const double dw30 = 2*c_H_2_x*dw28;
+    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+}
+
+/* symrot_tangent_m3_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * H_inverse_0_x = 1/9 (algebraic in x)
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x = (-x/(2*sqrt(x + 9)) - sqrt(x + 9) - 9 - 27/(2*sqrt(x + 9)))*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)**2) + (x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * ops: 224 */
+static inline void symrot_tangent_m3_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4294967296.0)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
+    const double c_H_inverse_0_x = 1.0/9.0;
+    const double c_H_inverse_2_x = (1.0/18.0)*(-1.0/2.0*x/sqrt(x + 9) - sqrt(x + 9) - 9 - (27.0/2.0)/sqrt(x + 9))*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/pow(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81, 2) + (1.0/18.0)*(x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_inverse_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[0]*p[1];
+    const double dw5 = -a[1]*p[0] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = a[0]*p[2];
+    const double dw8 = a[2]*p[0];
+    const double dw9 = dw7 - dw8;
+    const double dw10 = dw6*p[1] - dw9*p[2];
+    const double dw11 = 2*c_H_inverse_2_x;
+    const double dw12 = dw10*dw11;
+    const double dw13 = (1.0/2.0)*a[2];
+    const double dw14 = (1.0/2.0)*a[1];
+    const double dw15 = a[1]*p[0];
+    const double dw16 = a[1]*p[2];
+    const double dw17 = -a[2]*p[1] + dw16;
+    const double dw18 = -dw17;
+    const double dw19 = dw18*p[2] - dw6*p[0];
+    const double dw20 = dw11*dw19;
+    const double dw21 = (1.0/2.0)*a[0];
+    const double dw22 = -dw18*p[1] + dw9*p[0];
+    const double dw23 = a[2]*p[1];
+    const double dw24 = dw11*dw22;
+    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+}
+
+/* symrot_tangent_m3_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_0 = 9/(x + 9) (algebraic in x)
+ * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
+ * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 246 */
+static inline void symrot_tangent_m3_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4294967296.0)) {
+        alpha[0] = (double)NAN;
+        alpha[1] = (double)NAN;
+        alpha[2] = (double)NAN;
+        return;
+    }
+    const double c_H_0 = 9/(x + 9);
+    const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
+    const double c_H_0_x = -9/pow(x + 9, 2);
+    const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
+    double c_H_1, c_H_1_x;
+    if (x < 0.13136065202211897) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
+    } else {
+        const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        c_H_1 = 2*w3/w0;
+        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w2*cos(w1) - 12*w3*((1.0/9.0)*w0 + 1)/s)/((s*s*s)*(x + 9));
+    }
+    const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const double w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const double dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const double dw1 = c_H_0_x*dw0;
+    const double dw2 = p[1]*pdot[2] - p[2]*pdot[1];
+    const double dw3 = c_H_1_x*dw0;
+    const double dw4 = p[0]*pdot[1] - p[1]*pdot[0];
+    const double dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const double dw6 = c_H_2_x*dw0;
+    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+}
+
+/* symrot_tangent_m3_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_tangent_m3_compose_jacobians(const double p1[3], const double p2[3], double J1[9], double J2[9])
+{
+    double p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_tangent_m3_compose(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = (double)NAN;
+        J1[1] = (double)NAN;
+        J1[2] = (double)NAN;
+        J1[3] = (double)NAN;
+        J1[4] = (double)NAN;
+        J1[5] = (double)NAN;
+        J1[6] = (double)NAN;
+        J1[7] = (double)NAN;
+        J1[8] = (double)NAN;
+        J2[0] = (double)NAN;
+        J2[1] = (double)NAN;
+        J2[2] = (double)NAN;
+        J2[3] = (double)NAN;
+        J2[4] = (double)NAN;
+        J2[5] = (double)NAN;
+        J2[6] = (double)NAN;
+        J2[7] = (double)NAN;
+        J2[8] = (double)NAN;
+        return 1;
+    }
+    symrot_tangent_m3_tangent_inverse(p3, Hinv3);
+    symrot_tangent_m3_rotation_matrix(p2, R2);
+    symrot_tangent_m3_tangent(p1, H1);
+    symrot_tangent_m3_tangent(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_tangent_m3_rescale_jacobian: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_tangent_m3_rescale_jacobian(const double p[3], double J[9])
+{
+    double e[4], q[3], Hinv[9], H[9];
+    symrot_tangent_m3_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_tangent_m3_rescale(p, q) != 0) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    symrot_tangent_m3_tangent_inverse(q, Hinv);
+    symrot_tangent_m3_tangent(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
+}
+
 /* symrot_tangent_m3__phi_f: internal: phi from s = |p| (eq 11).
  * phi = 3*atan(s/3) (closed inverse of p(phi))
  * ops: 3 */
@@ -1878,6 +2462,579 @@ static inline int symrot_tangent_m3_rescale_f(const float p[3], float q[3])
         return 0;
     }
     return symrot_tangent_m3__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_tangent_m3_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 3*(s**2/9 + 1)*sin(phi)/s)/(2*s**2*(x + 9))
+ * R_2_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * ops: 244 */
+static inline void symrot_tangent_m3_rotation_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.2949673e+09F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.48711845F) {
+        c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+    } else {
+        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/s;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (s*s);
+        const float w4 = 1.0F/w3;
+        const float w5 = 1 - cosf(phi);
+        const float w6 = 3*sinf(phi);
+        const float w7 = w0*((1.0F/9.0F)*w3 + 1);
+        const float w8 = (3.0F/2.0F)/(x + 9);
+        c_R_1 = 2*w0*w2*cosf(w1);
+        c_R_2 = w4*w5;
+        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w4*w8*(-6*(w2*w2) - w6*w7 + 3);
+        c_R_2_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w8*(-6*w5*w7 + w6)/(s*s*s);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_R_2_x*dw13;
+    const float dw15 = a[2]*c_R_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_R_1_x;
+    const float dw18 = a[1]*c_R_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_R_2_x*dw20;
+    const float dw23 = a[0]*c_R_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_tangent_m3_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 3*(s**2/9 + 1)*sin(phi)/s)/(2*s**2*(x + 9))
+ * R_2_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * ops: 245 */
+static inline void symrot_tangent_m3_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.2949673e+09F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.48711845F) {
+        c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+    } else {
+        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/s;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (s*s);
+        const float w4 = 1.0F/w3;
+        const float w5 = 1 - cosf(phi);
+        const float w6 = 3*sinf(phi);
+        const float w7 = w0*((1.0F/9.0F)*w3 + 1);
+        const float w8 = (3.0F/2.0F)/(x + 9);
+        c_R_1 = 2*w0*w2*cosf(w1);
+        c_R_2 = w4*w5;
+        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w4*w8*(-6*(w2*w2) - w6*w7 + 3);
+        c_R_2_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w8*(-6*w5*w7 + w6)/(s*s*s);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = a[0]*p[1];
+    const float dw6 = -a[1]*p[0] + dw5;
+    const float dw7 = -dw6;
+    const float dw8 = dw7*p[1];
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8;
+    const float dw14 = a[2]*c_R_1;
+    const float dw15 = dw4*p[1];
+    const float dw16 = 2*c_R_1_x;
+    const float dw17 = a[1]*c_R_1;
+    const float dw18 = dw11*p[0];
+    const float dw19 = dw7*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = a[0]*c_R_1;
+    const float dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_tangent_m3_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_1_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 257 */
+static inline void symrot_tangent_m3_tangent_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.2949673e+09F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
+    const float c_H_0_x = -9/powf(x + 9, 2);
+    const float c_H_2_x = (1.0F/2.0F)/(powf(x + 9, 2)*(sqrtf(x + 9) + 3)) - 1.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 2)*powf(sqrtf(x + 9) + 3, 2)) - 3.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 5.0F/2.0F)*(sqrtf(x + 9) + 3));
+    float c_H_1, c_H_1_x;
+    if (x < 0.48711845F) {
+        c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+    } else {
+        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = 1 - cosf(phi);
+        c_H_1 = w1/w0;
+        c_H_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*w1*((1.0F/9.0F)*w0 + 1)/s)/((s*s*s)*(x + 9));
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = a[0]*p[2];
+    const float dw12 = a[2]*p[0];
+    const float dw13 = dw11 - dw12;
+    const float dw14 = dw13*p[2];
+    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const float dw16 = a[2]*c_H_1;
+    const float dw17 = dw6*p[1];
+    const float dw18 = 2*c_H_1_x;
+    const float dw19 = 2*dw15;
+    const float dw20 = a[1]*c_H_1;
+    const float dw21 = a[1]*p[0];
+    const float dw22 = dw13*p[0];
+    const float dw23 = dw10*p[0];
+    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const float dw25 = 2*dw24;
+    const float dw26 = a[0]*c_H_1;
+    const float dw27 = -dw17 + dw22;
+    const float dw28 = c_H_2_x*dw27;
+    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+}
+
+/* symrot_tangent_m3_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_1_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 263 */
+static inline void symrot_tangent_m3_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.2949673e+09F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
+    const float c_H_0_x = -9/powf(x + 9, 2);
+    const float c_H_2_x = (1.0F/2.0F)/(powf(x + 9, 2)*(sqrtf(x + 9) + 3)) - 1.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 2)*powf(sqrtf(x + 9) + 3, 2)) - 3.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 5.0F/2.0F)*(sqrtf(x + 9) + 3));
+    float c_H_1, c_H_1_x;
+    if (x < 0.48711845F) {
+        c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+    } else {
+        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = 1 - cosf(phi);
+        c_H_1 = w1/w0;
+        c_H_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*w1*((1.0F/9.0F)*w0 + 1)/s)/((s*s*s)*(x + 9));
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = dw10*p[1];
+    const float dw12 = a[0]*p[2];
+    const float dw13 = a[2]*p[0];
+    const float dw14 = dw12 - dw13;
+    const float dw15 = dw14*p[2];
+    const float dw16 = dw11 - dw15;
+    const float dw17 = c_H_2_x*dw16;
+    const float dw18 = a[2]*c_H_1;
+    const float dw19 = dw6*p[1];
+    const float dw20 = 2*c_H_1_x;
+    const float dw21 = a[1]*c_H_1;
+    const float dw22 = a[1]*p[0];
+    const float dw23 = dw14*p[0];
+    const float dw24 = dw10*p[0];
+    const float dw25 = -dw24 + dw6*p[2];
+    const float dw26 = c_H_2_x*dw25;
+    const float dw27 = a[0]*c_H_1;
+    const float dw28 = -dw19 + dw23;
+    const float dw29 = a[2]*p[1];
+    const float dw30 = 2*c_H_2_x*dw28;
+    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+}
+
+/* symrot_tangent_m3_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * H_inverse_0_x = 1/9 (algebraic in x)
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x = (-x/(2*sqrt(x + 9)) - sqrt(x + 9) - 9 - 27/(2*sqrt(x + 9)))*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)**2) + (x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * ops: 224 */
+static inline void symrot_tangent_m3_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.2949673e+09F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
+    const float c_H_inverse_0_x = 1.0F/9.0F;
+    const float c_H_inverse_2_x = (1.0F/18.0F)*(-1.0F/2.0F*x/sqrtf(x + 9) - sqrtf(x + 9) - 9 - (27.0F/2.0F)/sqrtf(x + 9))*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/powf(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81, 2) + (1.0F/18.0F)*(x/sqrtf(x + 9) + 2*sqrtf(x + 9) + 27 + 36/sqrtf(x + 9))/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_inverse_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[0]*p[1];
+    const float dw5 = -a[1]*p[0] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = a[0]*p[2];
+    const float dw8 = a[2]*p[0];
+    const float dw9 = dw7 - dw8;
+    const float dw10 = dw6*p[1] - dw9*p[2];
+    const float dw11 = 2*c_H_inverse_2_x;
+    const float dw12 = dw10*dw11;
+    const float dw13 = (1.0F/2.0F)*a[2];
+    const float dw14 = (1.0F/2.0F)*a[1];
+    const float dw15 = a[1]*p[0];
+    const float dw16 = a[1]*p[2];
+    const float dw17 = -a[2]*p[1] + dw16;
+    const float dw18 = -dw17;
+    const float dw19 = dw18*p[2] - dw6*p[0];
+    const float dw20 = dw11*dw19;
+    const float dw21 = (1.0F/2.0F)*a[0];
+    const float dw22 = -dw18*p[1] + dw9*p[0];
+    const float dw23 = a[2]*p[1];
+    const float dw24 = dw11*dw22;
+    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+}
+
+/* symrot_tangent_m3_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
+ * of two up to which every printed form was checked against 50+ digits; otherwise, and for
+ * non-finite p, every output is NaN.
+ * H_0 = 9/(x + 9) (algebraic in x)
+ * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_1_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
+ * ops: 220 */
+static inline void symrot_tangent_m3_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 4.2949673e+09F)) {
+        alpha[0] = NAN;
+        alpha[1] = NAN;
+        alpha[2] = NAN;
+        return;
+    }
+    const float c_H_0 = 9/(x + 9);
+    const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
+    const float c_H_0_x = -9/powf(x + 9, 2);
+    const float c_H_2_x = (1.0F/2.0F)/(powf(x + 9, 2)*(sqrtf(x + 9) + 3)) - 1.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 2)*powf(sqrtf(x + 9) + 3, 2)) - 3.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 5.0F/2.0F)*(sqrtf(x + 9) + 3));
+    float c_H_1, c_H_1_x;
+    if (x < 0.48711845F) {
+        c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+    } else {
+        const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = 1 - cosf(phi);
+        c_H_1 = w1/w0;
+        c_H_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*w1*((1.0F/9.0F)*w0 + 1)/s)/((s*s*s)*(x + 9));
+    }
+    const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const float w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const float dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const float dw1 = c_H_0_x*dw0;
+    const float dw2 = p[1]*pdot[2] - p[2]*pdot[1];
+    const float dw3 = c_H_1_x*dw0;
+    const float dw4 = p[0]*pdot[1] - p[1]*pdot[0];
+    const float dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const float dw6 = c_H_2_x*dw0;
+    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+}
+
+/* symrot_tangent_m3_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_tangent_m3_compose_jacobians_f(const float p1[3], const float p2[3], float J1[9], float J2[9])
+{
+    float p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_tangent_m3_compose_f(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = NAN;
+        J1[1] = NAN;
+        J1[2] = NAN;
+        J1[3] = NAN;
+        J1[4] = NAN;
+        J1[5] = NAN;
+        J1[6] = NAN;
+        J1[7] = NAN;
+        J1[8] = NAN;
+        J2[0] = NAN;
+        J2[1] = NAN;
+        J2[2] = NAN;
+        J2[3] = NAN;
+        J2[4] = NAN;
+        J2[5] = NAN;
+        J2[6] = NAN;
+        J2[7] = NAN;
+        J2[8] = NAN;
+        return 1;
+    }
+    symrot_tangent_m3_tangent_inverse_f(p3, Hinv3);
+    symrot_tangent_m3_rotation_matrix_f(p2, R2);
+    symrot_tangent_m3_tangent_f(p1, H1);
+    symrot_tangent_m3_tangent_f(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_tangent_m3_rescale_jacobian_f: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_tangent_m3_rescale_jacobian_f(const float p[3], float J[9])
+{
+    float e[4], q[3], Hinv[9], H[9];
+    symrot_tangent_m3_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_tangent_m3_rescale_f(p, q) != 0) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    symrot_tangent_m3_tangent_inverse_f(q, Hinv);
+    symrot_tangent_m3_tangent_f(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
 }
 
 #ifdef __cplusplus

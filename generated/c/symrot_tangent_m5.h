@@ -18,6 +18,11 @@
  * parameters e = (e0, e1, e2, e3), scalar first; the int they return is 0 on success and 1 when
  * the output is NaN (input out of range or not finite, or rotation not representable).
  *
+ * Derivatives (docs/derivatives.md): rotation_derivative, rotation_transpose_derivative,
+ * tangent_derivative, tangent_transpose_derivative, tangent_inverse_derivative (D = d(T a)/dp for a
+ * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
+ * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -958,6 +963,620 @@ static inline int symrot_tangent_m5_rescale(const double p[3], double q[3])
         return 0;
     }
     return symrot_tangent_m5__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_tangent_m5_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 25))
+ * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * ops: 306 */
+static inline void symrot_tangent_m5_rotation_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 236.80339887498948)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.11104807041853587) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
+    } else {
+        const double phi = symrot_tangent_m5__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = 1.0/s;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = w0*w2*cos(w1);
+        const double w4 = (s*s);
+        const double w5 = 1.0/w4;
+        const double w6 = (w2*w2);
+        const double w7 = (2.0/5.0)*w4 + 10;
+        const double w8 = (5.0/2.0)/(x + 25);
+        c_R_1 = 2*w3;
+        c_R_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : 2*w5*w6;
+        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w5*w8*(-w3*w7 - 10*w6 + 5);
+        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w8*(-w0*w7*(1 - cos(phi)) + 5*sin(phi))/(s*s*s);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_R_2_x*dw13;
+    const double dw15 = a[2]*c_R_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_R_1_x;
+    const double dw18 = a[1]*c_R_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_R_2_x*dw20;
+    const double dw23 = a[0]*c_R_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_tangent_m5_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 25))
+ * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * ops: 307 */
+static inline void symrot_tangent_m5_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 236.80339887498948)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.11104807041853587) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
+    } else {
+        const double phi = symrot_tangent_m5__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = 1.0/s;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = w0*w2*cos(w1);
+        const double w4 = (s*s);
+        const double w5 = 1.0/w4;
+        const double w6 = (w2*w2);
+        const double w7 = (2.0/5.0)*w4 + 10;
+        const double w8 = (5.0/2.0)/(x + 25);
+        c_R_1 = 2*w3;
+        c_R_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : 2*w5*w6;
+        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w5*w8*(-w3*w7 - 10*w6 + 5);
+        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w8*(-w0*w7*(1 - cos(phi)) + 5*sin(phi))/(s*s*s);
+    }
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = a[0]*p[1];
+    const double dw6 = -a[1]*p[0] + dw5;
+    const double dw7 = -dw6;
+    const double dw8 = dw7*p[1];
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8;
+    const double dw14 = a[2]*c_R_1;
+    const double dw15 = dw4*p[1];
+    const double dw16 = 2*c_R_1_x;
+    const double dw17 = a[1]*c_R_1;
+    const double dw18 = dw11*p[0];
+    const double dw19 = dw7*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = a[0]*c_R_1;
+    const double dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_tangent_m5_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_0_x = -25/(x + 25)**2 (algebraic in x)
+ * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + 50*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s**2)/(2*s**3*(x + 25))
+ * ops: 363 */
+static inline void symrot_tangent_m5_tangent_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 236.80339887498948)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    const double c_H_0_x = -25/pow(x + 25, 2);
+    double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 0.21392718170599553) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0;
+    } else {
+        const double phi = symrot_tangent_m5__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = 1.0/w0;
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = 2*(w3*w3);
+        const double w5 = 1.0/(x + 25);
+        const double w6 = 1.0/s;
+        const double w7 = cos(w2);
+        const double w8 = w3*w6*w7;
+        const double w9 = (1.0/25.0)*w0 + 1;
+        const double w10 = 10*w6*w9;
+        const double w11 = w5/(s*s*s);
+        c_H_1 = w1*w4;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w1*(25*w5 - 2*w8);
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(-w10*(1 - cos(phi)) + 5*sin(phi));
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w5 + 50*w1*w3*w7*w9 - w10*(125*w5 - 10*w8) - 25*w6*(1 - w4));
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = a[0]*p[2];
+    const double dw12 = a[2]*p[0];
+    const double dw13 = dw11 - dw12;
+    const double dw14 = dw13*p[2];
+    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const double dw16 = a[2]*c_H_1;
+    const double dw17 = dw6*p[1];
+    const double dw18 = 2*c_H_1_x;
+    const double dw19 = 2*dw15;
+    const double dw20 = a[1]*c_H_1;
+    const double dw21 = a[1]*p[0];
+    const double dw22 = dw13*p[0];
+    const double dw23 = dw10*p[0];
+    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const double dw25 = 2*dw24;
+    const double dw26 = a[0]*c_H_1;
+    const double dw27 = -dw17 + dw22;
+    const double dw28 = c_H_2_x*dw27;
+    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+}
+
+/* symrot_tangent_m5_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_0_x = -25/(x + 25)**2 (algebraic in x)
+ * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + 50*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s**2)/(2*s**3*(x + 25))
+ * ops: 369 */
+static inline void symrot_tangent_m5_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 236.80339887498948)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    const double c_H_0_x = -25/pow(x + 25, 2);
+    double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 0.21392718170599553) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0;
+    } else {
+        const double phi = symrot_tangent_m5__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = 1.0/w0;
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = 2*(w3*w3);
+        const double w5 = 1.0/(x + 25);
+        const double w6 = 1.0/s;
+        const double w7 = cos(w2);
+        const double w8 = w3*w6*w7;
+        const double w9 = (1.0/25.0)*w0 + 1;
+        const double w10 = 10*w6*w9;
+        const double w11 = w5/(s*s*s);
+        c_H_1 = w1*w4;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w1*(25*w5 - 2*w8);
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(-w10*(1 - cos(phi)) + 5*sin(phi));
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w5 + 50*w1*w3*w7*w9 - w10*(125*w5 - 10*w8) - 25*w6*(1 - w4));
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = dw10*p[1];
+    const double dw12 = a[0]*p[2];
+    const double dw13 = a[2]*p[0];
+    const double dw14 = dw12 - dw13;
+    const double dw15 = dw14*p[2];
+    const double dw16 = dw11 - dw15;
+    const double dw17 = c_H_2_x*dw16;
+    const double dw18 = a[2]*c_H_1;
+    const double dw19 = dw6*p[1];
+    const double dw20 = 2*c_H_1_x;
+    const double dw21 = a[1]*c_H_1;
+    const double dw22 = a[1]*p[0];
+    const double dw23 = dw14*p[0];
+    const double dw24 = dw10*p[0];
+    const double dw25 = -dw24 + dw6*p[2];
+    const double dw26 = c_H_2_x*dw25;
+    const double dw27 = a[0]*c_H_1;
+    const double dw28 = -dw19 + dw23;
+    const double dw29 = a[2]*p[1];
+    const double dw30 = 2*c_H_2_x*dw28;
+    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+}
+
+/* symrot_tangent_m5_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
+ * H_inverse_0_x = 1/25 (algebraic in x)
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x: Horner degree 21 in x below x = 6.51179, else 5*(-5*s*(1 - 2*sin(phi/2)**2)/(2*sin(phi/2)**2) + 4*s*(s**2/25 + 1)/5 + 5*s*cos(phi/2)**2/sin(phi/2)**2 - 5*(s**2/25 + 1)*cos(phi/2)/sin(phi/2) - 10*(s**2/25 + 1)*(2*s**2/25 - s*cos(phi/2)/sin(phi/2) + 2)/s)/(4*s**3*(x + 25))
+ * ops: 243 */
+static inline void symrot_tangent_m5_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 236.80339887498948)) {
+        D[0] = (double)NAN;
+        D[1] = (double)NAN;
+        D[2] = (double)NAN;
+        D[3] = (double)NAN;
+        D[4] = (double)NAN;
+        D[5] = (double)NAN;
+        D[6] = (double)NAN;
+        D[7] = (double)NAN;
+        D[8] = (double)NAN;
+        return;
+    }
+    const double c_H_inverse_0_x = 1.0/25.0;
+    double c_H_inverse_2, c_H_inverse_2_x;
+    if (x < 6.511791226584059) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+        c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.322761367777524e-35 + (-4.7283264209457356e-37)*x) - 3.7200737055323752e-34) + 1.0523099660610621e-32) - 2.995843178059776e-31) + 8.589770227948544e-30) - 2.48248932851712e-28) + 7.238659410816e-27) - 2.132050450432e-25) + 6.35205036544e-24) - 1.9175728128e-22) + 5.878086016e-21) - 1.8345344e-19) + 5.8500288e-18) - 1.9136e-16) + 6.48368e-15) - 351.0/1562500000000000.0) + 113.0/12500000000000.0) - 7.0/31250000000.0) + 87.0/2500000000.0) + 3.0/1250000.0) + 21.0/50000.0;
+    } else {
+        const double phi = symrot_tangent_m5__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = cos(w1);
+        const double w4 = w3/w2;
+        const double w5 = s*w4;
+        const double w6 = (1.0/25.0)*w0 + 1;
+        const double w7 = (w2*w2);
+        const double w8 = 1.0/w7;
+        c_H_inverse_2 = (-1.0/2.0*w5 + w6)/w0;
+        c_H_inverse_2_x = (5.0/4.0)*(5*s*(w3*w3)*w8 + (4.0/5.0)*s*w6 - 5.0/2.0*s*w8*(1 - 2*w7) - 5*w4*w6 - 10*w6*((2.0/25.0)*w0 - w5 + 2)/s)/((s*s*s)*(x + 25));
+    }
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_inverse_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[0]*p[1];
+    const double dw5 = -a[1]*p[0] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = a[0]*p[2];
+    const double dw8 = a[2]*p[0];
+    const double dw9 = dw7 - dw8;
+    const double dw10 = dw6*p[1] - dw9*p[2];
+    const double dw11 = 2*c_H_inverse_2_x;
+    const double dw12 = dw10*dw11;
+    const double dw13 = (1.0/2.0)*a[2];
+    const double dw14 = (1.0/2.0)*a[1];
+    const double dw15 = a[1]*p[0];
+    const double dw16 = a[1]*p[2];
+    const double dw17 = -a[2]*p[1] + dw16;
+    const double dw18 = -dw17;
+    const double dw19 = dw18*p[2] - dw6*p[0];
+    const double dw20 = dw11*dw19;
+    const double dw21 = (1.0/2.0)*a[0];
+    const double dw22 = -dw18*p[1] + dw9*p[0];
+    const double dw23 = a[2]*p[1];
+    const double dw24 = dw11*dw22;
+    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+}
+
+/* symrot_tangent_m5_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_0 = 25/(x + 25) (algebraic in x)
+ * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_0_x = -25/(x + 25)**2 (algebraic in x)
+ * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + 50*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s**2)/(2*s**3*(x + 25))
+ * ops: 326 */
+static inline void symrot_tangent_m5_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 236.80339887498948)) {
+        alpha[0] = (double)NAN;
+        alpha[1] = (double)NAN;
+        alpha[2] = (double)NAN;
+        return;
+    }
+    const double c_H_0 = 25/(x + 25);
+    const double c_H_0_x = -25/pow(x + 25, 2);
+    double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 0.21392718170599553) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0;
+    } else {
+        const double phi = symrot_tangent_m5__phi(sqrt(x));
+        const double s = sqrt(x);
+        const double w0 = (s*s);
+        const double w1 = 1.0/w0;
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = 2*(w3*w3);
+        const double w5 = 1.0/(x + 25);
+        const double w6 = 1.0/s;
+        const double w7 = cos(w2);
+        const double w8 = w3*w6*w7;
+        const double w9 = (1.0/25.0)*w0 + 1;
+        const double w10 = 10*w6*w9;
+        const double w11 = w5/(s*s*s);
+        c_H_1 = w1*w4;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w1*(25*w5 - 2*w8);
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(-w10*(1 - cos(phi)) + 5*sin(phi));
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w5 + 50*w1*w3*w7*w9 - w10*(125*w5 - 10*w8) - 25*w6*(1 - w4));
+    }
+    const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const double w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const double dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const double dw1 = c_H_0_x*dw0;
+    const double dw2 = p[1]*pdot[2] - p[2]*pdot[1];
+    const double dw3 = c_H_1_x*dw0;
+    const double dw4 = p[0]*pdot[1] - p[1]*pdot[0];
+    const double dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const double dw6 = c_H_2_x*dw0;
+    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+}
+
+/* symrot_tangent_m5_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_tangent_m5_compose_jacobians(const double p1[3], const double p2[3], double J1[9], double J2[9])
+{
+    double p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_tangent_m5_compose(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = (double)NAN;
+        J1[1] = (double)NAN;
+        J1[2] = (double)NAN;
+        J1[3] = (double)NAN;
+        J1[4] = (double)NAN;
+        J1[5] = (double)NAN;
+        J1[6] = (double)NAN;
+        J1[7] = (double)NAN;
+        J1[8] = (double)NAN;
+        J2[0] = (double)NAN;
+        J2[1] = (double)NAN;
+        J2[2] = (double)NAN;
+        J2[3] = (double)NAN;
+        J2[4] = (double)NAN;
+        J2[5] = (double)NAN;
+        J2[6] = (double)NAN;
+        J2[7] = (double)NAN;
+        J2[8] = (double)NAN;
+        return 1;
+    }
+    symrot_tangent_m5_tangent_inverse(p3, Hinv3);
+    symrot_tangent_m5_rotation_matrix(p2, R2);
+    symrot_tangent_m5_tangent(p1, H1);
+    symrot_tangent_m5_tangent(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_tangent_m5_rescale_jacobian: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_tangent_m5_rescale_jacobian(const double p[3], double J[9])
+{
+    double e[4], q[3], Hinv[9], H[9];
+    symrot_tangent_m5_to_quaternion(p, e);
+    if (isnan(e[0])) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_tangent_m5_rescale(p, q) != 0) {
+        J[0] = (double)NAN;
+        J[1] = (double)NAN;
+        J[2] = (double)NAN;
+        J[3] = (double)NAN;
+        J[4] = (double)NAN;
+        J[5] = (double)NAN;
+        J[6] = (double)NAN;
+        J[7] = (double)NAN;
+        J[8] = (double)NAN;
+        return 1;
+    }
+    symrot_tangent_m5_tangent_inverse(q, Hinv);
+    symrot_tangent_m5_tangent(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
 }
 
 /* symrot_tangent_m5__phi_f: internal: phi from s = |p| (eq 11).
@@ -1901,6 +2520,618 @@ static inline int symrot_tangent_m5_rescale_f(const float p[3], float q[3])
         return 0;
     }
     return symrot_tangent_m5__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
+}
+
+/* symrot_tangent_m5_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 1.57118, else sin(phi)/s
+ * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 11 in x below x = 3.13745, else 5*(5*cos(phi) - 5*(s**2/25 + 1)*sin(phi)/s)/(2*s**2*(x + 25))
+ * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * ops: 258 */
+static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.8034F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 1.5711837F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
+    } else {
+        const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = sinf(phi);
+        const float w1 = 1.0F/s;
+        const float w2 = w0*w1;
+        const float w3 = (s*s);
+        const float w4 = 1.0F/w3;
+        const float w5 = cosf(phi);
+        const float w6 = (1.0F/25.0F)*w3 + 1;
+        const float w7 = (5.0F/2.0F)/(x + 25);
+        c_R_1 = w2;
+        c_R_2 = 2*w4*powf(sinf((1.0F/2.0F)*phi), 2);
+        c_R_1_x = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F : w4*w7*(-5*w2*w6 + 5*w5);
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w7*(5*w0 - 10*w1*w6*(1 - w5))/(s*s*s);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_R_2_x*dw13;
+    const float dw15 = a[2]*c_R_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_R_1_x;
+    const float dw18 = a[1]*c_R_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_R_2_x*dw20;
+    const float dw23 = a[0]*c_R_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_R_2_x*dw24;
+    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+}
+
+/* symrot_tangent_m5_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * R_1: Horner degree 7 in x below x = 1.57118, else sin(phi)/s
+ * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * R_0_x = 0 (constant)
+ * R_1_x: Horner degree 11 in x below x = 3.13745, else 5*(5*cos(phi) - 5*(s**2/25 + 1)*sin(phi)/s)/(2*s**2*(x + 25))
+ * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * ops: 259 */
+static inline void symrot_tangent_m5_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.8034F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 1.5711837F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
+    } else {
+        const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = sinf(phi);
+        const float w1 = 1.0F/s;
+        const float w2 = w0*w1;
+        const float w3 = (s*s);
+        const float w4 = 1.0F/w3;
+        const float w5 = cosf(phi);
+        const float w6 = (1.0F/25.0F)*w3 + 1;
+        const float w7 = (5.0F/2.0F)/(x + 25);
+        c_R_1 = w2;
+        c_R_2 = 2*w4*powf(sinf((1.0F/2.0F)*phi), 2);
+        c_R_1_x = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F : w4*w7*(-5*w2*w6 + 5*w5);
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w7*(5*w0 - 10*w1*w6*(1 - w5))/(s*s*s);
+    }
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = a[0]*p[1];
+    const float dw6 = -a[1]*p[0] + dw5;
+    const float dw7 = -dw6;
+    const float dw8 = dw7*p[1];
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8;
+    const float dw14 = a[2]*c_R_1;
+    const float dw15 = dw4*p[1];
+    const float dw16 = 2*c_R_1_x;
+    const float dw17 = a[1]*c_R_1;
+    const float dw18 = dw11*p[0];
+    const float dw19 = dw7*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = a[0]*c_R_1;
+    const float dw23 = -dw15 + dw18;
+    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+}
+
+/* symrot_tangent_m5_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_0_x = -25/(x + 25)**2 (algebraic in x)
+ * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s - 25*cos(phi)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
+ * ops: 325 */
+static inline void symrot_tangent_m5_tangent_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.8034F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    const float c_H_0_x = -25/powf(x + 25, 2);
+    float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 1.5711837F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F;
+    } else {
+        const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = 1.0F/w0;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = 1.0F/(x + 25);
+        const float w5 = 1.0F/s;
+        const float w6 = sinf(phi);
+        const float w7 = 5*w6;
+        const float w8 = cosf(phi);
+        const float w9 = (1.0F/25.0F)*w0 + 1;
+        const float w10 = 10*w5*w9;
+        const float w11 = w4/(s*s*s);
+        c_H_1 = 2*w1*(w3*w3);
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w1*(-2*w3*w5*cosf(w2) + 25*w4);
+        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-w10*(1 - w8) + w7);
+        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w4 + 25*w1*w6*w9 - w10*(125*w4 - w5*w7) - 25*w5*w8);
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = a[0]*p[2];
+    const float dw12 = a[2]*p[0];
+    const float dw13 = dw11 - dw12;
+    const float dw14 = dw13*p[2];
+    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const float dw16 = a[2]*c_H_1;
+    const float dw17 = dw6*p[1];
+    const float dw18 = 2*c_H_1_x;
+    const float dw19 = 2*dw15;
+    const float dw20 = a[1]*c_H_1;
+    const float dw21 = a[1]*p[0];
+    const float dw22 = dw13*p[0];
+    const float dw23 = dw10*p[0];
+    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const float dw25 = 2*dw24;
+    const float dw26 = a[0]*c_H_1;
+    const float dw27 = -dw17 + dw22;
+    const float dw28 = c_H_2_x*dw27;
+    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+}
+
+/* symrot_tangent_m5_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_0_x = -25/(x + 25)**2 (algebraic in x)
+ * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s - 25*cos(phi)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
+ * ops: 331 */
+static inline void symrot_tangent_m5_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.8034F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    const float c_H_0_x = -25/powf(x + 25, 2);
+    float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 1.5711837F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F;
+    } else {
+        const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = 1.0F/w0;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = 1.0F/(x + 25);
+        const float w5 = 1.0F/s;
+        const float w6 = sinf(phi);
+        const float w7 = 5*w6;
+        const float w8 = cosf(phi);
+        const float w9 = (1.0F/25.0F)*w0 + 1;
+        const float w10 = 10*w5*w9;
+        const float w11 = w4/(s*s*s);
+        c_H_1 = 2*w1*(w3*w3);
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w1*(-2*w3*w5*cosf(w2) + 25*w4);
+        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-w10*(1 - w8) + w7);
+        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w4 + 25*w1*w6*w9 - w10*(125*w4 - w5*w7) - 25*w5*w8);
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = dw10*p[1];
+    const float dw12 = a[0]*p[2];
+    const float dw13 = a[2]*p[0];
+    const float dw14 = dw12 - dw13;
+    const float dw15 = dw14*p[2];
+    const float dw16 = dw11 - dw15;
+    const float dw17 = c_H_2_x*dw16;
+    const float dw18 = a[2]*c_H_1;
+    const float dw19 = dw6*p[1];
+    const float dw20 = 2*c_H_1_x;
+    const float dw21 = a[1]*c_H_1;
+    const float dw22 = a[1]*p[0];
+    const float dw23 = dw14*p[0];
+    const float dw24 = dw10*p[0];
+    const float dw25 = -dw24 + dw6*p[2];
+    const float dw26 = c_H_2_x*dw25;
+    const float dw27 = a[0]*c_H_1;
+    const float dw28 = -dw19 + dw23;
+    const float dw29 = a[2]*p[1];
+    const float dw30 = 2*c_H_2_x*dw28;
+    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+}
+
+/* symrot_tangent_m5_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
+ * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
+ * H_inverse_0_x = 1/25 (algebraic in x)
+ * H_inverse_1_x = 0 (constant)
+ * H_inverse_2_x: Horner degree 8 in x below x = 6.51179, else 5*(-5*s*(1 - 2*sin(phi/2)**2)/(2*sin(phi/2)**2) + 4*s*(s**2/25 + 1)/5 + 5*s*cos(phi/2)**2/sin(phi/2)**2 - 5*(s**2/25 + 1)*cos(phi/2)/sin(phi/2) - 10*(s**2/25 + 1)*(2*s**2/25 - s*cos(phi/2)/sin(phi/2) + 2)/s)/(4*s**3*(x + 25))
+ * ops: 172 */
+static inline void symrot_tangent_m5_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.8034F)) {
+        D[0] = NAN;
+        D[1] = NAN;
+        D[2] = NAN;
+        D[3] = NAN;
+        D[4] = NAN;
+        D[5] = NAN;
+        D[6] = NAN;
+        D[7] = NAN;
+        D[8] = NAN;
+        return;
+    }
+    const float c_H_inverse_0_x = 1.0F/25.0F;
+    float c_H_inverse_2, c_H_inverse_2_x;
+    if (x < 6.5117908F) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
+        c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*((5.850029e-18F)*x - 1.9136e-16F) + 6.48368e-15F) - 2.2464e-13F) + 9.04e-12F) - 2.24e-10F) + 3.48e-08F) + 3.0F/1250000.0F) + 21.0F/50000.0F;
+    } else {
+        const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = cosf(w1);
+        const float w4 = w3/w2;
+        const float w5 = s*w4;
+        const float w6 = (1.0F/25.0F)*w0 + 1;
+        const float w7 = (w2*w2);
+        const float w8 = 1.0F/w7;
+        c_H_inverse_2 = (-1.0F/2.0F*w5 + w6)/w0;
+        c_H_inverse_2_x = (5.0F/4.0F)*(5*s*(w3*w3)*w8 + (4.0F/5.0F)*s*w6 - 5.0F/2.0F*s*w8*(1 - 2*w7) - 5*w4*w6 - 10*w6*((2.0F/25.0F)*w0 - w5 + 2)/s)/((s*s*s)*(x + 25));
+    }
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_inverse_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[0]*p[1];
+    const float dw5 = -a[1]*p[0] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = a[0]*p[2];
+    const float dw8 = a[2]*p[0];
+    const float dw9 = dw7 - dw8;
+    const float dw10 = dw6*p[1] - dw9*p[2];
+    const float dw11 = 2*c_H_inverse_2_x;
+    const float dw12 = dw10*dw11;
+    const float dw13 = (1.0F/2.0F)*a[2];
+    const float dw14 = (1.0F/2.0F)*a[1];
+    const float dw15 = a[1]*p[0];
+    const float dw16 = a[1]*p[2];
+    const float dw17 = -a[2]*p[1] + dw16;
+    const float dw18 = -dw17;
+    const float dw19 = dw18*p[2] - dw6*p[0];
+    const float dw20 = dw11*dw19;
+    const float dw21 = (1.0F/2.0F)*a[0];
+    const float dw22 = -dw18*p[1] + dw9*p[0];
+    const float dw23 = a[2]*p[1];
+    const float dw24 = dw11*dw22;
+    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+}
+
+/* symrot_tangent_m5_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
+ * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
+ * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_0 = 25/(x + 25) (algebraic in x)
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_0_x = -25/(x + 25)**2 (algebraic in x)
+ * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s - 25*cos(phi)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
+ * ops: 288 */
+static inline void symrot_tangent_m5_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x < 236.8034F)) {
+        alpha[0] = NAN;
+        alpha[1] = NAN;
+        alpha[2] = NAN;
+        return;
+    }
+    const float c_H_0 = 25/(x + 25);
+    const float c_H_0_x = -25/powf(x + 25, 2);
+    float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 1.5711837F) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F;
+    } else {
+        const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
+        const float w0 = (s*s);
+        const float w1 = 1.0F/w0;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = 1.0F/(x + 25);
+        const float w5 = 1.0F/s;
+        const float w6 = sinf(phi);
+        const float w7 = 5*w6;
+        const float w8 = cosf(phi);
+        const float w9 = (1.0F/25.0F)*w0 + 1;
+        const float w10 = 10*w5*w9;
+        const float w11 = w4/(s*s*s);
+        c_H_1 = 2*w1*(w3*w3);
+        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w1*(-2*w3*w5*cosf(w2) + 25*w4);
+        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-w10*(1 - w8) + w7);
+        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w4 + 25*w1*w6*w9 - w10*(125*w4 - w5*w7) - 25*w5*w8);
+    }
+    const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
+    const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];
+    const float w2 = p[0]*pddot[1] - p[1]*pddot[0];
+    const float dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
+    const float dw1 = c_H_0_x*dw0;
+    const float dw2 = p[1]*pdot[2] - p[2]*pdot[1];
+    const float dw3 = c_H_1_x*dw0;
+    const float dw4 = p[0]*pdot[1] - p[1]*pdot[0];
+    const float dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
+    const float dw6 = c_H_2_x*dw0;
+    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+}
+
+/* symrot_tangent_m5_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).
+ * J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) for p3 = compose(p1, p2)
+ * (R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status
+ * (1: J1, J2 NaN).
+ * ops: 136 */
+static inline int symrot_tangent_m5_compose_jacobians_f(const float p1[3], const float p2[3], float J1[9], float J2[9])
+{
+    float p3[3], Hinv3[9], R2[9], H1[9], H2[9], M[9];
+    const int status = symrot_tangent_m5_compose_f(p1, p2, p3);
+    if (status != 0) {
+        J1[0] = NAN;
+        J1[1] = NAN;
+        J1[2] = NAN;
+        J1[3] = NAN;
+        J1[4] = NAN;
+        J1[5] = NAN;
+        J1[6] = NAN;
+        J1[7] = NAN;
+        J1[8] = NAN;
+        J2[0] = NAN;
+        J2[1] = NAN;
+        J2[2] = NAN;
+        J2[3] = NAN;
+        J2[4] = NAN;
+        J2[5] = NAN;
+        J2[6] = NAN;
+        J2[7] = NAN;
+        J2[8] = NAN;
+        return 1;
+    }
+    symrot_tangent_m5_tangent_inverse_f(p3, Hinv3);
+    symrot_tangent_m5_rotation_matrix_f(p2, R2);
+    symrot_tangent_m5_tangent_f(p1, H1);
+    symrot_tangent_m5_tangent_f(p2, H2);
+    M[0] = R2[0] * H1[0] + R2[1] * H1[3] + R2[2] * H1[6];
+    M[1] = R2[0] * H1[1] + R2[1] * H1[4] + R2[2] * H1[7];
+    M[2] = R2[0] * H1[2] + R2[1] * H1[5] + R2[2] * H1[8];
+    M[3] = R2[3] * H1[0] + R2[4] * H1[3] + R2[5] * H1[6];
+    M[4] = R2[3] * H1[1] + R2[4] * H1[4] + R2[5] * H1[7];
+    M[5] = R2[3] * H1[2] + R2[4] * H1[5] + R2[5] * H1[8];
+    M[6] = R2[6] * H1[0] + R2[7] * H1[3] + R2[8] * H1[6];
+    M[7] = R2[6] * H1[1] + R2[7] * H1[4] + R2[8] * H1[7];
+    M[8] = R2[6] * H1[2] + R2[7] * H1[5] + R2[8] * H1[8];
+    J1[0] = Hinv3[0] * M[0] + Hinv3[1] * M[3] + Hinv3[2] * M[6];
+    J1[1] = Hinv3[0] * M[1] + Hinv3[1] * M[4] + Hinv3[2] * M[7];
+    J1[2] = Hinv3[0] * M[2] + Hinv3[1] * M[5] + Hinv3[2] * M[8];
+    J1[3] = Hinv3[3] * M[0] + Hinv3[4] * M[3] + Hinv3[5] * M[6];
+    J1[4] = Hinv3[3] * M[1] + Hinv3[4] * M[4] + Hinv3[5] * M[7];
+    J1[5] = Hinv3[3] * M[2] + Hinv3[4] * M[5] + Hinv3[5] * M[8];
+    J1[6] = Hinv3[6] * M[0] + Hinv3[7] * M[3] + Hinv3[8] * M[6];
+    J1[7] = Hinv3[6] * M[1] + Hinv3[7] * M[4] + Hinv3[8] * M[7];
+    J1[8] = Hinv3[6] * M[2] + Hinv3[7] * M[5] + Hinv3[8] * M[8];
+    J2[0] = Hinv3[0] * H2[0] + Hinv3[1] * H2[3] + Hinv3[2] * H2[6];
+    J2[1] = Hinv3[0] * H2[1] + Hinv3[1] * H2[4] + Hinv3[2] * H2[7];
+    J2[2] = Hinv3[0] * H2[2] + Hinv3[1] * H2[5] + Hinv3[2] * H2[8];
+    J2[3] = Hinv3[3] * H2[0] + Hinv3[4] * H2[3] + Hinv3[5] * H2[6];
+    J2[4] = Hinv3[3] * H2[1] + Hinv3[4] * H2[4] + Hinv3[5] * H2[7];
+    J2[5] = Hinv3[3] * H2[2] + Hinv3[4] * H2[5] + Hinv3[5] * H2[8];
+    J2[6] = Hinv3[6] * H2[0] + Hinv3[7] * H2[3] + Hinv3[8] * H2[6];
+    J2[7] = Hinv3[6] * H2[1] + Hinv3[7] * H2[4] + Hinv3[8] * H2[7];
+    J2[8] = Hinv3[6] * H2[2] + Hinv3[7] * H2[5] + Hinv3[8] * H2[8];
+    return 0;
+}
+
+/* symrot_tangent_m5_rescale_jacobian_f: Jacobian of rescale (eq D1-D5 of the sheet).
+ * J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) (the same rotation),
+ * the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range.
+ * ops: 48 */
+static inline int symrot_tangent_m5_rescale_jacobian_f(const float p[3], float J[9])
+{
+    float e[4], q[3], Hinv[9], H[9];
+    symrot_tangent_m5_to_quaternion_f(p, e);
+    if (isnan(e[0])) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    if (e[0] >= 0) {
+        J[0] = 1;
+        J[1] = 0;
+        J[2] = 0;
+        J[3] = 0;
+        J[4] = 1;
+        J[5] = 0;
+        J[6] = 0;
+        J[7] = 0;
+        J[8] = 1;
+        return 0;
+    }
+    if (symrot_tangent_m5_rescale_f(p, q) != 0) {
+        J[0] = NAN;
+        J[1] = NAN;
+        J[2] = NAN;
+        J[3] = NAN;
+        J[4] = NAN;
+        J[5] = NAN;
+        J[6] = NAN;
+        J[7] = NAN;
+        J[8] = NAN;
+        return 1;
+    }
+    symrot_tangent_m5_tangent_inverse_f(q, Hinv);
+    symrot_tangent_m5_tangent_f(p, H);
+    J[0] = Hinv[0] * H[0] + Hinv[1] * H[3] + Hinv[2] * H[6];
+    J[1] = Hinv[0] * H[1] + Hinv[1] * H[4] + Hinv[2] * H[7];
+    J[2] = Hinv[0] * H[2] + Hinv[1] * H[5] + Hinv[2] * H[8];
+    J[3] = Hinv[3] * H[0] + Hinv[4] * H[3] + Hinv[5] * H[6];
+    J[4] = Hinv[3] * H[1] + Hinv[4] * H[4] + Hinv[5] * H[7];
+    J[5] = Hinv[3] * H[2] + Hinv[4] * H[5] + Hinv[5] * H[8];
+    J[6] = Hinv[6] * H[0] + Hinv[7] * H[3] + Hinv[8] * H[6];
+    J[7] = Hinv[6] * H[1] + Hinv[7] * H[4] + Hinv[8] * H[7];
+    J[8] = Hinv[6] * H[2] + Hinv[7] * H[5] + Hinv[8] * H[8];
+    return 0;
 }
 
 #ifdef __cplusplus

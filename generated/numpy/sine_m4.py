@@ -15,7 +15,17 @@ to_quaternion(p) -> e (..., 4); from_quaternion(e) -> p (normalizes e, takes the
 e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65;
 NaN unless R is a rotation: max |R^T R - I| <= 2^-26 (2^-11 in float32) and det R > 0);
 compose(p1, p2) -> p3 with R(p3) = R(p2) R(p1), p1 applied first (eqs 18-19, 67);
-rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).  Every rotation has
+rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).
+
+Derivatives for implicit solvers (docs/derivatives.md): with a fixed vector a, the (..., 3, 3)
+matrices rotation_derivative(p, a) = d(R a)/dp, rotation_transpose_derivative(p, a) = d(R^T a)/dp,
+tangent_derivative(p, a) = d(H a)/dp, tangent_transpose_derivative(p, a) = d(H^T a)/dp and
+tangent_inverse_derivative(p, a) = d(H^-1 a)/dp (column j is the derivative by p_j);
+angular_acceleration(p, pdot, pddot) -> alpha = H pddot + Hdot pdot; compose_jacobians(p1, p2) ->
+(dp3/dp1, dp3/dp2) of p3 = compose(p1, p2), i.e. H(p3)^-1 R(p2) H(p1) and H(p3)^-1 H(p2), rescaling
+of p3 included; rescale_jacobian(p) -> d rescale(p)/dp = H(rescale(p))^-1 H(p) (I where p is kept).
+The derivatives of R, H and H^-1 and angular_acceleration are NaN from |p|^2 >= _DERIVATIVE_X_LIMIT
+on (at most the edge of the other functions; smaller where a derivative's printed form overflows first).  Every rotation has
 such a representation, so these results are NaN only for non-finite input."""
 
 import functools
@@ -26,88 +36,124 @@ P_MAX = 4.0
 P_MAX_SQUARED = 16.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
 
 
-def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _p_prime_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _nu_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _nu_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-2*numpy.sqrt(d)/(x - 8)).astype(numpy.float64, copy=False)
+def _epsilon_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-2*numpy.sqrt(d)/(x - 8)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _mu_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _det_H_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _R_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-0.03125*numpy.sqrt(d)*(x - 8)).astype(numpy.float64, copy=False)
+def _R_1_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-0.03125*numpy.sqrt(d)*(x - 8)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _R_2_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_1_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-0.03125*(x - 24)/numpy.sqrt(d)).astype(numpy.float64, copy=False)
+def _H_2_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-0.03125*(x - 24)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _G_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _G_1_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.125)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _G_2_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _K_0_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _K_1_64(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return numpy.asarray(((0.125)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(1 - 0.125*x).astype(numpy.float64, copy=False)
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-0.03125*numpy.sqrt(d) + (0.015625)*(x - 8)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, -0.03125)
+
+
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((2/d**(1.5)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, -0.03125)
+
+
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-(0.03125)/numpy.sqrt(d) - 0.015625*(x - 24)/d**(1.5)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((-(0.125)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray(((0.125)/d**(1.5)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _e_0_64(x, phi, s, d, sin_half, cos_half):
+    return numpy.asarray((1 - 0.125*x) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
 def _angle_64(s, d):
@@ -119,119 +165,165 @@ def _scale_64(e0, e_norm):
     return ((2*numpy.sqrt(2)/numpy.sqrt(e0 + 1)) + 0.0 * e0).astype(numpy.float64)
 
 
-def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _nu_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
-    return numpy.asarray(-2*numpy.sqrt(d)/(x - 8)).astype(numpy.float32, copy=False)
+    return numpy.asarray((-2*numpy.sqrt(d)/(x - 8)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _mu_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _det_H_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _R_0_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _R_1_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
-    return numpy.asarray(-0.03125*numpy.sqrt(d)*(x - 8)).astype(numpy.float32, copy=False)
+    return numpy.asarray((-0.03125*numpy.sqrt(d)*(x - 8)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _R_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_0_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray((4/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_1_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.03125)*d) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
-    return numpy.asarray(-0.03125*(x - 24)/numpy.sqrt(d)).astype(numpy.float32, copy=False)
+    return numpy.asarray((-0.03125*(x - 24)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.25)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _G_0_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _G_1_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.125)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _G_2_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _K_0_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _K_1_32(x, phi, s, d, sin_half, cos_half):
     return numpy.full_like(x, 0.125)
 
 
-def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _K_2_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
     d = d.astype(numpy.float64)
     return numpy.asarray(((0.125)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = x.astype(numpy.float64)
-    return numpy.asarray(1 - 0.125*x).astype(numpy.float32, copy=False)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-0.03125*numpy.sqrt(d) + (0.015625)*(x - 8)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, -0.03125)
+
+
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((2/d**(1.5)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, -0.03125)
+
+
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-(0.03125)/numpy.sqrt(d) - 0.015625*(x - 24)/d**(1.5)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray((-(0.125)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return numpy.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.125)/d**(1.5)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _e_0_32(x, phi, s, d, sin_half, cos_half):
+    x = x.astype(numpy.float64)
+    return numpy.asarray((1 - 0.125*x) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
 def _angle_32(s, d):
@@ -265,6 +357,15 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "R_0_x": _R_0_x_64,
+        "R_1_x": _R_1_x_64,
+        "R_2_x": _R_2_x_64,
+        "H_0_x": _H_0_x_64,
+        "H_1_x": _H_1_x_64,
+        "H_2_x": _H_2_x_64,
+        "H_inverse_0_x": _H_inverse_0_x_64,
+        "H_inverse_1_x": _H_inverse_1_x_64,
+        "H_inverse_2_x": _H_inverse_2_x_64,
         "e_0": _e_0_64,
     },
     "32": {
@@ -288,25 +389,29 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "R_0_x": _R_0_x_32,
+        "R_1_x": _R_1_x_32,
+        "R_2_x": _R_2_x_32,
+        "H_0_x": _H_0_x_32,
+        "H_1_x": _H_1_x_32,
+        "H_2_x": _H_2_x_32,
+        "H_inverse_0_x": _H_inverse_0_x_32,
+        "H_inverse_1_x": _H_inverse_1_x_32,
+        "H_inverse_2_x": _H_inverse_2_x_32,
         "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
-    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
+    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
+    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
 }
-_SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {},
-    "32": {},
-}
-_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
-_SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
+_BLOCK = 16384
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
-_FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
+_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 E0_MIN = -numpy.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 
@@ -326,9 +431,9 @@ def _as_float(value, name, shape):
     """value as a float32 or float64 array of shape (..., *shape); ValueError for anything else
     (complex, bool, object, string and datetime input is refused, never silently converted)."""
     value = numpy.asarray(value)
-    if value.dtype != numpy.float64 and value.dtype != numpy.float32:  # float input is never copied
-        if value.dtype.kind not in "fiu":
-            raise ValueError(f"{name} must be a real float or integer array, got dtype {value.dtype}")
+    if value.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must be a real float or integer array, got dtype {value.dtype}")
+    if value.dtype != numpy.float32:
         value = value.astype(numpy.float64)
     if value.ndim < len(shape) or value.shape[value.ndim - len(shape):] != shape:
         raise ValueError(f"{name} must have shape (..., {', '.join(map(str, shape))}), got {value.shape}")
@@ -368,17 +473,9 @@ def _complement(p):
     return high + low
 
 
-def _squared_norm(p):
-    """x = |p|^2 = (p0^2 + p2^2) + p1^2: the one definition of x used by every validity test (the
-    summation order of NumPy's einsum on x86-64, used before; written out, it is 3 to 4 times
-    faster and the same on every CPU)."""
-    square = p * p
-    return numpy.asarray((square[..., 0] + square[..., 2]) + square[..., 1])
-
-
 def _length(p, suffix):
     """(|p|^2, |p|): the one definition of |p| used by every validity test."""
-    x = _squared_norm(p)
+    x = numpy.asarray(numpy.einsum("...i,...i->...", p, p))
     s = numpy.asarray(numpy.sqrt(x))
     extreme = ~((x >= _TINY[suffix]) & (x <= _HUGE[suffix]))
     if extreme.any():  # |p| without underflow or overflow
@@ -392,61 +489,26 @@ def _inside(x, suffix):
     return (x < P_MAX_SQUARED) & (x < _X_LIMIT[suffix])
 
 
-def _span(x, suffix):
-    """(min x, max x) when every lane of x = |p|^2 is finite, in [_TINY, _HUGE] (|p| = sqrt(x)
-    without underflow or overflow) and safely inside the validity range; None otherwise (empty
-    input, NaN, a lane near or beyond the boundary), which takes the exact lane-by-lane tests."""
-    if x.size <= _SMALL:  # a Python list is cheaper than two NumPy reductions here
-        values = x.ravel().tolist()
-        if not values:
-            return None
-        low, high, total = min(values), max(values), sum(values)
-        if total != total:  # NaN: min and max of a list with NaN depend on the order
-            return None
-    else:
-        low, high = x.min(), x.max()  # NaN propagates and fails the tests below
-    if low >= _TINY[suffix] and high <= _HUGE[suffix] and high < _FAST_LIMIT[suffix]:
-        return low, high
-    return None
-
-
 def _prepare(p, names):
-    """p, (x, phi, s, d, sin(phi/2), cos(phi/2), span), valid, suffix: the arguments of the
-    coefficient functions ``names`` (the half-angle sine and cosine computed once for all of them).
+    """p, (x, phi, s, d, sin(phi/2), cos(phi/2)), valid, suffix: the arguments of the coefficient
+    functions ``names`` (the half-angle sine and cosine computed once for all of them).
 
-    span = (min x, max x) when every lane is inside the range (see _span; then valid is
-    numpy.True_ and the coefficients take one branch on all lanes when the span allows), else
-    None.  phi is computed only when one of them needs it on some lane (None otherwise)."""
+    phi is computed only when one of them needs it (None otherwise)."""
     p = _as_float(p, "p", (3,))
     suffix = "32" if p.dtype == numpy.float32 else "64"
-    x = _squared_norm(p)
-    span = _span(x, suffix)
-    if span is not None:
-        s = numpy.sqrt(x)
-        valid = numpy.True_
-    else:
-        x, s = _length(p, suffix)
-        valid = _inside(x, suffix)
-        if not valid.all():
-            p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
-            s = numpy.where(valid, s, 0.0).astype(p.dtype)
-            x = numpy.where(valid, x, 0.0).astype(p.dtype)  # a lane's x never depends on the others
-    # lanes with x <= k^2/4 (x <= d/3: the rounding error of x, under 2.5 ulp of x, stays below
-    # one ulp of d) take d = k^2 - x, the others the compensated complement: lane by lane, so a
-    # lane's d never depends on the other lanes of its block
-    if span is not None and suffix == "64" and span[1] <= 16.0 / 4:
-        d = 16.0 - x
-    else:
-        d = numpy.where(valid, _complement(p), 1.0).astype(p.dtype)
-        if suffix == "64":
-            d = numpy.where(valid & (x <= 16.0 / 4), 16.0 - x, d)
+    x, s = _length(p, suffix)
+    valid = _inside(x, suffix)
+    if not valid.all():
+        p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
+        s = numpy.where(valid, s, 0.0).astype(p.dtype)
+        x = s * s
+    d = numpy.where(valid, _complement(p), 1.0).astype(p.dtype)
     table = _USES_PHI[suffix]
-    switch = _SWITCH[suffix]
-    if any(table[name] and (span is None or span[1] >= switch[name]) for name in names):
+    if any(table[name] for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half), span), valid, suffix
-    return p, (x, None, s, d, None, None, span), valid, suffix
+        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half)), valid, suffix
+    return p, (x, None, s, d, None, None), valid, suffix
 
 
 def _scalar(p, name):
@@ -456,45 +518,14 @@ def _scalar(p, name):
 
 
 def _tensor(p, name):
-    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3): written in place into the (n, 9) result,
-    in one pass for small n, else in cache-sized blocks."""
+    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3), computed in cache-sized blocks."""
     p = _as_float(p, "p", (3,))
     shape = p.shape[:-1]
     flat = p.reshape(-1, 3)
     out = numpy.empty((flat.shape[0], 9), dtype=p.dtype)
-    if flat.shape[0] <= _SMALL:
-        _tensor_small(flat, name, out)
-    else:
-        for start in range(0, flat.shape[0], _BLOCK):
-            _tensor_block(flat[start:start + _BLOCK], name, out[start:start + _BLOCK])
+    for start in range(0, flat.shape[0], _BLOCK):
+        _tensor_block(flat[start:start + _BLOCK], name, out[start:start + _BLOCK])
     return out.reshape(*shape, 3, 3)
-
-
-# entry e = 3 i + j of T: the off-diagonal p_i p_j as (c p_I[e]) p_J[e] (the same product for
-# (i, j) and (j, i)), the cross term sign[e] p_K[e] with (p x)_ij = -eps_ijk p_k, and
-# T_ii = c0 - c2 (p_j^2 + p_k^2) from the squares _OTHER_1, _OTHER_2 (no cancellation against |p|^2)
-_I = numpy.array([0, 0, 0, 0, 1, 1, 0, 1, 2])
-_J = numpy.array([0, 1, 2, 1, 1, 2, 2, 2, 2])
-_K = numpy.array([0, 2, 1, 2, 0, 0, 1, 0, 0])
-_SIGN = {"64": numpy.array([0.0, -1.0, 1.0, 1.0, 0.0, -1.0, -1.0, 1.0, 0.0])}
-_SIGN["32"] = _SIGN["64"].astype(numpy.float32)
-_OTHER_1 = numpy.array([1, 0, 0])
-_OTHER_2 = numpy.array([2, 2, 1])
-_DIAGONAL = numpy.array([0, 4, 8])
-
-
-def _tensor_small(p, name, out):
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
-    table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](*state)
-    b = table[name + "_1"](*state)
-    c = table[name + "_2"](*state)
-    numpy.multiply((c[:, None] * p)[:, _I], p[:, _J], out=out)
-    out += (b[:, None] * p)[:, _K] * _SIGN[suffix]
-    square = p * p
-    out[:, _DIAGONAL] = a[:, None] - c[:, None] * (square[:, _OTHER_1] + square[:, _OTHER_2])
-    if valid is not numpy.True_:
-        out[~valid] = numpy.nan
 
 
 def _tensor_block(p, name, out):
@@ -503,23 +534,25 @@ def _tensor_block(p, name, out):
     a = table[name + "_0"](*state)
     b = table[name + "_1"](*state)
     c = table[name + "_2"](*state)
-    p0, p1, p2 = p.T.copy()  # contiguous components
+    p0, p1, p2 = p.T
     c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
     s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
-    numpy.subtract(a, c * (s1 + s2), out=out[:, 0])  # T_ii = c0 - c2 (p_j^2 + p_k^2)
-    numpy.subtract(a, c * (s0 + s2), out=out[:, 4])
-    numpy.subtract(a, c * (s0 + s1), out=out[:, 8])
+    m = numpy.empty((9, p.shape[0]), dtype=p.dtype)  # entry-major: contiguous writes
+    m[0] = a - c * (s1 + s2)  # T_ii = c0 - c2 (p_j^2 + p_k^2): no cancellation against |p|^2
+    m[4] = a - c * (s0 + s2)
+    m[8] = a - c * (s0 + s1)
     q = c0 * p1
-    numpy.subtract(q, b2, out=out[:, 1])
-    numpy.add(q, b2, out=out[:, 3])
+    m[1] = q - b2
+    m[3] = q + b2
     q = c0 * p2
-    numpy.add(q, b1, out=out[:, 2])
-    numpy.subtract(q, b1, out=out[:, 6])
+    m[2] = q + b1
+    m[6] = q - b1
     q = c1 * p2
-    numpy.subtract(q, b0, out=out[:, 5])
-    numpy.add(q, b0, out=out[:, 7])
-    if valid is not numpy.True_:
+    m[5] = q - b0
+    m[7] = q + b0
+    out[:] = m.T
+    if not valid.all():
         out[~valid] = numpy.nan
 
 
@@ -536,6 +569,53 @@ def _apply(p, v, name):
     p_dot_v = numpy.einsum("...i,...i->...", p, v)[..., None]
     result = a * v + b * p_cross_v + c * (p * p_dot_v - x[..., None] * v)
     return numpy.where(valid[..., None], result, numpy.nan).astype(p.dtype)
+
+
+def _skew(v):
+    """(v x) of shape (..., 3, 3)."""
+    out = numpy.zeros((*v.shape, 3), dtype=v.dtype)
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.derivatives)."""
+    pa = numpy.cross(p, a)
+    ppa = numpy.cross(p, pa)
+    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
+    out = u[..., :, None] * p[..., None, :]
+    out = out + (-c1)[..., None, None] * (_skew(a))
+    out = out + (-c2)[..., None, None] * (_skew(pa))
+    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
+    return out
+
+
+def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.derivatives)."""
+    pa = numpy.cross(p, a)
+    ppa = numpy.cross(p, pa)
+    pta = numpy.einsum('...i,...i->...', p, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * numpy.cross(pa, a)
+
+
+def _with_slopes(p, a, name, sign):
+    """p, a, (c0, c1, c2, d0, d1, d2) of T = ``name`` (sign -1: of its transpose), valid."""
+    a = _as_float(a, "the second argument", (3,))
+    names = [name + "_0", name + "_1", name + "_2", name + "_0_x", name + "_1_x", name + "_2_x"]
+    p, state, valid, suffix = _prepare(p, names)
+    valid = valid & (state[0] < _DERIVATIVE_X_LIMIT[suffix])  # the slopes' own edge of the domain
+    a = a.astype(p.dtype)
+    table = _COEFFICIENTS[suffix]
+    c0, c1, c2, d0, d1, d2 = (table[n](*state) for n in names)
+    return p, a, (c0, sign * c1, c2, d0, sign * d1, d2), valid
+
+
+def _derivative(p, a, name, sign):
+    p, a, scalars, valid = _with_slopes(p, a, name, sign)
+    out = _derivative_matrix(*scalars, p, a)
+    return numpy.where(valid[..., None, None], out, numpy.nan).astype(p.dtype)
 
 
 @_quiet
@@ -592,6 +672,49 @@ def pdot(p, omega):
 def omega(p, pdot):
     """omega = H pdot (eq 20)."""
     return _apply(p, pdot, "H")
+
+
+@_quiet
+def rotation_derivative(p, a):
+    """d(R a)/dp for a fixed vector a (..., 3, 3); column j is d(R a)/dp_j (R of eq 16)."""
+    return _derivative(p, a, "R", 1)
+
+
+@_quiet
+def rotation_transpose_derivative(p, a):
+    """d(R^T a)/dp for a fixed vector a (..., 3, 3)."""
+    return _derivative(p, a, "R", -1)
+
+
+@_quiet
+def tangent_derivative(p, a):
+    """d(H a)/dp for a fixed vector a (..., 3, 3) (H of eq 20); Hdot = d(H a)/dp at a = pdot, times pdot."""
+    return _derivative(p, a, "H", 1)
+
+
+@_quiet
+def tangent_transpose_derivative(p, a):
+    """d(H^T a)/dp for a fixed vector a (..., 3, 3)."""
+    return _derivative(p, a, "H", -1)
+
+
+@_quiet
+def tangent_inverse_derivative(p, a):
+    """d(H^-1 a)/dp for a fixed vector a (..., 3, 3) (H^-1 of eq 26)."""
+    return _derivative(p, a, "H_inverse", 1)
+
+
+@_quiet
+def angular_acceleration(p, pdot, pddot):
+    """alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20)."""
+    pddot = _as_float(pddot, "pddot", (3,))
+    p, v, scalars, valid = _with_slopes(p, pdot, "H", 1)
+    w = pddot.astype(p.dtype)
+    c0, c1, c2 = scalars[:3]
+    pw = numpy.cross(p, w)
+    first = c0[..., None] * w + c1[..., None] * pw + c2[..., None] * numpy.cross(p, pw)
+    out = first + _rate_vector(*scalars, p, v)
+    return numpy.where(valid[..., None], out, numpy.nan).astype(p.dtype)
 
 
 def _quaternion(p):
@@ -697,6 +820,31 @@ def compose(p1, p2):
     e0 = numpy.where(valid, e0, 1.0).astype(a.dtype)
     e = numpy.where(valid[..., None], e, 0.0).astype(a.dtype)
     return _from_quaternion(e0, e, valid, suffix)
+
+
+@_quiet
+def compose_jacobians(p1, p2):
+    """(dp3/dp1, dp3/dp2) of p3 = compose(p1, p2), each (..., 3, 3): H(p3)^-1 R(p2) H(p1) and
+    H(p3)^-1 H(p2) (the rotation increments add as d theta3 = R(p2) d theta1 + d theta2, omega = H pdot).
+
+    p3 is the rescaled result of compose, so the rescaling is included; NaN where compose is NaN.
+    """
+    p3 = compose(p1, p2)
+    h3_inverse = _tensor(p3, "H_inverse")
+    return h3_inverse @ (_tensor(p2, "R") @ _tensor(p1, "H")), h3_inverse @ _tensor(p2, "H")
+
+
+@_quiet
+def rescale_jacobian(p):
+    """d rescale(p)/dp (..., 3, 3): H(rescale(p))^-1 H(p) where p is rescaled (the same rotation, so
+    the same increment d theta), the identity where p is kept; NaN outside the validity range."""
+    p = _as_float(p, "p", (3,))
+    e0, _e, valid, _suffix = _quaternion(p)
+    flip = valid & (e0 < 0)
+    jacobian = _tensor(rescale(p), "H_inverse") @ _tensor(p, "H")
+    identity = numpy.broadcast_to(numpy.eye(3, dtype=p.dtype), jacobian.shape)
+    out = numpy.where(flip[..., None, None], jacobian, identity)
+    return numpy.where(valid[..., None, None], out, numpy.nan).astype(p.dtype)
 
 
 @_quiet

@@ -5,8 +5,9 @@ Prints the evaluation plan of :mod:`symrot.plan` (one per precision) through
 :data:`~symrot.backends.c_functions.FUNCTIONS` the header has a double version and a float version
 (suffix ``_f``, float math functions, the float32 plan), and matrix functions also a ``_batch``
 kernel. The statements come from :mod:`symrot.backends.c_writer` (single calls, and how a plan
-becomes C), :mod:`symrot.backends.c_batch` (batch kernels) and :mod:`symrot.backends.c_operations`
-(quaternions, composition, rescaling); this module assembles them into the header and writes it.
+becomes C), :mod:`symrot.backends.c_batch` (batch kernels), :mod:`symrot.backends.c_operations`
+(quaternions, composition, rescaling) and :mod:`symrot.backends.c_derivatives` (the derivatives of
+issue 19); this module assembles them into the header and writes it.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from ..plan import evaluation_plan
 from ..plan_ir import ClosedAngle, EvaluationPlan
 from ..registry import NAMED, find_by_expression, lookup
 from .c_batch import DEFAULT_BLOCK, BatchWriter
+from .c_derivatives import DerivativeWriter
 from .c_functions import FUNCTIONS, CFunction
 from .c_operations import OperationWriter
 from .c_printer import PRECISIONS
@@ -52,6 +54,7 @@ def header_source(plan: EvaluationPlan, name: str, expression: str | None = None
                 function["batch_statements"], function["batch_notes"] = batch.kernel(spec)
         functions += public
         functions += OperationWriter(plan, name, precision).all()
+        functions += DerivativeWriter(plan, name, precision).all()
     identifier = registry_title(plan.p)
     text = expression or sp.sstr(plan.p)
     return render(

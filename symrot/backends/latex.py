@@ -21,6 +21,7 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES, Derivation
+from ..derivatives import DIFFERENTIATED, SLOPES, VALUES, rate_vector, slope_name, tensor_derivative
 from ..functions import RealCbrt
 from ..parsing import PHI
 from ..registry import NamedParameterization
@@ -337,6 +338,10 @@ def sheet(result: NamedDerivation, series_terms: int = 4) -> str:
     } for name in TENSOR_NAMES]
     series = [(symbol, series_latex(d.series_in_x(name, series_terms)))
               for name, symbol in SERIES]
+    # the slopes as exact series (their closed forms dc/dφ / (2 p p′) can be wider than the page)
+    slopes = [(TENSOR_SYMBOLS[name], [series_latex(d.series_in_x(slope_name(f"{name}_{k}"), series_terms))
+                                      for k in range(3)])
+              for name in DIFFERENTIATED]
     return render(
         "latex/sheet.tex.j2",
         title=title_of(result),
@@ -348,7 +353,51 @@ def sheet(result: NamedDerivation, series_terms: int = 4) -> str:
         series=series,
         terms=series_terms,
         validity=validity_text(d),
+        derivative=derivative_latex(),
+        rate=rate_latex(),
+        slopes=slopes,
     )
+
+
+_BASIS_LATEX = {"a*p": r"\mathbf{a}\otimes\mathbf{p}",
+                "(p x a)*p": r"(\mathbf{p}\times\mathbf{a})\otimes\mathbf{p}",
+                "(p x (p x a))*p": r"(\mathbf{p}\times(\mathbf{p}\times\mathbf{a}))\otimes\mathbf{p}",
+                "[a x]": r"(\mathbf{a}\times)", "[(p x a) x]": r"((\mathbf{p}\times\mathbf{a})\times)",
+                "[p x][a x]": r"(\mathbf{p}\times)(\mathbf{a}\times)",
+                "a (p.a)": r"(\mathbf{p}\cdot\dot{\mathbf{p}})\,\dot{\mathbf{p}}",
+                "(p x a) (p.a)": r"(\mathbf{p}\cdot\dot{\mathbf{p}})\,\mathbf{p}\times\dot{\mathbf{p}}",
+                "(p x (p x a)) (p.a)": r"(\mathbf{p}\cdot\dot{\mathbf{p}})\,"
+                                       r"\mathbf{p}\times(\mathbf{p}\times\dot{\mathbf{p}})",
+                "(p x a) x a": r"(\mathbf{p}\times\dot{\mathbf{p}})\times\dot{\mathbf{p}}"}
+
+
+def _combination(terms: dict[sp.Symbol, dict[str, sp.Rational]], symbols: dict[sp.Symbol, str],
+                 break_after: int) -> tuple[str, str]:
+    """Σ_s Σ_b k s b as LaTeX in the order the core derived it, split into two lines after
+    ``break_after`` terms (the sheet's lines stay within the page)."""
+    printed: list[str] = []
+    for scalar, combination in terms.items():
+        for name, factor in combination.items():
+            magnitude = "" if abs(factor) == 1 else latex(abs(factor)) + r"\,"
+            sign = "-" if factor < 0 else ("+" if printed else "")
+            printed.append(rf"{sign} {magnitude}{symbols[scalar]}\,{_BASIS_LATEX[name]}".strip())
+    return " ".join(printed[:break_after]), " ".join(printed[break_after:])
+
+
+def derivative_latex() -> tuple[str, str]:
+    """∂(T a)/∂p as derived by :func:`symrot.derivatives.tensor_derivative` (c_k′ = dc_k/dx): the
+    rank-one terms, then the others."""
+    symbols = {**{v: f"c_{k}" for k, v in enumerate(VALUES)}, **{s: f"c_{k}'" for k, s in enumerate(SLOPES)}}
+    terms = tensor_derivative().terms
+    rank_one = sum(name.endswith("*p") for combination in terms.values() for name in combination)
+    return _combination(terms, symbols, rank_one)
+
+
+def rate_latex() -> tuple[str, str]:
+    """Ḣ ṗ as derived by :func:`symrot.derivatives.rate_vector` (coefficients of H), in two lines."""
+    symbols = {**{v: rf"c_{k}^{{\mathbf{{H}}}}" for k, v in enumerate(VALUES)},
+               **{s: rf"c_{k}^{{\mathbf{{H}}\prime}}" for k, s in enumerate(SLOPES)}}
+    return _combination(rate_vector(), symbols, 2)
 
 
 def standalone(body: str) -> str:

@@ -5,7 +5,9 @@ eq 16), ``tangent`` (H, ω = H ṗ, eq 20), ``tangent_inverse`` (H⁻¹, eq 26),
 eq 24), ``root_matrix`` (G, eq 81), ``root_tangent`` (K, eq 83), ``pdot`` (ṗ = H⁻¹ ω, eq 25) and
 ``omega`` (ω = H ṗ), and the operations on rotations of any size ``to_quaternion``,
 ``from_quaternion``, ``from_rotation_matrix``, ``compose`` (R(p3) = R(p2) R(p1)) and ``rescale``
-(eqs 18–19, 40–47, 61–65, 74–75).  float32 input is evaluated with the float32 plan, anything else
+(eqs 18–19, 40–47, 61–65, 74–75), and the derivatives of issue 19 (``rotation_derivative``,
+``tangent_derivative``, … ``angular_acceleration``, ``compose_jacobians``, ``rescale_jacobian``;
+:mod:`symrot.backends.numpy_derivatives`).  float32 input is evaluated with the float32 plan, anything else
 as float64.  Outside the validity range |p| < p_max (|p|² < 2⁶⁰⁰ when p is unbounded) every output
 is NaN.  Tensors are written in place into the (..., 3, 3) result: up to 64 vectors in one pass
 (entries gathered by index), more in blocks of 4096 (temporaries of 32 KiB, under glibc's mmap
@@ -40,6 +42,7 @@ from ..plan import (
     evaluation_plan,
 )
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
+from .numpy_derivatives import derivative_lines, rate_lines
 from .templating import render
 
 TENSORS = ("R", "H", "H_inverse", "G", "K")
@@ -211,10 +214,13 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "inclusive": inclusive,
             "x_limit": {SUFFIX[label]: repr(precision.x_limit)
                         for label, precision in plan.precisions.items()},
+            "derivative_x_limit": {SUFFIX[label]: repr(precision.derivative_x_limit)
+                                   for label, precision in plan.precisions.items()},
             "x_limit_power": {SUFFIX[label]: math.frexp(precision.x_limit)[1] - 1
                               for label, precision in plan.precisions.items()},
             "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
                                          for label in plan.precisions},
+            "derivative_lines": derivative_lines(), "rate_lines": rate_lines(),
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()},
             "switch": {SUFFIX[label]: {n: branch_switch(c) for n, c in precision.coefficients.items()

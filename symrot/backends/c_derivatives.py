@@ -1,0 +1,172 @@
+"""C functions for the derivatives of issue 19, built on :class:`~symrot.backends.c_writer.FunctionWriter`.
+
+Single calls in double and, suffixed ``_f``, float; no allocation; matrices row-major
+(D[3*i + j] = ∂(T a)_i/∂p_j, column j the derivative by p_j; docs/derivatives.md):
+
+* ``rotation_derivative(p, a, D)``, ``rotation_transpose_derivative``, ``tangent_derivative``,
+  ``tangent_transpose_derivative``, ``tangent_inverse_derivative``: ∂(T a)/∂p printed entry by entry
+  from the form the core derives (:func:`symrot.derivatives.tensor_derivative`), with the planned
+  coefficients c_k and slopes c_k′ = dc_k/dx (Tᵀ: c1, c1′ negated); NaN outside the range, as
+  every function of the header;
+* ``angular_acceleration(p, pdot, pddot, alpha)``: α = H p̈ + Ḣ ṗ with Ḣ ṗ from
+  :func:`symrot.derivatives.rate_value`;
+* ``compose_jacobians(p1, p2, J1, J2)``: ∂p₃/∂p₁ = H(p₃)⁻¹ R(p₂) H(p₁), ∂p₃/∂p₂ = H(p₃)⁻¹ H(p₂) for
+  p₃ = compose(p₁, p₂); ``rescale_jacobian(p, J)``: H(p_r)⁻¹ H(p) when p is rescaled to p_r, I when
+  it is kept. Both return the status of compose/rescale (0, or 1 with NaN outputs).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import sympy as sp
+
+from ..derivatives import SLOPES, VALUES, rate_value, rate_vector, slope_name, tensor_derivative
+from ..plan_ir import EvaluationPlan
+from .c_functions import P, vector_entries
+from .c_printer import Precision
+from .c_writer import FunctionWriter, Statement, ops_of
+
+DERIVATIVES = {"rotation_derivative": ("R", 1, "d(R a)/dp"),
+               "rotation_transpose_derivative": ("R", -1, "d(R^T a)/dp"),
+               "tangent_derivative": ("H", 1, "d(H a)/dp"),
+               "tangent_transpose_derivative": ("H", -1, "d(H^T a)/dp"),
+               "tangent_inverse_derivative": ("H_inverse", 1, "d(H^-1 a)/dp")}
+"""C function → (tensor, sign of c1 and c1′, summary)."""
+
+
+def _vector(name: str) -> sp.Matrix:
+    return sp.Matrix([sp.Symbol(f"{name}[{i}]", real=True) for i in range(3)])
+
+
+def _product(left: str, right: str, i: int, j: int) -> str:
+    return " + ".join(f"{left}[{3 * i + k}] * {right}[{3 * k + j}]" for k in range(3))
+
+
+class DerivativeWriter(FunctionWriter):
+    """The derivative functions of one plan in one precision: their validity test uses the plan's
+    ``derivative_x_limit`` (the slopes' edge of the domain, at most ``x_limit``)."""
+
+    def __init__(self, plan: EvaluationPlan, header: str, precision: Precision) -> None:
+        super().__init__(plan, header, precision)
+        self.precision_plan = replace(self.precision_plan, x_limit=self.precision_plan.derivative_x_limit)
+
+    def name(self, function: str) -> str:
+        return f"symrot_{self.header}_{function}{self.suffix}"
+
+    def entry(self, function: str, summary: str, signature: str, statements: list[Statement],
+              notes: list[str]) -> dict[str, Any]:
+        return {"c_name": self.name(function), "summary": summary, "equation": "D1-D5 of the sheet",
+                "notes": notes, "ops": ops_of(statements), "signature": signature,
+                "statements": statements, "batch_signature": None, "output": None}
+
+    def nan_out(self, output: str, count: int, status: str = "") -> list[Statement]:
+        nan = [self.set(f"{output}[{i}]", self.nan) for i in range(count)]
+        return [*nan, {"kind": "return", "value": status}]
+
+    def scalars(self, tensor: str, sign: int, used: set[sp.Symbol]
+                ) -> tuple[list[Statement], dict[sp.Symbol, sp.Expr], list[str]]:
+        """Statements of T's coefficients and slopes among ``used`` (no unused C variable), the values
+        of VALUES/SLOPES (0 for the others), and the names computed."""
+        symbols = {**{VALUES[k]: f"{tensor}_{k}" for k in range(3)},
+                   **{SLOPES[k]: slope_name(f"{tensor}_{k}") for k in range(3)}}
+        names = [n for symbol, n in symbols.items() if symbol in used]
+        body, values = self.coefficients(names)
+        negated = {VALUES[1], SLOPES[1]}
+        scalars = {symbol: (sign if symbol in negated else 1) * values[n] if symbol in used else sp.S.Zero
+                   for symbol, n in symbols.items()}
+        return body, scalars, names
+
+    def derivative(self, function: str) -> dict[str, Any]:
+        tensor, sign, summary = DERIVATIVES[function]
+        t = self.ctype
+        statements: list[Statement] = [*self.prologue(), {"kind": "if", "condition": self.out_of_range(),
+                                                          "then": self.nan_out("D", 9), "otherwise": []}]
+        body, scalars, names = self.scalars(tensor, sign, set(tensor_derivative().terms))
+        statements += body
+        matrix = tensor_derivative().matrix(sp.Matrix(P), _vector("a"), scalars)
+        replacements, entries = sp.cse(list(matrix), symbols=sp.numbered_symbols("dw"))
+        statements += [self.let(str(symbol), value) for symbol, value in replacements]
+        statements += [self.set(f"D[{i}]", entry) for i, entry in enumerate(entries)]
+        notes = ["Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.",
+                 *self.validity_notes(), *self.coefficient_notes(names)]
+        signature = f"void {self.name(function)}(const {t} p[3], const {t} a[3], {t} D[9])"
+        return self.entry(function, f"{summary} for a fixed vector a", signature, statements, notes)
+
+    def angular_acceleration(self) -> dict[str, Any]:
+        t = self.ctype
+        statements: list[Statement] = [*self.prologue(), {"kind": "if", "condition": self.out_of_range(),
+                                                          "then": self.nan_out("alpha", 3), "otherwise": []}]
+        body, scalars, names = self.scalars("H", 1, {*VALUES, *rate_vector()})
+        statements += body
+        given = tuple(sp.Symbol(f"pddot[{i}]", real=True) for i in range(3))
+        w = tuple(sp.Symbol(f"w{i}", real=True) for i in range(3))
+        cross, first = vector_entries(scalars[VALUES[0]], scalars[VALUES[1]], scalars[VALUES[2]], given, w)
+        rate = rate_value(sp.Matrix(P), _vector("pdot"), scalars)
+        statements += [self.let(f"w{i}", cross[i]) for i in range(3)]
+        replacements, entries = sp.cse([first[i] + rate[i] for i in range(3)],
+                                       symbols=sp.numbered_symbols("dw"))
+        statements += [self.let(str(symbol), value) for symbol, value in replacements]
+        statements += [self.set(f"alpha[{i}]", entry) for i, entry in enumerate(entries)]
+        notes = ["alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).",
+                 *self.validity_notes(), *self.coefficient_notes(names)]
+        signature = (f"void {self.name('angular_acceleration')}(const {t} p[3], const {t} pdot[3], "
+                     f"const {t} pddot[3], {t} alpha[3])")
+        return self.entry("angular_acceleration", "angular acceleration", signature, statements, notes)
+
+    def compose_jacobians(self) -> dict[str, Any]:
+        t = self.ctype
+        statements: list[Statement] = [
+            {"kind": "declare", "type": t, "names": ["p3[3]", "Hinv3[9]", "R2[9]", "H1[9]", "H2[9]", "M[9]"]},
+            {"kind": "let", "type": "int", "name": "status", "value": f"{self.name('compose')}(p1, p2, p3)"},
+            {"kind": "if", "condition": "status != 0",
+             "then": [*self.nan_out("J1", 9)[:-1], *self.nan_out("J2", 9, "1")], "otherwise": []},
+            {"kind": "call", "value": f"{self.name('tangent_inverse')}(p3, Hinv3)"},
+            {"kind": "call", "value": f"{self.name('rotation_matrix')}(p2, R2)"},
+            {"kind": "call", "value": f"{self.name('tangent')}(p1, H1)"},
+            {"kind": "call", "value": f"{self.name('tangent')}(p2, H2)"},
+        ]
+        statements += [self.set(f"M[{3 * i + j}]", _product("R2", "H1", i, j), 5)
+                       for i in range(3) for j in range(3)]
+        statements += [self.set(f"J1[{3 * i + j}]", _product("Hinv3", "M", i, j), 5)
+                       for i in range(3) for j in range(3)]
+        statements += [self.set(f"J2[{3 * i + j}]", _product("Hinv3", "H2", i, j), 5)
+                       for i in range(3) for j in range(3)]
+        statements.append({"kind": "return", "value": "0"})
+        notes = ["J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) "
+                 "for p3 = compose(p1, p2)",
+                 "(R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status",
+                 "(1: J1, J2 NaN)."]
+        signature = (f"int {self.name('compose_jacobians')}(const {t} p1[3], const {t} p2[3], {t} J1[9], "
+                     f"{t} J2[9])")
+        return self.entry("compose_jacobians", "Jacobians of compose", signature, statements, notes)
+
+    def rescale_jacobian(self) -> dict[str, Any]:
+        t = self.ctype
+        identity = [self.set(f"J[{i}]", "1" if i % 4 == 0 else "0") for i in range(9)]
+        statements: list[Statement] = [
+            {"kind": "declare", "type": t, "names": ["e[4]", "q[3]", "Hinv[9]", "H[9]"]},
+            {"kind": "call", "value": f"{self.name('to_quaternion')}(p, e)"},
+            {"kind": "if", "condition": "isnan(e[0])", "then": self.nan_out("J", 9, "1"), "otherwise": []},
+            {"kind": "if", "condition": "e[0] >= 0", "then": [*identity, {"kind": "return", "value": "0"}],
+             "otherwise": []},
+            {"kind": "if", "condition": f"{self.name('rescale')}(p, q) != 0",
+             "then": self.nan_out("J", 9, "1"),
+             "otherwise": []},
+            {"kind": "call", "value": f"{self.name('tangent_inverse')}(q, Hinv)"},
+            {"kind": "call", "value": f"{self.name('tangent')}(p, H)"},
+        ]
+        statements += [self.set(f"J[{3 * i + j}]", _product("Hinv", "H", i, j), 5)
+                       for i in range(3) for j in range(3)]
+        statements.append({"kind": "return", "value": "0"})
+        notes = ["J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) "
+                 "(the same rotation),",
+                 "the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range."]
+        signature = f"int {self.name('rescale_jacobian')}(const {t} p[3], {t} J[9])"
+        return self.entry("rescale_jacobian", "Jacobian of rescale", signature, statements, notes)
+
+    def all(self) -> list[dict[str, Any]]:
+        """After the operations of the header (they call compose, rescale, to_quaternion)."""
+        return [*(self.derivative(f) for f in DERIVATIVES), self.angular_acceleration(),
+                self.compose_jacobians(), self.rescale_jacobian()]
