@@ -48,3 +48,20 @@ def test_a_pole_where_p_grows_exponentially_ends_the_domain_instead_of_failing()
     plan = evaluation_plan(derive("4*atanh(phi/4)").derivation, "atanh_user")
     for precision in plan.precisions.values():
         assert 2.0**32 <= precision.x_limit <= 2.0**600
+
+
+def test_a_p_too_small_for_a_format_is_refused_before_any_planning() -> None:
+    """'1e-20*phi' --emit c took 34 s to fail on its first float32 coefficient (issue 17): the
+    scale check refuses it at once, naming the format and the coefficient that overflows."""
+    import time
+
+    import pytest
+
+    from symrot.errors import SymrotError
+
+    derivation = derive("1e-20*phi").derivation
+    started = time.process_time()
+    with pytest.raises(SymrotError, match=r"no representable plan: .* too small in scale for float32"):
+        evaluation_plan(derivation, "tiny")
+    assert time.process_time() - started < 1.0
+    assert evaluation_plan(derive("1e-8*phi").derivation, "small").precisions["float32"] is not None
