@@ -120,7 +120,7 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
     """φ(s) with p(φ) = s, when SymPy finds a closed form that starts as s/κ."""
     if p == PHI:
         return S
-    if p.has(RealCbrt):
+    if p.has(RealCbrt) or not _solvable_shape(p):
         return None
     try:
         solutions: list[sp.Expr] = bounded(10, [], sp.solve, sp.Eq(p, S), PHI)
@@ -134,6 +134,21 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
         if value.is_real and abs(value - probe / kappa) < sp.Rational(1, 10**6):
             return sp.simplify(candidate) if len(str(candidate)) < 80 else candidate
     return None
+
+
+def _solvable_shape(p: sp.Expr) -> bool:
+    """Whether ``sp.solve(p = s)`` is attempted: p algebraic in φ, or one function application
+    f(…) with φ nowhere else (asinh(2φ)/2, atan(sin φ), log((1 + φ/2)/(1 − φ/2))). Sums and
+    products of several transcendental terms (sin φ cos φ, sinh φ cosh φ, φ cos(φ/4)) give
+    equations SymPy either cannot solve or spends its whole time bound on: the bound decided
+    whether sin φ cos φ got a closed inverse on a given machine. A shape, not a time: reproducible."""
+    outermost = [call for call in p.atoms(sp.Function) if call.has(PHI)
+                 and not any(other != call and other.has(call) for other in p.atoms(sp.Function))]
+    if not outermost:
+        return True
+    if len(outermost) > 1:
+        return False
+    return not p.xreplace({outermost[0]: sp.Dummy()}).has(PHI)
 
 
 def closed_angle_error(inverse: sp.Expr, p: sp.Expr, phi_max: float, dtype: type) -> float:
