@@ -249,13 +249,17 @@ def emit(expression: str, name: str) -> tuple[Any, str, float]:
 def worker(index: int, points: int, with_c: bool) -> dict[str, Any]:
     """Measure corpus entry ``index``; a JSON-ready result (emit failures included)."""
     entry = CORPUS[index]
-    name = f"corpus_{index:02d}"
     result: dict[str, Any] = {"index": index, "expression": entry.expression, "category": entry.category,
                               "edge": entry.edge, "closed_inverse": entry.closed_inverse}
-    function = entry.generating_function()
+    return measure_expression(entry.generating_function(), f"corpus_{index:02d}", points, with_c, result)
+
+
+def measure_expression(function: GeneratingFunction, name: str, points: int, with_c: bool,
+                       result: dict[str, Any]) -> dict[str, Any]:
+    """Emit ``function`` as module ``name``, measure it; ``result`` completed, JSON-ready."""
     result["phi_max_reference"] = float(function.phi_max)
     try:
-        plan, _source, seconds = emit(entry.expression, name)
+        plan, _source, seconds = emit(function.expression, name)
     except Exception as error:  # any exception of the emit is the measurement
         result["emit_error"] = f"{type(error).__name__}: {str(error).splitlines()[0][:300]}"
         result["traceback"] = traceback.format_exc()[-2000:]

@@ -38,6 +38,10 @@ CHECK_POINTS = 48
 UNBOUNDED_TOP = 1e40
 """Largest x checked when p is unbounded (p → ∞ at φ_max): |φ_max − φ| down to ~1e-18 for m tan(φ/m)."""
 INVERSE_FUNCTIONS = (sp.asin, sp.atan, sp.acos)
+REDUCTION_OPS = 300
+"""Largest expansion (:func:`reduction_size`) that :func:`reduce_to_x` simplifies: the tangent
+family's H⁻¹ coefficients expand to 200–300 operations and simplify in under a second; the raw
+H⁻¹₂ of 5 tan(φ/5) expands to 478 and takes 3–14 s (and failed its accuracy check anyway)."""
 
 
 def base_angle(inverse: sp.Expr) -> tuple[sp.Expr, sp.Expr] | None:
@@ -63,8 +67,10 @@ def tidy_radicals(expr: sp.Expr) -> sp.Expr:
     return sp.factor(combined)
 
 
-def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
-    """c(φ(√x)) with trigonometry removed, or None (time-bounded).
+@lru_cache(maxsize=1024)
+def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
+    """c(φ(s)) with multiple and half angles of the base angle expanded, before simplification;
+    None when no reduction is attempted.
 
     Only an inverse built on an inverse trigonometric function can make sin/cos of φ algebraic in
     s (asinh, atanh, Cardano's radicals, the identity φ = s cannot): for those, no time is spent."""
@@ -72,18 +78,40 @@ def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     if base is None and not inverse.has(*INVERSE_FUNCTIONS):
         return None
 
-    def reduce() -> sp.Expr:
+    def expand() -> sp.Expr:
         if base is None:
-            e = sp.expand_trig(closed.subs(PHI, inverse))
-        else:
-            factor, function = base
-            # φ = factor·θ; write θ = 2η so that half angles of θ are whole angles of η
-            eta = sp.Symbol("eta", positive=True)
-            e = sp.expand_trig(closed.subs(PHI, 2 * factor * eta))
-            e = _half_angle_radicals(e.subs(eta, THETA / 2), THETA / 2)
-            e = sp.expand_trig(e).subs(THETA, function)
-        e = sp.simplify(e)
-        return tidy_radicals(e.subs(S, sp.sqrt(X)))
+            return sp.expand_trig(closed.subs(PHI, inverse))
+        factor, function = base
+        # φ = factor·θ; write θ = 2η so that half angles of θ are whole angles of η
+        eta = sp.Symbol("eta", positive=True)
+        e = sp.expand_trig(closed.subs(PHI, 2 * factor * eta))
+        e = _half_angle_radicals(e.subs(eta, THETA / 2), THETA / 2)
+        return sp.expand_trig(e).subs(THETA, function)
+
+    expanded: sp.Expr | None = bounded(2, None, expand)
+    return expanded
+
+
+@lru_cache(maxsize=1024)
+def reduction_size(closed: sp.Expr, inverse: sp.Expr) -> int:
+    """The work of reducing ``closed`` to x: the operation count of :func:`expanded_in_s` (0 when
+    no reduction is attempted). Deterministic, unlike the time the simplification takes."""
+    expanded = expanded_in_s(closed, inverse)
+    return 0 if expanded is None else int(sp.count_ops(expanded))
+
+
+def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
+    """c(φ(√x)) with trigonometry removed, or None.
+
+    Which inputs are simplified is decided by size, not by time (reproducibility): an expansion
+    of more than ``REDUCTION_OPS`` operations is not attempted; the time bound on the rest is
+    only a safety net (:mod:`symrot.timeouts`)."""
+    expanded = expanded_in_s(closed, inverse)
+    if expanded is None or reduction_size(closed, inverse) > REDUCTION_OPS:
+        return None
+
+    def reduce() -> sp.Expr:
+        return tidy_radicals(sp.simplify(expanded).subs(S, sp.sqrt(X)))
 
     reduced: sp.Expr | None = bounded(6, None, reduce)
     if reduced is None or reduced.free_symbols - {X}:

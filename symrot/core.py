@@ -16,6 +16,7 @@ audit). Scalars: p′, ν (15), ε (16), μ (21), det H (24) = μ ν².
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import mpmath
 import sympy as sp
@@ -246,7 +247,16 @@ def derive_function(function: ValidatedFunction) -> Derivation:
 
 
 def derive_expression(expr: sp.Expr, normalize: bool = False) -> Derivation:
-    """Validate ``expr`` as p(φ) and derive everything; ``normalize`` divides p by κ."""
+    """Validate ``expr`` as p(φ) and derive everything; ``normalize`` divides p by κ.
+
+    Cached: the API, the plan, the C and NumPy emitters and the figures derive the same p many
+    times in one process (``make generate``); a Derivation is only ever extended by its own
+    caches (series), never changed."""
+    return _derive_cached(expr, normalize)
+
+
+@lru_cache(maxsize=128)
+def _derive_cached(expr: sp.Expr, normalize: bool) -> Derivation:
     with stage("validation"):
         function = validate(expr)
         if normalize and function.kappa != 1:

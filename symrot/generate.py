@@ -18,6 +18,7 @@ from pathlib import Path
 from . import strict_json
 from .api import derive
 from .registry import NAMED
+from .timeouts import deterministic
 
 Producer = Callable[[], dict[str, str | bytes]]
 Content = str | bytes
@@ -72,38 +73,39 @@ def figures() -> dict[str, str | bytes]:
     return {f"figures/figure{n}.{fmt}": render_figure(n, fmt) for n in FIGURES for fmt in ("pdf", "png")}
 
 
-def numpy_modules() -> dict[str, str | bytes]:
-    """generated/numpy/NAME.py: the NumPy kernels of every named parameterization."""
+def numpy_modules(names: Iterable[str] | None = None) -> dict[str, str | bytes]:
+    """generated/numpy/NAME.py: the NumPy kernels of every named parameterization (or ``names``)."""
     from .backends.numpy_backend import module_source
     from .plan import evaluation_plan
 
     return {f"numpy/{name}.py": module_source(evaluation_plan(derive(name).derivation, name))
-            for name in NAMED}
+            for name in (NAMED if names is None else names)}
 
 
-def _array_modules(framework: str) -> dict[str, str | bytes]:
+def _array_modules(framework: str, names: Iterable[str] | None = None) -> dict[str, str | bytes]:
     from .backends.array_backend import module_source
     from .plan import evaluation_plan
 
     return {f"{framework}/{name}.py": module_source(evaluation_plan(derive(name).derivation, name), framework)
-            for name in NAMED}
+            for name in (NAMED if names is None else names)}
 
 
-def jax_modules() -> dict[str, str | bytes]:
+def jax_modules(names: Iterable[str] | None = None) -> dict[str, str | bytes]:
     """generated/jax/NAME.py: the JAX kernels of every named parameterization."""
-    return _array_modules("jax")
+    return _array_modules("jax", names)
 
 
-def torch_modules() -> dict[str, str | bytes]:
+def torch_modules(names: Iterable[str] | None = None) -> dict[str, str | bytes]:
     """generated/torch/NAME.py: the PyTorch kernels of every named parameterization."""
-    return _array_modules("torch")
+    return _array_modules("torch", names)
 
 
-def c_headers() -> dict[str, str | bytes]:
-    """generated/c/symrot_NAME.h: the C99 headers (Table 1, eq 35, sine/tangent m <= 6)."""
+def c_headers(names: Iterable[str] | None = None) -> dict[str, str | bytes]:
+    """generated/c/symrot_NAME.h: the C99 headers (Table 1, eq 35, sine/tangent m <= 6), or those
+    of ``names``."""
     from .backends.c_backend import generated_headers
 
-    return dict(generated_headers())
+    return dict(generated_headers(None if names is None else tuple(names)))
 
 
 def producers() -> list[tuple[str, Producer]]:
@@ -114,14 +116,73 @@ def producers() -> list[tuple[str, Producer]]:
             ("jax/", jax_modules), ("torch/", torch_modules)]
 
 
-def render(only: str | None = None) -> dict[str, Content]:
+PER_NAME = ("numpy/", "c/", "jax/", "torch/")
+"""Producers that are split into one task per parameterization when ``render`` runs in parallel
+(a name's NumPy, JAX and PyTorch modules and C header share one task, so its plan is computed once)."""
+
+
+def _tasks(selected: list[str]) -> list[tuple[str, ...]]:
+    """Independent units of work: ("names", name) for the per-name producers, longest first (the
+    tangent and sine families of the C headers), then (prefix,) for every other producer."""
+    from .backends.c_backend import COVERED
+
+    names = [*COVERED] if "c/" in selected else []
+    array_prefixes = ("numpy/", "jax/", "torch/")
+    names += [name for name in NAMED if any(prefix in selected for prefix in array_prefixes) and name not in names]
+    tasks: list[tuple[str, ...]] = [("names", name) for name in reversed(names)]
+    return tasks + [(prefix,) for prefix in selected if prefix not in PER_NAME]
+
+
+def _run_task(task: tuple[str, ...], selected: tuple[str, ...]) -> dict[str, Content]:
+    with deterministic():  # no result of a bounded step may depend on this machine's speed or load
+        if task[0] != "names":
+            return dict(producers())[task[0]]()
+        from .backends.c_backend import COVERED
+
+        name = task[1]
+        out: dict[str, Content] = {}
+        if "numpy/" in selected and name in NAMED:
+            out.update(numpy_modules([name]))
+        if "jax/" in selected and name in NAMED:
+            out.update(jax_modules([name]))
+        if "torch/" in selected and name in NAMED:
+            out.update(torch_modules([name]))
+        if "c/" in selected and name in COVERED:
+            out.update(c_headers([name]))
+        return out
+
+
+def render(only: str | None = None, jobs: int = 1) -> dict[str, Content]:
+    """Every selected file; with ``jobs`` > 1 the work runs in that many forked processes (the
+    result does not depend on how it is split: every task is deterministic)."""
     from .cli.progress import each
 
     files: dict[str, Content] = {}
-    selected = [(prefix, producer) for prefix, producer in producers() if not only or prefix.startswith(only)]
-    for _prefix, producer in each(selected, "symrot.generate"):
-        files.update(producer())
+    selected = [prefix for prefix, _ in producers() if not only or prefix.startswith(only)]
+    tasks = _tasks(selected)
+    if jobs <= 1:
+        for task in each(tasks, "symrot.generate"):
+            files.update(_run_task(task, tuple(selected)))
+        return dict(sorted(files.items()))
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+        futures = [pool.submit(_run_task, task, tuple(selected)) for task in tasks]
+        for future in each(as_completed(futures), "symrot.generate", total=len(futures)):
+            files.update(future.result())
     return dict(sorted(files.items()))
+
+
+def default_jobs() -> int:
+    """Processes for ``render``: the CPUs this process may use, at most 4."""
+    import os
+
+    try:
+        available = len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        available = os.cpu_count() or 1
+    return max(1, min(available, 4))
 
 
 def owned(root: Path, prefixes: Iterable[str]) -> set[str]:
@@ -175,13 +236,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--check", action="store_true", help="compare instead of writing")
     parser.add_argument("--only", help="only producers whose prefix starts with this")
     parser.add_argument("--list", action="store_true", help="list producer prefixes")
+    parser.add_argument("--jobs", type=int, default=None,
+                        help="worker processes (default: the CPUs available, at most 4; 1: none)")
     args = parser.parse_args(argv)
     prefixes = [prefix for prefix, _ in producers() if not args.only or prefix.startswith(args.only)]
     if args.list:
         print("\n".join(prefixes))
         return 0
     root = Path(args.directory)
-    files = render(args.only)
+    files = render(args.only, args.jobs if args.jobs is not None else default_jobs())
     if args.check:
         diffs = check(root, files, prefixes)
         if diffs:

@@ -37,6 +37,9 @@ PHI = sp.Symbol("phi", real=True)
 
 MAX_LENGTH = 400
 MAX_DEPTH = 32
+MAX_FUNCTION_NESTING = 4
+"""Functions applied to functions: tan nested 31 times ran into the 60 s budget in the series
+engine and the validity analysis, and 5 levels still do (> 20 s CPU); the corpus needs 2."""
 MAX_NODES = 160
 MAX_LITERAL_DIGITS = 30
 MAX_EXPONENT = 64
@@ -178,6 +181,8 @@ class _Builder:
     def __init__(self, source: str, extra_names: dict[str, sp.Expr]) -> None:
         self.source = source
         self.extra_names = extra_names
+        self.calls = 0
+        """Function calls enclosing the node being built."""
 
     def build(self, node: ast.AST, depth: int) -> tuple[sp.Expr, Size]:
         """The SymPy expression of ``node`` and its expanded :class:`Size` (checked)."""
@@ -278,7 +283,12 @@ class _Builder:
                              f"(allowed: {allowed})")
         if node.keywords or len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
             raise ParseError(f"function '{name}' takes exactly one argument")
+        self.calls += 1
+        if self.calls > MAX_FUNCTION_NESTING:
+            raise ParseError(f"functions are nested more than {MAX_FUNCTION_NESTING} deep "
+                             f"(e.g. {name}({name}(...))): their derivation would not end within a budget")
         argument, size = self.build(node.args[0], depth + 1)
+        self.calls -= 1
         if name in _ROOTS:  # a power in SymPy: numbers and polynomials inside keep their size
             return FUNCTIONS[name](argument), size.power(_ROOTS[name]).check()
         return FUNCTIONS[name](argument), _ATOM

@@ -26,7 +26,6 @@ arguments (sin a and cos a: one sincos).
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import replace
 from functools import lru_cache
 
@@ -36,12 +35,14 @@ import sympy as sp
 
 from .algebraic import (
     D,
+    REDUCTION_OPS,
     S,
     algebraic_in_x,
     angle_with_complement,
     closed_with_base_angle,
     closed_with_complement,
     fold_complement,
+    reduction_size,
     with_complement,
 )
 from .algebraic import X as X  # re-exported: the symbol of the coefficients' variable x = |p|²
@@ -85,7 +86,10 @@ GRID_POINTS = 56
 EDGE_POINTS = 12
 JITTER = 0.0137
 JITTER_SAMPLES = 6
-ALGEBRAIC_BUDGET_SECONDS = 20.0
+ALGEBRAIC_WORK = 4000
+"""Total expansion size (:func:`symrot.algebraic.reduction_size`, operations) the algebraic search
+of one plan may simplify; past it, coefficients get branches. A count, not a time: the plan is
+the same on every machine and under any load."""
 PRECISIONS: dict[str, type[np.floating]] = {"float64": np.float64, "float32": np.float32}
 CLOSED_TOLERANCE_ULP = 1.5
 ANGLE_TOLERANCE_ULP = 2.0
@@ -118,7 +122,7 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
     """φ(s) with p(φ) = s, when SymPy finds a closed form that starts as s/κ."""
     if p == PHI:
         return S
-    if p.has(RealCbrt):
+    if p.has(RealCbrt) or not _solvable_shape(p):
         return None
     try:
         solutions: list[sp.Expr] = bounded(10, [], sp.solve, sp.Eq(p, S), PHI)
@@ -132,6 +136,21 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
         if value.is_real and abs(value - probe / kappa) < sp.Rational(1, 10**6):
             return sp.simplify(candidate) if len(str(candidate)) < 80 else candidate
     return None
+
+
+def _solvable_shape(p: sp.Expr) -> bool:
+    """Whether ``sp.solve(p = s)`` is attempted: p algebraic in φ, or one function application
+    f(…) with φ nowhere else (asinh(2φ)/2, atan(sin φ), log((1 + φ/2)/(1 − φ/2))). Sums and
+    products of several transcendental terms (sin φ cos φ, sinh φ cosh φ, φ cos(φ/4)) give
+    equations SymPy either cannot solve or spends its whole time bound on: the bound decided
+    whether sin φ cos φ got a closed inverse on a given machine. A shape, not a time: reproducible."""
+    outermost = [call for call in p.atoms(sp.Function) if call.has(PHI)
+                 and not any(other != call and other.has(call) for other in p.atoms(sp.Function))]
+    if not outermost:
+        return True
+    if len(outermost) > 1:
+        return False
+    return not p.xreplace({outermost[0]: sp.Dummy()}).has(PHI)
 
 
 def closed_angle_error(inverse: sp.Expr, p: sp.Expr, phi_max: float, dtype: type) -> float:
@@ -298,15 +317,17 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     from .singularities import validity
 
     derivation = derive_expression(p)
+    _check_scale(derivation)
     limits = validity(derivation)
     phi_max = float(limits.phi_max_float) if np.isfinite(limits.phi_max_float) else 4 * float(np.pi)
     inverse = closed_inverse(p, derivation.kappa)
     x_of_phi = p ** 2
     p_max = float(limits.p_max_float)
     complement = fold_complement(inverse, p_max)
-    # the algebraic search of one plan is capped (a few seconds for every named parameterization;
-    # expressions whose forms never simplify would otherwise spend minutes): past it, branches
-    algebraic_deadline = time.monotonic() + ALGEBRAIC_BUDGET_SECONDS
+    # the algebraic search of one plan is capped by the size of what it simplifies (a few seconds
+    # for every named parameterization; expressions whose forms never simplify would otherwise
+    # spend minutes): past ALGEBRAIC_WORK, coefficients get branches
+    algebraic_work = 0
     algebraic_forms: dict[str, sp.Expr | None] = {}
     precisions = {}
     for label, dtype in PRECISIONS.items():
@@ -323,9 +344,13 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                 if coefficient not in algebraic_forms:  # the first precision searches, both use it
                     simplest_form = derivation.simplified_form(coefficient)
                     found = None
-                    if time.monotonic() < algebraic_deadline:
-                        found = (algebraic_in_x(simplest_form, inverse, p_max)
-                                 or algebraic_in_x(closed, inverse, p_max))
+                    for form in dict.fromkeys((simplest_form, closed)):
+                        size = reduction_size(form, inverse)
+                        if (found is not None or size > REDUCTION_OPS
+                                or algebraic_work + size > ALGEBRAIC_WORK):
+                            continue
+                        algebraic_work += size
+                        found = algebraic_in_x(form, inverse, p_max)
                     algebraic_forms[coefficient] = found
                 algebraic = algebraic_forms[coefficient]
                 if algebraic is not None:
@@ -366,6 +391,23 @@ def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coeff
         return Algebraic(sp.diff(parent.expression, X) - sp.diff(parent.expression, D))
     series = derivation.series_in_x(name, MAX_TERMS)
     return plan_branch(derivation.simplified_form(name), series, derivation.p ** 2, phi_max, dtype)
+
+
+def _check_scale(derivation: Derivation) -> None:
+    """Refuse at once a p whose scale no format can hold: the coefficient of (p×)² in R at p = 0 is
+    1/(2κ²) (eq 16), so κ = 1e-20 overflows float32 (any plan would fail, after a minute of
+    planning, on the first coefficient; issue 17)."""
+    kappa = mpmath.mpf(float(abs(derivation.kappa))) if derivation.kappa.is_number else None
+    if kappa is None or kappa == 0:
+        return
+    needed = 1 / (2 * kappa**2)
+    for label, dtype in PRECISIONS.items():
+        largest = float(np.finfo(dtype).max)
+        if needed > largest:
+            raise SymrotError(f"no representable plan: p = {sp.sstr(derivation.p)[:60]} is too small "
+                              f"in scale for {label} (kappa = {float(kappa):.3g}: 1/(2 kappa^2) = "
+                              f"{float(needed):.3g}, the (p x)^2 coefficient of R at p = 0, exceeds "
+                              f"{largest:.3g}); --normalize divides p by kappa")
 
 
 def _domain_limit(derivation: Derivation, coefficients: dict[str, Coefficient],
@@ -418,11 +460,20 @@ def _quaternion_scalar(derivation: Derivation, inverse: sp.Expr | None, phi_max:
 
 def _quaternion_scale(p: sp.Expr, phi_top: float, dtype: type) -> QuaternionScale:
     """σ = p(φ)/sin(φ/2) on 0 ≤ φ ≤ min(φ_max, π): trig-free in e₀ if possible, else a Branch in φ²."""
-    algebraic = scale_in_e0(p)
+    algebraic, closed = _scale_forms(p)
     if algebraic is not None:
         return QuaternionScale(algebraic, None)
-    closed = sp.simplify(scale_expression(p)) if not p.has(RealCbrt) else scale_expression(p)
     return QuaternionScale(None, plan_branch(closed, scale_series(p, MAX_TERMS), PHI ** 2, phi_top, dtype))
+
+
+@lru_cache(maxsize=64)
+def _scale_forms(p: sp.Expr) -> tuple[sp.Expr | None, sp.Expr]:
+    """(σ algebraic in e₀ or None, σ simplified in φ): the symbolic work of
+    :func:`_quaternion_scale`, the same for both precisions."""
+    algebraic = scale_in_e0(p)
+    if algebraic is not None:
+        return algebraic, scale_expression(p)
+    return None, (sp.simplify(scale_expression(p)) if not p.has(RealCbrt) else scale_expression(p))
 
 
 def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: type) -> NewtonAngle:
@@ -435,8 +486,12 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
                         phi_max, dtype)
     reverted = derivation.phi_of_p(2 * START_TERMS)
     start = tuple(reverted[1::2][:START_TERMS])
-    far = far_start(p, p_max, phi_max, start)
+    far = _far_start(p, p_max, phi_max, start)
     return NewtonAngle(start, ratio, slope, NEWTON_ITERATIONS, phi_max, far)
+
+
+_far_start = lru_cache(maxsize=64)(far_start)
+"""The far start does not depend on the precision: both plans share one fit."""
 
 
 def evaluation_plan(derivation: Derivation, name: str) -> EvaluationPlan:

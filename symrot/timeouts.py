@@ -6,6 +6,14 @@ enforced and :func:`time_limit` runs the body unbounded (documented, never silen
 
 Limits nest: an inner limit never extends an outer one, and each limit's :class:`SymrotTimeout`
 carries a marker so that :func:`bounded` absorbs only its own expiry, never an outer one.
+
+A fallback taken because a step ran out of *time* makes the result depend on the machine's speed
+and load. Steps whose result feeds code generation are therefore gated by deterministic size caps
+(operation counts, see :mod:`symrot.simplify` and :mod:`symrot.algebraic`) that decide which
+inputs are attempted at all, and their time bound is only a safety net. Under
+:func:`deterministic` (``make generate``) the safety net is ``SAFETY_FACTOR`` times wider and its
+expiry is an error, never a silent fallback: ``generated/`` is the same on every machine or its
+generation fails loudly.
 """
 
 from __future__ import annotations
@@ -20,6 +28,25 @@ from typing import Any, TypeVar
 from .errors import SymrotTimeout
 
 T = TypeVar("T")
+
+SAFETY_FACTOR = 10.0
+"""How much wider the time bounds of :func:`bounded` are under :func:`deterministic`."""
+_deterministic = threading.local()
+
+
+@contextmanager
+def deterministic() -> Iterator[None]:
+    """In the body, :func:`bounded` never falls back because of time (see the module docstring)."""
+    previous = getattr(_deterministic, "on", False)
+    _deterministic.on = True
+    try:
+        yield
+    finally:
+        _deterministic.on = previous
+
+
+def is_deterministic() -> bool:
+    return bool(getattr(_deterministic, "on", False))
 
 
 def _can_use_signals() -> bool:
@@ -70,14 +97,21 @@ def bounded(seconds: float, fallback: T, func: Callable[..., T], *args: Any) -> 
     """Return ``func(*args)`` if it finishes within ``seconds``, else ``fallback``.
 
     Used for optional work such as simplification: a slow simplify never blocks a derivation,
-    while an enclosing limit that expires meanwhile still propagates.
+    while an enclosing limit that expires meanwhile still propagates. Under :func:`deterministic`
+    the bound is ``SAFETY_FACTOR`` times wider and its expiry raises :class:`SymrotTimeout`.
     """
     marker = object()
+    strict = is_deterministic()
     try:
-        with time_limit(seconds, "simplification", marker):
+        with time_limit(seconds * SAFETY_FACTOR if strict else seconds, "simplification", marker):
             return func(*args)
     except SymrotTimeout as exc:
         if getattr(exc, "marker", None) is marker:
+            if strict:
+                name = getattr(func, "__qualname__", repr(func))
+                raise SymrotTimeout(f"{name} ran past its safety bound of {seconds * SAFETY_FACTOR:g} s "
+                                    "in deterministic mode (its result would depend on the machine's "
+                                    "speed)") from None
             return fallback
         raise
     except RecursionError:

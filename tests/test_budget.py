@@ -16,7 +16,8 @@ import pytest
 from symrot import budget
 from symrot.cli import main, run, worker
 
-TOWER = "tan(" * 31 + "phi" + ")" * 31
+TOWER = "tan(" * 4 + "phi" + ")" * 4
+"""The deepest nesting the parser accepts; its derivation takes longer than the 1 s budgets below."""
 
 
 def test_stages_nest_and_are_shared() -> None:
@@ -72,7 +73,30 @@ def test_worker_passes_the_exit_status_and_survives_a_crash(capsys: pytest.Captu
         return 0
 
     assert worker.run(crash, 5) == 2
-    assert "out of memory during derivation" in capsys.readouterr().err
+    assert "out of memory during derivation (killed by SIGKILL" in capsys.readouterr().err
+
+
+def test_worker_names_a_genuine_crash_by_its_signal(capsys: pytest.CaptureFixture[str]) -> None:
+    """A segmentation fault far below the memory limit is a bug (exit 70), not "out of memory"."""
+    def segfault() -> int:
+        with budget.stage("printing"):
+            os.kill(os.getpid(), signal.SIGSEGV)
+        return 0
+
+    assert worker.run(segfault, 5) == 70
+    err = capsys.readouterr().err
+    assert "SIGSEGV" in err and "during printing" in err and "out of memory" not in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_worker_counts_a_crash_at_the_memory_limit_as_memory(capsys: pytest.CaptureFixture[str]) -> None:
+    """The same signal from a worker that had filled its limit: exit 2, memory and signal named."""
+    limit = 4 * 2**30
+    assert worker._report_signal(signal.SIGBUS, 3 * 2**30, limit, "derivation") == 2
+    assert "out of memory during derivation (SIGBUS" in capsys.readouterr().err
+    assert worker._report_signal(signal.SIGBUS, 2**28, limit, "derivation") == 70
+    assert "internal error" in capsys.readouterr().err
+    assert worker._report_signal(signal.SIGTERM, 0, limit, "derivation") == 128 + signal.SIGTERM
 
 
 def test_worker_address_space_limit_turns_a_memory_bomb_into_exit_2() -> None:

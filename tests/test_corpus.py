@@ -42,6 +42,9 @@ CATEGORIES = {"polynomial", "rational", "hyperbolic", "inverse hyperbolic", "inv
 HYPOTHESIS_EXAMPLES = 2
 EMIT_LIMIT = 30.0
 """Seconds an emit may take in these tests (issue 16 asks ≤ 10 s; the machine may be shared)."""
+SAFETY_LIMIT = 600.0
+"""Seconds the hypothesis sample's emits may take: a bound on a hang, never the verdict (its
+slowest function takes ~19 s CPU; issue 16's 10 s target is measured by bench/accuracy_hypothesis.py)."""
 POINTS = 4
 """Log-spaced angles of the sweep in the tests (bench/accuracy_corpus.py runs 8 or more)."""
 
@@ -193,9 +196,10 @@ SAMPLE: dict[str, str | None] = {
 }
 
 
-def measure(function: GeneratingFunction, name: str) -> dict[str, list[dict[str, Any]]]:
+def measure(function: GeneratingFunction, name: str,
+            limit: float = EMIT_LIMIT) -> dict[str, list[dict[str, Any]]]:
     """{precision: tallies} of the emitted NumPy module over the sweep with POINTS angles."""
-    with time_limit(EMIT_LIMIT, "emit"):
+    with time_limit(limit, "emit"):
         plan, _source, _seconds = emit(function.expression, name)
     with tempfile.TemporaryDirectory() as tmp:
         module = load_module(plan, Path(tmp))
@@ -231,11 +235,14 @@ def test_corpus_sample_meets_the_target(expression: str) -> None:
     assert not misses(results), misses(results)
 
 
-@pytest.mark.xfail(strict=True, reason="measured: the 2nd derandomized function, "
-                   "18*sin(phi/2)*cosh(phi/2)/41 + 12*cosh(phi/4)*atanh(2*phi/3)/41 + "
-                   "12*cosh(3*phi/2)*asin(2*phi)/41, takes > 30 s to emit")
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="measured: the 2nd derandomized function (the 1st is phi), "
+                   "3*cosh(2*phi)*atanh(phi/3), misses near the pole of atanh at phi = 3: float64 "
+                   "rotation_matrix 9.4e16 ulp, tangent_inverse 4.6e15 ulp at phi = 3")
 def test_hypothesis_sample_meets_the_target() -> None:
-    """A few derandomized functions of the grammar, each emitted and measured."""
+    """A few derandomized functions of the grammar, each emitted and measured. The verdict is the
+    measured accuracy only: the emit's time limit (SAFETY_LIMIT) is far above what the functions
+    take, so a loaded machine cannot flip the outcome (the plan itself is deterministic)."""
     found: list[str] = []
 
     @settings(derandomize=True, max_examples=HYPOTHESIS_EXAMPLES, deadline=None, database=None,
@@ -243,7 +250,7 @@ def test_hypothesis_sample_meets_the_target() -> None:
     @given(generating_functions())
     def check(function: GeneratingFunction) -> None:
         try:
-            missed = misses(measure(function, "generated"))
+            missed = misses(measure(function, "generated", SAFETY_LIMIT))
         except Exception as error:  # an emit that raises is a miss like any other
             missed = [f"emit: {type(error).__name__}: {str(error)[:120]}"]
         if missed:

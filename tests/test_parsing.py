@@ -156,3 +156,22 @@ def test_real_cube_root_in_mpmath_evaluation() -> None:
     f = sp.lambdify(PHI, RealCbrt(PHI), modules=[mpmath_namespace(), "mpmath"])
     assert f(mpmath.mpf(-8)) == -2
     assert abs(sp.N(RealCbrt(PHI).subs(PHI, sp.Float(-27)), 30) + 3) < 1e-25
+
+
+def test_functions_nested_beyond_the_cap_are_refused_at_once() -> None:
+    """tan nested 31 times ran until the 60 s budget (issue 17); past MAX_FUNCTION_NESTING the
+    parser refuses it in one line, while the deepest accepted nesting still parses."""
+    import time
+
+    from symrot.parsing import MAX_FUNCTION_NESTING
+
+    deepest = "tan(" * MAX_FUNCTION_NESTING + "phi" + ")" * MAX_FUNCTION_NESTING
+    assert parse_expression(deepest).has(PHI)
+    started = time.monotonic()
+    for depth in (MAX_FUNCTION_NESTING + 1, 31):
+        with pytest.raises(ParseError, match=f"nested more than {MAX_FUNCTION_NESTING} deep"):
+            parse_expression("tan(" * depth + "phi" + ")" * depth)
+    with pytest.raises(ParseError, match="nested more than"):  # through other operators too
+        depth = MAX_FUNCTION_NESTING
+        parse_expression("2*sin(" + "1 + tan(" * depth + "phi" + ")" * depth + ")")
+    assert time.monotonic() - started < 1

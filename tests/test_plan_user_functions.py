@@ -48,3 +48,35 @@ def test_a_pole_where_p_grows_exponentially_ends_the_domain_instead_of_failing()
     plan = evaluation_plan(derive("4*atanh(phi/4)").derivation, "atanh_user")
     for precision in plan.precisions.values():
         assert 2.0**32 <= precision.x_limit <= 2.0**600
+
+
+def test_a_p_too_small_for_a_format_is_refused_before_any_planning() -> None:
+    """'1e-20*phi' --emit c took 34 s to fail on its first float32 coefficient (issue 17): the
+    scale check refuses it at once, naming the format and the coefficient that overflows."""
+    import time
+
+    import pytest
+
+    from symrot.errors import SymrotError
+
+    derivation = derive("1e-20*phi").derivation
+    started = time.process_time()
+    with pytest.raises(SymrotError, match=r"no representable plan: .* too small in scale for float32"):
+        evaluation_plan(derivation, "tiny")
+    assert time.process_time() - started < 1.0
+    assert evaluation_plan(derive("1e-8*phi").derivation, "small").precisions["float32"] is not None
+
+
+def test_which_equations_are_solved_is_decided_by_shape_not_by_time() -> None:
+    """sp.solve ran into its 10 s bound on sin(phi)*cos(phi): the closed inverse depended on the
+    machine's speed. Several transcendental terms are not solved at all; one function of an
+    algebraic argument is."""
+    import time
+
+    started = time.process_time()
+    assert closed_inverse(sp.sin(PHI) * sp.cos(PHI), sp.Integer(1)) is None
+    assert closed_inverse(sp.sinh(PHI) * sp.cosh(PHI), sp.Integer(1)) is None
+    assert time.process_time() - started < 0.5
+    s = sp.Symbol("s", nonnegative=True)
+    assert closed_inverse(sp.asinh(2 * PHI) / 2, sp.Integer(1)) == sp.sinh(2 * s) / 2
+    assert closed_inverse(PHI + PHI**3 / 6, sp.Integer(1)) is not None  # Cardano

@@ -38,3 +38,18 @@ def test_outer_limit_is_rearmed_after_an_inner_one() -> None:
     with pytest.raises(SymrotTimeout, match="outer"), time_limit(0.3, "outer"):
         assert bounded(0.05, "fallback", spin, 1) == "fallback"
         spin(2)
+
+
+def test_deterministic_mode_turns_a_time_fallback_into_an_error() -> None:
+    """Under deterministic() (make generate) a bounded step never silently falls back because the
+    machine was slow: it gets SAFETY_FACTOR more time, and an expiry is an error."""
+    from symrot.timeouts import SAFETY_FACTOR, deterministic, is_deterministic
+
+    assert not is_deterministic()
+    with deterministic():
+        assert is_deterministic()
+        assert bounded(0.02, "fallback", spin, 0.05) == "finished"  # within 0.02 * SAFETY_FACTOR
+        with pytest.raises(SymrotTimeout, match="deterministic mode"):
+            bounded(0.01, "fallback", spin, 0.01 * SAFETY_FACTOR + 0.5)
+    assert not is_deterministic()
+    assert bounded(0.02, "fallback", spin, 0.05) == "fallback"

@@ -97,10 +97,11 @@ COVERED: tuple[str, ...] = (
 wiener_milenkovic)."""
 
 
-def generated_headers() -> dict[str, str]:
-    """generated/c/symrot_NAME.h for every name in :data:`COVERED` (``make generate``)."""
+def generated_headers(names: tuple[str, ...] | None = None) -> dict[str, str]:
+    """generated/c/symrot_NAME.h for every name in :data:`COVERED` (``make generate``), or for
+    ``names``."""
     headers = {}
-    for name in COVERED:
+    for name in COVERED if names is None else names:
         derivation = derive_expression(lookup(name).expression)
         headers[f"c/symrot_{name}.h"] = header_source(plan_for(derivation, name), name)
     return headers

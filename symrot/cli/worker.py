@@ -25,10 +25,15 @@ GRACE_SECONDS = 1.5
 """How long the parent waits after the budget for the worker to report its own expiry."""
 MEMORY_LIMIT = 4 * 2**30
 """Address-space limit of a worker (bytes). SymPy and NumPy need about 1 GiB of it."""
-CRASH_SIGNALS = (signal.SIGKILL, signal.SIGSEGV, signal.SIGABRT, signal.SIGBUS)
-"""Deaths a worker suffers when the address-space limit hits C code that cannot raise."""
+CRASH_SIGNALS = (signal.SIGSEGV, signal.SIGABRT, signal.SIGBUS, signal.SIGFPE, signal.SIGILL)
+"""Deaths of C code: after exhausting the address-space limit (C code that cannot raise when an
+allocation fails), or a genuine crash; the worker's peak resident size tells them apart."""
+MEMORY_FRACTION = 0.5
+"""A crash with a peak resident size of at least this fraction of the limit counts as memory
+exhaustion (exit 2); below it, it is a genuine crash (exit 70, signal named)."""
 
 EXIT_ERROR = 2
+EXIT_INTERNAL = 70
 PR_SET_PDEATHSIG = 1
 
 
@@ -55,9 +60,9 @@ def run(command: Callable[[], int], seconds: float | None, memory: int = MEMORY_
         finally:
             os._exit(code)
     try:
-        status = _wait(pid, None if not seconds else seconds + GRACE_SECONDS)
+        status, peak = _wait(pid, None if not seconds else seconds + GRACE_SECONDS)
     except KeyboardInterrupt:  # the worker got the same SIGINT: let it report, briefly
-        status = _wait(pid, GRACE_SECONDS)
+        status, peak = _wait(pid, GRACE_SECONDS)
         if status is None:
             _kill(pid)
             print("symrot: interrupted", file=sys.stderr)
@@ -68,13 +73,40 @@ def run(command: Callable[[], int], seconds: float | None, memory: int = MEMORY_
         print(f"symrot: error: the time budget of {seconds:g} s ran out during "
               f"{budget.read_shared(shared)} (--timeout changes it)", file=sys.stderr)
         return EXIT_ERROR
-    if os.WIFSIGNALED(status) and os.WTERMSIG(status) in CRASH_SIGNALS:
-        print(f"symrot: error: out of memory during {budget.read_shared(shared)} "
-              f"(limit {memory / 2**30:g} GiB)", file=sys.stderr)
-        return EXIT_ERROR
     if os.WIFSIGNALED(status):
-        return 128 + os.WTERMSIG(status)
+        return _report_signal(os.WTERMSIG(status), peak, memory, budget.read_shared(shared))
     return os.WEXITSTATUS(status)
+
+
+def signal_name(number: int) -> str:
+    """'SIGSEGV (Segmentation fault)' for 11; the number when the signal is unknown."""
+    try:
+        name = signal.Signals(number).name
+    except ValueError:
+        return f"signal {number}"
+    description = signal.strsignal(number)
+    return f"{name} ({description})" if description else name
+
+
+def _report_signal(number: int, peak: int, memory: int, where: str) -> int:
+    """One line on stderr for a worker killed by signal ``number``; the exit status.
+
+    SIGKILL is the kernel's out-of-memory killer (exit 2). A crash signal of C code is memory
+    exhaustion when the worker had reached ``MEMORY_FRACTION`` of its limit (exit 2), else a bug
+    (exit 70); either way the line names the signal. Other signals pass as 128 + number."""
+    limit = f"limit {memory / 2**30:g} GiB"
+    if number == signal.SIGKILL:
+        print(f"symrot: error: out of memory during {where} (killed by SIGKILL; {limit})", file=sys.stderr)
+        return EXIT_ERROR
+    if number not in CRASH_SIGNALS:
+        return 128 + number
+    if peak >= MEMORY_FRACTION * memory:
+        print(f"symrot: error: out of memory during {where} ({signal_name(number)} at "
+              f"{peak / 2**30:.2g} GiB resident; {limit})", file=sys.stderr)
+        return EXIT_ERROR
+    print(f"symrot: internal error: the worker crashed with {signal_name(number)} during {where} "
+          f"({peak / 2**20:.0f} MiB resident, {limit}); please report it", file=sys.stderr)
+    return EXIT_INTERNAL
 
 
 def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int) -> int:
@@ -105,8 +137,9 @@ def _die_with_parent() -> None:
         pass
 
 
-def _wait(pid: int, seconds: float | None) -> int | None:
-    """The worker's wait status, or None if it is still running after ``seconds``."""
+def _wait(pid: int, seconds: float | None) -> tuple[int | None, int]:
+    """(the worker's wait status, its peak resident size in bytes), or (None, 0) if it is still
+    running after ``seconds``."""
     deadline = None if seconds is None else time.monotonic() + seconds
     try:
         handle = os.pidfd_open(pid)
@@ -114,12 +147,12 @@ def _wait(pid: int, seconds: float | None) -> int | None:
         handle = None
     try:
         while True:
-            done, status = os.waitpid(pid, os.WNOHANG)
+            done, status, usage = os.wait4(pid, os.WNOHANG)
             if done:
-                return status
+                return status, usage.ru_maxrss * 1024  # kilobytes on Linux
             left = None if deadline is None else deadline - time.monotonic()
             if left is not None and left <= 0:
-                return None
+                return None, 0
             if handle is not None:
                 select.select([handle], [], [], left)
             else:

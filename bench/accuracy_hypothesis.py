@@ -1,0 +1,128 @@
+"""Accuracy of the generated code for hypothesis-generated generating functions (issue 16).
+
+Draws ``--count`` distinct functions from the grammar of tests/strategies.py (derandomized, so
+every run draws the same ones), emits each through the public API and measures it exactly as
+bench/accuracy_corpus.py measures the corpus (independent reference of tests/reference.py,
+verdicts of docs/accuracy.md), each in its own worker process with a time limit. Writes the
+fraction meeting the target and every miss (function, size, where) as markdown.
+
+Run: ``python bench/accuracy_hypothesis.py [--count 200] [--points 4] [--no-c] [--json FILE]
+[--out docs/accuracy_hypothesis.md]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+from accuracy_corpus import COLUMNS, _verdicts, measure_expression  # noqa: E402
+
+WORKER_TIMEOUT = 600
+GOOD = ("meets", "conditioned")
+
+
+def draw(count: int) -> list[str]:
+    """The first ``count`` distinct expressions the derandomized strategy generates."""
+    from hypothesis import HealthCheck, Phase, given, settings
+
+    from tests.strategies import generating_functions
+
+    found: list[str] = []
+
+    @settings(derandomize=True, max_examples=count + count // 4, deadline=None, database=None,
+              phases=[Phase.generate], suppress_health_check=list(HealthCheck))
+    @given(generating_functions())
+    def collect(function: Any) -> None:
+        if function.expression not in found and len(found) < count:
+            found.append(function.expression)
+
+    collect()
+    return found
+
+
+def worker(expression: str, points: int, with_c: bool) -> dict[str, Any]:
+    from tests.reference import GeneratingFunction
+
+    return measure_expression(GeneratingFunction(expression), "generated", points, with_c,
+                              {"expression": expression})
+
+
+def misses(result: dict[str, Any]) -> list[str]:
+    """'precision backend function ulp at φ (κ)' of every tally that misses the target."""
+    from accuracy_corpus import verdict
+
+    return [f"{t['backend']} {t['precision']} {t['function']} {t['ulp']:.3g} ulp at φ = {t['at']:.3g}"
+            + (f" ({t['nonfinite']} NaN/Inf)" if t["nonfinite"] else "")
+            for t in result.get("tallies", []) if verdict([t]) not in GOOD]
+
+
+def report(results: list[dict[str, Any]], command: str, with_c: bool) -> str:
+    columns = COLUMNS if with_c else COLUMNS[:2]
+    met = [r for r in results if "tallies" in r and all(_verdicts(r).get(k) in GOOD for k in columns)]
+    failed = [r for r in results if "tallies" not in r]
+    lines = ["# Accuracy of the generated code for hypothesis-generated functions (issue 16)", "",
+             f"Produced by `{command}`: the grammar of tests/strategies.py, derandomized; each function "
+             "emitted and measured as in docs/accuracy_corpus.md "
+             f"({'NumPy and C' if with_c else 'NumPy only'}, both precisions).", "",
+             f"**Target met** (meets or conditioned, no NaN/Inf): {len(met)} of {len(results)}; "
+             f"emit or worker failures: {len(failed)}.", "",
+             "| # | p(φ) | emit s | φ_max | verdicts (" + ", ".join(f"{b} {p}" for b, p in columns)
+             + ") | misses (worst 3) |", "|---|---|---|---|---|---|"]
+    for i, r in enumerate(results):
+        if "tallies" not in r:
+            reason = r.get("emit_error") or r.get("worker_error") or "no result"
+            lines.append(f"| {i} | `{r['expression']}` | — | — | **failed**: {reason} | |")
+            continue
+        found = _verdicts(r)
+        cells = ", ".join(found.get(k, "—") for k in columns)
+        worst = "; ".join(misses(r)[:3])
+        lines.append(f"| {i} | `{r['expression']}` | {r['emit_seconds']:.1f} | "
+                     f"{r['phi_max_reference']:.4g} | {cells} | {worst} |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=200)
+    parser.add_argument("--points", type=int, default=4)
+    parser.add_argument("--no-c", action="store_true")
+    parser.add_argument("--out", default="docs/accuracy_hypothesis.md")
+    parser.add_argument("--json", help="also write the raw results here (after every function)")
+    parser.add_argument("--worker", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker is not None:
+        print(json.dumps(worker(args.worker, args.points, not args.no_c)))
+        return 0
+    results: list[dict[str, Any]] = []
+    command = "python bench/accuracy_hypothesis.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    for expression in draw(args.count):
+        run = [sys.executable, __file__, "--worker", expression, "--points", str(args.points)]
+        run += ["--no-c"] if args.no_c else []
+        start = time.perf_counter()
+        try:
+            done = subprocess.run(run, capture_output=True, text=True, timeout=WORKER_TIMEOUT, check=False)
+            result = json.loads(done.stdout.strip().splitlines()[-1]) if done.returncode == 0 else {
+                "expression": expression,
+                "worker_error": f"worker exit {done.returncode}: {done.stderr.strip().splitlines()[-1:]}"}
+        except subprocess.TimeoutExpired:
+            result = {"expression": expression, "worker_error": f"timeout after {WORKER_TIMEOUT} s"}
+        results.append(result)
+        print(f"{len(results)} {expression}: {time.perf_counter() - start:.0f} s "
+              f"{result.get('emit_error') or result.get('worker_error') or ''}", flush=True)
+        if args.json:
+            Path(args.json).write_text(json.dumps(results, indent=1), encoding="utf-8")
+        Path(args.out).write_text(report(results, command.strip(), not args.no_c) + "\n", encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
