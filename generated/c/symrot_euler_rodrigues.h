@@ -805,7 +805,7 @@ static inline int symrot_euler_rodrigues_rescale(const double p[3], double q[3])
 static inline void symrot_euler_rodrigues_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -862,7 +862,7 @@ static inline void symrot_euler_rodrigues_rotation_derivative(const double p[3],
 static inline void symrot_euler_rodrigues_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -916,7 +916,7 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative(const do
 static inline void symrot_euler_rodrigues_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -978,7 +978,7 @@ static inline void symrot_euler_rodrigues_tangent_derivative(const double p[3], 
 static inline void symrot_euler_rodrigues_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1042,7 +1042,7 @@ static inline void symrot_euler_rodrigues_tangent_transpose_derivative(const dou
 static inline void symrot_euler_rodrigues_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1087,7 +1087,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_derivative(const doubl
 static inline void symrot_euler_rodrigues_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_euler_rodrigues__complement(p);
+    const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
         alpha[0] = (double)NAN;
         alpha[1] = (double)NAN;
@@ -1996,7 +1996,7 @@ static inline int symrot_euler_rodrigues_rescale_f(const float p[3], float q[3])
 static inline void symrot_euler_rodrigues_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2053,7 +2053,7 @@ static inline void symrot_euler_rodrigues_rotation_derivative_f(const float p[3]
 static inline void symrot_euler_rodrigues_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2107,7 +2107,7 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative_f(const 
 static inline void symrot_euler_rodrigues_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2169,7 +2169,7 @@ static inline void symrot_euler_rodrigues_tangent_derivative_f(const float p[3],
 static inline void symrot_euler_rodrigues_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2233,7 +2233,7 @@ static inline void symrot_euler_rodrigues_tangent_transpose_derivative_f(const f
 static inline void symrot_euler_rodrigues_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2278,7 +2278,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_derivative_f(const flo
 static inline void symrot_euler_rodrigues_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_euler_rodrigues__complement_f(p);
+    const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
         alpha[0] = NAN;
         alpha[1] = NAN;

@@ -918,7 +918,7 @@ static inline int symrot_linear_rescale(const double p[3], double q[3])
 static inline void symrot_linear_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -972,7 +972,7 @@ static inline void symrot_linear_rotation_derivative(const double p[3], const do
 static inline void symrot_linear_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1025,7 +1025,7 @@ static inline void symrot_linear_rotation_transpose_derivative(const double p[3]
 static inline void symrot_linear_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1104,7 +1104,7 @@ static inline void symrot_linear_tangent_derivative(const double p[3], const dou
 static inline void symrot_linear_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1185,7 +1185,7 @@ static inline void symrot_linear_tangent_transpose_derivative(const double p[3],
 static inline void symrot_linear_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1250,7 +1250,7 @@ static inline void symrot_linear_tangent_inverse_derivative(const double p[3], c
 static inline void symrot_linear_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_linear__complement(p);
+    const double d = symrot_linear__complement(p, x);
     if (!(x < 1.0)) {
         alpha[0] = (double)NAN;
         alpha[1] = (double)NAN;
@@ -2284,7 +2284,7 @@ static inline int symrot_linear_rescale_f(const float p[3], float q[3])
 static inline void symrot_linear_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2338,7 +2338,7 @@ static inline void symrot_linear_rotation_derivative_f(const float p[3], const f
 static inline void symrot_linear_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2391,7 +2391,7 @@ static inline void symrot_linear_rotation_transpose_derivative_f(const float p[3
 static inline void symrot_linear_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2470,7 +2470,7 @@ static inline void symrot_linear_tangent_derivative_f(const float p[3], const fl
 static inline void symrot_linear_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2551,7 +2551,7 @@ static inline void symrot_linear_tangent_transpose_derivative_f(const float p[3]
 static inline void symrot_linear_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2616,7 +2616,7 @@ static inline void symrot_linear_tangent_inverse_derivative_f(const float p[3], 
 static inline void symrot_linear_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_linear__complement_f(p);
+    const float d = symrot_linear__complement_f(p, x);
     if (!(x < 1.0F)) {
         alpha[0] = NAN;
         alpha[1] = NAN;

@@ -1005,7 +1005,7 @@ static inline int symrot_sine_m3_rescale(const double p[3], double q[3])
 static inline void symrot_sine_m3_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1078,7 +1078,7 @@ static inline void symrot_sine_m3_rotation_derivative(const double p[3], const d
 static inline void symrot_sine_m3_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1152,7 +1152,7 @@ static inline void symrot_sine_m3_rotation_transpose_derivative(const double p[3
 static inline void symrot_sine_m3_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1242,7 +1242,7 @@ static inline void symrot_sine_m3_tangent_derivative(const double p[3], const do
 static inline void symrot_sine_m3_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1334,7 +1334,7 @@ static inline void symrot_sine_m3_tangent_transpose_derivative(const double p[3]
 static inline void symrot_sine_m3_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1399,7 +1399,7 @@ static inline void symrot_sine_m3_tangent_inverse_derivative(const double p[3], 
 static inline void symrot_sine_m3_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m3__complement(p);
+    const double d = symrot_sine_m3__complement(p, x);
     if (!(x < 9.0)) {
         alpha[0] = (double)NAN;
         alpha[1] = (double)NAN;
@@ -2521,7 +2521,7 @@ static inline int symrot_sine_m3_rescale_f(const float p[3], float q[3])
 static inline void symrot_sine_m3_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2592,7 +2592,7 @@ static inline void symrot_sine_m3_rotation_derivative_f(const float p[3], const 
 static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2664,7 +2664,7 @@ static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[
 static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2752,7 +2752,7 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
 static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2842,7 +2842,7 @@ static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3
 static inline void symrot_sine_m3_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2907,7 +2907,7 @@ static inline void symrot_sine_m3_tangent_inverse_derivative_f(const float p[3],
 static inline void symrot_sine_m3_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m3__complement_f(p);
+    const float d = symrot_sine_m3__complement_f(p, x);
     if (!(x < 9.0F)) {
         alpha[0] = NAN;
         alpha[1] = NAN;

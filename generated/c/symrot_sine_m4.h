@@ -808,7 +808,7 @@ static inline int symrot_sine_m4_rescale(const double p[3], double q[3])
 static inline void symrot_sine_m4_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -865,7 +865,7 @@ static inline void symrot_sine_m4_rotation_derivative(const double p[3], const d
 static inline void symrot_sine_m4_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -928,7 +928,7 @@ static inline void symrot_sine_m4_rotation_transpose_derivative(const double p[3
 static inline void symrot_sine_m4_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -996,7 +996,7 @@ static inline void symrot_sine_m4_tangent_derivative(const double p[3], const do
 static inline void symrot_sine_m4_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1063,7 +1063,7 @@ static inline void symrot_sine_m4_tangent_transpose_derivative(const double p[3]
 static inline void symrot_sine_m4_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
@@ -1128,7 +1128,7 @@ static inline void symrot_sine_m4_tangent_inverse_derivative(const double p[3], 
 static inline void symrot_sine_m4_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const double d = symrot_sine_m4__complement(p);
+    const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
         alpha[0] = (double)NAN;
         alpha[1] = (double)NAN;
@@ -2044,7 +2044,7 @@ static inline int symrot_sine_m4_rescale_f(const float p[3], float q[3])
 static inline void symrot_sine_m4_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2101,7 +2101,7 @@ static inline void symrot_sine_m4_rotation_derivative_f(const float p[3], const 
 static inline void symrot_sine_m4_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2164,7 +2164,7 @@ static inline void symrot_sine_m4_rotation_transpose_derivative_f(const float p[
 static inline void symrot_sine_m4_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2232,7 +2232,7 @@ static inline void symrot_sine_m4_tangent_derivative_f(const float p[3], const f
 static inline void symrot_sine_m4_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2299,7 +2299,7 @@ static inline void symrot_sine_m4_tangent_transpose_derivative_f(const float p[3
 static inline void symrot_sine_m4_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         D[0] = NAN;
         D[1] = NAN;
@@ -2364,7 +2364,7 @@ static inline void symrot_sine_m4_tangent_inverse_derivative_f(const float p[3],
 static inline void symrot_sine_m4_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    const float d = symrot_sine_m4__complement_f(p);
+    const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
         alpha[0] = NAN;
         alpha[1] = NAN;

@@ -36,9 +36,30 @@ P_MAX = 3.3530783864394875
 P_MAX_SQUARED = 11.243134665607636  # fl(p_max^2); inside the range: x = |p|^2 <= P_MAX_SQUARED
 
 
-def _p_prime_64(x, phi, s, d, sin_half, cos_half):
+def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = -6.816125240403192e-19
+        series = -8.626941850237128e-18 + t * series
+        series = -1.1016217975387359e-16 + t * series
+        series = -1.4213047418173123e-15 + t * series
+        series = -1.8561269939266666e-14 + t * series
+        series = -2.4592808133854967e-13 + t * series
+        series = -3.3160977010058107e-12 + t * series
+        series = -4.569666554548725e-11 + t * series
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -6.816125240403192e-19
@@ -58,16 +79,30 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
         series = -0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _nu_64(x, phi, s, d, sin_half, cos_half):
+def _nu_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = -2.4717768942862145e-15
+        series = -3.1172082783912966e-14 + t * series
+        series = -3.9741810435255436e-13 + t * series
+        series = -5.1339188726594446e-12 + t * series
+        series = -6.740882557422226e-11 + t * series
+        series = -9.035261398610608e-10 + t * series
+        series = -1.244209181073502e-08 + t * series
+        series = -1.7778215165910478e-07 + t * series
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
     small = x < 0.764824235244299
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -2.4717768942862145e-15
@@ -84,17 +119,34 @@ def _nu_64(x, phi, s, d, sin_half, cos_half):
         series = -0.025 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = 2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
     return out
 
 
-def _epsilon_64(x, phi, s, d, sin_half, cos_half):
+def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = 1.5905201294923517e-14
+        series = 1.1265276036398177e-13 + t * series
+        series = 7.978953359858307e-13 + t * series
+        series = 5.651354180596242e-12 + t * series
+        series = 4.0027973542176834e-11 + t * series
+        series = 2.8351938089872594e-10 + t * series
+        series = 2.0082446735268566e-09 + t * series
+        series = 1.4225834946840515e-08 + t * series
+        series = 1.0078371181814193e-07 + t * series
+        series = 7.141710355470859e-07 + t * series
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
     small = x < 0.764824235244299
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 1.5905201294923517e-14
@@ -115,16 +167,31 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
         series = 0.1 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = 2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
     return out
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half):
+def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = 5.253841918550812e-15
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
     small = x < 0.764824235244299
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 5.253841918550812e-15
@@ -142,25 +209,39 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
         series = 0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
     return out
 
 
-def _det_H_64(x, phi, s, d, sin_half, cos_half):
+def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 1.0)
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half):
+def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 1.0)
 
 
-def _R_1_64(x, phi, s, d, sin_half, cos_half):
+def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = 2.4273770483331233e-15
+        series = 3.054732998294483e-14 + t * series
+        series = 3.8844043825273724e-13 + t * series
+        series = 5.001592370976041e-12 + t * series
+        series = 6.539638581589419e-11 + t * series
+        series = 8.716860870222215e-10 + t * series
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.sin(phi)
+    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
     small = x < 0.764824235244299
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 2.4273770483331233e-15
@@ -177,17 +258,33 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
         series = -0.15 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        w0 = numpy.sin(phi)
-        out[big] = w0/numpy.cbrt(6*phi - 6*w0)
     return out
 
 
-def _R_2_64(x, phi, s, d, sin_half, cos_half):
+def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = -3.408062620201596e-19
+        series = -4.313470925118564e-18 + t * series
+        series = -5.5081089876936793e-17 + t * series
+        series = -7.106523709086561e-16 + t * series
+        series = -9.280634969633333e-15 + t * series
+        series = -1.2296404066927484e-13 + t * series
+        series = -1.6580488505029053e-12 + t * series
+        series = -2.2848332772743624e-11 + t * series
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -3.408062620201596e-19
@@ -207,16 +304,31 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
         series = -0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half):
+def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = 5.253841918550812e-15
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
     small = x < 0.764824235244299
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 5.253841918550812e-15
@@ -234,17 +346,33 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half):
         series = 0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
     return out
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half):
+def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = -3.408062620201596e-19
+        series = -4.313470925118564e-18 + t * series
+        series = -5.5081089876936793e-17 + t * series
+        series = -7.106523709086561e-16 + t * series
+        series = -9.280634969633333e-15 + t * series
+        series = -1.2296404066927484e-13 + t * series
+        series = -1.6580488505029053e-12 + t * series
+        series = -2.2848332772743624e-11 + t * series
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -3.408062620201596e-19
@@ -264,16 +392,40 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
         series = -0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = (1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _H_2_64(x, phi, s, d, sin_half, cos_half):
+def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = 1.499151775319712e-24
+        series = 1.7102707948061374e-23 + t * series
+        series = 1.9524132761456664e-22 + t * series
+        series = 2.230454684338051e-21 + t * series
+        series = 2.5501224371929e-20 + t * series
+        series = 2.918170543767923e-19 + t * series
+        series = 3.3425985887827363e-18 + t * series
+        series = 3.8329294257465515e-17 + t * series
+        series = 4.4005658265072545e-16 + t * series
+        series = 5.0592551808267075e-15 + t * series
+        series = 5.825704915999495e-14 + t * series
+        series = 6.720412596247862e-13 + t * series
+        series = 7.768808765054745e-12 + t * series
+        series = 9.002866267756873e-11 + t * series
+        series = 1.046342173054307e-09 + t * series
+        series = 1.22036052183111e-08 + t * series
+        series = 1.42940015388995e-07 + t * series
+        series = 1.683039183039183e-06 + t * series
+        series = 1.99443413729128e-05 + t * series
+        series = 0.0002380952380952381 + t * series
+        series = 0.002857142857142857 + t * series
+        series = 0.2 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    out = numpy.asarray((0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 1.499151775319712e-24
@@ -299,19 +451,33 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        out[big] = (0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0))
     return out
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = -6.816125240403192e-19
+        series = -8.626941850237128e-18 + t * series
+        series = -1.1016217975387359e-16 + t * series
+        series = -1.4213047418173123e-15 + t * series
+        series = -1.8561269939266666e-14 + t * series
+        series = -2.4592808133854967e-13 + t * series
+        series = -3.3160977010058107e-12 + t * series
+        series = -4.569666554548725e-11 + t * series
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -6.816125240403192e-19
@@ -331,20 +497,46 @@ def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
         series = -0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = 2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = 3.42701592796967e-25
+        series = 3.982335375612905e-24 + t * series
+        series = 4.6352839539983977e-23 + t * series
+        series = 5.40513214847762e-22 + t * series
+        series = 6.315600653020195e-21 + t * series
+        series = 7.396110286959959e-20 + t * series
+        series = 8.683469103988305e-19 + t * series
+        series = 1.0224187860604788e-17 + t * series
+        series = 1.207771859033198e-16 + t * series
+        series = 1.4321083368003567e-15 + t * series
+        series = 1.7055656901807745e-14 + t * series
+        series = 2.0417396933193335e-13 + t * series
+        series = 2.4592808133854965e-12 + t * series
+        series = 2.9844879309052296e-11 + t * series
+        series = 3.65573324363898e-10 + t * series
+        series = 4.531479857547785e-09 + t * series
+        series = 5.705962593717696e-08 + t * series
+        series = 7.343103325246182e-07 + t * series
+        series = 9.760874046588332e-06 + t * series
+        series = 0.0001369047619047619 + t * series
+        series = 0.002142857142857143 + t * series
+        series = 0.05 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = sin_half**2
+    w1 = 6*phi
+    w2 = cos_half*sin_half
+    out = numpy.asarray(-0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4), dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 3.42701592796967e-25
@@ -370,25 +562,34 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
         series = 0.002142857142857143 + t * series
         series = 0.05 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = sin_half**2
-        w1 = 6*phi
-        w2 = cos_half*sin_half
-        out[big] = -0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4)
     return out
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half):
+def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_64(x, phi, s, d, sin_half, cos_half):
+def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = -1.2358884471431072e-15
+        series = -1.5586041391956483e-14 + t * series
+        series = -1.9870905217627718e-13 + t * series
+        series = -2.5669594363297223e-12 + t * series
+        series = -3.370441278711113e-11 + t * series
+        series = -4.517630699305304e-10 + t * series
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
     small = x < 0.764824235244299
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -1.2358884471431072e-15
@@ -405,17 +606,33 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
         series = -0.0125 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi))
     return out
 
 
-def _G_2_64(x, phi, s, d, sin_half, cos_half):
+def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = 7.005500832060205e-20
+        series = 8.78575012329886e-19 + t * series
+        series = 1.1103729250660078e-17 + t * series
+        series = 1.415858727786663e-16 + t * series
+        series = 1.8241874371141333e-15 + t * series
+        series = 2.3791812685232493e-14 + t * series
+        series = 3.1488034564609846e-13 + t * series
+        series = 4.242513271852192e-12 + t * series
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 7.005500832060205e-20
@@ -435,16 +652,31 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = 2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _K_0_64(x, phi, s, d, sin_half, cos_half):
+def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = 2.626920959275406e-15
+        series = 3.034221310416404e-14 + t * series
+        series = 3.512942948038655e-13 + t * series
+        series = 4.078624601653741e-12 + t * series
+        series = 4.7515127524272383e-11 + t * series
+        series = 5.558692794351005e-10 + t * series
+        series = 6.5376456526666615e-09 + t * series
+        series = 7.742584166903895e-08 + t * series
+        series = 9.256715506715507e-07 + t * series
+        series = 1.1218692022263451e-05 + t * series
+        series = 0.0001388888888888889 + t * series
+        series = 0.0017857142857142857 + t * series
+        series = 0.025 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
     small = x < 0.764824235244299
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 2.626920959275406e-15
@@ -462,17 +694,33 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
         series = 0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = (0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
     return out
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half):
+def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = 7.005500832060205e-20
+        series = 8.78575012329886e-19 + t * series
+        series = 1.1103729250660078e-17 + t * series
+        series = 1.415858727786663e-16 + t * series
+        series = 1.8241874371141333e-15 + t * series
+        series = 2.3791812685232493e-14 + t * series
+        series = 3.1488034564609846e-13 + t * series
+        series = 4.242513271852192e-12 + t * series
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 7.005500832060205e-20
@@ -492,16 +740,41 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = 2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _K_2_64(x, phi, s, d, sin_half, cos_half):
+def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = 7.837904569910299e-25
+        series = 8.960375161004176e-24 + t * series
+        series = 1.0252484904999445e-22 + t * series
+        series = 1.1742209353136828e-21 + t * series
+        series = 1.3462827495637501e-20 + t * series
+        series = 1.5454156215361094e-19 + t * series
+        series = 1.7764157194142527e-18 + t * series
+        series = 2.0451064003372294e-17 + t * series
+        series = 2.3586252560910385e-16 + t * series
+        series = 2.725820183855303e-15 + t * series
+        series = 3.157810155130715e-14 + t * series
+        series = 3.6688033619582197e-13 + t * series
+        series = 4.277333653830018e-12 + t * series
+        series = 5.008208696060211e-11 + t * series
+        series = 5.895736922222117e-10 + t * series
+        series = 6.9894087225971915e-09 + t * series
+        series = 8.364688757440645e-08 + t * series
+        series = 1.0145626265011032e-06 + t * series
+        series = 1.2558898737051639e-05 + t * series
+        series = 0.0001609002976190476 + t * series
+        series = 0.0022098214285714286 + t * series
+        series = 0.0375 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
+    w1 = w0**2
+    out = numpy.asarray((sin_half/w0 + (0.125)*w1/sin_half**2)/w1, dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 7.837904569910299e-25
@@ -527,24 +800,39 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
         series = 0.0022098214285714286 + t * series
         series = 0.0375 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
-        w1 = w0**2
-        out[big] = (sin_half/w0 + (0.125)*w1/sin_half**2)/w1
     return out
 
 
-def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
 
-def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = 1.4590852718839616e-19
+        series = 1.6712992943913682e-18 + t * series
+        series = 1.9164647128732757e-17 + t * series
+        series = 2.2002829132536273e-16 + t * series
+        series = 2.5296275904133537e-15 + t * series
+        series = 2.912852457999748e-14 + t * series
+        series = 3.360206298123931e-13 + t * series
+        series = 3.884404382527373e-12 + t * series
+        series = 4.5014331338784364e-11 + t * series
+        series = 5.231710865271535e-10 + t * series
+        series = 6.10180260915555e-09 + t * series
+        series = 7.14700076944975e-08 + t * series
+        series = 8.415195915195915e-07 + t * series
+        series = 9.9721706864564e-06 + t * series
+        series = 0.00011904761904761905 + t * series
+        series = 0.0014285714285714286 + t * series
+        series = -0.15 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = sin_half**2
+    out = numpy.asarray((0.125)*(-1.3333333333333333*cos_half*sin_half**3/(-2*cos_half*sin_half + phi) - 2*w0 + 1)/w0, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 1.4590852718839616e-19
@@ -565,19 +853,41 @@ def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
         series = 0.0014285714285714286 + t * series
         series = -0.15 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = sin_half**2
-        out[big] = (0.125)*(-1.3333333333333333*cos_half*sin_half**3/(-2*cos_half*sin_half + phi) - 2*w0 + 1)/w0
     return out
 
 
-def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = -1.713507963984835e-25
+        series = -1.9911676878064524e-24 + t * series
+        series = -2.3176419769991988e-23 + t * series
+        series = -2.70256607423881e-22 + t * series
+        series = -3.1578003265100976e-21 + t * series
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -1.713507963984835e-25
@@ -603,20 +913,38 @@ def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
         series = -0.0010714285714285715 + t * series
         series = -0.025 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
     return out
 
 
-def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+        t = x
+        series = 4.002447216098616e-21
+        series = 4.349386634459199e-20 + t * series
+        series = 4.717726508806865e-19 + t * series
+        series = 5.106798451593866e-18 + t * series
+        series = 5.515287671491515e-17 + t * series
+        series = 5.941040609907155e-16 + t * series
+        series = 6.3808204484355186e-15 + t * series
+        series = 6.829994494116056e-14 + t * series
+        series = 7.28213114499937e-13 + t * series
+        series = 7.72847448568504e-12 + t * series
+        series = 8.157249203307483e-11 + t * series
+        series = 8.552722954369029e-10 + t * series
+        series = 8.893908470961609e-09 + t * series
+        series = 9.152703913733326e-08 + t * series
+        series = 9.291101000284673e-07 + t * series
+        series = 9.256715506715507e-06 + t * series
+        series = 8.974953617810761e-05 + t * series
+        series = 0.0008333333333333334 + t * series
+        series = 0.007142857142857143 + t * series
+        series = 0.05 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    out = numpy.asarray((0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+        return out
     small = x < 1.4342812090283275
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 4.002447216098616e-21
@@ -640,19 +968,41 @@ def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
         series = 0.007142857142857143 + t * series
         series = 0.05 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        out[big] = (0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2
     return out
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = -1.713507963984835e-25
+        series = -1.9911676878064524e-24 + t * series
+        series = -2.3176419769991988e-23 + t * series
+        series = -2.70256607423881e-22 + t * series
+        series = -3.1578003265100976e-21 + t * series
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -1.713507963984835e-25
@@ -678,20 +1028,46 @@ def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
         series = -0.0010714285714285715 + t * series
         series = -0.025 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
     return out
 
 
-def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = 2.892762495883202e-24
+        series = 3.1482187281713954e-23 + t * series
+        series = 3.420541589612275e-22 + t * series
+        series = 3.7095852246767656e-21 + t * series
+        series = 4.0148184318084914e-20 + t * series
+        series = 4.33520814322793e-19 + t * series
+        series = 4.669072870028677e-18 + t * series
+        series = 5.0138978831741045e-17 + t * series
+        series = 5.366101196045172e-16 + t * series
+        series = 5.720735574459431e-15 + t * series
+        series = 6.07110621699205e-14 + t * series
+        series = 6.408275407599445e-13 + t * series
+        series = 6.7204125962478614e-12 + t * series
+        series = 6.991927888549271e-11 + t * series
+        series = 7.202293014205498e-10 + t * series
+        series = 7.324395211380149e-09 + t * series
+        series = 7.32216313098666e-08 + t * series
+        series = 7.147000769449749e-07 + t * series
+        series = 6.732156732156732e-06 + t * series
+        series = 5.983302411873841e-05 + t * series
+        series = 0.0004761904761904762 + t * series
+        series = 0.002857142857142857 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = sin_half**2
+    w1 = w0**(-1.0)
+    w2 = cos_half*sin_half
+    w3 = (phi - 2*w2)**(-1.0)
+    w4 = 6*phi
+    w5 = 2*phi
+    w6 = -16*w2 + w4 + numpy.sin(w5)
+    out = numpy.asarray((0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 2.892762495883202e-24
@@ -717,25 +1093,41 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
         series = 0.0004761904761904762 + t * series
         series = 0.002857142857142857 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = sin_half**2
-        w1 = w0**(-1.0)
-        w2 = cos_half*sin_half
-        w3 = (phi - 2*w2)**(-1.0)
-        w4 = 6*phi
-        w5 = 2*phi
-        w6 = -16*w2 + w4 + numpy.sin(w5)
-        out[big] = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4)
     return out
 
 
-def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = -3.42701592796967e-25
+        series = -3.982335375612905e-24 + t * series
+        series = -4.6352839539983977e-23 + t * series
+        series = -5.40513214847762e-22 + t * series
+        series = -6.315600653020195e-21 + t * series
+        series = -7.396110286959959e-20 + t * series
+        series = -8.683469103988305e-19 + t * series
+        series = -1.0224187860604788e-17 + t * series
+        series = -1.207771859033198e-16 + t * series
+        series = -1.4321083368003567e-15 + t * series
+        series = -1.7055656901807745e-14 + t * series
+        series = -2.0417396933193335e-13 + t * series
+        series = -2.4592808133854965e-12 + t * series
+        series = -2.9844879309052296e-11 + t * series
+        series = -3.65573324363898e-10 + t * series
+        series = -4.531479857547785e-09 + t * series
+        series = -5.705962593717696e-08 + t * series
+        series = -7.343103325246182e-07 + t * series
+        series = -9.760874046588332e-06 + t * series
+        series = -0.0001369047619047619 + t * series
+        series = -0.002142857142857143 + t * series
+        series = -0.05 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    out = numpy.asarray((0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -3.42701592796967e-25
@@ -761,24 +1153,49 @@ def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
         series = -0.002142857142857143 + t * series
         series = -0.05 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        out[big] = (0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
     return out
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
 
-def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+        t = x
+        series = 6.497844255354877e-25
+        series = 7.196733448736306e-24 + t * series
+        series = 7.96467075122581e-23 + t * series
+        series = 8.807039512596957e-22 + t * series
+        series = 9.729237867259716e-21 + t * series
+        series = 1.0736521110134332e-19 + t * series
+        series = 1.1833776459135935e-18 + t * series
+        series = 1.3025203655982459e-17 + t * series
+        series = 1.4313863004846702e-16 + t * series
+        series = 1.5701034167431574e-15 + t * series
+        series = 1.718530004160428e-14 + t * series
+        series = 1.8761222591988522e-13 + t * series
+        series = 2.0417396933193335e-12 + t * series
+        series = 2.213352732046947e-11 + t * series
+        series = 2.3875903447241837e-10 + t * series
+        series = 2.559013270547286e-09 + t * series
+        series = 2.7188879145286708e-08 + t * series
+        series = 2.852981296858848e-07 + t * series
+        series = 2.937241330098473e-06 + t * series
+        series = 2.9282622139764997e-05 + t * series
+        series = 0.0002738095238095238 + t * series
+        series = 0.002142857142857143 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    w2 = (phi - w1)**(-1.0)
+    w3 = sin_half**2
+    w4 = 1 - 2*w3
+    w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+    out = numpy.asarray(-0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4, dtype=x.dtype)
+    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+        return out
     small = x < 2.6302227241416043
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 6.497844255354877e-25
@@ -804,33 +1221,24 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
         series = 0.0002738095238095238 + t * series
         series = 0.002142857142857143 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        w2 = (phi - w1)**(-1.0)
-        w3 = sin_half**2
-        w4 = 1 - 2*w3
-        w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
-        out[big] = -0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4
     return out
 
 
-def _e_0_64(x, phi, s, d, sin_half, cos_half):
+def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
+        t = x
+        series = -0.125
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.array(cos_half, dtype=x.dtype)
+    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
+        return out
     small = x < 1.9211893090849666e-14
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -0.125
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        cos_half = cos_half[big]
-        out[big] = cos_half
     return out
 
 
@@ -962,9 +1370,23 @@ def _scale_64(e0, e_norm):
     return out
 
 
-def _p_prime_32(x, phi, s, d, sin_half, cos_half):
+def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+        t = x
+        series = -4.569666554548725e-11
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
+    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+        return out
     small = x < 2.630222574480542
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -4.569666554548725e-11
@@ -977,18 +1399,23 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half):
         series = -0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = 4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
-def _nu_32(x, phi, s, d, sin_half, cos_half):
+def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = -1.7778215165910478e-07
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(-2*sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi), dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+        return out
     small = x < 0.7648242161335777
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -1.7778215165910478e-07
@@ -998,18 +1425,25 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
         series = -0.025 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = -2*sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi)
     return out
 
 
-def _epsilon_32(x, phi, s, d, sin_half, cos_half):
+def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = 7.141710355470859e-07
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+        return out
     small = x < 0.7648242161335777
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 7.141710355470859e-07
@@ -1021,16 +1455,36 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
         series = 0.1 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        out[big] = 2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi))
     return out
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half):
+def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 2.6209591715593697e-20
+        series = 3.0039990891728625e-19 + t * series
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 2.6209591715593697e-20
@@ -1053,25 +1507,32 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
         series = 0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
     return out
 
 
-def _det_H_32(x, phi, s, d, sin_half, cos_half):
+def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 1.0)
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half):
+def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 1.0)
 
 
-def _R_1_32(x, phi, s, d, sin_half, cos_half):
+def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = 1.683039183039183e-07
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.sin(phi)
+    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+        return out
     small = x < 0.7648242161335777
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 1.683039183039183e-07
@@ -1081,17 +1542,26 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
         series = -0.15 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        w0 = numpy.sin(phi)
-        out[big] = w0/numpy.cbrt(6*phi - 6*w0)
     return out
 
 
-def _R_2_32(x, phi, s, d, sin_half, cos_half):
+def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+        t = x
+        series = -2.2848332772743624e-11
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
+    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+        return out
     small = x < 2.630222574480542
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -2.2848332772743624e-11
@@ -1104,18 +1574,36 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
         series = -0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = 2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half):
+def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 2.6209591715593697e-20
+        series = 3.0039990891728625e-19 + t * series
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
+        series = 6.068442620832808e-14 + t * series
+        series = 7.02588589607731e-13 + t * series
+        series = 8.157249203307483e-12 + t * series
+        series = 9.503025504854477e-11 + t * series
+        series = 1.111738558870201e-09 + t * series
+        series = 1.3075291305333323e-08 + t * series
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
+        series = 0.0002777777777777778 + t * series
+        series = 0.0035714285714285713 + t * series
+        series = 0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 2.6209591715593697e-20
@@ -1138,17 +1626,26 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half):
         series = 0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = (0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
     return out
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half):
+def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+        t = x
+        series = -2.2848332772743624e-11
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
+        series = -0.025 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
+    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+        return out
     small = x < 2.630222574480542
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -2.2848332772743624e-11
@@ -1161,18 +1658,36 @@ def _H_1_32(x, phi, s, d, sin_half, cos_half):
         series = -0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = 2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
-def _H_2_32(x, phi, s, d, sin_half, cos_half):
+def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 2.5501224371929e-20
+        series = 2.918170543767923e-19 + t * series
+        series = 3.3425985887827363e-18 + t * series
+        series = 3.8329294257465515e-17 + t * series
+        series = 4.4005658265072545e-16 + t * series
+        series = 5.0592551808267075e-15 + t * series
+        series = 5.825704915999495e-14 + t * series
+        series = 6.720412596247862e-13 + t * series
+        series = 7.768808765054745e-12 + t * series
+        series = 9.002866267756873e-11 + t * series
+        series = 1.046342173054307e-09 + t * series
+        series = 1.22036052183111e-08 + t * series
+        series = 1.42940015388995e-07 + t * series
+        series = 1.683039183039183e-06 + t * series
+        series = 1.99443413729128e-05 + t * series
+        series = 0.0002380952380952381 + t * series
+        series = 0.002857142857142857 + t * series
+        series = 0.2 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    out = numpy.asarray((0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 2.5501224371929e-20
@@ -1194,19 +1709,26 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        out[big] = (0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0))
     return out
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+        t = x
+        series = -4.569666554548725e-11
+        series = -6.473542653639692e-10 + t * series
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.05 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
+    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+        return out
     small = x < 2.630222574480542
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -4.569666554548725e-11
@@ -1219,22 +1741,42 @@ def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
         series = -0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = 4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2
     return out
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, -0.5)
 
 
-def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 6.315600653020195e-21
+        series = 7.396110286959959e-20 + t * series
+        series = 8.683469103988305e-19 + t * series
+        series = 1.0224187860604788e-17 + t * series
+        series = 1.207771859033198e-16 + t * series
+        series = 1.4321083368003567e-15 + t * series
+        series = 1.7055656901807745e-14 + t * series
+        series = 2.0417396933193335e-13 + t * series
+        series = 2.4592808133854965e-12 + t * series
+        series = 2.9844879309052296e-11 + t * series
+        series = 3.65573324363898e-10 + t * series
+        series = 4.531479857547785e-09 + t * series
+        series = 5.705962593717696e-08 + t * series
+        series = 7.343103325246182e-07 + t * series
+        series = 9.760874046588332e-06 + t * series
+        series = 0.0001369047619047619 + t * series
+        series = 0.002142857142857143 + t * series
+        series = 0.05 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = sin_half**2
+    w1 = 6*phi
+    w2 = cos_half*sin_half
+    out = numpy.asarray(-0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4), dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 6.315600653020195e-21
@@ -1256,25 +1798,27 @@ def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
         series = 0.002142857142857143 + t * series
         series = 0.05 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = sin_half**2
-        w1 = 6*phi
-        w2 = cos_half*sin_half
-        out[big] = -0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4)
     return out
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half):
+def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 1.0)
 
 
-def _G_1_32(x, phi, s, d, sin_half, cos_half):
+def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = -8.889107582955239e-08
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(-sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi), dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+        return out
     small = x < 0.7648242161335777
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -8.889107582955239e-08
@@ -1284,18 +1828,26 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
         series = -0.0125 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        out[big] = -sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi)
     return out
 
 
-def _G_2_32(x, phi, s, d, sin_half, cos_half):
+def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+        t = x
+        series = 4.242513271852192e-12
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+        return out
     small = x < 2.630222574480542
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 4.242513271852192e-12
@@ -1308,17 +1860,36 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _K_0_32(x, phi, s, d, sin_half, cos_half):
+def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 1.3104795857796848e-20
+        series = 1.5019995445864313e-19 + t * series
+        series = 1.7235273973410984e-18 + t * series
+        series = 1.9803468699690516e-17 + t * series
+        series = 2.2788644458698284e-16 + t * series
+        series = 2.626920959275406e-15 + t * series
+        series = 3.034221310416404e-14 + t * series
+        series = 3.512942948038655e-13 + t * series
+        series = 4.078624601653741e-12 + t * series
+        series = 4.7515127524272383e-11 + t * series
+        series = 5.558692794351005e-10 + t * series
+        series = 6.5376456526666615e-09 + t * series
+        series = 7.742584166903895e-08 + t * series
+        series = 9.256715506715507e-07 + t * series
+        series = 1.1218692022263451e-05 + t * series
+        series = 0.0001388888888888889 + t * series
+        series = 0.0017857142857142857 + t * series
+        series = 0.025 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 1.3104795857796848e-20
@@ -1341,17 +1912,26 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
         series = 0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        out[big] = (0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2
     return out
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half):
+def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+        t = x
+        series = 4.242513271852192e-12
+        series = 5.844969408074523e-11 + t * series
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
+        series = 3.189329117063492e-06 + t * series
+        series = 6.138392857142858e-05 + t * series
+        series = 0.0015625 + t * series
+        series = 0.125 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+        return out
     small = x < 2.630222574480542
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 4.242513271852192e-12
@@ -1364,17 +1944,38 @@ def _K_1_32(x, phi, s, d, sin_half, cos_half):
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        cos_half = cos_half[big]
-        out[big] = (1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2
     return out
 
 
-def _K_2_32(x, phi, s, d, sin_half, cos_half):
+def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 1.1742209353136828e-21
+        series = 1.3462827495637501e-20 + t * series
+        series = 1.5454156215361094e-19 + t * series
+        series = 1.7764157194142527e-18 + t * series
+        series = 2.0451064003372294e-17 + t * series
+        series = 2.3586252560910385e-16 + t * series
+        series = 2.725820183855303e-15 + t * series
+        series = 3.157810155130715e-14 + t * series
+        series = 3.6688033619582197e-13 + t * series
+        series = 4.277333653830018e-12 + t * series
+        series = 5.008208696060211e-11 + t * series
+        series = 5.895736922222117e-10 + t * series
+        series = 6.9894087225971915e-09 + t * series
+        series = 8.364688757440645e-08 + t * series
+        series = 1.0145626265011032e-06 + t * series
+        series = 1.2558898737051639e-05 + t * series
+        series = 0.0001609002976190476 + t * series
+        series = 0.0022098214285714286 + t * series
+        series = 0.0375 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
+    w1 = w0**2
+    out = numpy.asarray((sin_half/w0 + (0.125)*w1/sin_half**2)/w1, dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 1.1742209353136828e-21
@@ -1397,24 +1998,34 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
         series = 0.0022098214285714286 + t * series
         series = 0.0375 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
-        w1 = w0**2
-        out[big] = (sin_half/w0 + (0.125)*w1/sin_half**2)/w1
     return out
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
 
-def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+        t = x
+        series = 3.360206298123931e-13
+        series = 3.884404382527373e-12 + t * series
+        series = 4.5014331338784364e-11 + t * series
+        series = 5.231710865271535e-10 + t * series
+        series = 6.10180260915555e-09 + t * series
+        series = 7.14700076944975e-08 + t * series
+        series = 8.415195915195915e-07 + t * series
+        series = 9.9721706864564e-06 + t * series
+        series = 0.00011904761904761905 + t * series
+        series = 0.0014285714285714286 + t * series
+        series = -0.15 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = sin_half**2
+    w1 = numpy.sin(phi)
+    out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) - 2*w0 + 1)/w0, dtype=x.dtype)
+    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+        return out
     small = x < 2.630222574480542
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 3.360206298123931e-13
@@ -1429,19 +2040,37 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
         series = 0.0014285714285714286 + t * series
         series = -0.15 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        w0 = sin_half**2
-        w1 = numpy.sin(phi)
-        out[big] = (0.125)*(-0.6666666666666666*w0*w1/(phi - w1) - 2*w0 + 1)/w0
     return out
 
 
-def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = -3.1578003265100976e-21
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -3.1578003265100976e-21
@@ -1463,20 +2092,40 @@ def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
         series = -0.0010714285714285715 + t * series
         series = -0.025 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
     return out
 
 
-def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 3.373091494469352e-23
+        series = 3.6770822088331955e-22 + t * series
+        series = 4.002447216098616e-21 + t * series
+        series = 4.349386634459199e-20 + t * series
+        series = 4.717726508806865e-19 + t * series
+        series = 5.106798451593866e-18 + t * series
+        series = 5.515287671491515e-17 + t * series
+        series = 5.941040609907155e-16 + t * series
+        series = 6.3808204484355186e-15 + t * series
+        series = 6.829994494116056e-14 + t * series
+        series = 7.28213114499937e-13 + t * series
+        series = 7.72847448568504e-12 + t * series
+        series = 8.157249203307483e-11 + t * series
+        series = 8.552722954369029e-10 + t * series
+        series = 8.893908470961609e-09 + t * series
+        series = 9.152703913733326e-08 + t * series
+        series = 9.291101000284673e-07 + t * series
+        series = 9.256715506715507e-06 + t * series
+        series = 8.974953617810761e-05 + t * series
+        series = 0.0008333333333333334 + t * series
+        series = 0.007142857142857143 + t * series
+        series = 0.05 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    out = numpy.asarray((0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 3.373091494469352e-23
@@ -1502,19 +2151,37 @@ def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
         series = 0.007142857142857143 + t * series
         series = 0.05 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        out[big] = (0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2
     return out
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = -3.1578003265100976e-21
+        series = -3.6980551434799796e-20 + t * series
+        series = -4.341734551994152e-19 + t * series
+        series = -5.112093930302394e-18 + t * series
+        series = -6.03885929516599e-17 + t * series
+        series = -7.160541684001784e-16 + t * series
+        series = -8.527828450903873e-15 + t * series
+        series = -1.0208698466596667e-13 + t * series
+        series = -1.2296404066927483e-12 + t * series
+        series = -1.4922439654526148e-11 + t * series
+        series = -1.82786662181949e-10 + t * series
+        series = -2.2657399287738925e-09 + t * series
+        series = -2.852981296858848e-08 + t * series
+        series = -3.671551662623091e-07 + t * series
+        series = -4.880437023294166e-06 + t * series
+        series = -6.845238095238096e-05 + t * series
+        series = -0.0010714285714285715 + t * series
+        series = -0.025 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -3.1578003265100976e-21
@@ -1536,20 +2203,46 @@ def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
         series = -0.0010714285714285715 + t * series
         series = -0.025 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        out[big] = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
     return out
 
 
-def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 2.892762495883202e-24
+        series = 3.1482187281713954e-23 + t * series
+        series = 3.420541589612275e-22 + t * series
+        series = 3.7095852246767656e-21 + t * series
+        series = 4.0148184318084914e-20 + t * series
+        series = 4.33520814322793e-19 + t * series
+        series = 4.669072870028677e-18 + t * series
+        series = 5.0138978831741045e-17 + t * series
+        series = 5.366101196045172e-16 + t * series
+        series = 5.720735574459431e-15 + t * series
+        series = 6.07110621699205e-14 + t * series
+        series = 6.408275407599445e-13 + t * series
+        series = 6.7204125962478614e-12 + t * series
+        series = 6.991927888549271e-11 + t * series
+        series = 7.202293014205498e-10 + t * series
+        series = 7.324395211380149e-09 + t * series
+        series = 7.32216313098666e-08 + t * series
+        series = 7.147000769449749e-07 + t * series
+        series = 6.732156732156732e-06 + t * series
+        series = 5.983302411873841e-05 + t * series
+        series = 0.0004761904761904762 + t * series
+        series = 0.002857142857142857 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = sin_half**2
+    w1 = w0**(-1.0)
+    w2 = cos_half*sin_half
+    w3 = (phi - 2*w2)**(-1.0)
+    w4 = 6*phi
+    w5 = 2*phi
+    w6 = -16*w2 + w4 + numpy.sin(w5)
+    out = numpy.asarray((0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 2.892762495883202e-24
@@ -1575,25 +2268,37 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
         series = 0.0004761904761904762 + t * series
         series = 0.002857142857142857 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = sin_half**2
-        w1 = w0**(-1.0)
-        w2 = cos_half*sin_half
-        w3 = (phi - 2*w2)**(-1.0)
-        w4 = 6*phi
-        w5 = 2*phi
-        w6 = -16*w2 + w4 + numpy.sin(w5)
-        out[big] = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4)
     return out
 
 
-def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = -6.315600653020195e-21
+        series = -7.396110286959959e-20 + t * series
+        series = -8.683469103988305e-19 + t * series
+        series = -1.0224187860604788e-17 + t * series
+        series = -1.207771859033198e-16 + t * series
+        series = -1.4321083368003567e-15 + t * series
+        series = -1.7055656901807745e-14 + t * series
+        series = -2.0417396933193335e-13 + t * series
+        series = -2.4592808133854965e-12 + t * series
+        series = -2.9844879309052296e-11 + t * series
+        series = -3.65573324363898e-10 + t * series
+        series = -4.531479857547785e-09 + t * series
+        series = -5.705962593717696e-08 + t * series
+        series = -7.343103325246182e-07 + t * series
+        series = -9.760874046588332e-06 + t * series
+        series = -0.0001369047619047619 + t * series
+        series = -0.002142857142857143 + t * series
+        series = -0.05 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    out = numpy.asarray((0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = -6.315600653020195e-21
@@ -1615,24 +2320,49 @@ def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
         series = -0.002142857142857143 + t * series
         series = -0.05 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        out[big] = (0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0))
     return out
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
 
-def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+        t = x
+        series = 6.497844255354877e-25
+        series = 7.196733448736306e-24 + t * series
+        series = 7.96467075122581e-23 + t * series
+        series = 8.807039512596957e-22 + t * series
+        series = 9.729237867259716e-21 + t * series
+        series = 1.0736521110134332e-19 + t * series
+        series = 1.1833776459135935e-18 + t * series
+        series = 1.3025203655982459e-17 + t * series
+        series = 1.4313863004846702e-16 + t * series
+        series = 1.5701034167431574e-15 + t * series
+        series = 1.718530004160428e-14 + t * series
+        series = 1.8761222591988522e-13 + t * series
+        series = 2.0417396933193335e-12 + t * series
+        series = 2.213352732046947e-11 + t * series
+        series = 2.3875903447241837e-10 + t * series
+        series = 2.559013270547286e-09 + t * series
+        series = 2.7188879145286708e-08 + t * series
+        series = 2.852981296858848e-07 + t * series
+        series = 2.937241330098473e-06 + t * series
+        series = 2.9282622139764997e-05 + t * series
+        series = 0.0002738095238095238 + t * series
+        series = 0.002142857142857143 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    w2 = (phi - w1)**(-1.0)
+    w3 = sin_half**2
+    w4 = 1 - 2*w3
+    w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+    out = numpy.asarray(-0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4, dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+        return out
     small = x < 4.619481091176478
-    out = numpy.empty_like(x)
     if small.any():
         t = x[small]
         series = 6.497844255354877e-25
@@ -1658,31 +2388,19 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
         series = 0.0002738095238095238 + t * series
         series = 0.002142857142857143 + t * series
         out[small] = series
-    if not small.all():
-        big = ~small
-        phi = phi[big]
-        sin_half = sin_half[big]
-        cos_half = cos_half[big]
-        w0 = cos_half*sin_half
-        w1 = 2*w0
-        w2 = (phi - w1)**(-1.0)
-        w3 = sin_half**2
-        w4 = 1 - 2*w3
-        w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
-        out[big] = -0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4
     return out
 
 
-def _e_0_32(x, phi, s, d, sin_half, cos_half):
+def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 1.0)
+    out = numpy.array(cos_half, dtype=x.dtype)
+    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+        return out
     small = x < 1.921189444436213e-14
-    out = numpy.empty_like(x)
     if small.any():
         series = 1.0
         out[small] = series
-    if not small.all():
-        big = ~small
-        cos_half = cos_half[big]
-        out[big] = cos_half
     return out
 
 
@@ -1871,10 +2589,16 @@ _USES_PHI = {
     "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
-_BLOCK = 16384
+_SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
+    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 0.764824235244299, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 0.764824235244299, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 1.4342812090283275, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 0.764824235244299, 'K_1': 1.4342812090283275, 'K_2': 2.6302227241416043, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
+    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 2.630222574480542, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 2.630222574480542, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 4.619481091176478, 'K_1': 2.630222574480542, 'K_2': 4.619481091176478, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
+}
+_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
+_SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+_FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
 _DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 E0_MIN = -numpy.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
@@ -1895,9 +2619,9 @@ def _as_float(value, name, shape):
     """value as a float32 or float64 array of shape (..., *shape); ValueError for anything else
     (complex, bool, object, string and datetime input is refused, never silently converted)."""
     value = numpy.asarray(value)
-    if value.dtype.kind not in "fiu":
-        raise ValueError(f"{name} must be a real float or integer array, got dtype {value.dtype}")
-    if value.dtype != numpy.float32:
+    if value.dtype != numpy.float64 and value.dtype != numpy.float32:  # float input is never copied
+        if value.dtype.kind not in "fiu":
+            raise ValueError(f"{name} must be a real float or integer array, got dtype {value.dtype}")
         value = value.astype(numpy.float64)
     if value.ndim < len(shape) or value.shape[value.ndim - len(shape):] != shape:
         raise ValueError(f"{name} must have shape (..., {', '.join(map(str, shape))}), got {value.shape}")
@@ -1912,9 +2636,17 @@ def _norm(v):
     return scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))
 
 
+def _squared_norm(p):
+    """x = |p|^2 = (p0^2 + p2^2) + p1^2: the one definition of x used by every validity test (the
+    summation order of NumPy's einsum on x86-64, used before; written out, it is 3 to 4 times
+    faster and the same on every CPU)."""
+    square = p * p
+    return numpy.asarray((square[..., 0] + square[..., 2]) + square[..., 1])
+
+
 def _length(p, suffix):
     """(|p|^2, |p|): the one definition of |p| used by every validity test."""
-    x = numpy.asarray(numpy.einsum("...i,...i->...", p, p))
+    x = _squared_norm(p)
     s = numpy.asarray(numpy.sqrt(x))
     extreme = ~((x >= _TINY[suffix]) & (x <= _HUGE[suffix]))
     if extreme.any():  # |p| without underflow or overflow
@@ -1928,26 +2660,53 @@ def _inside(x, suffix):
     return (x <= P_MAX_SQUARED) & (x < _X_LIMIT[suffix])
 
 
-def _prepare(p, names):
-    """p, (x, phi, s, d, sin(phi/2), cos(phi/2)), valid, suffix: the arguments of the coefficient
-    functions ``names`` (the half-angle sine and cosine computed once for all of them).
+def _span(x, suffix):
+    """(min x, max x) when every lane of x = |p|^2 is finite, in [_TINY, _HUGE] (|p| = sqrt(x)
+    without underflow or overflow) and safely inside the validity range; None otherwise (empty
+    input, NaN, a lane near or beyond the boundary), which takes the exact lane-by-lane tests."""
+    if x.size <= _SMALL:  # a Python list is cheaper than two NumPy reductions here
+        values = x.ravel().tolist()
+        if not values:
+            return None
+        low, high, total = min(values), max(values), sum(values)
+        if total != total:  # NaN: min and max of a list with NaN depend on the order
+            return None
+    else:
+        low, high = x.min(), x.max()  # NaN propagates and fails the tests below
+    if low >= _TINY[suffix] and high <= _HUGE[suffix] and high < _FAST_LIMIT[suffix]:
+        return low, high
+    return None
 
-    phi is computed only when one of them needs it (None otherwise)."""
+
+def _prepare(p, names):
+    """p, (x, phi, s, d, sin(phi/2), cos(phi/2), span), valid, suffix: the arguments of the
+    coefficient functions ``names`` (the half-angle sine and cosine computed once for all of them).
+
+    span = (min x, max x) when every lane is inside the range (see _span; then valid is
+    numpy.True_ and the coefficients take one branch on all lanes when the span allows), else
+    None.  phi is computed only when one of them needs it on some lane (None otherwise)."""
     p = _as_float(p, "p", (3,))
     suffix = "32" if p.dtype == numpy.float32 else "64"
-    x, s = _length(p, suffix)
-    valid = _inside(x, suffix)
-    if not valid.all():
-        p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
-        s = numpy.where(valid, s, 0.0).astype(p.dtype)
-        x = s * s
+    x = _squared_norm(p)
+    span = _span(x, suffix)
+    if span is not None:
+        s = numpy.sqrt(x)
+        valid = numpy.True_
+    else:
+        x, s = _length(p, suffix)
+        valid = _inside(x, suffix)
+        if not valid.all():
+            p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
+            s = numpy.where(valid, s, 0.0).astype(p.dtype)
+            x = numpy.where(valid, x, 0.0).astype(p.dtype)  # a lane's x never depends on the others
     d = None
     table = _USES_PHI[suffix]
-    if any(table[name] for name in names):
+    switch = _SWITCH[suffix]
+    if any(table[name] and (span is None or span[1] >= switch[name]) for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half)), valid, suffix
-    return p, (x, None, s, d, None, None), valid, suffix
+        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half), span), valid, suffix
+    return p, (x, None, s, d, None, None, span), valid, suffix
 
 
 def _scalar(p, name):
@@ -1957,14 +2716,45 @@ def _scalar(p, name):
 
 
 def _tensor(p, name):
-    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3), computed in cache-sized blocks."""
+    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3): written in place into the (n, 9) result,
+    in one pass for small n, else in cache-sized blocks."""
     p = _as_float(p, "p", (3,))
     shape = p.shape[:-1]
     flat = p.reshape(-1, 3)
     out = numpy.empty((flat.shape[0], 9), dtype=p.dtype)
-    for start in range(0, flat.shape[0], _BLOCK):
-        _tensor_block(flat[start:start + _BLOCK], name, out[start:start + _BLOCK])
+    if flat.shape[0] <= _SMALL:
+        _tensor_small(flat, name, out)
+    else:
+        for start in range(0, flat.shape[0], _BLOCK):
+            _tensor_block(flat[start:start + _BLOCK], name, out[start:start + _BLOCK])
     return out.reshape(*shape, 3, 3)
+
+
+# entry e = 3 i + j of T: the off-diagonal p_i p_j as (c p_I[e]) p_J[e] (the same product for
+# (i, j) and (j, i)), the cross term sign[e] p_K[e] with (p x)_ij = -eps_ijk p_k, and
+# T_ii = c0 - c2 (p_j^2 + p_k^2) from the squares _OTHER_1, _OTHER_2 (no cancellation against |p|^2)
+_I = numpy.array([0, 0, 0, 0, 1, 1, 0, 1, 2])
+_J = numpy.array([0, 1, 2, 1, 1, 2, 2, 2, 2])
+_K = numpy.array([0, 2, 1, 2, 0, 0, 1, 0, 0])
+_SIGN = {"64": numpy.array([0.0, -1.0, 1.0, 1.0, 0.0, -1.0, -1.0, 1.0, 0.0])}
+_SIGN["32"] = _SIGN["64"].astype(numpy.float32)
+_OTHER_1 = numpy.array([1, 0, 0])
+_OTHER_2 = numpy.array([2, 2, 1])
+_DIAGONAL = numpy.array([0, 4, 8])
+
+
+def _tensor_small(p, name, out):
+    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
+    table = _COEFFICIENTS[suffix]
+    a = table[name + "_0"](*state)
+    b = table[name + "_1"](*state)
+    c = table[name + "_2"](*state)
+    numpy.multiply((c[:, None] * p)[:, _I], p[:, _J], out=out)
+    out += (b[:, None] * p)[:, _K] * _SIGN[suffix]
+    square = p * p
+    out[:, _DIAGONAL] = a[:, None] - c[:, None] * (square[:, _OTHER_1] + square[:, _OTHER_2])
+    if valid is not numpy.True_:
+        out[~valid] = numpy.nan
 
 
 def _tensor_block(p, name, out):
@@ -1973,25 +2763,23 @@ def _tensor_block(p, name, out):
     a = table[name + "_0"](*state)
     b = table[name + "_1"](*state)
     c = table[name + "_2"](*state)
-    p0, p1, p2 = p.T
+    p0, p1, p2 = p.T.copy()  # contiguous components
     c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
     s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
-    m = numpy.empty((9, p.shape[0]), dtype=p.dtype)  # entry-major: contiguous writes
-    m[0] = a - c * (s1 + s2)  # T_ii = c0 - c2 (p_j^2 + p_k^2): no cancellation against |p|^2
-    m[4] = a - c * (s0 + s2)
-    m[8] = a - c * (s0 + s1)
+    numpy.subtract(a, c * (s1 + s2), out=out[:, 0])  # T_ii = c0 - c2 (p_j^2 + p_k^2)
+    numpy.subtract(a, c * (s0 + s2), out=out[:, 4])
+    numpy.subtract(a, c * (s0 + s1), out=out[:, 8])
     q = c0 * p1
-    m[1] = q - b2
-    m[3] = q + b2
+    numpy.subtract(q, b2, out=out[:, 1])
+    numpy.add(q, b2, out=out[:, 3])
     q = c0 * p2
-    m[2] = q + b1
-    m[6] = q - b1
+    numpy.add(q, b1, out=out[:, 2])
+    numpy.subtract(q, b1, out=out[:, 6])
     q = c1 * p2
-    m[5] = q - b0
-    m[7] = q + b0
-    out[:] = m.T
-    if not valid.all():
+    numpy.subtract(q, b0, out=out[:, 5])
+    numpy.add(q, b0, out=out[:, 7])
+    if valid is not numpy.True_:
         out[~valid] = numpy.nan
 
 

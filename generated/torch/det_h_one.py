@@ -600,6 +600,252 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283275
+    t = _where(small, x, 0.0)
+    series = 1.4590852718839616e-19 + 0.0 * x
+    series = 1.6712992943913682e-18 + t * series
+    series = 1.9164647128732757e-17 + t * series
+    series = 2.2002829132536273e-16 + t * series
+    series = 2.5296275904133537e-15 + t * series
+    series = 2.912852457999748e-14 + t * series
+    series = 3.360206298123931e-13 + t * series
+    series = 3.884404382527373e-12 + t * series
+    series = 4.5014331338784364e-11 + t * series
+    series = 5.231710865271535e-10 + t * series
+    series = 6.10180260915555e-09 + t * series
+    series = 7.14700076944975e-08 + t * series
+    series = 8.415195915195915e-07 + t * series
+    series = 9.9721706864564e-06 + t * series
+    series = 0.00011904761904761905 + t * series
+    series = 0.0014285714285714286 + t * series
+    series = -0.15 + t * series
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    w0 = sin_half**2
+    closed = (0.125)*(-1.3333333333333333*cos_half*sin_half**3/(-2*cos_half*sin_half + phi) - 2*w0 + 1)/w0
+    return _where(small, series, closed)
+
+
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    t = _where(small, x, 0.0)
+    series = -1.713507963984835e-25 + 0.0 * x
+    series = -1.9911676878064524e-24 + t * series
+    series = -2.3176419769991988e-23 + t * series
+    series = -2.70256607423881e-22 + t * series
+    series = -3.1578003265100976e-21 + t * series
+    series = -3.6980551434799796e-20 + t * series
+    series = -4.341734551994152e-19 + t * series
+    series = -5.112093930302394e-18 + t * series
+    series = -6.03885929516599e-17 + t * series
+    series = -7.160541684001784e-16 + t * series
+    series = -8.527828450903873e-15 + t * series
+    series = -1.0208698466596667e-13 + t * series
+    series = -1.2296404066927483e-12 + t * series
+    series = -1.4922439654526148e-11 + t * series
+    series = -1.82786662181949e-10 + t * series
+    series = -2.2657399287738925e-09 + t * series
+    series = -2.852981296858848e-08 + t * series
+    series = -3.671551662623091e-07 + t * series
+    series = -4.880437023294166e-06 + t * series
+    series = -6.845238095238096e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.025 + t * series
+    phi = _where(small, 1.7023118078717785, phi)
+    sin_half = _where(small, 0.7520427801883164, sin_half)
+    cos_half = _where(small, 0.6591142971948246, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    closed = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
+    return _where(small, series, closed)
+
+
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812090283275
+    t = _where(small, x, 0.0)
+    series = 4.002447216098616e-21 + 0.0 * x
+    series = 4.349386634459199e-20 + t * series
+    series = 4.717726508806865e-19 + t * series
+    series = 5.106798451593866e-18 + t * series
+    series = 5.515287671491515e-17 + t * series
+    series = 5.941040609907155e-16 + t * series
+    series = 6.3808204484355186e-15 + t * series
+    series = 6.829994494116056e-14 + t * series
+    series = 7.28213114499937e-13 + t * series
+    series = 7.72847448568504e-12 + t * series
+    series = 8.157249203307483e-11 + t * series
+    series = 8.552722954369029e-10 + t * series
+    series = 8.893908470961609e-09 + t * series
+    series = 9.152703913733326e-08 + t * series
+    series = 9.291101000284673e-07 + t * series
+    series = 9.256715506715507e-06 + t * series
+    series = 8.974953617810761e-05 + t * series
+    series = 0.0008333333333333334 + t * series
+    series = 0.007142857142857143 + t * series
+    series = 0.05 + t * series
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    w0 = cos_half*sin_half
+    closed = (0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2
+    return _where(small, series, closed)
+
+
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    t = _where(small, x, 0.0)
+    series = -1.713507963984835e-25 + 0.0 * x
+    series = -1.9911676878064524e-24 + t * series
+    series = -2.3176419769991988e-23 + t * series
+    series = -2.70256607423881e-22 + t * series
+    series = -3.1578003265100976e-21 + t * series
+    series = -3.6980551434799796e-20 + t * series
+    series = -4.341734551994152e-19 + t * series
+    series = -5.112093930302394e-18 + t * series
+    series = -6.03885929516599e-17 + t * series
+    series = -7.160541684001784e-16 + t * series
+    series = -8.527828450903873e-15 + t * series
+    series = -1.0208698466596667e-13 + t * series
+    series = -1.2296404066927483e-12 + t * series
+    series = -1.4922439654526148e-11 + t * series
+    series = -1.82786662181949e-10 + t * series
+    series = -2.2657399287738925e-09 + t * series
+    series = -2.852981296858848e-08 + t * series
+    series = -3.671551662623091e-07 + t * series
+    series = -4.880437023294166e-06 + t * series
+    series = -6.845238095238096e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.025 + t * series
+    phi = _where(small, 1.7023118078717785, phi)
+    sin_half = _where(small, 0.7520427801883164, sin_half)
+    cos_half = _where(small, 0.6591142971948246, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    closed = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
+    return _where(small, series, closed)
+
+
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    t = _where(small, x, 0.0)
+    series = 2.892762495883202e-24 + 0.0 * x
+    series = 3.1482187281713954e-23 + t * series
+    series = 3.420541589612275e-22 + t * series
+    series = 3.7095852246767656e-21 + t * series
+    series = 4.0148184318084914e-20 + t * series
+    series = 4.33520814322793e-19 + t * series
+    series = 4.669072870028677e-18 + t * series
+    series = 5.0138978831741045e-17 + t * series
+    series = 5.366101196045172e-16 + t * series
+    series = 5.720735574459431e-15 + t * series
+    series = 6.07110621699205e-14 + t * series
+    series = 6.408275407599445e-13 + t * series
+    series = 6.7204125962478614e-12 + t * series
+    series = 6.991927888549271e-11 + t * series
+    series = 7.202293014205498e-10 + t * series
+    series = 7.324395211380149e-09 + t * series
+    series = 7.32216313098666e-08 + t * series
+    series = 7.147000769449749e-07 + t * series
+    series = 6.732156732156732e-06 + t * series
+    series = 5.983302411873841e-05 + t * series
+    series = 0.0004761904761904762 + t * series
+    series = 0.002857142857142857 + t * series
+    phi = _where(small, 1.7023118078717785, phi)
+    sin_half = _where(small, 0.7520427801883164, sin_half)
+    cos_half = _where(small, 0.6591142971948246, cos_half)
+    w0 = sin_half**2
+    w1 = w0**(-1.0)
+    w2 = cos_half*sin_half
+    w3 = (phi - 2*w2)**(-1.0)
+    w4 = 6*phi
+    w5 = 2*phi
+    w6 = -16*w2 + w4 + _xp.sin(w5)
+    closed = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + _xp.cos(w5) - 1) + (0.5)*w3*w6)*_cbrt(12*w2 - w4)
+    return _where(small, series, closed)
+
+
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    t = _where(small, x, 0.0)
+    series = -3.42701592796967e-25 + 0.0 * x
+    series = -3.982335375612905e-24 + t * series
+    series = -4.6352839539983977e-23 + t * series
+    series = -5.40513214847762e-22 + t * series
+    series = -6.315600653020195e-21 + t * series
+    series = -7.396110286959959e-20 + t * series
+    series = -8.683469103988305e-19 + t * series
+    series = -1.0224187860604788e-17 + t * series
+    series = -1.207771859033198e-16 + t * series
+    series = -1.4321083368003567e-15 + t * series
+    series = -1.7055656901807745e-14 + t * series
+    series = -2.0417396933193335e-13 + t * series
+    series = -2.4592808133854965e-12 + t * series
+    series = -2.9844879309052296e-11 + t * series
+    series = -3.65573324363898e-10 + t * series
+    series = -4.531479857547785e-09 + t * series
+    series = -5.705962593717696e-08 + t * series
+    series = -7.343103325246182e-07 + t * series
+    series = -9.760874046588332e-06 + t * series
+    series = -0.0001369047619047619 + t * series
+    series = -0.002142857142857143 + t * series
+    series = -0.05 + t * series
+    phi = _where(small, 1.7023118078717785, phi)
+    sin_half = _where(small, 0.7520427801883164, sin_half)
+    cos_half = _where(small, 0.6591142971948246, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    closed = (0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
+    return _where(small, series, closed)
+
+
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.6302227241416043
+    t = _where(small, x, 0.0)
+    series = 6.497844255354877e-25 + 0.0 * x
+    series = 7.196733448736306e-24 + t * series
+    series = 7.96467075122581e-23 + t * series
+    series = 8.807039512596957e-22 + t * series
+    series = 9.729237867259716e-21 + t * series
+    series = 1.0736521110134332e-19 + t * series
+    series = 1.1833776459135935e-18 + t * series
+    series = 1.3025203655982459e-17 + t * series
+    series = 1.4313863004846702e-16 + t * series
+    series = 1.5701034167431574e-15 + t * series
+    series = 1.718530004160428e-14 + t * series
+    series = 1.8761222591988522e-13 + t * series
+    series = 2.0417396933193335e-12 + t * series
+    series = 2.213352732046947e-11 + t * series
+    series = 2.3875903447241837e-10 + t * series
+    series = 2.559013270547286e-09 + t * series
+    series = 2.7188879145286708e-08 + t * series
+    series = 2.852981296858848e-07 + t * series
+    series = 2.937241330098473e-06 + t * series
+    series = 2.9282622139764997e-05 + t * series
+    series = 0.0002738095238095238 + t * series
+    series = 0.002142857142857143 + t * series
+    phi = _where(small, 1.7023118078717785, phi)
+    sin_half = _where(small, 0.7520427801883164, sin_half)
+    cos_half = _where(small, 0.6591142971948246, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    w2 = (phi - w1)**(-1.0)
+    w3 = sin_half**2
+    w4 = 1 - 2*w3
+    w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+    closed = -0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4
+    return _where(small, series, closed)
+
+
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
@@ -1098,6 +1344,236 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 2.630222574480542
+    t = _where(small, x, 0.0)
+    series = 3.360206298123931e-13 + 0.0 * x
+    series = 3.884404382527373e-12 + t * series
+    series = 4.5014331338784364e-11 + t * series
+    series = 5.231710865271535e-10 + t * series
+    series = 6.10180260915555e-09 + t * series
+    series = 7.14700076944975e-08 + t * series
+    series = 8.415195915195915e-07 + t * series
+    series = 9.9721706864564e-06 + t * series
+    series = 0.00011904761904761905 + t * series
+    series = 0.0014285714285714286 + t * series
+    series = -0.15 + t * series
+    phi = _where(small, 1.7023118078717785, phi)
+    sin_half = _where(small, 0.7520427801883164, sin_half)
+    w0 = sin_half**2
+    w1 = _xp.sin(phi)
+    closed = (0.125)*(-0.6666666666666666*w0*w1/(phi - w1) - 2*w0 + 1)/w0
+    return _where(small, series, closed)
+
+
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    t = _where(small, x, 0.0)
+    series = -3.1578003265100976e-21 + 0.0 * x
+    series = -3.6980551434799796e-20 + t * series
+    series = -4.341734551994152e-19 + t * series
+    series = -5.112093930302394e-18 + t * series
+    series = -6.03885929516599e-17 + t * series
+    series = -7.160541684001784e-16 + t * series
+    series = -8.527828450903873e-15 + t * series
+    series = -1.0208698466596667e-13 + t * series
+    series = -1.2296404066927483e-12 + t * series
+    series = -1.4922439654526148e-11 + t * series
+    series = -1.82786662181949e-10 + t * series
+    series = -2.2657399287738925e-09 + t * series
+    series = -2.852981296858848e-08 + t * series
+    series = -3.671551662623091e-07 + t * series
+    series = -4.880437023294166e-06 + t * series
+    series = -6.845238095238096e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.025 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    closed = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
+    return _where(small, series, closed)
+
+
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    t = _where(small, x, 0.0)
+    series = 3.373091494469352e-23 + 0.0 * x
+    series = 3.6770822088331955e-22 + t * series
+    series = 4.002447216098616e-21 + t * series
+    series = 4.349386634459199e-20 + t * series
+    series = 4.717726508806865e-19 + t * series
+    series = 5.106798451593866e-18 + t * series
+    series = 5.515287671491515e-17 + t * series
+    series = 5.941040609907155e-16 + t * series
+    series = 6.3808204484355186e-15 + t * series
+    series = 6.829994494116056e-14 + t * series
+    series = 7.28213114499937e-13 + t * series
+    series = 7.72847448568504e-12 + t * series
+    series = 8.157249203307483e-11 + t * series
+    series = 8.552722954369029e-10 + t * series
+    series = 8.893908470961609e-09 + t * series
+    series = 9.152703913733326e-08 + t * series
+    series = 9.291101000284673e-07 + t * series
+    series = 9.256715506715507e-06 + t * series
+    series = 8.974953617810761e-05 + t * series
+    series = 0.0008333333333333334 + t * series
+    series = 0.007142857142857143 + t * series
+    series = 0.05 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = cos_half*sin_half
+    closed = (0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2
+    return _where(small, series, closed)
+
+
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    t = _where(small, x, 0.0)
+    series = -3.1578003265100976e-21 + 0.0 * x
+    series = -3.6980551434799796e-20 + t * series
+    series = -4.341734551994152e-19 + t * series
+    series = -5.112093930302394e-18 + t * series
+    series = -6.03885929516599e-17 + t * series
+    series = -7.160541684001784e-16 + t * series
+    series = -8.527828450903873e-15 + t * series
+    series = -1.0208698466596667e-13 + t * series
+    series = -1.2296404066927483e-12 + t * series
+    series = -1.4922439654526148e-11 + t * series
+    series = -1.82786662181949e-10 + t * series
+    series = -2.2657399287738925e-09 + t * series
+    series = -2.852981296858848e-08 + t * series
+    series = -3.671551662623091e-07 + t * series
+    series = -4.880437023294166e-06 + t * series
+    series = -6.845238095238096e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.025 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    closed = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
+    return _where(small, series, closed)
+
+
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    t = _where(small, x, 0.0)
+    series = 2.892762495883202e-24 + 0.0 * x
+    series = 3.1482187281713954e-23 + t * series
+    series = 3.420541589612275e-22 + t * series
+    series = 3.7095852246767656e-21 + t * series
+    series = 4.0148184318084914e-20 + t * series
+    series = 4.33520814322793e-19 + t * series
+    series = 4.669072870028677e-18 + t * series
+    series = 5.0138978831741045e-17 + t * series
+    series = 5.366101196045172e-16 + t * series
+    series = 5.720735574459431e-15 + t * series
+    series = 6.07110621699205e-14 + t * series
+    series = 6.408275407599445e-13 + t * series
+    series = 6.7204125962478614e-12 + t * series
+    series = 6.991927888549271e-11 + t * series
+    series = 7.202293014205498e-10 + t * series
+    series = 7.324395211380149e-09 + t * series
+    series = 7.32216313098666e-08 + t * series
+    series = 7.147000769449749e-07 + t * series
+    series = 6.732156732156732e-06 + t * series
+    series = 5.983302411873841e-05 + t * series
+    series = 0.0004761904761904762 + t * series
+    series = 0.002857142857142857 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = sin_half**2
+    w1 = w0**(-1.0)
+    w2 = cos_half*sin_half
+    w3 = (phi - 2*w2)**(-1.0)
+    w4 = 6*phi
+    w5 = 2*phi
+    w6 = -16*w2 + w4 + _xp.sin(w5)
+    closed = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + _xp.cos(w5) - 1) + (0.5)*w3*w6)*_cbrt(12*w2 - w4)
+    return _where(small, series, closed)
+
+
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    t = _where(small, x, 0.0)
+    series = -6.315600653020195e-21 + 0.0 * x
+    series = -7.396110286959959e-20 + t * series
+    series = -8.683469103988305e-19 + t * series
+    series = -1.0224187860604788e-17 + t * series
+    series = -1.207771859033198e-16 + t * series
+    series = -1.4321083368003567e-15 + t * series
+    series = -1.7055656901807745e-14 + t * series
+    series = -2.0417396933193335e-13 + t * series
+    series = -2.4592808133854965e-12 + t * series
+    series = -2.9844879309052296e-11 + t * series
+    series = -3.65573324363898e-10 + t * series
+    series = -4.531479857547785e-09 + t * series
+    series = -5.705962593717696e-08 + t * series
+    series = -7.343103325246182e-07 + t * series
+    series = -9.760874046588332e-06 + t * series
+    series = -0.0001369047619047619 + t * series
+    series = -0.002142857142857143 + t * series
+    series = -0.05 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    closed = (0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
+    return _where(small, series, closed)
+
+
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 4.619481091176478
+    t = _where(small, x, 0.0)
+    series = 6.497844255354877e-25 + 0.0 * x
+    series = 7.196733448736306e-24 + t * series
+    series = 7.96467075122581e-23 + t * series
+    series = 8.807039512596957e-22 + t * series
+    series = 9.729237867259716e-21 + t * series
+    series = 1.0736521110134332e-19 + t * series
+    series = 1.1833776459135935e-18 + t * series
+    series = 1.3025203655982459e-17 + t * series
+    series = 1.4313863004846702e-16 + t * series
+    series = 1.5701034167431574e-15 + t * series
+    series = 1.718530004160428e-14 + t * series
+    series = 1.8761222591988522e-13 + t * series
+    series = 2.0417396933193335e-12 + t * series
+    series = 2.213352732046947e-11 + t * series
+    series = 2.3875903447241837e-10 + t * series
+    series = 2.559013270547286e-09 + t * series
+    series = 2.7188879145286708e-08 + t * series
+    series = 2.852981296858848e-07 + t * series
+    series = 2.937241330098473e-06 + t * series
+    series = 2.9282622139764997e-05 + t * series
+    series = 0.0002738095238095238 + t * series
+    series = 0.002142857142857143 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = cos_half*sin_half
+    w1 = 2*w0
+    w2 = (phi - w1)**(-1.0)
+    w3 = sin_half**2
+    w4 = 1 - 2*w3
+    w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+    closed = -0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4
+    return _where(small, series, closed)
+
+
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
@@ -1246,6 +1722,15 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "R_0_x": _R_0_x_64,
+        "R_1_x": _R_1_x_64,
+        "R_2_x": _R_2_x_64,
+        "H_0_x": _H_0_x_64,
+        "H_1_x": _H_1_x_64,
+        "H_2_x": _H_2_x_64,
+        "H_inverse_0_x": _H_inverse_0_x_64,
+        "H_inverse_1_x": _H_inverse_1_x_64,
+        "H_inverse_2_x": _H_inverse_2_x_64,
         "e_0": _e_0_64,
     },
     "32": {
@@ -1269,14 +1754,23 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "R_0_x": _R_0_x_32,
+        "R_1_x": _R_1_x_32,
+        "R_2_x": _R_2_x_32,
+        "H_0_x": _H_0_x_32,
+        "H_1_x": _H_1_x_32,
+        "H_2_x": _H_2_x_32,
+        "H_inverse_0_x": _H_inverse_0_x_32,
+        "H_inverse_1_x": _H_inverse_1_x_32,
+        "H_inverse_2_x": _H_inverse_2_x_32,
         "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'e_0': True},
-    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'e_0': True},
+    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
+    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}

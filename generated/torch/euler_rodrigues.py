@@ -209,6 +209,42 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return (-(0.25)/_xp.sqrt(d)) + 0.0 * x
+
+
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return (d**(-1.5)) + 0.0 * x
+
+
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return ((0.25)/d**(1.5)) + 0.0 * x
+
+
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return (-(0.25)/_xp.sqrt(d)) + 0.0 * x
+
+
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
     return ((0.5)*_xp.sqrt(d)) + 0.0 * x
 
@@ -332,6 +368,50 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow((-(0.25)/_xp.sqrt(d)) + 0.0 * x, s)
+
+
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow((d**(-1.5)) + 0.0 * x, s)
+
+
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow(((0.25)/d**(1.5)) + 0.0 * x, s)
+
+
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow((-(0.25)/_xp.sqrt(d)) + 0.0 * x, s)
+
+
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
@@ -373,6 +453,15 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "R_0_x": _R_0_x_64,
+        "R_1_x": _R_1_x_64,
+        "R_2_x": _R_2_x_64,
+        "H_0_x": _H_0_x_64,
+        "H_1_x": _H_1_x_64,
+        "H_2_x": _H_2_x_64,
+        "H_inverse_0_x": _H_inverse_0_x_64,
+        "H_inverse_1_x": _H_inverse_1_x_64,
+        "H_inverse_2_x": _H_inverse_2_x_64,
         "e_0": _e_0_64,
     },
     "32": {
@@ -396,14 +485,23 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "R_0_x": _R_0_x_32,
+        "R_1_x": _R_1_x_32,
+        "R_2_x": _R_2_x_32,
+        "H_0_x": _H_0_x_32,
+        "H_1_x": _H_1_x_32,
+        "H_2_x": _H_2_x_32,
+        "H_inverse_0_x": _H_inverse_0_x_32,
+        "H_inverse_1_x": _H_inverse_1_x_32,
+        "H_inverse_2_x": _H_inverse_2_x_32,
         "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
-    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'e_0': False},
+    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
+    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}

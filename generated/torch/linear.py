@@ -281,6 +281,67 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return ((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x
+
+
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return ((0.5)/d**(1.5)) + 0.0 * x
+
+
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return ((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x
+
+
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.116472206314816
+    t = _where(small, x, 0.0)
+    series = 2.382043064772006 + 0.0 * x
+    series = 2.3145357714383863 + t * series
+    series = 2.245030192716513 + t * series
+    series = 2.1733401529490948 + t * series
+    series = 2.0992490113712847 + t * series
+    series = 2.0225022733211517 + t * series
+    series = 1.9427977502346039 + t * series
+    series = 1.8597722053527832 + t * series
+    series = 1.7729828357696533 + t * series
+    series = 1.6818809509277344 + t * series
+    series = 1.5857734680175781 + t * series
+    series = 1.4837646484375 + t * series
+    series = 1.374664306640625 + t * series
+    series = 1.2568359375 + t * series
+    series = 1.1279296875 + t * series
+    series = 0.984375 + t * series
+    series = 0.8203125 + t * series
+    series = 0.625 + t * series
+    series = 0.375 + t * series
+    d = _where(small, 0.883527793685184, d)
+    w0 = _xp.sqrt(d)
+    w1 = (w0 + 1)**(-1.0)
+    closed = (0.5)*w1*(w1 + w0**(-1.0))/d
+    return _where(small, series, closed)
+
+
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return (-(0.5)/_xp.sqrt(d)) + 0.0 * x
+
+
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+    return (-(0.25)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x
+
+
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.010853448794044025
     t = _where(small, x, 0.0)
@@ -475,6 +536,65 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow(((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x, s)
+
+
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow(((0.5)/d**(1.5)) + 0.0 * x, s)
+
+
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow(((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x, s)
+
+
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.06494452598491793
+    t = _where(small, x, 0.0)
+    series = 1.374664306640625 + 0.0 * x
+    series = 1.2568359375 + t * series
+    series = 1.1279296875 + t * series
+    series = 0.984375 + t * series
+    series = 0.8203125 + t * series
+    series = 0.625 + t * series
+    series = 0.375 + t * series
+    d = _where(small, 0.935055474015082, d)
+    w0 = _xp.sqrt(d)
+    w1 = (w0 + 1)**(-1.0)
+    closed = (0.5)*w1*(w1 + w0**(-1.0))/d
+    return _where(small, series, closed)
+
+
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow((-(0.5)/_xp.sqrt(d)) + 0.0 * x, s)
+
+
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    d = _wide(d)
+    return _narrow((-(0.25)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x, s)
+
+
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.20569006626255124
     t = _where(small, x, 0.0)
@@ -526,6 +646,15 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "R_0_x": _R_0_x_64,
+        "R_1_x": _R_1_x_64,
+        "R_2_x": _R_2_x_64,
+        "H_0_x": _H_0_x_64,
+        "H_1_x": _H_1_x_64,
+        "H_2_x": _H_2_x_64,
+        "H_inverse_0_x": _H_inverse_0_x_64,
+        "H_inverse_1_x": _H_inverse_1_x_64,
+        "H_inverse_2_x": _H_inverse_2_x_64,
         "e_0": _e_0_64,
     },
     "32": {
@@ -549,14 +678,23 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "R_0_x": _R_0_x_32,
+        "R_1_x": _R_1_x_32,
+        "R_2_x": _R_2_x_32,
+        "H_0_x": _H_0_x_32,
+        "H_1_x": _H_1_x_32,
+        "H_2_x": _H_2_x_32,
+        "H_inverse_0_x": _H_inverse_0_x_32,
+        "H_inverse_1_x": _H_inverse_1_x_32,
+        "H_inverse_2_x": _H_inverse_2_x_32,
         "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'e_0': True},
-    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'e_0': True},
+    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': True},
+    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': True},
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}

@@ -362,6 +362,134 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.7851233626304374
+    t = _where(small, x, 0.0)
+    series = -7.398571721961897e-17 + 0.0 * x
+    series = 2.2491658034764165e-14 + t * series
+    series = -5.353014612273871e-12 + t * series
+    series = 9.635426302092969e-10 + t * series
+    series = -1.252605419272086e-07 + t * series
+    series = 1.1022927689594357e-05 + t * series
+    series = -0.0005952380952380953 + t * series
+    series = 0.016666666666666666 + t * series
+    series = -0.16666666666666666 + t * series
+    phi = _where(small, 0.886071872158482, phi)
+    closed = (0.5)*(_xp.cos(phi) - _xp.sin(phi)/phi)/phi**2
+    return _where(small, series, closed)
+
+
+def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.5673482008975155
+    t = _where(small, x, 0.0)
+    series = 2.975515515869757e-26 + 0.0 * x
+    series = -1.77291132820573e-23 + t * series
+    series = 8.896791392450573e-21 + t * series
+    series = -3.6992858609809485e-18 + t * series
+    series = 1.249536557486898e-15 + t * series
+    series = -3.3456341326711696e-13 + t * series
+    series = 6.882447358637835e-11 + t * series
+    series = -1.043837849393405e-08 + t * series
+    series = 1.1022927689594355e-06 + t * series
+    series = -7.440476190476191e-05 + t * series
+    series = 0.002777777777777778 + t * series
+    series = -0.041666666666666664 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3
+    return _where(small, series, closed)
+
+
+def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.5673482008975155
+    t = _where(small, x, 0.0)
+    series = 2.975515515869757e-26 + 0.0 * x
+    series = -1.77291132820573e-23 + t * series
+    series = 8.896791392450573e-21 + t * series
+    series = -3.6992858609809485e-18 + t * series
+    series = 1.249536557486898e-15 + t * series
+    series = -3.3456341326711696e-13 + t * series
+    series = 6.882447358637835e-11 + t * series
+    series = -1.043837849393405e-08 + t * series
+    series = 1.1022927689594355e-06 + t * series
+    series = -7.440476190476191e-05 + t * series
+    series = 0.002777777777777778 + t * series
+    series = -0.041666666666666664 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3
+    return _where(small, series, closed)
+
+
+def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.5673482008975155
+    t = _where(small, x, 0.0)
+    series = -7.091645312822921e-25 + 0.0 * x
+    series = 3.868170170630684e-22 + t * series
+    series = -1.7615646957052136e-19 + t * series
+    series = 6.576508197299464e-17 + t * series
+    series = -1.9680200780418645e-14 + t * series
+    series = 4.58829823909189e-12 + t * series
+    series = -8.029521918410807e-10 + t * series
+    series = 1.0020843354176688e-07 + t * series
+    series = -8.267195767195768e-06 + t * series
+    series = 0.0003968253968253968 + t * series
+    series = -0.008333333333333333 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    closed = (0.5)*(-_xp.cos(phi) + 1 + 3*(-phi + _xp.sin(phi))/phi)/phi**4
+    return _where(small, series, closed)
+
+
+def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.5673482008975155
+    t = _where(small, x, 0.0)
+    series = 3.1866552573834097e-34 + 0.0 * x
+    series = 1.1981343524964268e-32 + t * series
+    series = 4.4935425898311966e-31 + t * series
+    series = 1.6806121662771081e-29 + t * series
+    series = 6.266191399131027e-28 + t * series
+    series = 2.328275960983784e-26 + t * series
+    series = 8.617186003308303e-25 + t * series
+    series = 3.1751334332727565e-23 + t * series
+    series = 1.163957265514881e-21 + t * series
+    series = 4.241648447555361e-20 + t * series
+    series = 1.5349911154393775e-18 + t * series
+    series = 5.5090028283602297e-17 + t * series
+    series = 1.9573818287022555e-15 + t * series
+    series = 6.868849645022276e-14 + t * series
+    series = 2.372776207425808e-12 + t * series
+    series = 8.029521918410807e-11 + t * series
+    series = 2.6420950693437467e-09 + t * series
+    series = 8.35070279514724e-08 + t * series
+    series = 2.48015873015873e-06 + t * series
+    series = 6.613756613756614e-05 + t * series
+    series = 0.001388888888888889 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = sin_half**2
+    closed = (0.5)*((0.25)*(2*cos_half**2*phi - 2*cos_half*sin_half - phi*(1 - 2*w0))/w0 - (-cos_half*phi/sin_half + 2)/phi)/phi**3
+    return _where(small, series, closed)
+
+
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.5083706105984371
     t = _where(small, x, 0.0)
@@ -613,6 +741,112 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.567347935831094
+    t = _where(small, x, 0.0)
+    series = -5.353014612273871e-12 + 0.0 * x
+    series = 9.635426302092969e-10 + t * series
+    series = -1.252605419272086e-07 + t * series
+    series = 1.1022927689594357e-05 + t * series
+    series = -0.0005952380952380953 + t * series
+    series = 0.016666666666666666 + t * series
+    series = -0.16666666666666666 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.5)*(-2*cos_half*sin_half/phi - 2*sin_half**2 + 1)/phi**2
+    return _where(small, series, closed)
+
+
+def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.567347935831094
+    t = _where(small, x, 0.0)
+    series = -3.3456341326711696e-13 + 0.0 * x
+    series = 6.882447358637835e-11 + t * series
+    series = -1.043837849393405e-08 + t * series
+    series = 1.1022927689594355e-06 + t * series
+    series = -7.440476190476191e-05 + t * series
+    series = 0.002777777777777778 + t * series
+    series = -0.041666666666666664 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3
+    return _where(small, series, closed)
+
+
+def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.567347935831094
+    t = _where(small, x, 0.0)
+    series = -3.3456341326711696e-13 + 0.0 * x
+    series = 6.882447358637835e-11 + t * series
+    series = -1.043837849393405e-08 + t * series
+    series = 1.1022927689594355e-06 + t * series
+    series = -7.440476190476191e-05 + t * series
+    series = 0.002777777777777778 + t * series
+    series = -0.041666666666666664 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3
+    return _where(small, series, closed)
+
+
+def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.567347935831094
+    t = _where(small, x, 0.0)
+    series = -1.9680200780418645e-14 + 0.0 * x
+    series = 4.58829823909189e-12 + t * series
+    series = -8.029521918410807e-10 + t * series
+    series = 1.0020843354176688e-07 + t * series
+    series = -8.267195767195768e-06 + t * series
+    series = 0.0003968253968253968 + t * series
+    series = -0.008333333333333333 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.5)*(2*sin_half**2 + 3*(2*cos_half*sin_half - phi)/phi)/phi**4
+    return _where(small, series, closed)
+
+
+def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 0.0)
+
+
+def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 5.567347935831094
+    t = _where(small, x, 0.0)
+    series = 1.5349911154393775e-18 + 0.0 * x
+    series = 5.5090028283602297e-17 + t * series
+    series = 1.9573818287022555e-15 + t * series
+    series = 6.868849645022276e-14 + t * series
+    series = 2.372776207425808e-12 + t * series
+    series = 8.029521918410807e-11 + t * series
+    series = 2.6420950693437467e-09 + t * series
+    series = 8.35070279514724e-08 + t * series
+    series = 2.48015873015873e-06 + t * series
+    series = 6.613756613756614e-05 + t * series
+    series = 0.001388888888888889 + t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    w0 = sin_half**2
+    closed = (0.5)*((0.25)*(2*cos_half**2*phi - 2*cos_half*sin_half - phi*(1 - 2*w0))/w0 - (-cos_half*phi/sin_half + 2)/phi)/phi**3
+    return _where(small, series, closed)
+
+
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
@@ -673,6 +907,15 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "R_0_x": _R_0_x_64,
+        "R_1_x": _R_1_x_64,
+        "R_2_x": _R_2_x_64,
+        "H_0_x": _H_0_x_64,
+        "H_1_x": _H_1_x_64,
+        "H_2_x": _H_2_x_64,
+        "H_inverse_0_x": _H_inverse_0_x_64,
+        "H_inverse_1_x": _H_inverse_1_x_64,
+        "H_inverse_2_x": _H_inverse_2_x_64,
         "e_0": _e_0_64,
     },
     "32": {
@@ -696,14 +939,23 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "R_0_x": _R_0_x_32,
+        "R_1_x": _R_1_x_32,
+        "R_2_x": _R_2_x_32,
+        "H_0_x": _H_0_x_32,
+        "H_1_x": _H_1_x_32,
+        "H_2_x": _H_2_x_32,
+        "H_inverse_0_x": _H_inverse_0_x_32,
+        "H_inverse_1_x": _H_inverse_1_x_32,
+        "H_inverse_2_x": _H_inverse_2_x_32,
         "e_0": _e_0_32,
     },
 }
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'e_0': True},
-    "32": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'e_0': True},
+    "64": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': False, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
+    "32": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': False, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
