@@ -128,7 +128,8 @@ def _tasks(selected: list[str]) -> list[tuple[str, ...]]:
 
     names = [*COVERED] if "c/" in selected else []
     array_prefixes = ("numpy/", "jax/", "torch/")
-    names += [name for name in NAMED if any(prefix in selected for prefix in array_prefixes) and name not in names]
+    if any(prefix in selected for prefix in array_prefixes):
+        names += [name for name in NAMED if name not in names]
     tasks: list[tuple[str, ...]] = [("names", name) for name in reversed(names)]
     return tasks + [(prefix,) for prefix in selected if prefix not in PER_NAME]
 

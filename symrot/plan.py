@@ -34,8 +34,8 @@ import numpy as np
 import sympy as sp
 
 from .algebraic import (
-    D,
     REDUCTION_OPS,
+    D,
     S,
     algebraic_in_x,
     angle_with_complement,
@@ -212,8 +212,8 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
             continue
     if not branches:
-        raise SymrotError(f"cannot plan {closed} in {np.dtype(dtype).name}: every form divides by zero "
-                          "on the grid")
+        raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: every form divides "
+                                     "by zero on the grid")
     return min(branches, key=lambda b: (max(_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
                                         len(b.smallest_switch[1]), trig_arguments(b.closed), b.edge_ulp,
                                         b.measured_ulp))
@@ -270,7 +270,7 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     largest = float(np.finfo(dtype).max)
     top = min(MAX_TERMS - 2, next((n for n, c in enumerate(floats) if not c <= largest), len(floats)))
     if top == 0:
-        raise SymrotError(f"cannot plan {closed} in {np.dtype(dtype).name}: its value at p = 0 "
+        raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: its value at p = 0 "
                           f"({float(series[0]):.3g}) is not finite in that format")
 
     def tail(t: float, n: int) -> float:
@@ -290,8 +290,9 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         elif worst < best:
             best, best_k = worst, k
     if best_k >= near_zero:  # every error estimate is inf/NaN: e.g. p = 1e-20*phi, the series overflows
-        raise SymrotError(f"cannot plan {closed} in {np.dtype(dtype).name}: neither it nor its series "
-                          "in x = |p|^2 is finite on the grid (p is too small or too large in scale)")
+        raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: neither it nor its "
+                                     "series in x = |p|^2 is finite on the grid (p is too small or too large "
+                                     "in scale)")
     def terms_at(threshold: float) -> int:
         target = max(0.25, tail(threshold, top))
         return next((n for n in range(1, top + 1) if tail(threshold, n) <= target), top)
@@ -332,13 +333,19 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     precisions = {}
     for label, dtype in PRECISIONS.items():
         coefficients: dict[str, Coefficient] = {}
+        slopes_unrepresentable = False
         for coefficient, closed in derivation.planned_expressions().items():
             constant = derivation.constant_value(coefficient)
             if constant is not None:
                 coefficients[coefficient] = Constant(constant)
                 continue
             if coefficient in derivation.slopes:  # after every parent: its parent's plan is known
-                coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max, dtype)
+                try:
+                    coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max,
+                                                            dtype)
+                except UnplannableCoefficient:  # e.g. 1e-8*phi in float32: dc/dx ~ 1/kappa^4 overflows
+                    coefficients[coefficient] = Constant(sp.Integer(0))  # never used: see slope_limit
+                    slopes_unrepresentable = True
                 continue
             if inverse is not None:
                 if coefficient not in algebraic_forms:  # the first precision searches, both use it
@@ -375,10 +382,17 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
         kinematic = {n: c for n, c in coefficients.items() if n not in derivation.slopes}
         limit = _domain_limit(derivation, kinematic, angle, inverse, phi_max, p_max, dtype)
         slope_limit = min(limit, _domain_limit(derivation, slopes, angle, inverse, phi_max, p_max, dtype))
+        if slopes_unrepresentable:  # the derivative functions are NaN everywhere in this format
+            slope_limit = 0.0
         precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale,
                                           limit, slope_limit)
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
                           _p_max_squared(p, limits.phi_max, p_max))
+
+
+class UnplannableCoefficient(SymrotError):
+    """No form of a coefficient is finite on the grid in the format (the scale of p is too small or
+    too large for it)."""
 
 
 def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coefficient], phi_max: float,

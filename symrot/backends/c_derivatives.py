@@ -17,6 +17,7 @@ Single calls in double and, suffixed ``_f``, float; no allocation; matrices row-
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
@@ -50,7 +51,17 @@ class DerivativeWriter(FunctionWriter):
 
     def __init__(self, plan: EvaluationPlan, header: str, precision: Precision) -> None:
         super().__init__(plan, header, precision)
+        self.kinematic_x_limit = self.precision_plan.x_limit
         self.precision_plan = replace(self.precision_plan, x_limit=self.precision_plan.derivative_x_limit)
+
+    def out_of_range(self, x: str = "x") -> str:
+        """The kinematic validity test, and, where the slopes end before it (for a bounded p too),
+        their own edge: a plan whose slopes no form represents in the format has edge 0 (NaN)."""
+        test = super().out_of_range(x)  # unbounded p: tests x_limit, which is the slopes' edge here
+        limit = self.precision_plan.x_limit
+        if math.isfinite(self.plan.p_max) and limit < min(self.kinematic_x_limit, self.plan.p_max ** 2):
+            test = f"{test} || !({x} < {self.printer.literal(sp.Float(limit))})"
+        return test
 
     def name(self, function: str) -> str:
         return f"symrot_{self.header}_{function}{self.suffix}"
