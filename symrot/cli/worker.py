@@ -11,6 +11,7 @@ parsing, ``--help`` and usage errors happen in the parent before the fork.
 
 from __future__ import annotations
 
+import faulthandler
 import mmap
 import os
 import select
@@ -113,6 +114,7 @@ def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int) -> int:
     import resource
 
     _die_with_parent()
+    faulthandler.disable()  # a crash is reported by the parent in one line, not as a dump
     try:
         _, hard = resource.getrlimit(resource.RLIMIT_AS)
         limit = memory if hard == resource.RLIM_INFINITY else min(memory, hard)
