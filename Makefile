@@ -2,6 +2,7 @@
 PYTHON ?= python3
 PIP ?= $(PYTHON) -m pip
 PYTEST_ARGS ?=
+TEST_JOBS ?= auto
 SYMFORCE_VENV ?= /tmp/symforce_venv
 
 .DEFAULT_GOAL := help
@@ -46,8 +47,8 @@ lint: ## ruff over the package, tests and benchmarks
 typecheck: ## mypy over the package
 	$(PYTHON) -m mypy
 
-pytest: ## The test suite only
-	$(PYTHON) -m pytest $(PYTEST_ARGS)
+pytest: ## The test suite only, on TEST_JOBS processes (pytest-xdist; default: one per CPU)
+	$(PYTHON) -m pytest -n $(TEST_JOBS) --dist worksteal $(PYTEST_ARGS)
 
 generate: ## Rewrite generated/ for the named parameterizations (deterministic)
 	$(PYTHON) -m symrot.generate generated
