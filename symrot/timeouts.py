@@ -7,6 +7,12 @@ enforced and :func:`time_limit` runs the body unbounded (documented, never silen
 Limits nest: an inner limit never extends an outer one, and each limit's :class:`SymrotTimeout`
 carries a marker so that :func:`bounded` absorbs only its own expiry, never an outer one.
 
+An expiry can land while the interpreter runs a callback whose exceptions it swallows ("Exception
+ignored in ...": a garbage-collector callback such as JAX's ``_xla_gc_callback``, a ``__del__``,
+a weakref callback). The limit would then be lost and the body run unbounded (a 0.5 s bound on a
+simplification that took over 20 minutes in a process that had imported JAX). The timer
+therefore repeats every :data:`RETRY_SECONDS` after it first expires, until the body ends.
+
 A fallback taken because a step ran out of *time* makes the result depend on the machine's speed
 and load. Steps whose result feeds code generation are therefore gated by deterministic size caps
 (operation counts, see :mod:`symrot.simplify` and :mod:`symrot.algebraic`) that decide which
@@ -29,6 +35,8 @@ from .errors import SymrotTimeout
 
 T = TypeVar("T")
 
+RETRY_SECONDS = 0.05
+"""Interval of the repeated expiry after the first (see the module docstring)."""
 SAFETY_FACTOR = 10.0
 """How much wider the time bounds of :func:`bounded` are under :func:`deterministic`."""
 _deterministic = threading.local()
@@ -69,7 +77,7 @@ def alarm(seconds: float, error: Callable[[], BaseException]) -> Iterator[None]:
 
     previous = signal.signal(signal.SIGALRM, _on_alarm)
     started = time.monotonic()
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+    signal.setitimer(signal.ITIMER_REAL, seconds, RETRY_SECONDS)
     try:
         yield
     finally:
@@ -77,7 +85,7 @@ def alarm(seconds: float, error: Callable[[], BaseException]) -> Iterator[None]:
         signal.signal(signal.SIGALRM, previous)
         if outer_remaining:
             elapsed = time.monotonic() - started
-            signal.setitimer(signal.ITIMER_REAL, max(outer_remaining - elapsed, 1e-3))
+            signal.setitimer(signal.ITIMER_REAL, max(outer_remaining - elapsed, 1e-3), RETRY_SECONDS)
 
 
 @contextmanager

@@ -30,9 +30,9 @@ LARGEST = {"float64": 1.7976931348623157e308, "float32": 3.4028234663852886e38}
 
 
 def emit(expression: str, out: Path) -> tuple[int, str]:
-    """``symrot derive EXPR --emit c`` as a user runs it, in a fresh process. (In the test process,
-    after the JAX/PyTorch tests had run, cayley_m800's simplification once ran for over 20 minutes
-    instead of 40 s; the cause is not understood, a fresh process does not show it.)"""
+    """``symrot derive EXPR --emit c`` as a user runs it, in a fresh process (in the test process,
+    after the JAX tests, a time bound once landed in JAX's garbage-collector callback and was lost;
+    symrot.timeouts now repeats the expiry, tests/test_timeouts.py checks it)."""
     command = [sys.executable, "-m", "symrot", "derive", expression, "--name", "t", "--emit", "c",
                "--out", str(out)]
     result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)

@@ -53,3 +53,35 @@ def test_deterministic_mode_turns_a_time_fallback_into_an_error() -> None:
             bounded(0.01, "fallback", spin, 0.01 * SAFETY_FACTOR + 0.5)
     assert not is_deterministic()
     assert bounded(0.02, "fallback", spin, 0.05) == "fallback"
+
+
+class _SlowFinalizer:
+    """An object whose ``__del__`` sleeps: an exception raised in it is printed as "Exception
+    ignored" and dropped by the interpreter, as in JAX's garbage-collector callback."""
+
+    def __del__(self) -> None:
+        time.sleep(0.3)
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_expiry_swallowed_by_a_finalizer_is_raised_again() -> None:
+    started = time.monotonic()
+    with pytest.raises(SymrotTimeout), time_limit(0.1):
+        _SlowFinalizer()  # finalized at once; the expiry lands in its sleep and is dropped
+        while time.monotonic() - started < 3.0:
+            pass
+    assert time.monotonic() - started < 1.0
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_bounded_falls_back_when_its_expiry_is_swallowed() -> None:
+    def slow() -> str:
+        _SlowFinalizer()
+        deadline = time.monotonic() + 3.0
+        while time.monotonic() < deadline:
+            pass
+        return "finished"
+
+    started = time.monotonic()
+    assert bounded(0.1, "fallback", slow) == "fallback"
+    assert time.monotonic() - started < 1.0

@@ -53,11 +53,12 @@ def run(command: Callable[[], int], seconds: float | None, memory: int = MEMORY_
     shared = mmap.mmap(-1, budget.SHARED_SIZE)
     sys.stdout.flush()
     sys.stderr.flush()
+    parent = os.getpid()
     pid = os.fork()
     if pid == 0:  # pragma: no cover - the worker's coverage is the parent's result
         code = 70
         try:
-            code = _worker(command, shared, memory)
+            code = _worker(command, shared, memory, parent)
         finally:
             os._exit(code)
     try:
@@ -110,10 +111,10 @@ def _report_signal(number: int, peak: int, memory: int, where: str) -> int:
     return EXIT_INTERNAL
 
 
-def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int) -> int:
+def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int, parent: int) -> int:
     import resource
 
-    _die_with_parent()
+    _die_with_parent(parent)
     faulthandler.disable()  # a crash is reported by the parent in one line, not as a dump
     try:
         _, hard = resource.getrlimit(resource.RLIMIT_AS)
@@ -129,14 +130,19 @@ def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int) -> int:
             pass
 
 
-def _die_with_parent() -> None:
-    """Linux: the worker gets SIGKILL when the parent dies, so none outlives a killed command."""
+def _die_with_parent(parent: int) -> None:
+    """Linux: the worker gets SIGKILL when the parent dies, so none outlives a killed command.
+
+    A parent killed between the fork and the ``prctl`` call sends no signal: the worker then
+    already has another parent and ends at once."""
     try:
         import ctypes
 
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
     except (OSError, AttributeError):
         pass
+    if os.getppid() != parent:
+        os._exit(EXIT_ERROR)
 
 
 def _wait(pid: int, seconds: float | None) -> tuple[int | None, int]:
