@@ -380,6 +380,41 @@ def test_derivative_functions(adapter: Adapter) -> None:
     assert np.allclose(value, expected, rtol=0, atol=1e-14)
 
 
+def test_compose_and_rescale_jacobians(adapter: Adapter) -> None:
+    """The closed forms H(p3)⁻¹R(p2)H(p1), H(p3)⁻¹H(p2) and H(p_r)⁻¹H(p) equal the Jacobians of
+    compose and rescale by automatic differentiation through their quaternion arithmetic (an
+    independent path), with and without rescaling, and the NumPy module's functions."""
+    module = generated(adapter.kind, "wiener_milenkovic")
+    numpy_module = generated("numpy", "wiener_milenkovic")
+    transforms = adapter.fw.func if adapter.kind == "torch" else adapter.fw
+    rng = np.random.default_rng(21)
+    axis = rng.normal(size=3)
+    axis /= np.linalg.norm(axis)
+    half_turn = 4 * np.tan(2.5 / 4)  # φ = 2.5
+    pairs = {"kept": (0.3 * rng.normal(size=3), 0.3 * rng.normal(size=3)),
+             # φ1 + φ2 ≈ 5 > π about nearly the same axis: compose rescales
+             "rescaled": (half_turn * axis, half_turn * (axis + 0.01 * rng.normal(size=3)))}
+    for case, (p1, p2) in pairs.items():
+        closed = [adapter.numpy(j) for j in module.compose_jacobians(adapter.array(p1), adapter.array(p2))]
+        automatic = transforms.jacfwd(module.compose, argnums=(0, 1))(adapter.array(p1), adapter.array(p2))
+        reference = numpy_module.compose_jacobians(p1, p2)
+        for k in range(2):
+            scale = np.max(np.abs(reference[k]))
+            assert np.max(np.abs(closed[k] - adapter.numpy(automatic[k]))) <= 1e-13 * scale, (case, k)
+            assert np.max(np.abs(closed[k] - reference[k])) <= 16 * np.finfo(float).eps * scale, (case, k)
+    for size in (1.0, 4.0):  # kept (identity) and rescaled (|φ| > π)
+        p = 4 * np.tan(size / 4) * axis
+        closed = adapter.numpy(module.rescale_jacobian(adapter.array(p)))
+        automatic = adapter.numpy(transforms.jacfwd(module.rescale)(adapter.array(p)))
+        reference = numpy_module.rescale_jacobian(p)
+        scale = np.max(np.abs(reference))
+        assert np.max(np.abs(closed - automatic)) <= 1e-13 * scale, size
+        assert np.max(np.abs(closed - reference)) <= 16 * np.finfo(float).eps * scale, size
+    assert np.array_equal(numpy_module.rescale_jacobian(0.5 * axis), np.eye(3))
+    outside = adapter.numpy(module.rescale_jacobian(adapter.array(np.array([1e300, 0.0, 0.0]))))
+    assert np.isnan(outside).all()
+
+
 def test_newton_angle_derivative_is_implicit(adapter: Adapter) -> None:
     """eq 35 has no closed inverse: its angle's derivative is 1/p′(φ), from the implicit
     function theorem, not from the iterations (whose derivative would be 0 or wrong)."""
@@ -440,7 +475,9 @@ def test_torch_runs_on_any_device_without_host_synchronization() -> None:
     p = torch.zeros(5, 3, device="meta", dtype=torch.float64)
     calls = {"angle": (p,), "rotation_matrix": (p,), "tangent_inverse": (p,), "pdot": (p, p),
              "to_quaternion": (p,), "compose": (p, p), "rescale": (p,), "rotation_derivative": (p, p),
-             "angular_acceleration": (p, p, p),
+             "angular_acceleration": (p, p, p), "compose_jacobians": (p, p), "rescale_jacobian": (p,),
              "from_rotation_matrix": (torch.zeros(5, 3, 3, device="meta", dtype=torch.float64),)}
     for name, args in calls.items():
-        assert getattr(module, name)(*args).device.type == "meta", name
+        result = getattr(module, name)(*args)
+        for output in result if isinstance(result, tuple) else (result,):
+            assert output.device.type == "meta", name

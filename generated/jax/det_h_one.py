@@ -28,7 +28,9 @@ to_quaternion(p) -> e (..., 4); from_quaternion(e) -> p (normalizes e, takes the
 e0 >= 0, i.e. |phi| <= pi); from_rotation_matrix(R) -> p (Shepperd's largest pivot, eqs 61-65;
 NaN unless R is a rotation: max |R^T R - I| <= 2^-26 (2^-11 in float32) and det R > 0);
 compose(p1, p2) -> p3 with R(p3) = R(p2) R(p1), p1 applied first (eqs 18-19, 67);
-rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47).  Every rotation has
+rescale(p) -> the equivalent p with |phi| <= pi (eqs 40-47); compose_jacobians(p1, p2) ->
+(dp3/dp1, dp3/dp2) = (H(p3)^-1 R(p2) H(p1), H(p3)^-1 H(p2)); rescale_jacobian(p) -> dp_r/dp.
+Every rotation has
 such a representation, so these results are NaN only for non-finite input."""
 
 import math
@@ -1951,6 +1953,32 @@ def angular_acceleration(p, pdot, pddot):
     p, rate = _vectors(p, pdot)
     acceleration = _vectors(p, pddot)[1]
     return _jvp(lambda q, v: omega(q, v), (p, rate), (rate, acceleration))[1]
+
+
+def compose_jacobians(p1, p2):
+    """(dp3/dp1, dp3/dp2) of p3 = compose(p1, p2), each (..., 3, 3): H(p3)^-1 R(p2) H(p1) and
+    H(p3)^-1 H(p2) (the rotation increments add as d theta3 = R(p2) d theta1 + d theta2, omega = H pdot).
+
+    Closed forms, not derivatives of compose's quaternion arithmetic; p3 is the rescaled result of
+    compose, so the rescaling is included; NaN where compose is NaN.
+    """
+    p1 = _as_float(p1, "p1", (3,))
+    p2 = _as_float(p2, "p2", (3,))
+    if p1.dtype != p2.dtype:
+        raise ValueError("compose_jacobians: p1 and p2 must have the same dtype")
+    h3_inverse = _tensor(compose(p1, p2), "H_inverse")
+    return h3_inverse @ (_tensor(p2, "R") @ _tensor(p1, "H")), h3_inverse @ _tensor(p2, "H")
+
+
+def rescale_jacobian(p):
+    """d rescale(p)/dp (..., 3, 3): H(rescale(p))^-1 H(p) where p is rescaled (the same rotation, so
+    the same increment d theta), the identity where p is kept; NaN outside the validity range."""
+    p = _as_float(p, "p", (3,))
+    e0, _, valid, _ = _quaternion(p)
+    flip = valid & (e0 < 0)
+    jacobian = _tensor(rescale(p), "H_inverse") @ _tensor(p, "H")
+    identity = _xp.stack([_unit(p, k) for k in range(3)], -1)
+    return _where(valid[..., None, None], _where(flip[..., None, None], jacobian, identity), math.nan)
 
 
 def _quaternion(p):
