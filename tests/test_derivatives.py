@@ -37,7 +37,8 @@ FUNCTIONS = {"rotation_derivative": "R", "rotation_transpose_derivative": "R_T",
              "tangent_transpose_derivative": "H_T", "tangent_inverse_derivative": "H_inverse"}
 NAMED = {"rotation_vector": "phi", "cayley_gibbs_rodrigues": "2*tan(phi/2)",
          "wiener_milenkovic": "4*tan(phi/4)",
-         "euler_rodrigues": "2*sin(phi/2)", "det_h_one": "cbrt(6*(phi - sin(phi)))"}
+         "euler_rodrigues": "2*sin(phi/2)", "det_h_one": "cbrt(6*(phi - sin(phi)))",
+         "linear": "sin(phi)", "sine_m4": "4*sin(phi/4)"}
 SWEPT = ("rotation_vector", "wiener_milenkovic", "euler_rodrigues", "det_h_one")
 """Closed inverse with a pole, algebraic forms, the fold complement of the sine family, Newton's angle."""
 CORPUS_SAMPLE = ("sinh(phi)",)
