@@ -1,12 +1,12 @@
 """C derivatives of issue 19 (symrot/backends/c_derivatives.py), called through ctypes.
 
-The generated headers of four parameterizations (closed inverse, Newton angle, the fold complement
+The generated headers of the seven named parameterizations (closed inverse, Newton angle, the fold complement
 of the sine family) are compiled in one translation unit with the strict flags of
 tests/c_harness.py (gcc, -std=c99 -Wall -Wextra -Wpedantic -Wdouble-promotion -Wconversion -Wshadow
 -Werror; clang as well when installed) and compared with:
 
 * the independent 150-digit reference of tests/reference.py on a φ sweep (p = 0, 1e-300 … φ_max −
-  10⁻⁶) for all four: every derivative within 8 ulp of the reference matrix's largest entry, double and float;
+  10⁻⁶): every derivative within 8 ulp of the reference matrix's largest entry, double and float;
 * the NumPy modules (tested against the same reference in tests/test_derivatives.py) on random
   batches, for α and the Jacobians of compose and rescale, with the same NaN and status.
 """
