@@ -8,8 +8,9 @@ axes u and random a, and ``angular_acceleration`` at random ṗ, p̈, in float64
 reference is tests/reference.py (R from eq 1, H from ω = H ṗ, differentiated again at 150 digits),
 evaluated at the rounded inputs. Error: max |D − D_ref| / (ε max |D_ref|), the worst over the sweep.
 Target ≤ 8 ulp, or 8 κ ulp ("conditioned") where the radial condition number κ of the derivative
-(how much the one rounding of x = |p|² moves it) exceeds 1, next to singular edges. α is measured
-without κ.
+(how much the one rounding of x = |p|² moves it) exceeds 1, next to singular edges. For α = H p̈ + Ḣ ṗ
+κ is the larger of its radial condition and the cancellation (|H p̈| + |Ḣ ṗ|)/|α| of its two terms
+(tests/test_derivatives.py: acceleration_condition).
 
 Run: ``python bench/accuracy_derivatives.py [--points N] [--names a,b]`` (prints a Markdown table).
 """
@@ -33,7 +34,7 @@ from accuracy import sweep  # noqa: E402
 
 from tests.reference import GeneratingFunction, Reference  # noqa: E402
 from tests.test_derivatives import _as_array as _array  # noqa: E402
-from tests.test_derivatives import _ulp, radial_condition  # noqa: E402
+from tests.test_derivatives import _ulp, acceleration_condition, radial_condition  # noqa: E402
 from tests.test_derivatives import load as load_module  # noqa: E402
 
 NAMED = {"rotation_vector": "phi", "linear": "sin(phi)", "euler_rodrigues": "2*sin(phi/2)",
@@ -93,6 +94,9 @@ def measure(name: str, points: int, seed: int = 19) -> dict[tuple[str, str], tup
                 if ulp > TARGET_ULP and f in FUNCTIONS:  # next to a singular edge: its radial κ
                     kappa = max(1.0, radial_condition(reference, np.array(exact[0]), np.array(exact[1]),
                                                       FUNCTIONS[f], refs[f]))
+                elif ulp > TARGET_ULP:  # α: radial κ or the cancellation of H p̈ and Ḣ ṗ
+                    kappa = max(1.0, acceleration_condition(reference, np.array(exact[0]), np.array(exact[2]),
+                                                            np.array(exact[3]), refs[f]))
                 key = (f, label)
                 if ulp / kappa >= worst.get(key, (-1.0, 0.0, 1.0))[0] / worst.get(key, (0, 0, 1.0))[2]:
                     worst[key] = (ulp, float(angle), kappa)

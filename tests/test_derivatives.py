@@ -112,6 +112,21 @@ def radial_condition(reference: Reference, p: np.ndarray, a: np.ndarray, tensor:
     return float(change / delta) / float(np.max(np.abs(base)))
 
 
+def acceleration_condition(reference: Reference, p: np.ndarray, pdot: np.ndarray, pddot: np.ndarray,
+                           alpha: np.ndarray) -> float:
+    """κ of α = H p̈ + Ḣ ṗ: the larger of its radial condition (as :func:`radial_condition`: how much
+    the rounding of x = |p|² moves α) and the cancellation of its two terms, (|H p̈| + |Ḣ ṗ|) / |α|
+    (largest entries): correctly rounded terms summed in floating point can be no closer than that."""
+    delta = mpmath.mpf(10) ** -20
+    scale = float(np.max(np.abs(alpha)))
+    with mpmath.workdps(150):
+        rate, exact = reference.along(list(p), list(pdot), list(pddot))
+        moved = reference.along([mpmath.mpf(v) * (1 + delta) for v in p], list(pdot), list(pddot))[1]
+        radial = float(max(abs(moved[i] - exact[i]) for i in range(3)) / delta) / scale
+        terms = max(abs(rate[i]) for i in range(3)) + max(abs(exact[i] - rate[i]) for i in range(3))
+    return max(radial, float(terms) / scale)
+
+
 def check_sweep(module: ModuleType, function: GeneratingFunction, angles: list[float],
                 functions: dict[str, str], seed: int = 19) -> dict[tuple[str, str], float]:
     """Worst ulp / max(1, κ) of each (function, precision) over ``angles``; asserts no NaN inside."""
