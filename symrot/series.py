@@ -20,6 +20,7 @@ from .series_engine import (
     NeedsSymbolicDomain,
     Series,
     SeriesEngine,
+    exact_number,
     series_ring,
 )
 
@@ -58,7 +59,7 @@ def taylor_series(expr: sp.Expr, order: int) -> Series:
 def coefficient_list(series: Series, start: int, stop: int) -> list[sp.Expr]:
     """Coefficients of φ**k, k in [start, stop), as SymPy numbers."""
     domain = series.ring.domain
-    return [sp.nsimplify(domain.to_sympy(c)) if domain == EX else domain.to_sympy(c)
+    return [exact_number(domain.to_sympy(c)) if domain == EX else domain.to_sympy(c)
             for c in series.coefficients(start, stop)]
 
 
@@ -116,8 +117,7 @@ def compose_even_in_x(even_coeffs: list[sp.Expr], phi_of_p: list[sp.Expr], n_ter
     halves = [domain.from_sympy(even_coeffs[2 * j]) for j in range(n_terms)]
     in_p = compose(halves, phi_squared, order)
     values = [domain.to_sympy(in_p.coeff(x ** (2 * j)) if j else in_p.coeff(1)) for j in range(n_terms)]
-    # nsimplify only non-rationals: on a large exact Rational it can return a wrong algebraic number
-    return [v if (v.is_Rational or not j) else sp.nsimplify(v) for j, v in enumerate(values)]
+    return [exact_number(v) if j else v for j, v in enumerate(values)]
 
 
 __all__ = ["InsufficientOrder", "Series", "coefficient_list", "compose", "compose_even_in_x", "revert",

@@ -39,6 +39,16 @@ from .errors import InvalidGeneratingFunction, NonAnalyticError, SymrotError
 from .functions import RealCbrt
 from .parsing import PHI
 
+
+def exact_number(value: sp.Expr) -> sp.Expr:
+    """``value`` with SymPy's nsimplify applied unless it is already a Rational.
+
+    nsimplify cleans up exact expressions that the EX domain leaves unevaluated, but on a large
+    exact Rational it can return a *different*, irrational number: nsimplify(1300075/226492416)
+    gives 2·2^(248/347)·3^(164/347)·5^(224/347)·7^(145/347)/6125 (equal to 15 digits only), which
+    made the series of pi/2 − acos(φ) wrong at φ^27 and its planning run past every budget."""
+    return value if value.is_Rational else sp.nsimplify(value)
+
 Coefficient = Any  # an element of QQ or EX
 
 
@@ -232,7 +242,7 @@ class SeriesEngine:
         unit = self.domain.one / a.leading_coefficient()
         normalized = self.scale(Series(a.poly, 0, a.order - a.shift), unit)
         root = self.unit_power(normalized, r)
-        root = self.scale(root, self._to_element(sp.nsimplify(lead_root)))
+        root = self.scale(root, self._to_element(exact_number(lead_root)))
         return _make(root.poly, int(new_shift), int(new_shift) + root.order)
 
     def derivative(self, a: Series) -> Series:

@@ -27,6 +27,7 @@ import sympy as sp
 from .errors import InvalidGeneratingFunction, SymrotError, SymrotTimeout
 from .functions import RealCbrt, mpmath_namespace
 from .parsing import PHI, parse_expression
+from .series_engine import exact_number
 from .simplify import complexity, simplest
 from .timeouts import bounded, time_limit
 from .validation import validate
@@ -269,5 +270,5 @@ def _series_ansatz(equation: sp.Expr) -> tuple[list[sp.Expr], sp.Expr | None]:
     solution = solutions[0]
     taylor = [sp.S.Zero, sp.S.One] + [sp.S.Zero] * (SERIES_ORDER - 1)
     for a, k in zip(coefficients, range(3, SERIES_ORDER + 1, 2), strict=True):
-        taylor[k] = sp.nsimplify(solution.get(a, a))
+        taylor[k] = exact_number(solution.get(a, a))
     return taylor, solution.get(_C)

@@ -103,3 +103,18 @@ def test_reciprocal_trigonometric_functions_match_sympy(expr: sp.Expr) -> None:
 
 def test_cot_has_a_pole_not_a_missing_rule() -> None:
     assert taylor_series(parse_expression("tan(pi/2 + phi)"), 4).valuation == -1
+
+
+def test_exact_rational_coefficients_survive_the_symbolic_domain() -> None:
+    """pi/2 − acos(φ) has its series in the EX domain (pi in the constant term); its φ^27
+    coefficient 1300075/226492416 once went through nsimplify, which returned an irrational number
+    equal to 15 digits only, so the series was wrong and reverting it ran for minutes."""
+    from symrot.series_engine import exact_number
+
+    rational = sp.Rational(1300075, 226492416)
+    assert exact_number(rational) == rational
+    assert exact_number(sp.sqrt(2) * sp.sqrt(8) / 8) == sp.Rational(1, 2)
+    ours = coefficient_list(taylor_series(parse_expression("pi/2 - acos(phi)"), 50), 0, 50)
+    exact = sp.series(sp.asin(PHI), PHI, 0, 50).removeO()
+    assert ours == [exact.coeff(PHI, k) for k in range(50)]
+    assert all(c.is_Rational for c in ours)
