@@ -200,6 +200,11 @@ def _angle_grid(phi_max: float) -> np.ndarray:
     return np.unique(np.concatenate([log_grid(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
 
 
+class UnplannableCoefficient(SymrotError):
+    """No form of a coefficient is finite on the grid in the format (the scale of p is too small or
+    too large for it)."""
+
+
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type) -> Branch:
     """Choose the switch t₀ and Horner degree for one coefficient in one precision."""
@@ -271,7 +276,7 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     top = min(MAX_TERMS - 2, next((n for n, c in enumerate(floats) if not c <= largest), len(floats)))
     if top == 0:
         raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: its value at p = 0 "
-                          f"({float(series[0]):.3g}) is not finite in that format")
+                                     f"({float(series[0]):.3g}) is not finite in that format")
 
     def tail(t: float, n: int) -> float:
         rest = floats[n:n + 2]
@@ -388,11 +393,6 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                                           limit, slope_limit)
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
                           _p_max_squared(p, limits.phi_max, p_max))
-
-
-class UnplannableCoefficient(SymrotError):
-    """No form of a coefficient is finite on the grid in the format (the scale of p is too small or
-    too large for it)."""
 
 
 def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coefficient], phi_max: float,
