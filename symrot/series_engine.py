@@ -49,6 +49,7 @@ def exact_number(value: sp.Expr) -> sp.Expr:
     made the series of pi/2 − acos(φ) wrong at φ^27 and its planning run past every budget."""
     return value if value.is_Rational else sp.nsimplify(value)
 
+
 Coefficient = Any  # an element of QQ or EX
 
 
