@@ -128,6 +128,11 @@ class ModelPrinter(PythonCodePrinter):
 
     _print_RealCbrt = _print_known_func
 
+    def _print_sign(self, expr: Any) -> str:
+        """sign is exact (no libm): NumPy's elementwise sign, for arrays as for scalars (the
+        inherited printing is a scalar conditional expression)."""
+        return f"_sign({self._print(expr.args[0])})"
+
     def _print_Pow(self, expr: Any, rational: bool = False) -> str:
         base, exponent = expr.as_base_exp()
         if exponent == sp.S.Half:
@@ -162,7 +167,7 @@ def model_function(expr: sp.Expr, variables: Sequence[sp.Symbol]) -> Callable[..
     names = [str(v) for v in variables]
     body = ModelPrinter().doprint(expr)
     source = f"def f({', '.join(names)}):\n    return {body}\n"
-    namespace: dict[str, Any] = {"_m": _MODEL}
+    namespace: dict[str, Any] = {"_m": _MODEL, "_sign": np.sign}
     exec(compile(source, "<symrot model>", "exec"), namespace)
     function = namespace["f"]
 

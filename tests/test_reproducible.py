@@ -85,6 +85,15 @@ def test_model_treats_points_off_the_real_domain_as_nan() -> None:
     assert np.isfinite(values[0]) and np.isnan(values[1])
 
 
+def test_model_evaluates_sign_on_arrays() -> None:
+    """sign appears in derived slopes (asinh(tan(phi)): |cos φ| sign(cos φ)); it printed as a scalar
+    conditional and made the emit of that corpus function an internal error on arrays."""
+    function = model_function(sp.sign(sp.cos(PHI)) * sp.Abs(sp.cos(PHI)), [PHI])
+    x = np.array([0.0, 1.0, 2.0, 4.0, 5.0])
+    assert function(x).tolist() == model_function(sp.cos(PHI), [PHI])(x).tolist()  # no libm of the CPU
+    assert function(x.astype(np.float32)).dtype == np.float32
+
+
 def test_log_grid_is_exact_at_the_ends_and_monotone() -> None:
     grid = log_grid(1e-7, 6.283185307179586, 56)
     assert grid[0] == 1e-7 and grid[-1] == 6.283185307179586 and np.all(np.diff(grid) > 0)
