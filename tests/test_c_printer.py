@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import re
+import shutil
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -125,3 +127,31 @@ def test_non_finite_literal_is_refused_in_one_line(value: sp.Expr, precision: st
     message = str(caught.value)
     assert "\n" not in message and precision in message and "not finite" in message
     assert print_c(sp.Float("3.4028234e38") * X, "float").startswith("3.4028235e+38F")  # largest float
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+def test_sign_is_real_typed_and_compiles_strictly(tmp_path: Path) -> None:
+    """sign appears in derived slopes (asinh(tan(φ))); SymPy's C form is an int, which
+    -Wconversion rejects in float code. Values: ±1, 0 at ±0, NaN for NaN (as NumPy's sign)."""
+    import ctypes
+    import subprocess
+
+    from .c_harness import STRICT_C
+
+    v = sp.Symbol("v", real=True)
+    lines = []
+    for precision, t in (("double", "double"), ("float", "float")):
+        body = SymrotCPrinter(precision).doprint(sp.sign(v))
+        lines.append(f"{t} sign_{precision}({t} v) {{ return {body}; }}")
+    source = tmp_path / "sign.c"
+    source.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    library = tmp_path / "sign.so"
+    command = ["gcc", *STRICT_C, "-fPIC", "-shared", str(source), "-o", str(library)]
+    result = subprocess.run(command, capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr
+    loaded = ctypes.CDLL(str(library))
+    for precision, ctype in (("double", ctypes.c_double), ("float", ctypes.c_float)):
+        function = getattr(loaded, f"sign_{precision}")
+        function.argtypes, function.restype = [ctype], ctype
+        assert [function(x) for x in (-2.5, -0.0, 0.0, 3.0)] == [-1.0, 0.0, 0.0, 1.0]
+        assert np.isnan(function(float("nan")))

@@ -109,6 +109,13 @@ class SymrotCPrinter(C99CodePrinter):
         return self.literal(expr)
 
     # -- functions -------------------------------------------------------------------------------
+    def _print_sign(self, expr: sp.Expr) -> str:
+        """sign(v) in the real type (NaN for NaN, as NumPy's): C99CodePrinter's ``((v > 0) - (v < 0))``
+        is an int, which -Wconversion rejects in float code."""
+        argument = self._print(expr.args[0])
+        zero, one = self.literal(0), self.literal(1)
+        return f"(({argument}) > {zero} ? {one} : (({argument}) < {zero} ? -{one} : ({argument}) * {zero}))"
+
     def _print_RealCbrt(self, expr: sp.Expr) -> str:
         return f"cbrt{self._get_func_suffix(real)}({self._print(expr.args[0])})"
 
