@@ -82,7 +82,7 @@ CORPUS: tuple[Entry, ...] = (
     Entry("atan(phi)", "inverse trigonometric", "nu", True, TWO_PI),
     Entry("2*atan(phi/2)", "inverse trigonometric", "nu", True, TWO_PI),
     Entry("2*asin(phi/2)", "inverse trigonometric", "slope", True, "2"),
-    Entry("pi/2 - acos(phi)", "inverse trigonometric", "slope", True, "1"),
+    Entry("pi/2 - acos(phi)", "inverse trigonometric", "slope", True, "1", cancels=True),
     Entry("atan(sin(phi))", "inverse trigonometric", "fold", True, "pi/2"),
     Entry("2*asin(sin(phi)/2)", "inverse trigonometric", "fold", True, "pi/2"),
     Entry("asin(tanh(phi))", "inverse trigonometric", "nu", True, TWO_PI),
