@@ -155,3 +155,13 @@ def test_sign_is_real_typed_and_compiles_strictly(tmp_path: Path) -> None:
         function.argtypes, function.restype = [ctype], ctype
         assert [function(x) for x in (-2.5, -0.0, 0.0, 3.0)] == [-1.0, 0.0, 0.0, 1.0]
         assert np.isnan(function(float("nan")))
+
+
+def test_integers_the_type_cannot_hold_print_as_rounded_literals() -> None:
+    """-42181425 (a Horner coefficient of phi + phi**3) is exact in double but not in float, where an
+    int constant is rounded by the compiler and rejected by -Wfloat-conversion."""
+    x = sp.Symbol("x", real=True)
+    expression = 42181425 * x + 3
+    assert SymrotCPrinter("double").doprint(expression) == "42181425*x + 3"
+    assert SymrotCPrinter("float").doprint(expression) == "4.2181424e+07F*x + 3"
+    assert SymrotCPrinter("float").doprint(16777216 * x) == "16777216*x"  # 2^24: exact in float

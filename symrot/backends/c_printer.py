@@ -86,7 +86,9 @@ class SymrotCPrinter(C99CodePrinter):
         return self.literal(expr)
 
     def _print_Integer(self, expr: sp.Integer) -> str:
-        if abs(int(expr)) < 2**31:  # an int constant; C converts it exactly (rounded once if huge)
+        # an int constant only where the type holds it exactly: -42181425 in float code is rounded
+        # by the compiler and rejected by -Wfloat-conversion (a Horner coefficient of phi + phi**3)
+        if abs(int(expr)) < 2**31 and self._exact_in_type(int(expr)):
             return str(super()._print_Integer(expr))
         return self.literal(expr)
 
