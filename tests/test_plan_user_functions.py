@@ -42,6 +42,26 @@ def test_user_function_angle_keeps_relative_accuracy_down_to_1e_300() -> None:
     assert all(isinstance(p.angle, NewtonAngle) for p in plan.precisions.values())
 
 
+def test_a_poor_far_start_gets_the_newton_steps_it_needs() -> None:
+    """sinh(φ)cosh(φ): the far start in s/p_max is only within 2e-3 of φ_max, and 6 fixed steps
+    left the angle 1e-4 off at φ = 0.1 (8e11 ulp); the step count follows the measured start."""
+    from symrot.backends.numpy_backend import module_source
+
+    plan = evaluation_plan(derive("sinh(phi)*cosh(phi)").derivation, "sinh_cosh")
+    namespace: dict[str, object] = {}
+    exec(compile(module_source(plan), "<sinh_cosh>", "exec"), namespace)
+    angle = namespace["angle"]
+    phis = np.concatenate([np.geomspace(1e-3, 6.2, 60), np.linspace(0.05, 1.5, 60)])
+    with mpmath.workdps(50):
+        sizes = np.array([float(mpmath.sinh(f) * mpmath.cosh(f)) for f in phis])
+        for dtype in (np.float64, np.float32):
+            s = sizes.astype(dtype)
+            exact = np.array([float(mpmath.asinh(2 * mpmath.mpf(float(v))) / 2) for v in s])
+            got = angle(np.stack([s, 0 * s, 0 * s], axis=-1)).astype(np.float64)  # type: ignore[operator]
+            assert np.max(np.abs(got - exact) / exact) <= 2 * float(np.finfo(dtype).eps), dtype
+    assert all(p.angle.iterations > 6 for p in plan.precisions.values())  # type: ignore[union-attr]
+
+
 def test_a_pole_where_p_grows_exponentially_ends_the_domain_instead_of_failing() -> None:
     """p = 4 atanh(φ/4) → ∞ at φ = 4 like e^(1/(4 − φ)): the domain sweep cannot resolve φ next to
     the pole at any fixed precision and must end the domain there (it raised ZeroDivisionError)."""
