@@ -7,7 +7,7 @@ verdicts of docs/accuracy.md), each in its own worker process with a time limit.
 fraction meeting the target and every miss (function, size, where) as markdown.
 
 Run: ``python bench/accuracy_hypothesis.py [--count 200] [--points 4] [--no-c] [--json FILE]
-[--out docs/accuracy_hypothesis.md]``.
+[--out docs/accuracy_hypothesis.md] [--jobs N] [--resume]``.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import json
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
@@ -90,37 +91,61 @@ def report(results: list[dict[str, Any]], command: str, with_c: bool) -> str:
     return "\n".join(lines)
 
 
+def run_worker(expression: str, points: int, with_c: bool) -> dict[str, Any]:
+    """Emit and measure one function in its own process, bounded by WORKER_TIMEOUT."""
+    run = [sys.executable, __file__, "--worker", expression, "--points", str(points)]
+    run += [] if with_c else ["--no-c"]
+    try:
+        done = subprocess.run(run, capture_output=True, text=True, timeout=WORKER_TIMEOUT, check=False)
+    except subprocess.TimeoutExpired:
+        return {"expression": expression, "worker_error": f"timeout after {WORKER_TIMEOUT} s"}
+    if done.returncode != 0:
+        return {"expression": expression,
+                "worker_error": f"worker exit {done.returncode}: {done.stderr.strip().splitlines()[-1:]}"}
+    result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+    return result
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=200)
     parser.add_argument("--points", type=int, default=4)
     parser.add_argument("--no-c", action="store_true")
+    parser.add_argument("--jobs", type=int, default=1, help="functions measured at once (one process each)")
     parser.add_argument("--out", default="docs/accuracy_hypothesis.md")
     parser.add_argument("--json", help="also write the raw results here (after every function)")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep the results already in --json and measure only the missing functions")
     parser.add_argument("--worker", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker is not None:
         print(json.dumps(worker(args.worker, args.points, not args.no_c)))
         return 0
-    results: list[dict[str, Any]] = []
-    command = "python bench/accuracy_hypothesis.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    for expression in draw(args.count):
-        run = [sys.executable, __file__, "--worker", expression, "--points", str(args.points)]
-        run += ["--no-c"] if args.no_c else []
-        start = time.perf_counter()
-        try:
-            done = subprocess.run(run, capture_output=True, text=True, timeout=WORKER_TIMEOUT, check=False)
-            result = json.loads(done.stdout.strip().splitlines()[-1]) if done.returncode == 0 else {
-                "expression": expression,
-                "worker_error": f"worker exit {done.returncode}: {done.stderr.strip().splitlines()[-1:]}"}
-        except subprocess.TimeoutExpired:
-            result = {"expression": expression, "worker_error": f"timeout after {WORKER_TIMEOUT} s"}
-        results.append(result)
-        print(f"{len(results)} {expression}: {time.perf_counter() - start:.0f} s "
-              f"{result.get('emit_error') or result.get('worker_error') or ''}", flush=True)
-        if args.json:
-            Path(args.json).write_text(json.dumps(results, indent=1), encoding="utf-8")
-        Path(args.out).write_text(report(results, command.strip(), not args.no_c) + "\n", encoding="utf-8")
+    if args.resume and not args.json:
+        parser.error("--resume needs --json")
+    command = "python bench/accuracy_hypothesis.py " + " ".join(
+        a for a in (argv if argv is not None else sys.argv[1:]) if a != "--resume")
+    expressions = draw(args.count)
+    found: dict[str, dict[str, Any]] = {}
+    if args.resume and Path(args.json).exists():
+        found = {r["expression"]: r for r in json.loads(Path(args.json).read_text(encoding="utf-8"))
+                 if r["expression"] in expressions}
+    pending = [e for e in expressions if e not in found]
+    print(f"{len(found)} of {len(expressions)} already measured; {len(pending)} to go", flush=True)
+    started = time.perf_counter()
+    with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        futures = {pool.submit(run_worker, e, args.points, not args.no_c): e for e in pending}
+        for future in as_completed(futures):
+            result = future.result()
+            found[result["expression"]] = result
+            print(f"{len(found)}/{len(expressions)} {result['expression']}: "
+                  f"{time.perf_counter() - started:.0f} s "
+                  f"{result.get('emit_error') or result.get('worker_error') or ''}", flush=True)
+            results = [found[e] for e in expressions if e in found]
+            if args.json:
+                Path(args.json).write_text(json.dumps(results, indent=1), encoding="utf-8")
+            Path(args.out).write_text(report(results, command.strip(), not args.no_c) + "\n",
+                                      encoding="utf-8")
     return 0
 
 
