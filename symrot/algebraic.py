@@ -230,6 +230,31 @@ def closed_with_base_angle(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr:
     return _replace_base_trig(closed, PHI / base[0], S / radius, k / radius)
 
 
+INVERSE_REWRITE_OPS = 16
+"""Largest algebraic part (SymPy operation count after substitution) that :func:`with_inverse`
+simplifies: trigsimp of such parts takes milliseconds, so the plan never depends on machine load."""
+
+
+def with_inverse(expr: sp.Expr, inverse: sp.Expr) -> sp.Expr:
+    """``expr`` with every maximal part free of sin, cos and tan but not of φ (p′, 1 − φ²/4 …)
+    written through φ = φ(s) and trigsimp'ed, when that removes φ from it: near an edge where p′ → ∞
+    (p = 2 asin(φ/2)), √(1 − φ²/4) recomputed from a rounded φ loses every digit, cos(s/2) none."""
+    def rewrite(part: sp.Expr) -> sp.Expr:
+        if not part.has(PHI) or part == PHI:
+            return part
+        if isinstance(part, (sp.sin, sp.cos, sp.tan)):  # the angle comes from the backends' φ̂
+            return part
+        if part.has(sp.sin, sp.cos, sp.tan):
+            return part.func(*[rewrite(a) for a in part.args])
+        substituted = part.xreplace({PHI: inverse})
+        if sp.count_ops(substituted) > INVERSE_REWRITE_OPS:
+            return part
+        simplified = sp.powdenest(sp.trigsimp(substituted), force=True)
+        return simplified if not simplified.has(sp.I, sp.nan, sp.zoo) else part
+
+    return rewrite(expr)
+
+
 def _replace_base_trig(closed: sp.Expr, angle: sp.Expr, sine: sp.Expr, cosine: sp.Expr) -> sp.Expr:
     rules = {sp.sin(angle): sine, sp.cos(angle): cosine, sp.tan(angle): sine / cosine,
              1 - 2 * sp.sin(angle / 2) ** 2: cosine}  # the half-angle form of cos

@@ -12,15 +12,19 @@ The plan's IR (``EvaluationPlan``, ``PrecisionPlan``, ``Constant``, ``Algebraic`
 builds it and re-exports its names.
 
 Thresholds and degrees come from an error model per precision: the closed form's error is
-measured against 30-digit mpmath on a log grid of φ plus points approaching φ_max, each point
+measured against 60-digit mpmath on a log grid of φ plus points approaching φ_max, each point
 taking the worst of a few nearby arguments (a cancellation must not hide behind one lucky
-rounding); the Horner tail is bounded by its next two terms at the threshold.  The switch is
+rounding). The inputs are those of the backends: x = |p|² rounded, s = √x, and the angle φ̂
+computed from s, rounded; the reference is the exact coefficient of the rounded x, so a form is
+charged the rounding of φ̂ but not the input's own (:func:`measured_inputs`). The Horner tail is
+bounded by its next two terms at the threshold.  The switch is
 the grid point minimising the worse of the two, moved up for speed as far as a polynomial of
 ``CHEAP_TERMS`` terms still truncates below a quarter ulp, and the degree is the smallest meeting
 the target.  Among equivalent closed forms (as derived, half-angle forms of cos φ, everything in
-sin(φ/2), cos(φ/2)) the plan takes the one whose worst error is smallest, then the shortest
-polynomial at the smallest switch the accuracy allows, then the fewest distinct trigonometric
-arguments (sin a and cos a: one sincos).
+sin(φ/2), cos(φ/2), p written as s and p² as x, algebraic parts such as p′ written through the
+closed inverse φ(s)) the plan takes the one whose worst error is smallest, then the shortest
+polynomial at the smallest switch the accuracy allows, then a form in s, then the fewest distinct
+trigonometric arguments (sin a and cos a: one sincos).
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ from .algebraic import (
     fold_complement,
     reduction_size,
     with_complement,
+    with_inverse,
 )
 from .algebraic import X as X  # re-exported: the symbol of the coefficients' variable x = |p|²
 from .core import Derivation, derive_expression
@@ -51,6 +56,15 @@ from .domain import FIRST_POWER, domain_limit
 from .errors import SymrotError
 from .evaluation import log_grid, model_function
 from .functions import RealCbrt, mpmath_namespace
+from .measurement import (
+    EDGE_POINTS,
+    GRID_POINTS,
+    MeasuredInputs,
+    angle_grid,
+    measured_inputs,
+    reference_values,
+    with_length,
+)
 from .newton_start import START_TOLERANCE, far_start
 from .newton_start import FarStart as FarStart
 from .parsing import PHI
@@ -82,10 +96,6 @@ CHEAP_TERMS = 8
 """A Horner polynomial of up to this many terms (8 fused multiply-adds) is cheaper than a closed
 form with sin/cos (a libm call is 20–60 cycles) or a division: switches move up to where it stays
 accurate, so that small rotations, the common case in time stepping, never reach libm."""
-GRID_POINTS = 56
-EDGE_POINTS = 12
-JITTER = 0.0137
-JITTER_SAMPLES = 6
 ALGEBRAIC_WORK = 4000
 """Total expansion size (:func:`symrot.algebraic.reduction_size`, operations) the algebraic search
 of one plan may simplify; past it, coefficients get branches. A count, not a time: the plan is
@@ -189,39 +199,47 @@ def closed_angle_error(inverse: sp.Expr, p: sp.Expr, phi_max: float, dtype: type
     return worst
 
 
-def _mp_function(expr: sp.Expr) -> object:
-    return sp.lambdify(PHI, expr, modules=[mpmath_namespace(), "mpmath"])
-
-
-def _angle_grid(phi_max: float) -> np.ndarray:
-    """Log grid towards 0 plus points approaching the edge of the range (φ_max − 10⁻ᵏ φ_max)."""
-    end = min(phi_max, 4 * np.pi)
-    edge = end * (1 - log_grid(0.25, 1e-6, EDGE_POINTS))
-    return np.unique(np.concatenate([log_grid(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
-
-
 class UnplannableCoefficient(SymrotError):
     """No form of a coefficient is finite on the grid in the format (the scale of p is too small or
     too large for it)."""
 
 
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
-                dtype: type) -> Branch:
-    """Choose the switch t₀ and Horner degree for one coefficient in one precision."""
-    candidates = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
-    candidates += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
+                dtype: type, argument: sp.Expr = PHI, inverse: sp.Expr | None = None,
+                complement: sp.Rational | None = None) -> Branch:
+    """Choose the form, the switch t₀ and the Horner degree for one coefficient in one precision.
+
+    The coefficient is evaluated from s = ``argument``(φ) (p for the coefficients of x, φ itself
+    for Newton's ratio and slope). Besides the forms in φ, the same with p written as s
+    (:func:`with_length`) and, given the closed ``inverse`` φ(s), with their algebraic parts written
+    through it (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of
+    the tangent family, fold complement d of the sine family), measured on the inputs of
+    :func:`measured_inputs` against one reference at REFERENCE_DIGITS."""
+    forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
+    forms += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
+    plain = tuple(dict.fromkeys([closed, *forms]))
+    forms += [with_length(form, argument) for form in forms]
+    if inverse is not None and argument != PHI:
+        forms += [with_inverse(form, inverse) for form in forms]
+        forms = [closed_with_base_angle(form, inverse) for form in forms]
+        if complement is not None:
+            forms = [closed_with_complement(form, inverse, complement) for form in forms]
+    inputs = measured_inputs(argument, phi_max, dtype, complement)
+    reference = reference_values(plain, argument, phi_max, dtype, complement)
     branches = []
-    for form in candidates:
+    for form in dict.fromkeys(forms):
         try:
-            branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype))
+            branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype, inputs, reference))
         except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
             continue
     if not branches:
         raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: every form divides "
                                      "by zero on the grid")
+    # equally accurate forms: the shortest polynomial, then a form in φ alone (a form in s and x is
+    # taken where it is measurably more accurate), then the fewest sin/cos arguments
     return min(branches, key=lambda b: (max(_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
-                                        len(b.smallest_switch[1]), trig_arguments(b.closed), b.edge_ulp,
-                                        b.measured_ulp))
+                                        len(b.smallest_switch[1]), b.closed.has(S, X),
+                                        trig_arguments(b.closed), b.edge_ulp, b.measured_ulp))
 
 
 def _error_class(ulp: float) -> float:
@@ -244,30 +262,27 @@ def _magnitude(coefficient: sp.Expr) -> float:
 
 
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
-                dtype: type) -> Branch:
+                dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...]) -> Branch:
     epsilon = float(np.finfo(dtype).eps)
-    mp_closed, model_closed = _mp_function(closed), model_function(closed, [PHI])
+    model_closed = model_function(closed, [PHI, S, X, D])
     to_t = sp.lambdify(PHI, variable_of_phi, modules=[mpmath_namespace(), "mpmath"])
-    angles = _angle_grid(phi_max)
+    angles = angle_grid(phi_max)
     scale0 = abs(float(series[0])) or 1.0
     closed_error = np.zeros(len(angles))
     t_values = np.zeros(len(angles))
     with mpmath.workdps(30):
         for k, angle in enumerate(angles):
             t_values[k] = float(to_t(mpmath.mpf(float(dtype(angle)))))
-            # rounding errors fluctuate from one argument to the next: take the worst of a few
-            # nearby arguments, so that a cancellation cannot hide behind one lucky grid point
-            samples: np.ndarray = np.unique(np.asarray(angle * (1 - JITTER * np.arange(JITTER_SAMPLES)),
-                                                       dtype=dtype))
-            samples = samples[samples.astype(np.float64) < phi_max * (1 - 2 * epsilon)]  # rounded inside
-            values = np.asarray(model_closed(samples), dtype=np.float64)
-            worst = 0.0
-            for sample, value in zip(samples, np.broadcast_to(values, samples.shape), strict=True):
-                reference = float(mp_closed(mpmath.mpf(float(sample))))  # type: ignore[operator]
-                scale = max(abs(reference), scale0)
-                error = abs(value - reference) / (scale * epsilon) if np.isfinite(value) else np.inf
-                worst = max(worst, error)
-            closed_error[k] = worst
+            if not len(inputs.angles[k]):
+                continue
+            printed = model_closed(inputs.angles[k], inputs.lengths[k], inputs.squares[k],
+                                   inputs.complements[k])
+            values = np.broadcast_to(np.asarray(printed, dtype=np.float64), inputs.angles[k].shape)
+            exact = reference[k]
+            with np.errstate(all="ignore"):
+                errors = np.abs(values - exact) / (np.maximum(np.abs(exact), scale0) * epsilon)
+            errors = np.where(np.isfinite(values), np.where(np.isnan(exact), 0.0, errors), np.inf)
+            closed_error[k] = float(np.max(errors))
     floats = [_magnitude(c) for c in series]
     # every Horner coefficient must be finite in the format (e.g. 1000 tan(φ/1000) has a
     # coefficient 1.1e42 of x in H⁻¹, beyond float32): the polynomial keeps only the leading terms
@@ -347,7 +362,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             if coefficient in derivation.slopes:  # after every parent: its parent's plan is known
                 try:
                     coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max,
-                                                            dtype)
+                                                            dtype, inverse, complement)
                 except UnplannableCoefficient:  # e.g. 1e-8*phi in float32: dc/dx ~ 1/kappa^4 overflows
                     coefficients[coefficient] = Constant(sp.Integer(0))  # never used: see slope_limit
                     slopes_unrepresentable = True
@@ -370,8 +385,10 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                     continue
             series = derivation.series_in_x(coefficient, MAX_TERMS)
             simplest_form = derivation.simplified_form(coefficient)
-            coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype)
-        coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, phi_max, p_max, dtype)
+            coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
+                                                    inverse, complement)
+        coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
+                                                             dtype)
         scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
         angle = (ClosedAngle(inverse) if inverse is not None and complement is None
                  and closed_angle_error(inverse, p, phi_max, dtype) <= ANGLE_TOLERANCE_ULP
@@ -396,7 +413,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
 
 
 def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coefficient], phi_max: float,
-                dtype: type) -> Coefficient:
+                dtype: type, inverse: sp.Expr | None, complement: sp.Rational | None) -> Coefficient:
     """A slope dc/dx (:mod:`symrot.derivatives`): the derivative in x of its parent's algebraic form when
     the parent has one (d(D)/dx = −1), else a Branch of its closed form and exact series. Never a search
     of its own under the algebraic time budget, so that the plan is the same on a loaded machine."""
@@ -404,7 +421,8 @@ def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coeff
     if isinstance(parent, Algebraic):
         return Algebraic(sp.diff(parent.expression, X) - sp.diff(parent.expression, D))
     series = derivation.series_in_x(name, MAX_TERMS)
-    return plan_branch(derivation.simplified_form(name), series, derivation.p ** 2, phi_max, dtype)
+    return plan_branch(derivation.simplified_form(name), series, derivation.p ** 2, phi_max, dtype,
+                       derivation.p, inverse, complement)
 
 
 def _check_scale(derivation: Derivation) -> None:
@@ -461,15 +479,16 @@ def _use_complement(coefficient: Coefficient, inverse: sp.Expr, complement: sp.R
     return coefficient
 
 
-def _quaternion_scalar(derivation: Derivation, inverse: sp.Expr | None, phi_max: float,
-                       p_max: float, dtype: type) -> Coefficient:
+def _quaternion_scalar(derivation: Derivation, inverse: sp.Expr | None, complement: sp.Rational | None,
+                       phi_max: float, p_max: float, dtype: type) -> Coefficient:
     """e₀ = cos(φ/2) as a coefficient of x (eq 74)."""
     if inverse is not None:
         algebraic = algebraic_in_x(quaternion_scalar(), inverse, p_max)
         if algebraic is not None:
             return Algebraic(algebraic)
     series = quaternion_scalar_series(derivation, MAX_TERMS)
-    return plan_branch(quaternion_scalar(), series, derivation.p ** 2, phi_max, dtype)
+    return plan_branch(quaternion_scalar(), series, derivation.p ** 2, phi_max, dtype, derivation.p, inverse,
+                       complement)
 
 
 def _quaternion_scale(p: sp.Expr, phi_top: float, dtype: type) -> QuaternionScale:

@@ -100,3 +100,32 @@ def test_which_equations_are_solved_is_decided_by_shape_not_by_time() -> None:
     s = sp.Symbol("s", nonnegative=True)
     assert closed_inverse(sp.asinh(2 * PHI) / 2, sp.Integer(1)) == sp.sinh(2 * s) / 2
     assert closed_inverse(PHI + PHI**3 / 6, sp.Integer(1)) is not None  # Cardano
+
+
+def test_forms_near_an_edge_where_p_prime_grows_use_s_not_phi() -> None:
+    """4 atanh(φ/4) and 2 asin(φ/2): p′ → ∞ at φ_max, so the rounded angle φ̂ computed from s
+    carries far less information than s. Forms that recompute p or √(1 − φ²/4) from φ̂ lost every
+    digit there in float32 (R 8e4 ulp, 343 ulp); the plan measures forms on the backends' inputs
+    and writes p as s, p² as x and p′ through the closed inverse (cosh²(s/4), 1/cos(s/2))."""
+    from symrot.backends.numpy_backend import module_source
+
+    eps = float(np.finfo(np.float32).eps)
+    cases = {"4*atanh(phi/4)": (4.0, lambda s: 4 * mpmath.tanh(s / 4)),
+             "2*asin(phi/2)": (2.0, lambda s: 2 * mpmath.sin(s / 2))}
+    for expression, (phi_max, inverse) in cases.items():
+        plan = evaluation_plan(derive(expression).derivation, "edge")
+        namespace: dict[str, object] = {}
+        exec(compile(module_source(plan), "<edge>", "exec"), namespace)
+        p_of = sp.lambdify(PHI, sp.sympify(expression), "mpmath")
+        for gap in (1e-2, 1e-4, 1e-6):
+            with mpmath.workdps(50):
+                length = np.float32(float(p_of(mpmath.mpf(phi_max - gap))))
+                angle = inverse(mpmath.mpf(float(length)))
+                cosine, sine = float(mpmath.cos(angle)), float(mpmath.sin(angle))
+                slope = float(mpmath.diff(p_of, angle))  # H⁻¹ u = p′ u on the axis (eq 26)
+            vector = np.array([length, 0, 0], dtype=np.float32)
+            rotation = namespace["rotation_matrix"](vector).astype(np.float64)  # type: ignore[operator]
+            exact = np.array([[1, 0, 0], [0, cosine, -sine], [0, sine, cosine]])
+            assert np.abs(rotation - exact).max() <= 4 * eps, (expression, gap)
+            axial = float(namespace["tangent_inverse"](vector)[0, 0])  # type: ignore[index, operator]
+            assert abs(axial - slope) <= 4 * eps * abs(slope), (expression, gap, axial, slope)

@@ -420,8 +420,8 @@ static inline double symrot_linear_tangent_det(const double p[3])
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
- * G_2: Horner degree 12 in x below x = 0.0649445, else 2*sin(phi/4)**2/s**2
- * ops: 112 */
+ * G_2: Horner degree 15 in x below x = 0.116472, else 2*sin(phi/4)**2/x
+ * ops: 121 */
 static inline void symrot_linear_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -440,12 +440,11 @@ static inline void symrot_linear_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = (1.0/2.0)*sqrt(2)/sqrt(sqrt(d) + 1);
     double c_G_2;
-    if (x < 0.0649445220708132) {
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1215486600363.0/562949953421312.0)*x + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+    if (x < 0.116472206314816) {
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
     } else {
         const double phi = symrot_linear__phi(sqrt(x), d);
-        const double s = sqrt(x);
-        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -462,12 +461,12 @@ static inline void symrot_linear_root_matrix(const double p[3], double G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = 1/sqrt(sqrt(d) + 1).
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(d) + 1).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -476,7 +475,6 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
@@ -484,21 +482,18 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
                 const double s = sqrt(x);
                 const double phi = symrot_linear__phi(s, d);
                 const double u0 = 1.0/sqrt(sqrt(d) + 1);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
@@ -512,8 +507,8 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.7071067811865476*u0;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1215486600363.0/562949953421312.0)*x + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -523,7 +518,7 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
             c_G_1_lanes[k] = !(x < 1.0) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.0649445220708132 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.116472206314816 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 1.0) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -545,9 +540,9 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
 /* symrot_linear_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/(2*sqrt(d)) (algebraic in x)
- * K_1: Horner degree 12 in x below x = 0.0649445, else 2*sin(phi/4)**2/s**2
- * K_2: Horner degree 16 in x below x = 0.116472, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/s**2
- * ops: 156 */
+ * K_1: Horner degree 15 in x below x = 0.116472, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 16 in x below x = 0.116472, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/x
+ * ops: 165 */
 static inline void symrot_linear_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -566,15 +561,14 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
     }
     const double c_K_0 = (1.0/2.0)/sqrt(d);
     double c_K_1, c_K_2;
-    if (x < 0.0649445220708132) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1215486600363.0/562949953421312.0)*x + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+    if (x < 0.116472206314816) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06653969900370939)*x + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0;
     } else {
         const double phi = symrot_linear__phi(sqrt(x), d);
-        const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
+        const double w0 = 1.0/x;
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 0.116472206314816 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06653969900370939)*x + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0 : w0*(-(1.0/2.0)/cos((1.0/2.0)*phi) + (1.0/2.0)/sqrt(d));
+        c_K_2 = w0*(-(1.0/2.0)/cos((1.0/2.0)*phi) + (1.0/2.0)/sqrt(d));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -591,12 +585,12 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = 1/sqrt(d).
+ * Scalar pass: phi, u0 = 1/sqrt(d).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -605,7 +599,6 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
@@ -613,21 +606,18 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
                 const double s = sqrt(x);
                 const double phi = symrot_linear__phi(s, d);
                 const double u0 = 1.0/sqrt(d);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
@@ -652,10 +642,10 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const double w0 = (1.0/2.0)*u0;
-            const double w1 = 1.0/(s*s);
+            const double w1 = 1.0/x;
             c_K_0_lanes[k] = w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1215486600363.0/562949953421312.0)*x + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
             c_K_2_lanes[k] = w1*(w0 - (1.0/2.0)/cos1);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06653969900370939)*x + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0;
         }
@@ -666,7 +656,7 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             c_K_0_lanes[k] = !(x < 1.0) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.0649445220708132 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.116472206314816 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 1.0) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -1020,8 +1010,8 @@ static inline void symrot_linear_rotation_transpose_derivative(const double p[3]
  * H_2: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*(sqrt(d) + 1))
  * H_0_x = 1/(2*d**(3/2)) (algebraic in x)
  * H_1_x = 1/(2*sqrt(d)*(sqrt(d) + 1)**2) (algebraic in x)
- * H_2_x: Horner degree 18 in x below x = 0.116472, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
- * ops: 255 */
+ * H_2_x: Horner degree 7 in x below x = 0.0059512, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
+ * ops: 222 */
 static inline void symrot_linear_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1044,13 +1034,13 @@ static inline void symrot_linear_tangent_derivative(const double p[3], const dou
     double c_H_2, c_H_2_x;
     if (x < 0.005951203046330052) {
         c_H_2 = x*(x*(x*(x*(x*(x*((6435.0/32768.0)*x + 429.0/2048.0) + 231.0/1024.0) + 63.0/256.0) + 35.0/128.0) + 5.0/16.0) + 3.0/8.0) + 1.0/2.0;
-        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((654771011895.0/274877906944.0)*x + 39763421775.0/17179869184.0) + 38569325025.0/17179869184.0) + 583401555.0/268435456.0) + 4508102925.0/2147483648.0) + 67863915.0/33554432.0) + 65189475.0/33554432.0) + 3900225.0/2097152.0) + 7436429.0/4194304.0) + 440895.0/262144.0) + 415701.0/262144.0) + 12155.0/8192.0) + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*((12155.0/8192.0)*x + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0;
     } else {
         const double w0 = sqrt(d);
         const double w1 = 1.0/w0;
         const double w2 = 1.0/(w0 + 1);
         c_H_2 = w1*w2;
-        c_H_2_x = x < 0.116472206314816 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((654771011895.0/274877906944.0)*x + 39763421775.0/17179869184.0) + 38569325025.0/17179869184.0) + 583401555.0/268435456.0) + 4508102925.0/2147483648.0) + 67863915.0/33554432.0) + 65189475.0/33554432.0) + 3900225.0/2097152.0) + 7436429.0/4194304.0) + 440895.0/262144.0) + 415701.0/262144.0) + 12155.0/8192.0) + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0 : (1.0/2.0)*w2*(w1 + w2)/d;
+        c_H_2_x = (1.0/2.0)*w2*(w1 + w2)/d;
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1099,8 +1089,8 @@ static inline void symrot_linear_tangent_derivative(const double p[3], const dou
  * H_2: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*(sqrt(d) + 1))
  * H_0_x = 1/(2*d**(3/2)) (algebraic in x)
  * H_1_x = 1/(2*sqrt(d)*(sqrt(d) + 1)**2) (algebraic in x)
- * H_2_x: Horner degree 18 in x below x = 0.116472, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
- * ops: 261 */
+ * H_2_x: Horner degree 7 in x below x = 0.0059512, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
+ * ops: 228 */
 static inline void symrot_linear_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1123,13 +1113,13 @@ static inline void symrot_linear_tangent_transpose_derivative(const double p[3],
     double c_H_2, c_H_2_x;
     if (x < 0.005951203046330052) {
         c_H_2 = x*(x*(x*(x*(x*(x*((6435.0/32768.0)*x + 429.0/2048.0) + 231.0/1024.0) + 63.0/256.0) + 35.0/128.0) + 5.0/16.0) + 3.0/8.0) + 1.0/2.0;
-        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((654771011895.0/274877906944.0)*x + 39763421775.0/17179869184.0) + 38569325025.0/17179869184.0) + 583401555.0/268435456.0) + 4508102925.0/2147483648.0) + 67863915.0/33554432.0) + 65189475.0/33554432.0) + 3900225.0/2097152.0) + 7436429.0/4194304.0) + 440895.0/262144.0) + 415701.0/262144.0) + 12155.0/8192.0) + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*((12155.0/8192.0)*x + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0;
     } else {
         const double w0 = sqrt(d);
         const double w1 = 1.0/w0;
         const double w2 = 1.0/(w0 + 1);
         c_H_2 = w1*w2;
-        c_H_2_x = x < 0.116472206314816 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((654771011895.0/274877906944.0)*x + 39763421775.0/17179869184.0) + 38569325025.0/17179869184.0) + 583401555.0/268435456.0) + 4508102925.0/2147483648.0) + 67863915.0/33554432.0) + 65189475.0/33554432.0) + 3900225.0/2097152.0) + 7436429.0/4194304.0) + 440895.0/262144.0) + 415701.0/262144.0) + 12155.0/8192.0) + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0 : (1.0/2.0)*w2*(w1 + w2)/d;
+        c_H_2_x = (1.0/2.0)*w2*(w1 + w2)/d;
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1245,8 +1235,8 @@ static inline void symrot_linear_tangent_inverse_derivative(const double p[3], c
  * H_2: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*(sqrt(d) + 1))
  * H_0_x = 1/(2*d**(3/2)) (algebraic in x)
  * H_1_x = 1/(2*sqrt(d)*(sqrt(d) + 1)**2) (algebraic in x)
- * H_2_x: Horner degree 18 in x below x = 0.116472, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
- * ops: 219 */
+ * H_2_x: Horner degree 7 in x below x = 0.0059512, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
+ * ops: 186 */
 static inline void symrot_linear_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1264,13 +1254,13 @@ static inline void symrot_linear_angular_acceleration(const double p[3], const d
     double c_H_2, c_H_2_x;
     if (x < 0.005951203046330052) {
         c_H_2 = x*(x*(x*(x*(x*(x*((6435.0/32768.0)*x + 429.0/2048.0) + 231.0/1024.0) + 63.0/256.0) + 35.0/128.0) + 5.0/16.0) + 3.0/8.0) + 1.0/2.0;
-        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((654771011895.0/274877906944.0)*x + 39763421775.0/17179869184.0) + 38569325025.0/17179869184.0) + 583401555.0/268435456.0) + 4508102925.0/2147483648.0) + 67863915.0/33554432.0) + 65189475.0/33554432.0) + 3900225.0/2097152.0) + 7436429.0/4194304.0) + 440895.0/262144.0) + 415701.0/262144.0) + 12155.0/8192.0) + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*((12155.0/8192.0)*x + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0;
     } else {
         const double w0 = sqrt(d);
         const double w1 = 1.0/w0;
         const double w2 = 1.0/(w0 + 1);
         c_H_2 = w1*w2;
-        c_H_2_x = x < 0.116472206314816 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((654771011895.0/274877906944.0)*x + 39763421775.0/17179869184.0) + 38569325025.0/17179869184.0) + 583401555.0/268435456.0) + 4508102925.0/2147483648.0) + 67863915.0/33554432.0) + 65189475.0/33554432.0) + 3900225.0/2097152.0) + 7436429.0/4194304.0) + 440895.0/262144.0) + 415701.0/262144.0) + 12155.0/8192.0) + 45045.0/32768.0) + 1287.0/1024.0) + 1155.0/1024.0) + 63.0/64.0) + 105.0/128.0) + 5.0/8.0) + 3.0/8.0 : (1.0/2.0)*w2*(w1 + w2)/d;
+        c_H_2_x = (1.0/2.0)*w2*(w1 + w2)/d;
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1786,7 +1776,7 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
- * G_2: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/s**2
+ * G_2: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/x
  * ops: 94 */
 static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
 {
@@ -1810,8 +1800,7 @@ static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
         c_G_2 = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_linear__phi_f(sqrtf(x), d);
-        const float s = sqrtf(x);
-        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1828,12 +1817,12 @@ static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = 1/sqrt(sqrt(d) + 1).
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(d) + 1).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1842,7 +1831,6 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0F)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
@@ -1850,21 +1838,18 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
                 const float s = sqrtf(x);
                 const float phi = symrot_linear__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(sqrtf(d) + 1);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
@@ -1878,8 +1863,8 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.70710677F*u0;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_G_2_lanes[k] = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_G_2_lanes[k] = (5.0F/128.0F)*x + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1889,7 +1874,7 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             c_G_1_lanes[k] = !(x < 1.0F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.0032607575F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 7.888951e-06F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 1.0F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1911,8 +1896,8 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
 /* symrot_linear_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/(2*sqrt(d)) (algebraic in x)
- * K_1: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/s**2
- * K_2: Horner degree 15 in x below x = 0.35302, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/s**2
+ * K_1: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 15 in x below x = 0.35302, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/(4*sin(phi/2)**2*cos(phi/2)**2)
  * ops: 135 */
 static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
 {
@@ -1937,10 +1922,10 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
     } else {
         const float phi = symrot_linear__phi_f(sqrtf(x), d);
-        const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 0.35302037F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F : w0*(-(1.0F/2.0F)/cosf((1.0F/2.0F)*phi) + (1.0F/2.0F)/sqrtf(d));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = cosf(w0);
+        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
+        c_K_2 = x < 0.35302037F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F : (1.0F/4.0F)*(-(1.0F/2.0F)/w1 + (1.0F/2.0F)/sqrtf(d))/((w1*w1)*powf(sinf(w0), 2));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -1957,12 +1942,12 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = 1/sqrt(d).
+ * Scalar pass: phi, u0 = 1/sqrt(d).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1971,7 +1956,6 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0F)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
@@ -1979,21 +1963,18 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
                 const float s = sqrtf(x);
                 const float phi = symrot_linear__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(d);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
@@ -2015,14 +1996,14 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float w0 = (1.0F/2.0F)*u0;
-            const float w1 = 1.0F/(s*s);
             c_K_0_lanes[k] = w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*((21.0F/1024.0F)*x + 5.0F/128.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = w1*(w0 - (1.0F/2.0F)/cos1);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_K_1_lanes[k] = (5.0F/128.0F)*x + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/4.0F)*(w0 - (1.0F/2.0F)/cos1)/((cos1*cos1)*(sin1*sin1));
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2032,7 +2013,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             c_K_0_lanes[k] = !(x < 1.0F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.0032607575F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 7.888951e-06F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 1.0F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

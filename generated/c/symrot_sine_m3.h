@@ -101,8 +101,8 @@ static inline double symrot_sine_m3_angle(const double p[3])
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
- * ops: 101 */
+ * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
+ * ops: 92 */
 static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -121,12 +121,11 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = 1 - 4.0/27.0*x;
     double c_R_2;
-    if (x < 0.4621072324955599) {
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+    if (x < 0.1294709423110197) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
-        const double s = sqrt(x);
-        c_R_2 = (1 - cos(phi))/(s*s);
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -143,12 +142,12 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -156,28 +155,24 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0) || x < 0.4621072324955599) {
-                s_lanes[k] = 0;
+            if (!(x < 9.0) || x < 0.1294709423110197) {
                 phi_lanes[k] = 0;
             } else {
                 const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -186,11 +181,10 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = 1 - 4.0/27.0*x;
-            c_R_2_lanes[k] = (1 - cos0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -200,7 +194,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 9.0) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.4621072324955599 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.1294709423110197 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -222,9 +216,9 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
 /* symrot_sine_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
- * H_2: Horner degree 9 in x below x = 0.245082, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
- * ops: 129 */
+ * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
+ * ops: 117 */
 static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -243,16 +237,15 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
-    if (x < 0.24508162850254916) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+    if (x < 0.1294709423110197) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*((12155.0/25389989167104.0)*x + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
-        const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = sqrt(d);
-        c_H_1 = x < 0.4621072324955599 ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0 : w0*(1 - cos(phi));
-        c_H_2 = w0*(-2.0/3.0*w1 + 2*pow(sin((1.0/2.0)*phi), 2) + 2)/w1;
+        const double w0 = 1.0/x;
+        const double w1 = 2*pow(sin((1.0/2.0)*phi), 2);
+        c_H_1 = w0*w1;
+        c_H_2 = w0*(w1 + 4*pow(sin((1.0/6.0)*phi), 2))/sqrt(d);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -269,12 +262,12 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = 1/sqrt(d), u1 = sqrt(d).
+ * Scalar pass: phi, u0 = 1/sqrt(d).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -283,37 +276,28 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.0)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
                 const double u0 = 1.0/sqrt(d);
-                const double u1 = sqrt(d);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
-            const double a0_a = phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -322,9 +306,8 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/2.0)*phi;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a1_a = (1.0/6.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -334,12 +317,13 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = 1.0/(s*s);
+            const double w0 = 1.0/x;
+            const double w1 = 2*(sin0*sin0);
             c_H_0_lanes[k] = 3*u0;
-            c_H_1_lanes[k] = w0*(1 - cos0);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-            c_H_2_lanes[k] = u0*w0*(2*(sin1*sin1) - 2.0/3.0*u1 + 2);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+            c_H_1_lanes[k] = w0*w1;
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + w1);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((12155.0/25389989167104.0)*x + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -348,11 +332,11 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 9.0) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.4621072324955599 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.1294709423110197 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 9.0) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 0.24508162850254916 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 0.1294709423110197 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 9.0) ? (double)NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -468,8 +452,8 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m3_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 7 in x below x = 0.0682556, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
- * ops: 48 */
+ * det_H: Horner degree 8 in x below x = 0.129471, else 12*sin(phi/2)**2/(sqrt(d)*x)
+ * ops: 51 */
 static inline double symrot_sine_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -478,12 +462,11 @@ static inline double symrot_sine_m3_tangent_det(const double p[3])
         return (double)NAN;
     }
     double c_det_H;
-    if (x < 0.06825555929208893) {
-        c_det_H = x*(x*(x*(x*(x*(x*((715.0/78364164096.0)*x + 143.0/1632586752.0) + 77.0/90699264.0) + 7.0/839808.0) + 35.0/419904.0) + 5.0/5832.0) + 1.0/108.0) + 1;
+    if (x < 0.1294709423110197) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*((12155.0/12694994583552.0)*x + 715.0/78364164096.0) + 143.0/1632586752.0) + 77.0/90699264.0) + 7.0/839808.0) + 35.0/419904.0) + 5.0/5832.0) + 1.0/108.0) + 1;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
-        const double s = sqrt(x);
-        c_det_H = 12*pow(sin((1.0/2.0)*phi), 2)/(sqrt(d)*(s*s));
+        c_det_H = 12*pow(sin((1.0/2.0)*phi), 2)/(sqrt(d)*x);
     }
     return c_det_H;
 }
@@ -492,7 +475,7 @@ static inline double symrot_sine_m3_tangent_det(const double p[3])
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.129471, else sin(phi/2)/s
- * G_2: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/s**2
+ * G_2: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/x
  * ops: 129 */
 static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
 {
@@ -518,7 +501,7 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
         c_G_1 = sin((1.0/2.0)*phi)/s;
-        c_G_2 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        c_G_2 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -591,7 +574,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0/2.0 + (-5.0/432.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -626,7 +609,7 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
 /* symrot_sine_m3_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * K_0 = 3/(2*sqrt(d)) (algebraic in x)
- * K_1: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/s**2
+ * K_1: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 20 in x below x = 1.59536, else (-6*sin(phi/2)/s + 9/sqrt(d))/(6*s**2)
  * ops: 171 */
 static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
@@ -653,9 +636,8 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*w0*(-6*sin((1.0/2.0)*phi)/s + 9/sqrt(d));
+        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
+        c_K_2 = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*(-6*sin((1.0/2.0)*phi)/s + 9/sqrt(d))/(s*s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -731,11 +713,10 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = 1.0/(s*s);
             c_K_0_lanes[k] = (3.0/2.0)*u0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/6.0)*w0*(9*u0 - 6*sin1/s);
+            c_K_2_lanes[k] = (1.0/6.0)*(9*u0 - 6*sin1/s)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -797,9 +778,9 @@ static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3],
 /* symrot_sine_m3_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
- * H_2: Horner degree 9 in x below x = 0.245082, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
- * ops: 123 */
+ * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
+ * ops: 111 */
 static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -812,16 +793,15 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
     }
     const double c_H_0 = 3/sqrt(d);
     double c_H_1, c_H_2;
-    if (x < 0.24508162850254916) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+    if (x < 0.1294709423110197) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*((12155.0/25389989167104.0)*x + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
-        const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = sqrt(d);
-        c_H_1 = x < 0.4621072324955599 ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0 : w0*(1 - cos(phi));
-        c_H_2 = w0*(-2.0/3.0*w1 + 2*pow(sin((1.0/2.0)*phi), 2) + 2)/w1;
+        const double w0 = 1.0/x;
+        const double w1 = 2*pow(sin((1.0/2.0)*phi), 2);
+        c_H_1 = w0*w1;
+        c_H_2 = w0*(w1 + 4*pow(sin((1.0/6.0)*phi), 2))/sqrt(d);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -997,11 +977,11 @@ static inline int symrot_sine_m3_rescale(const double p[3], double q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)
  * R_2_x: Horner degree 20 in x below x = 1.59536, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
- * ops: 252 */
+ * ops: 243 */
 static inline void symrot_sine_m3_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1020,17 +1000,18 @@ static inline void symrot_sine_m3_rotation_derivative(const double p[3], const d
     }
     const double c_R_1 = 1 - 4.0/27.0*x;
     double c_R_2, c_R_2_x;
-    if (x < 0.4621072324955599) {
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+    if (x < 0.1294709423110197) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        const double w0 = sqrt(d);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        c_R_2 = (1 - cos(phi))/(s*s);
-        c_R_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*(6*w2*cos(w1) - 4*w0*(w2*w2)/s)/((s*s*s)*w0);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = sqrt(d);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*(6*w1*cos(w0) - 4*w2*w3/s)/((s*s*s)*w3);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1070,11 +1051,11 @@ static inline void symrot_sine_m3_rotation_derivative(const double p[3], const d
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)
  * R_2_x: Horner degree 20 in x below x = 1.59536, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
- * ops: 247 */
+ * ops: 238 */
 static inline void symrot_sine_m3_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1093,17 +1074,18 @@ static inline void symrot_sine_m3_rotation_transpose_derivative(const double p[3
     }
     const double c_R_1 = 1 - 4.0/27.0*x;
     double c_R_2, c_R_2_x;
-    if (x < 0.4621072324955599) {
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+    if (x < 0.1294709423110197) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        const double w0 = sqrt(d);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        c_R_2 = (1 - cos(phi))/(s*s);
-        c_R_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*(6*w2*cos(w1) - 4*w0*(w2*w2)/s)/((s*s*s)*w0);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = sqrt(d);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*(6*w1*cos(w0) - 4*w2*w3/s)/((s*s*s)*w3);
     }
     const double dw0 = a[1]*p[2];
     const double dw1 = -a[2]*p[1] + dw0;
@@ -1143,12 +1125,12 @@ static inline void symrot_sine_m3_rotation_transpose_derivative(const double p[3
 /* symrot_sine_m3_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
- * H_2: Horner degree 9 in x below x = 0.245082, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
+ * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 20 in x below x = 1.59536, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
  * H_2_x: Horner degree 21 in x below x = 1.59536, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/s**2 + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*s**2)
- * ops: 351 */
+ * ops: 339 */
 static inline void symrot_sine_m3_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1167,28 +1149,29 @@ static inline void symrot_sine_m3_tangent_derivative(const double p[3], const do
     }
     const double c_H_0_x = (3.0/2.0)/pow(d, 3.0/2.0);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.24508162850254916) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+    if (x < 0.1294709423110197) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*((12155.0/25389989167104.0)*x + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = sqrt(d);
-        const double w2 = 1.0/w1;
-        const double w3 = (1.0/2.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = (w4*w4);
-        const double w6 = -2.0/3.0*w1 + 2*w5 + 2;
-        const double w7 = w0*w6;
-        const double w8 = cos(w3);
-        const double w9 = 1.0/s;
-        c_H_1 = x < 0.4621072324955599 ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0 : w0*(1 - cos(phi));
-        c_H_2 = w2*w7;
-        c_H_1_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*w2*(-4*w1*w5*w9 + 6*w4*w8)/(s*s*s);
-        c_H_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0 : (1.0/18.0)*w0*w2*(9*w2*w9*((2.0/3.0)*s + 6*w4*w8) - 18*w7 + 9*w6/d);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 2*w3;
+        const double w5 = sqrt(d);
+        const double w6 = 1.0/w5;
+        const double w7 = cos(w1);
+        const double w8 = 1.0/s;
+        const double w9 = 1.0/(s*s);
+        const double w10 = w4 - 2.0/3.0*w5 + 2;
+        c_H_1 = w0*w4;
+        c_H_2 = w0*w6*(w4 + 4*pow(sin((1.0/6.0)*phi), 2));
+        c_H_1_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*w6*(6*w2*w7 - 4*w3*w5*w8)/(s*s*s);
+        c_H_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0 : (1.0/18.0)*w6*w9*(-18*w10*w9 + 9*w6*w8*((2.0/3.0)*s + 6*w2*w7) + 9*w10/d);
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1233,12 +1216,12 @@ static inline void symrot_sine_m3_tangent_derivative(const double p[3], const do
 /* symrot_sine_m3_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
- * H_2: Horner degree 9 in x below x = 0.245082, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
+ * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 20 in x below x = 1.59536, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
  * H_2_x: Horner degree 21 in x below x = 1.59536, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/s**2 + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*s**2)
- * ops: 357 */
+ * ops: 345 */
 static inline void symrot_sine_m3_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1257,28 +1240,29 @@ static inline void symrot_sine_m3_tangent_transpose_derivative(const double p[3]
     }
     const double c_H_0_x = (3.0/2.0)/pow(d, 3.0/2.0);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.24508162850254916) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+    if (x < 0.1294709423110197) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*((12155.0/25389989167104.0)*x + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = sqrt(d);
-        const double w2 = 1.0/w1;
-        const double w3 = (1.0/2.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = (w4*w4);
-        const double w6 = -2.0/3.0*w1 + 2*w5 + 2;
-        const double w7 = w0*w6;
-        const double w8 = cos(w3);
-        const double w9 = 1.0/s;
-        c_H_1 = x < 0.4621072324955599 ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0 : w0*(1 - cos(phi));
-        c_H_2 = w2*w7;
-        c_H_1_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*w2*(-4*w1*w5*w9 + 6*w4*w8)/(s*s*s);
-        c_H_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0 : (1.0/18.0)*w0*w2*(9*w2*w9*((2.0/3.0)*s + 6*w4*w8) - 18*w7 + 9*w6/d);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 2*w3;
+        const double w5 = sqrt(d);
+        const double w6 = 1.0/w5;
+        const double w7 = cos(w1);
+        const double w8 = 1.0/s;
+        const double w9 = 1.0/(s*s);
+        const double w10 = w4 - 2.0/3.0*w5 + 2;
+        c_H_1 = w0*w4;
+        c_H_2 = w0*w6*(w4 + 4*pow(sin((1.0/6.0)*phi), 2));
+        c_H_1_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*w6*(6*w2*w7 - 4*w3*w5*w8)/(s*s*s);
+        c_H_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0 : (1.0/18.0)*w6*w9*(-18*w10*w9 + 9*w6*w8*((2.0/3.0)*s + 6*w2*w7) + 9*w10/d);
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1390,12 +1374,12 @@ static inline void symrot_sine_m3_tangent_inverse_derivative(const double p[3], 
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 10 in x below x = 0.462107, else (1 - cos(phi))/s**2
- * H_2: Horner degree 9 in x below x = 0.245082, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*s**2)
+ * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 20 in x below x = 1.59536, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
  * H_2_x: Horner degree 21 in x below x = 1.59536, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/s**2 + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*s**2)
- * ops: 315 */
+ * ops: 303 */
 static inline void symrot_sine_m3_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1409,28 +1393,29 @@ static inline void symrot_sine_m3_angular_acceleration(const double p[3], const 
     const double c_H_0 = 3/sqrt(d);
     const double c_H_0_x = (3.0/2.0)/pow(d, 3.0/2.0);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.24508162850254916) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((46189.0/914039610015744.0)*x + 12155.0/25389989167104.0) + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+    if (x < 0.1294709423110197) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*((12155.0/25389989167104.0)*x + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = sqrt(d);
-        const double w2 = 1.0/w1;
-        const double w3 = (1.0/2.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = (w4*w4);
-        const double w6 = -2.0/3.0*w1 + 2*w5 + 2;
-        const double w7 = w0*w6;
-        const double w8 = cos(w3);
-        const double w9 = 1.0/s;
-        c_H_1 = x < 0.4621072324955599 ? x*(x*(x*(x*(x*(x*(x*(x*(x*((-5083.0/5484237660094464.0)*x - 1001.0/101559956668416.0) - 2717.0/25389989167104.0) - 187.0/156728328192.0) - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0 : w0*(1 - cos(phi));
-        c_H_2 = w2*w7;
-        c_H_1_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*w2*(-4*w1*w5*w9 + 6*w4*w8)/(s*s*s);
-        c_H_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0 : (1.0/18.0)*w0*w2*(9*w2*w9*((2.0/3.0)*s + 6*w4*w8) - 18*w7 + 9*w6/d);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 2*w3;
+        const double w5 = sqrt(d);
+        const double w6 = 1.0/w5;
+        const double w7 = cos(w1);
+        const double w8 = 1.0/s;
+        const double w9 = 1.0/(s*s);
+        const double w10 = w4 - 2.0/3.0*w5 + 2;
+        c_H_1 = w0*w4;
+        c_H_2 = w0*w6*(w4 + 4*pow(sin((1.0/6.0)*phi), 2));
+        c_H_1_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.9530434105760433e-22)*x - 1.8047170367813792e-21) - 1.6700835577772424e-20) - 1.5480048293470188e-19) - 1.437467421563809e-18) - 1.3375767422356916e-17) - 1.2475538740544348e-16) - 1.1667359059170363e-15) - 1.094581086297651e-14) - 1.030681081006004e-13) - 9.747843557133503e-13) - 25415.0/2742118830047232.0) - 1001.0/11284439629824.0) - 2717.0/3173748645888.0) - 1309.0/156728328192.0) - 5.0/60466176.0) - 455.0/544195584.0) - 11.0/1259712.0) - 1.0/10368.0) - 7.0/5832.0) - 5.0/216.0 : (1.0/2.0)*w6*(6*w2*w7 - 4*w3*w5*w8)/(s*s*s);
+        c_H_2_x = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9043302554482946e-22)*x + 2.5505300243300477e-21) + 2.2370097223359885e-20) + 1.9592931494898868e-19) + 1.7133899606875123e-18) + 1.4957431278434227e-17) + 1.3031819117210595e-16) + 1.1328797300756938e-15) + 9.823163594978919e-15) + 8.492439462654188e-14) + 7.316563229363608e-13) + 6.277611250793976e-12) + 146965.0/2742118830047232.0) + 46189.0/101559956668416.0) + 12155.0/3173748645888.0) + 5005.0/156728328192.0) + 143.0/544195584.0) + 385.0/181398528.0) + 7.0/419904.0) + 35.0/279936.0) + 5.0/5832.0) + 1.0/216.0 : (1.0/18.0)*w6*w9*(-18*w10*w9 + 9*w6*w8*((2.0/3.0)*s + 6*w2*w7) + 9*w10/d);
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1628,7 +1613,7 @@ static inline float symrot_sine_m3_angle_f(const float p[3])
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * ops: 92 */
 static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9])
 {
@@ -1652,8 +1637,7 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
         c_R_2 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
-        const float s = sqrtf(x);
-        c_R_2 = (1 - cosf(phi))/(s*s);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1670,12 +1654,12 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1683,28 +1667,24 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0F) || x < 0.46210724F) {
-                s_lanes[k] = 0;
+            if (!(x < 9.0F) || x < 0.03594455F) {
                 phi_lanes[k] = 0;
             } else {
                 const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1713,11 +1693,10 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = 1 - 4.0F/27.0F*x;
-            c_R_2_lanes[k] = (1 - cos0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*((-11.0F/5038848.0F)*x - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1727,7 +1706,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             c_R_1_lanes[k] = !(x < 9.0F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 0.46210724F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.03594455F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1749,9 +1728,9 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
 /* symrot_sine_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
- * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
- * ops: 116 */
+ * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
+ * ops: 132 */
 static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1770,15 +1749,16 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
     }
     const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
-    if (x < 0.8648057F) {
+    if (x < 1.5953637F) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
-        const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        c_H_1 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*(1 - cosf(phi));
-        c_H_2 = w0*(4*powf(sinf((1.0F/6.0F)*phi), 2) + 2*powf(sinf((1.0F/2.0F)*phi), 2))/sqrtf(d);
+        const float w0 = 1.0F/x;
+        const float w1 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
+        const float w2 = sqrtf(d);
+        c_H_1 = w0*w1;
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w0*(w1 - 2.0F/3.0F*w2 + 2)/w2;
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1795,12 +1775,12 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = 1/sqrt(d).
+ * Scalar pass: phi, u0 = 1/sqrt(d), u1 = sqrt(d).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1809,32 +1789,33 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.0F)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(d);
-                s_lanes[k] = s;
+                const float u1 = sqrtf(d);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = phi;
+            const float u1 = u1_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1843,34 +1824,14 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = (1.0F/6.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float a2_a = (1.0F/2.0F)*phi;
-            const float a2_q = rintf(a2_a*0.63661975F);
-            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
-            const float a2_z = a2_r*a2_r;
-            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
-            const float a2_h = rintf(0.5F*a2_j - 0.25F);
-            const float a2_odd = a2_j - 2*a2_h;
-            const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const float w0 = 1.0F/(s*s);
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float w0 = 1.0F/x;
+            const float w1 = 2*(sin0*sin0);
             c_H_0_lanes[k] = 3*u0;
-            c_H_1_lanes[k] = w0*(1 - cos0);
-            poly_H_1_lanes[k] = x*(x*(x*((-11.0F/5038848.0F)*x - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + 2*(sin2*sin2));
-            poly_H_2_lanes[k] = x*(x*(x*(x*((4.2447974e-07F)*x + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+            c_H_1_lanes[k] = w0*w1;
+            poly_H_1_lanes[k] = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = u0*w0*(-2.0F/3.0F*u1 + w1 + 2);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1879,11 +1840,11 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             c_H_0_lanes[k] = !(x < 9.0F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 0.46210724F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.03594455F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 9.0F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 0.46210724F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 2.8627653F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 9.0F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1999,7 +1960,7 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m3_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 6 in x below x = 0.864806, else 12*sin(phi/2)**2/(sqrt(d)*s**2)
+ * det_H: Horner degree 6 in x below x = 0.864806, else 12*sin(phi/2)**2/(sqrt(d)*x)
  * ops: 45 */
 static inline float symrot_sine_m3_tangent_det_f(const float p[3])
 {
@@ -2013,8 +1974,7 @@ static inline float symrot_sine_m3_tangent_det_f(const float p[3])
         c_det_H = x*(x*(x*(x*(x*((8.7591054e-08F)*x + 8.489595e-07F) + 7.0F/839808.0F) + 35.0F/419904.0F) + 5.0F/5832.0F) + 1.0F/108.0F) + 1;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
-        const float s = sqrtf(x);
-        c_det_H = 12*powf(sinf((1.0F/2.0F)*phi), 2)/(sqrtf(d)*(s*s));
+        c_det_H = 12*powf(sinf((1.0F/2.0F)*phi), 2)/(sqrtf(d)*x);
     }
     return c_det_H;
 }
@@ -2023,7 +1983,7 @@ static inline float symrot_sine_m3_tangent_det_f(const float p[3])
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 1.59536, else sin(phi/2)/s
- * G_2: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi/2))/s**2
+ * G_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/4)**2/x
  * ops: 111 */
 static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
 {
@@ -2048,9 +2008,8 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        c_G_1 = sinf(w0)/s;
-        c_G_2 = (1 - cosf(w0))/(s*s);
+        c_G_1 = sinf((1.0F/2.0F)*phi)/s;
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -2111,12 +2070,20 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = (1 - cos0)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*(x*((55.0F/7962624.0F)*x + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2128,7 +2095,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             c_G_1_lanes[k] = !(x < 9.0F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 1.5953637F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.24508163F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.0F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2150,7 +2117,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
 /* symrot_sine_m3_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * K_0 = 3/(2*sqrt(d)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi/2))/s**2
+ * K_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 13 in x below x = 2.86277, else (-6*sin(phi/2)/s + 9/sqrt(d))/(6*s**2)
  * ops: 132 */
 static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
@@ -2177,10 +2144,8 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        const float w1 = (1.0F/2.0F)*phi;
-        c_K_1 = w0*(1 - cosf(w1));
-        c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (1.0F/6.0F)*w0*(-6*sinf(w1)/s + 9/sqrtf(d));
+        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
+        c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (1.0F/6.0F)*(-6*sinf((1.0F/2.0F)*phi)/s + 9/sqrtf(d))/(s*s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2236,7 +2201,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2246,13 +2211,20 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = 1.0F/(s*s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_K_0_lanes[k] = (3.0F/2.0F)*u0;
-            c_K_1_lanes[k] = w0*(1 - cos0);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/6.0F)*w0*(9*u0 - 6*sin0/s);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_K_1_lanes[k] = x*(x*((55.0F/7962624.0F)*x + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/6.0F)*(9*u0 - 6*sin1/s)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2262,7 +2234,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             c_K_0_lanes[k] = !(x < 9.0F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 1.5953637F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.24508163F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 9.0F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -2314,9 +2286,9 @@ static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3],
 /* symrot_sine_m3_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
- * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
- * ops: 110 */
+ * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
+ * ops: 126 */
 static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2329,15 +2301,16 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
     }
     const float c_H_0 = 3/sqrtf(d);
     float c_H_1, c_H_2;
-    if (x < 0.8648057F) {
+    if (x < 1.5953637F) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
-        const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        c_H_1 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*(1 - cosf(phi));
-        c_H_2 = w0*(4*powf(sinf((1.0F/6.0F)*phi), 2) + 2*powf(sinf((1.0F/2.0F)*phi), 2))/sqrtf(d);
+        const float w0 = 1.0F/x;
+        const float w1 = 2*powf(sinf((1.0F/2.0F)*phi), 2);
+        const float w2 = sqrtf(d);
+        c_H_1 = w0*w1;
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w0*(w1 - 2.0F/3.0F*w2 + 2)/w2;
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2513,10 +2486,10 @@ static inline int symrot_sine_m3_rescale_f(const float p[3], float q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)
- * R_2_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 3*sin(phi))/(2*sqrt(d)*s**3)
+ * R_2_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
  * ops: 222 */
 static inline void symrot_sine_m3_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
@@ -2542,9 +2515,12 @@ static inline void symrot_sine_m3_rotation_derivative_f(const float p[3], const 
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        const float w0 = sqrtf(d);
-        c_R_2 = (1 - cosf(phi))/(s*s);
-        c_R_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*(3*sinf(phi) - 4*w0*powf(sinf((1.0F/2.0F)*phi), 2)/s)/((s*s*s)*w0);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = sqrtf(d);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*(6*w1*cosf(w0) - 4*w2*w3/s)/((s*s*s)*w3);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2584,10 +2560,10 @@ static inline void symrot_sine_m3_rotation_derivative_f(const float p[3], const 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(4*x - 27)/27 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)
- * R_2_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 3*sin(phi))/(2*sqrt(d)*s**3)
+ * R_2_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
  * ops: 217 */
 static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
@@ -2613,9 +2589,12 @@ static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        const float w0 = sqrtf(d);
-        c_R_2 = (1 - cosf(phi))/(s*s);
-        c_R_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*(3*sinf(phi) - 4*w0*powf(sinf((1.0F/2.0F)*phi), 2)/s)/((s*s*s)*w0);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = sqrtf(d);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*(6*w1*cosf(w0) - 4*w2*w3/s)/((s*s*s)*w3);
     }
     const float dw0 = a[1]*p[2];
     const float dw1 = -a[2]*p[1] + dw0;
@@ -2655,12 +2634,12 @@ static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[
 /* symrot_sine_m3_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
- * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
+ * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
- * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 3*sin(phi))/(2*sqrt(d)*s**3)
- * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(4*sin(phi/6)**2 + 2*sin(phi/2)**2)/s**2 + 9*(4*sin(phi/6)**2 + 2*sin(phi/2)**2)/d + 9*(2*s/3 + 3*sin(phi))/(sqrt(d)*s))/(18*sqrt(d)*s**2)
- * ops: 307 */
+ * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
+ * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/x + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*x)
+ * ops: 322 */
 static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2679,26 +2658,29 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
     }
     const float c_H_0_x = (3.0F/2.0F)/powf(d, 3.0F/2.0F);
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.8648057F) {
+    if (x < 1.5953637F) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        const float w1 = sqrtf(d);
-        const float w2 = 1.0F/w1;
-        const float w3 = powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w4 = 2*w3 + 4*powf(sinf((1.0F/6.0F)*phi), 2);
-        const float w5 = w0*w4;
-        const float w6 = sinf(phi);
-        const float w7 = 1.0F/s;
-        c_H_1 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*(1 - cosf(phi));
-        c_H_2 = w2*w5;
-        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w2*(-4*w1*w3*w7 + 3*w6)/(s*s*s);
-        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w2*(9*w2*w7*((2.0F/3.0F)*s + 3*w6) - 18*w5 + 9*w4/d);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 2*w3;
+        const float w5 = sqrtf(d);
+        const float w6 = 1.0F/w5;
+        const float w7 = w4 - 2.0F/3.0F*w5 + 2;
+        const float w8 = w0*w7;
+        const float w9 = cosf(w1);
+        const float w10 = 1.0F/s;
+        c_H_1 = w0*w4;
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w6*w8;
+        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w6*(-4*w10*w3*w5 + 6*w2*w9)/(s*s*s);
+        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w6*(9*w10*w6*((2.0F/3.0F)*s + 6*w2*w9) - 18*w8 + 9*w7/d);
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2743,12 +2725,12 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
 /* symrot_sine_m3_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
- * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
+ * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
- * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 3*sin(phi))/(2*sqrt(d)*s**3)
- * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(4*sin(phi/6)**2 + 2*sin(phi/2)**2)/s**2 + 9*(4*sin(phi/6)**2 + 2*sin(phi/2)**2)/d + 9*(2*s/3 + 3*sin(phi))/(sqrt(d)*s))/(18*sqrt(d)*s**2)
- * ops: 313 */
+ * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
+ * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/x + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*x)
+ * ops: 328 */
 static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2767,26 +2749,29 @@ static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3
     }
     const float c_H_0_x = (3.0F/2.0F)/powf(d, 3.0F/2.0F);
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.8648057F) {
+    if (x < 1.5953637F) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        const float w1 = sqrtf(d);
-        const float w2 = 1.0F/w1;
-        const float w3 = powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w4 = 2*w3 + 4*powf(sinf((1.0F/6.0F)*phi), 2);
-        const float w5 = w0*w4;
-        const float w6 = sinf(phi);
-        const float w7 = 1.0F/s;
-        c_H_1 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*(1 - cosf(phi));
-        c_H_2 = w2*w5;
-        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w2*(-4*w1*w3*w7 + 3*w6)/(s*s*s);
-        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w2*(9*w2*w7*((2.0F/3.0F)*s + 3*w6) - 18*w5 + 9*w4/d);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 2*w3;
+        const float w5 = sqrtf(d);
+        const float w6 = 1.0F/w5;
+        const float w7 = w4 - 2.0F/3.0F*w5 + 2;
+        const float w8 = w0*w7;
+        const float w9 = cosf(w1);
+        const float w10 = 1.0F/s;
+        c_H_1 = w0*w4;
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w6*w8;
+        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w6*(-4*w10*w3*w5 + 6*w2*w9)/(s*s*s);
+        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w6*(9*w10*w6*((2.0F/3.0F)*s + 6*w2*w9) - 18*w8 + 9*w7/d);
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2898,12 +2883,12 @@ static inline void symrot_sine_m3_tangent_inverse_derivative_f(const float p[3],
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * H_0 = 3/sqrt(d) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.59536, else (1 - cos(phi))/s**2
- * H_2: Horner degree 6 in x below x = 0.864806, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*s**2)
+ * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
- * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 3*sin(phi))/(2*sqrt(d)*s**3)
- * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(4*sin(phi/6)**2 + 2*sin(phi/2)**2)/s**2 + 9*(4*sin(phi/6)**2 + 2*sin(phi/2)**2)/d + 9*(2*s/3 + 3*sin(phi))/(sqrt(d)*s))/(18*sqrt(d)*s**2)
- * ops: 271 */
+ * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
+ * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/x + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*x)
+ * ops: 286 */
 static inline void symrot_sine_m3_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2917,26 +2902,29 @@ static inline void symrot_sine_m3_angular_acceleration_f(const float p[3], const
     const float c_H_0 = 3/sqrtf(d);
     const float c_H_0_x = (3.0F/2.0F)/powf(d, 3.0F/2.0F);
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.8648057F) {
+    if (x < 1.5953637F) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((4.3795527e-08F)*x + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        const float w1 = sqrtf(d);
-        const float w2 = 1.0F/w1;
-        const float w3 = powf(sinf((1.0F/2.0F)*phi), 2);
-        const float w4 = 2*w3 + 4*powf(sinf((1.0F/6.0F)*phi), 2);
-        const float w5 = w0*w4;
-        const float w6 = sinf(phi);
-        const float w7 = 1.0F/s;
-        c_H_1 = x < 1.5953637F ? x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F : w0*(1 - cosf(phi));
-        c_H_2 = w2*w5;
-        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w2*(-4*w1*w3*w7 + 3*w6)/(s*s*s);
-        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w2*(9*w2*w7*((2.0F/3.0F)*s + 3*w6) - 18*w5 + 9*w4/d);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 2*w3;
+        const float w5 = sqrtf(d);
+        const float w6 = 1.0F/w5;
+        const float w7 = w4 - 2.0F/3.0F*w5 + 2;
+        const float w8 = w0*w7;
+        const float w9 = cosf(w1);
+        const float w10 = 1.0F/s;
+        c_H_1 = w0*w4;
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w6*w8;
+        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w6*(-4*w10*w3*w5 + 6*w2*w9)/(s*s*s);
+        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w6*(9*w10*w6*((2.0F/3.0F)*s + 6*w2*w9) - 18*w8 + 9*w7/d);
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

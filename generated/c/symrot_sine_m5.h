@@ -76,8 +76,8 @@ static inline double symrot_sine_m5_angle(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * ops: 81 */
+ * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * ops: 75 */
 static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -95,11 +95,11 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     double c_R_2;
-    if (x < 0.776938784878973) {
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+    if (x < 0.4064433613155127) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        c_R_2 = (2.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/pow(sin((1.0/5.0)*phi), 2);
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -129,7 +129,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844) || x < 0.776938784878973) {
+            if (!(x < 22.612712429686844) || x < 0.000596571734285774) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -145,7 +145,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/5.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -155,19 +155,9 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_R_1_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
-            c_R_2_lanes[k] = (2.0/25.0)*(sin1*sin1)/(sin0*sin0);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -177,7 +167,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.776938784878973 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.000596571734285774 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -199,9 +189,9 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
 /* symrot_sine_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 21 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 142 */
+ * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 118 */
 static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -219,18 +209,17 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 0.776938784878973) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.4064433613155127) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = (1.0/2.0)*phi;
-        const double w4 = sin(w3);
-        c_H_1 = (2.0/25.0)*w2*(w4*w4);
-        c_H_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
+        const double w2 = (1.0/5.0)*phi;
+        const double w3 = sin(w2);
+        c_H_1 = 2*(w1*w1)/x;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*(-2.0/5.0*w1*cos(w0)/w3 + 1.0/cos(w2))/(w3*w3);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -281,7 +270,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/5.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -293,7 +282,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = (1.0/5.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -305,12 +294,11 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double w0 = 1.0/(sin0*sin0);
             c_H_0_lanes[k] = 5*u0;
-            c_H_1_lanes[k] = (2.0/25.0)*(sin1*sin1)*w0;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-            c_H_2_lanes[k] = (1.0/25.0)*w0*(-2.0/5.0*cos1*sin1/sin0 + 1.0/cos0);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_H_1_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            c_H_2_lanes[k] = (1.0/25.0)*(-2.0/5.0*cos0*sin0/sin1 + 1.0/cos1)/(sin1*sin1);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -319,11 +307,11 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             c_H_0_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.776938784878973 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.000596571734285774 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 5.166154456090205 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 2.787613413593369 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -480,7 +468,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
 
 /* symrot_sine_m5_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 6 in x below x = 0.212112, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
+ * det_H: Horner degree 6 in x below x = 0.212112, else 4*sin(phi/2)**2/(x*(1 - 2*sin(phi/10)**2))
  * ops: 25 */
 static inline double symrot_sine_m5_tangent_det(const double p[3])
 {
@@ -493,8 +481,7 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
         c_det_H = x*(x*(x*(x*(x*((429.0/6250000000000.0)*x + 231.0/125000000000.0) + 63.0/1250000000.0) + 7.0/5000000.0) + 1.0/25000.0) - 1.0/20.0) + 1;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
-        c_det_H = (4.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/(pow(sin(w0), 2)*cos(w0));
+        c_det_H = 4*pow(sin((1.0/2.0)*phi), 2)/(x*(1 - 2*pow(sin((1.0/10.0)*phi), 2)));
     }
     return c_det_H;
 }
@@ -503,8 +490,8 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
- * G_2: Horner degree 14 in x below x = 2.78761, else (1 - cos(phi/2))/(25*sin(phi/5)**2)
- * ops: 109 */
+ * G_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/x
+ * ops: 88 */
 static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -522,11 +509,11 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = -1.0/250.0*sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/sqrt(sqrt(25 - x) + 5);
     double c_G_2;
-    if (x < 2.787613413593369) {
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+    if (x < 0.4064433613155127) {
+        c_G_2 = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        c_G_2 = (1.0/25.0)*(1 - cos((1.0/2.0)*phi))/pow(sin((1.0/5.0)*phi), 2);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -582,7 +569,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/5.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -592,20 +579,9 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_G_1_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
-            c_G_2_lanes[k] = (1.0/25.0)*(1 - cos1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_G_2_lanes[k] = 1.0/8.0 + (-3.0/3200.0)*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -615,7 +591,7 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 2.787613413593369 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 4.692488584147999e-09 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -637,9 +613,9 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
 /* symrot_sine_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
- * K_1: Horner degree 14 in x below x = 2.78761, else (1 - cos(phi/2))/(25*sin(phi/5)**2)
+ * K_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 21 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
- * ops: 159 */
+ * ops: 138 */
 static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -657,17 +633,15 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
     }
     const double c_K_0 = (5.0/2.0)/sqrt(25 - x);
     double c_K_1, c_K_2;
-    if (x < 2.787613413593369) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
+    if (x < 0.4064433613155127) {
+        c_K_1 = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double w0 = (1.0/5.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = (1.0/2.0)*phi;
-        c_K_1 = (1.0/25.0)*w2*(1 - cos(w3));
-        c_K_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*w2*(5/cos(w0) - 2*sin(w3)/w1);
+        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
+        c_K_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*(5/cos(w0) - 2*sin((1.0/2.0)*phi)/w1)/(w1*w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -718,7 +692,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/5.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -728,9 +702,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = (1.0/5.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -742,11 +714,20 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double w0 = 1.0/(sin0*sin0);
+            const double a2_a = (1.0/2.0)*phi;
+            const double a2_q = rint(a2_a*0.6366197723675814);
+            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
+            const double a2_z = a2_r*a2_r;
+            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
+            const double a2_h = rint(0.5*a2_j - 0.25);
+            const double a2_odd = a2_j - 2*a2_h;
+            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             c_K_0_lanes[k] = (5.0/2.0)*u0;
-            c_K_1_lanes[k] = (1.0/25.0)*w0*(1 - cos1);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.0352374345019027e-23)*x - 2.8950709354440868e-22) - 8.16974104962945e-21) - 2.330114823281765e-19) - 6.73062994480133e-18) - 1.9743181171417237e-16) - 5.902760696411133e-15) - 1.8080528259277343e-13) - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/250.0)*w0*(-2*sin1/sin0 + 5/cos0);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_K_1_lanes[k] = 1.0/8.0 + (-3.0/3200.0)*x;
+            c_K_2_lanes[k] = (1.0/250.0)*(-2*sin2/sin1 + 5/cos1)/(sin1*sin1);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -756,7 +737,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 2.787613413593369 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 4.692488584147999e-09 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -816,9 +797,9 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
 /* symrot_sine_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 21 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 136 */
+ * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * ops: 112 */
 static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -830,18 +811,17 @@ static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3],
     }
     const double c_H_0 = 5/sqrt(25 - x);
     double c_H_1, c_H_2;
-    if (x < 0.776938784878973) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.4064433613155127) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = (1.0/2.0)*phi;
-        const double w4 = sin(w3);
-        c_H_1 = (2.0/25.0)*w2*(w4*w4);
-        c_H_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(1.0/cos(w0) - 2.0/5.0*w4*cos(w3)/w1);
+        const double w2 = (1.0/5.0)*phi;
+        const double w3 = sin(w2);
+        c_H_1 = 2*(w1*w1)/x;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*(-2.0/5.0*w1*cos(w0)/w3 + 1.0/cos(w2))/(w3*w3);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -1007,11 +987,11 @@ static inline int symrot_sine_m5_rescale(const double p[3], double q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)
  * R_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * ops: 230 */
+ * ops: 224 */
 static inline void symrot_sine_m5_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1030,15 +1010,15 @@ static inline void symrot_sine_m5_rotation_derivative(const double p[3], const d
     const double c_R_1 = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     const double c_R_1_x = (32.0/3125.0)*x - 4.0/25.0;
     double c_R_2, c_R_2_x;
-    if (x < 0.776938784878973) {
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+    if (x < 0.4064433613155127) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double w0 = (1.0/5.0)*phi;
         const double w1 = sin(w0);
         const double w2 = cos(w0);
-        c_R_2 = (2.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/(w1*w1);
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
         c_R_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*(5*sin(phi) - 2*w2*(1 - cos(phi))/w1)/((w1*w1*w1)*w2);
     }
     const double dw0 = a[1]*p[1];
@@ -1082,11 +1062,11 @@ static inline void symrot_sine_m5_rotation_derivative(const double p[3], const d
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
+ * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)
  * R_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * ops: 231 */
+ * ops: 225 */
 static inline void symrot_sine_m5_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1105,15 +1085,15 @@ static inline void symrot_sine_m5_rotation_transpose_derivative(const double p[3
     const double c_R_1 = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     const double c_R_1_x = (32.0/3125.0)*x - 4.0/25.0;
     double c_R_2, c_R_2_x;
-    if (x < 0.776938784878973) {
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+    if (x < 0.4064433613155127) {
+        c_R_2 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double w0 = (1.0/5.0)*phi;
         const double w1 = sin(w0);
         const double w2 = cos(w0);
-        c_R_2 = (2.0/25.0)*pow(sin((1.0/2.0)*phi), 2)/(w1*w1);
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
         c_R_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*(5*sin(phi) - 2*w2*(1 - cos(phi))/w1)/((w1*w1*w1)*w2);
     }
     const double dw0 = a[1]*p[1];
@@ -1154,12 +1134,12 @@ static inline void symrot_sine_m5_rotation_transpose_derivative(const double p[3
 /* symrot_sine_m5_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 21 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * H_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(5/cos(phi/5) - sin(phi)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 - 5*cos(phi)/sin(phi/5) + sin(phi)*cos(phi/5)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 366 */
+ * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
+ * ops: 347 */
 static inline void symrot_sine_m5_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1177,29 +1157,30 @@ static inline void symrot_sine_m5_tangent_derivative(const double p[3], const do
     }
     const double c_H_0_x = (5.0/2.0)/pow(25 - x, 3.0/2.0);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.776938784878973) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.4064433613155127) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = (1.0/2.0)*phi;
+        const double w2 = 2*(w1*w1);
+        const double w3 = (1.0/5.0)*phi;
         const double w4 = sin(w3);
-        const double w5 = cos(w0);
-        const double w6 = 1.0/w5;
-        const double w7 = 1.0/w1;
-        const double w8 = sin(phi);
-        const double w9 = cos(phi);
-        const double w10 = 2*w5*w7;
-        const double w11 = w6/(w1*w1*w1);
-        c_H_1 = (2.0/25.0)*w2*(w4*w4);
-        c_H_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(-2.0/5.0*w4*w7*cos(w3) + w6);
-        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w11*(-w10*(1 - w9) + 5*w8);
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w11*(5*w1/(w5*w5) - w10*(5*w6 - w7*w8) + w2*w5*w8 - 5*w7*w9);
+        const double w5 = 1.0/(w4*w4);
+        const double w6 = cos(w3);
+        const double w7 = 1.0/w6;
+        const double w8 = 1.0/w4;
+        const double w9 = cos(w0);
+        const double w10 = w1*w8*w9;
+        const double w11 = 2*w6*w8;
+        const double w12 = w7/(w4*w4*w4);
+        c_H_1 = w2/x;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w5*(-2.0/5.0*w10 + w7);
+        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(2*w1*w5*w6*w9 - w11*(-2*w10 + 5*w7) + 5*w4/(w6*w6) - 5*w8*(1 - w2));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1244,12 +1225,12 @@ static inline void symrot_sine_m5_tangent_derivative(const double p[3], const do
 /* symrot_sine_m5_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 21 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * H_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(5/cos(phi/5) - sin(phi)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 - 5*cos(phi)/sin(phi/5) + sin(phi)*cos(phi/5)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 372 */
+ * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
+ * ops: 353 */
 static inline void symrot_sine_m5_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1267,29 +1248,30 @@ static inline void symrot_sine_m5_tangent_transpose_derivative(const double p[3]
     }
     const double c_H_0_x = (5.0/2.0)/pow(25 - x, 3.0/2.0);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.776938784878973) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.4064433613155127) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = (1.0/2.0)*phi;
+        const double w2 = 2*(w1*w1);
+        const double w3 = (1.0/5.0)*phi;
         const double w4 = sin(w3);
-        const double w5 = cos(w0);
-        const double w6 = 1.0/w5;
-        const double w7 = 1.0/w1;
-        const double w8 = sin(phi);
-        const double w9 = cos(phi);
-        const double w10 = 2*w5*w7;
-        const double w11 = w6/(w1*w1*w1);
-        c_H_1 = (2.0/25.0)*w2*(w4*w4);
-        c_H_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(-2.0/5.0*w4*w7*cos(w3) + w6);
-        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w11*(-w10*(1 - w9) + 5*w8);
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w11*(5*w1/(w5*w5) - w10*(5*w6 - w7*w8) + w2*w5*w8 - 5*w7*w9);
+        const double w5 = 1.0/(w4*w4);
+        const double w6 = cos(w3);
+        const double w7 = 1.0/w6;
+        const double w8 = 1.0/w4;
+        const double w9 = cos(w0);
+        const double w10 = w1*w8*w9;
+        const double w11 = 2*w6*w8;
+        const double w12 = w7/(w4*w4*w4);
+        c_H_1 = w2/x;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w5*(-2.0/5.0*w10 + w7);
+        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(2*w1*w5*w6*w9 - w11*(-2*w10 + 5*w7) + 5*w4/(w6*w6) - 5*w8*(1 - w2));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1417,12 +1399,12 @@ static inline void symrot_sine_m5_tangent_inverse_derivative(const double p[3], 
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.776939, else 2*sin(phi/2)**2/(25*sin(phi/5)**2)
- * H_2: Horner degree 21 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * H_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(5/cos(phi/5) - sin(phi)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 - 5*cos(phi)/sin(phi/5) + sin(phi)*cos(phi/5)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 331 */
+ * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
+ * ops: 312 */
 static inline void symrot_sine_m5_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1435,29 +1417,30 @@ static inline void symrot_sine_m5_angular_acceleration(const double p[3], const 
     const double c_H_0 = 5/sqrt(25 - x);
     const double c_H_0_x = (5.0/2.0)/pow(25 - x, 3.0/2.0);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.776938784878973) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*((9.2092e-16)*x + 2.926e-14) + 969.0/1000000000000000.0) + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+    if (x < 0.4064433613155127) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = (1.0/2.0)*phi;
+        const double w2 = 2*(w1*w1);
+        const double w3 = (1.0/5.0)*phi;
         const double w4 = sin(w3);
-        const double w5 = cos(w0);
-        const double w6 = 1.0/w5;
-        const double w7 = 1.0/w1;
-        const double w8 = sin(phi);
-        const double w9 = cos(phi);
-        const double w10 = 2*w5*w7;
-        const double w11 = w6/(w1*w1*w1);
-        c_H_1 = (2.0/25.0)*w2*(w4*w4);
-        c_H_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.10409896372e-32)*x + 5.3825787444e-31) + 1.3784652882e-29) + 3.53452638e-28) + 9.0751353e-27) + 2.33360622e-25) + 6.0108039e-24) + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w2*(-2.0/5.0*w4*w7*cos(w3) + w6);
-        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w11*(-w10*(1 - w9) + 5*w8);
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w11*(5*w1/(w5*w5) - w10*(5*w6 - w7*w8) + w2*w5*w8 - 5*w7*w9);
+        const double w5 = 1.0/(w4*w4);
+        const double w6 = cos(w3);
+        const double w7 = 1.0/w6;
+        const double w8 = 1.0/w4;
+        const double w9 = cos(w0);
+        const double w10 = w1*w8*w9;
+        const double w11 = 2*w6*w8;
+        const double w12 = w7/(w4*w4*w4);
+        c_H_1 = w2/x;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w5*(-2.0/5.0*w10 + w7);
+        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(2*w1*w5*w6*w9 - w11*(-2*w10 + 5*w7) + 5*w4/(w6*w6) - 5*w8*(1 - w2));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1630,7 +1613,7 @@ static inline float symrot_sine_m5_angle_f(const float p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
+ * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * ops: 72 */
 static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9])
 {
@@ -1653,7 +1636,7 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
         c_R_2 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        c_R_2 = (1.0F/25.0F)*(1 - cosf(phi))/powf(sinf((1.0F/5.0F)*phi), 2);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1683,7 +1666,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612713F) || x < 0.21211211F) {
+            if (!(x < 22.612713F) || x < 0.0022018803F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1699,7 +1682,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1709,20 +1692,9 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
-            c_R_2_lanes[k] = (1.0F/25.0F)*(1 - cos1)/(sin0*sin0);
-            poly_R_2_lanes[k] = x*(x*((33.0F/10000000.0F)*x + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = 1.0F/2.0F + (-7.0F/200.0F)*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1732,7 +1704,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             c_R_1_lanes[k] = !(x < 22.612713F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 0.21211211F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.0022018803F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612713F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1754,9 +1726,9 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
 /* symrot_sine_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
- * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 97 */
+ * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 88 */
 static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1776,15 +1748,15 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
     float c_H_1, c_H_2;
     if (x < 2.7876132F) {
         c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (1.0F/25.0F)/(w1*w1);
-        const float w3 = (1.0F/2.0F)*phi;
-        c_H_1 = w2*(1 - cosf(phi));
-        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : w2*(1.0F/cosf(w0) - 2.0F/5.0F*sinf(w3)*cosf(w3)/w1);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = w0*(1.0F/cosf((1.0F/5.0F)*phi) - 2*w2*cosf(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1801,12 +1773,12 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * Scalar pass: s, phi, u0 = 1/sqrt(25 - x).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1815,27 +1787,31 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 22.612713F)) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
                 const float u0 = 1.0F/sqrtf(25 - x);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1847,7 +1823,7 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = phi;
+            const float a1_a = (1.0F/5.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -1858,24 +1834,12 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float a1_odd = a1_j - 2*a1_h;
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float a2_a = (1.0F/2.0F)*phi;
-            const float a2_q = rintf(a2_a*0.63661975F);
-            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
-            const float a2_z = a2_r*a2_r;
-            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
-            const float a2_h = rintf(0.5F*a2_j - 0.25F);
-            const float a2_odd = a2_j - 2*a2_h;
-            const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const float a2_up = fabsf(a2_j - 1.5F) - 0.5F;
-            const float cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
-            const float w0 = (1.0F/25.0F)/(sin0*sin0);
+            const float w0 = 1.0F/x;
             c_H_0_lanes[k] = 5*u0;
-            c_H_1_lanes[k] = w0*(1 - cos1);
-            poly_H_1_lanes[k] = x*(x*((33.0F/10000000.0F)*x + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w0*(-2.0F/5.0F*cos2*sin2/sin0 + 1.0F/cos0);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+            c_H_1_lanes[k] = 2*(sin0*sin0)*w0;
+            poly_H_1_lanes[k] = 1.0F/2.0F + (-7.0F/200.0F)*x;
+            c_H_2_lanes[k] = w0*(-2*cos0*sin0/s + 1.0F/cos1);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1884,11 +1848,11 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             c_H_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 0.21211211F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.0022018803F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 22.612713F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 5.1661544F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 2.7876132F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 22.612713F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2045,7 +2009,7 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
 
 /* symrot_sine_m5_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 6 in x below x = 2.78761, else 4*sin(phi/2)**2/(25*sin(phi/5)**2*cos(phi/5))
+ * det_H: Horner degree 6 in x below x = 2.78761, else 4*sin(phi/2)**2/(x*cos(phi/5))
  * ops: 25 */
 static inline float symrot_sine_m5_tangent_det_f(const float p[3])
 {
@@ -2058,8 +2022,7 @@ static inline float symrot_sine_m5_tangent_det_f(const float p[3])
         c_det_H = x*(x*(x*(x*(x*((6.864e-11F)*x + 1.848e-09F) + 5.04e-08F) + 7.0F/5000000.0F) + 1.0F/25000.0F) - 1.0F/20.0F) + 1;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = (1.0F/5.0F)*phi;
-        c_det_H = (4.0F/25.0F)*powf(sinf((1.0F/2.0F)*phi), 2)/(powf(sinf(w0), 2)*cosf(w0));
+        c_det_H = 4*powf(sinf((1.0F/2.0F)*phi), 2)/(x*cosf((1.0F/5.0F)*phi));
     }
     return c_det_H;
 }
@@ -2068,7 +2031,7 @@ static inline float symrot_sine_m5_tangent_det_f(const float p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
- * G_2: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * G_2: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/x
  * ops: 88 */
 static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
 {
@@ -2091,7 +2054,7 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
         c_G_2 = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        c_G_2 = (2.0F/25.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/powf(sinf((1.0F/5.0F)*phi), 2);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -2147,7 +2110,7 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2157,19 +2120,9 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/4.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = -0.0126491105F*u0*(-10*u1 + 4*x - 75);
-            c_G_2_lanes[k] = (2.0F/25.0F)*(sin1*sin1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_G_2_lanes[k] = 1.0F/8.0F + (-3.0F/3200.0F)*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2179,7 +2132,7 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             c_G_1_lanes[k] = !(x < 22.612713F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.21211211F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.008126427F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612713F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2201,7 +2154,7 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
 /* symrot_sine_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/(25*sin(phi/5)**2)
+ * K_1: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 9 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
  * ops: 102 */
 static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
@@ -2228,9 +2181,8 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         const float w0 = (1.0F/5.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = 1.0F/(w1*w1);
-        c_K_1 = (2.0F/25.0F)*w2*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = (1.0F/250.0F)*w2*(5/cosf(w0) - 2*sinf((1.0F/2.0F)*phi)/w1);
+        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
+        c_K_2 = (1.0F/250.0F)*(5/cosf(w0) - 2*sinf((1.0F/2.0F)*phi)/w1)/(w1*w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2281,7 +2233,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/5.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2291,9 +2243,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_a = (1.0F/5.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -2303,6 +2253,8 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float a2_a = (1.0F/2.0F)*phi;
             const float a2_q = rintf(a2_a*0.63661975F);
             const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
@@ -2313,11 +2265,10 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float a2_h = rintf(0.5F*a2_j - 0.25F);
             const float a2_odd = a2_j - 2*a2_h;
             const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const float w0 = 1.0F/(sin0*sin0);
             c_K_0_lanes[k] = (5.0F/2.0F)*u0;
-            c_K_1_lanes[k] = (2.0F/25.0F)*(sin1*sin1)*w0;
-            poly_K_1_lanes[k] = x*((-39.0F/3200000.0F)*x - 3.0F/3200.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/250.0F)*w0*(-2*sin2/sin0 + 5/cos0);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_K_1_lanes[k] = 1.0F/8.0F + (-3.0F/3200.0F)*x;
+            c_K_2_lanes[k] = (1.0F/250.0F)*(-2*sin2/sin1 + 5/cos1)/(sin1*sin1);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2327,7 +2278,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             c_K_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.21211211F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.008126427F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 22.612713F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -2387,9 +2338,9 @@ static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3],
 /* symrot_sine_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
- * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 91 */
+ * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 82 */
 static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2403,15 +2354,15 @@ static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3],
     float c_H_1, c_H_2;
     if (x < 2.7876132F) {
         c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (1.0F/25.0F)/(w1*w1);
-        const float w3 = (1.0F/2.0F)*phi;
-        c_H_1 = w2*(1 - cosf(phi));
-        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : w2*(1.0F/cosf(w0) - 2.0F/5.0F*sinf(w3)*cosf(w3)/w1);
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = w0*(1.0F/cosf((1.0F/5.0F)*phi) - 2*w2*cosf(w1)/s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2577,10 +2528,10 @@ static inline int symrot_sine_m5_rescale_f(const float p[3], float q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
+ * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)
- * R_2_x: Horner degree 8 in x below x = 5.16615, else (-4*(1 - 2*sin(phi/10)**2)*sin(phi/2)**2/sin(phi/5) + 5*sin(phi))/(1250*(1 - 2*sin(phi/10)**2)*sin(phi/5)**3)
+ * R_2_x: Horner degree 8 in x below x = 5.16615, else (5*sin(phi) - 10*(1 - cos(phi))*cos(phi/5)/s)/(10*s**3*cos(phi/5))
  * ops: 182 */
 static inline void symrot_sine_m5_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
@@ -2605,10 +2556,10 @@ static inline void symrot_sine_m5_rotation_derivative_f(const float p[3], const 
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        const float w1 = 1 - 2*powf(sinf((1.0F/10.0F)*phi), 2);
-        c_R_2 = (1.0F/25.0F)*(1 - cosf(phi))/(w0*w0);
-        c_R_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/1250.0F)*(5*sinf(phi) - 4*w1*powf(sinf((1.0F/2.0F)*phi), 2)/w0)/((w0*w0*w0)*w1);
+        const float s = sqrtf(x);
+        const float w0 = cosf((1.0F/5.0F)*phi);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        c_R_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/10.0F)*(5*sinf(phi) - 10*w0*(1 - cosf(phi))/s)/((s*s*s)*w0);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2651,10 +2602,10 @@ static inline void symrot_sine_m5_rotation_derivative_f(const float p[3], const 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
+ * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)
- * R_2_x: Horner degree 8 in x below x = 5.16615, else (-4*(1 - 2*sin(phi/10)**2)*sin(phi/2)**2/sin(phi/5) + 5*sin(phi))/(1250*(1 - 2*sin(phi/10)**2)*sin(phi/5)**3)
+ * R_2_x: Horner degree 8 in x below x = 5.16615, else (5*sin(phi) - 10*(1 - cos(phi))*cos(phi/5)/s)/(10*s**3*cos(phi/5))
  * ops: 183 */
 static inline void symrot_sine_m5_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
@@ -2679,10 +2630,10 @@ static inline void symrot_sine_m5_rotation_transpose_derivative_f(const float p[
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = sinf((1.0F/5.0F)*phi);
-        const float w1 = 1 - 2*powf(sinf((1.0F/10.0F)*phi), 2);
-        c_R_2 = (1.0F/25.0F)*(1 - cosf(phi))/(w0*w0);
-        c_R_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/1250.0F)*(5*sinf(phi) - 4*w1*powf(sinf((1.0F/2.0F)*phi), 2)/w0)/((w0*w0*w0)*w1);
+        const float s = sqrtf(x);
+        const float w0 = cosf((1.0F/5.0F)*phi);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        c_R_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/10.0F)*(5*sinf(phi) - 10*w0*(1 - cosf(phi))/s)/((s*s*s)*w0);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2722,12 +2673,12 @@ static inline void symrot_sine_m5_rotation_transpose_derivative_f(const float p[
 /* symrot_sine_m5_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
- * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
- * H_1_x: Horner degree 8 in x below x = 5.16615, else (-4*(1 - 2*sin(phi/10)**2)*sin(phi/2)**2/sin(phi/5) + 5*sin(phi))/(1250*(1 - 2*sin(phi/10)**2)*sin(phi/5)**3)
- * H_2_x: Horner degree 10 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 262 */
+ * H_1_x: Horner degree 8 in x below x = 5.16615, else (5*sin(phi) - 10*(1 - cos(phi))*cos(phi/5)/s)/(10*s**3*cos(phi/5))
+ * H_2_x: Horner degree 10 in x below x = 5.16615, else (s/cos(phi/5)**2 + 25*sin(phi)*cos(phi/5)/x - 10*(5/cos(phi/5) - 5*sin(phi)/s)*cos(phi/5)/s - 25*cos(phi)/s)/(50*s**3*cos(phi/5))
+ * ops: 240 */
 static inline void symrot_sine_m5_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2747,29 +2698,27 @@ static inline void symrot_sine_m5_tangent_derivative_f(const float p[3], const f
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     if (x < 2.7876132F) {
         c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = 1.0F/(w1*w1);
-        const float w3 = (1.0F/25.0F)*w2;
-        const float w4 = cosf(w0);
-        const float w5 = 1.0F/w4;
-        const float w6 = 1.0F/w1;
-        const float w7 = (1.0F/2.0F)*phi;
-        const float w8 = cosf(w7);
-        const float w9 = sinf(w7);
-        const float w10 = w6*w8*w9;
-        const float w11 = 1.0F/(w1*w1*w1);
-        const float w12 = 1 - 2*powf(sinf((1.0F/10.0F)*phi), 2);
-        const float w13 = (w9*w9);
-        c_H_1 = w3*(1 - cosf(phi));
-        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : w3*(-2.0F/5.0F*w10 + w5);
-        c_H_1_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/1250.0F)*w11*(-4*w12*w13*w6 + 5*sinf(phi))/w12;
-        c_H_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F : (1.0F/6250.0F)*w11*w5*(5*w1/(w4*w4) + 2*w2*w4*w8*w9 - 2*w4*w6*(-2*w10 + 5*w5) - 5*w6*(1 - 2*w13));
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = cosf((1.0F/5.0F)*phi);
+        const float w4 = 1.0F/w3;
+        const float w5 = 1.0F/s;
+        const float w6 = sinf(phi);
+        const float w7 = 5*w6;
+        const float w8 = cosf(phi);
+        const float w9 = 10*w3*w5;
+        const float w10 = w4/(s*s*s);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = w0*(-2*w2*w5*cosf(w1) + w4);
+        c_H_1_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/10.0F)*w10*(w7 - w9*(1 - w8));
+        c_H_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F : (1.0F/50.0F)*w10*(s/(w3*w3) + 25*w0*w3*w6 - 25*w5*w8 - w9*(5*w4 - w5*w7));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2814,12 +2763,12 @@ static inline void symrot_sine_m5_tangent_derivative_f(const float p[3], const f
 /* symrot_sine_m5_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
- * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
- * H_1_x: Horner degree 8 in x below x = 5.16615, else (-4*(1 - 2*sin(phi/10)**2)*sin(phi/2)**2/sin(phi/5) + 5*sin(phi))/(1250*(1 - 2*sin(phi/10)**2)*sin(phi/5)**3)
- * H_2_x: Horner degree 10 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 268 */
+ * H_1_x: Horner degree 8 in x below x = 5.16615, else (5*sin(phi) - 10*(1 - cos(phi))*cos(phi/5)/s)/(10*s**3*cos(phi/5))
+ * H_2_x: Horner degree 10 in x below x = 5.16615, else (s/cos(phi/5)**2 + 25*sin(phi)*cos(phi/5)/x - 10*(5/cos(phi/5) - 5*sin(phi)/s)*cos(phi/5)/s - 25*cos(phi)/s)/(50*s**3*cos(phi/5))
+ * ops: 246 */
 static inline void symrot_sine_m5_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2839,29 +2788,27 @@ static inline void symrot_sine_m5_tangent_transpose_derivative_f(const float p[3
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     if (x < 2.7876132F) {
         c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = 1.0F/(w1*w1);
-        const float w3 = (1.0F/25.0F)*w2;
-        const float w4 = cosf(w0);
-        const float w5 = 1.0F/w4;
-        const float w6 = 1.0F/w1;
-        const float w7 = (1.0F/2.0F)*phi;
-        const float w8 = cosf(w7);
-        const float w9 = sinf(w7);
-        const float w10 = w6*w8*w9;
-        const float w11 = 1.0F/(w1*w1*w1);
-        const float w12 = 1 - 2*powf(sinf((1.0F/10.0F)*phi), 2);
-        const float w13 = (w9*w9);
-        c_H_1 = w3*(1 - cosf(phi));
-        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : w3*(-2.0F/5.0F*w10 + w5);
-        c_H_1_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/1250.0F)*w11*(-4*w12*w13*w6 + 5*sinf(phi))/w12;
-        c_H_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F : (1.0F/6250.0F)*w11*w5*(5*w1/(w4*w4) + 2*w2*w4*w8*w9 - 2*w4*w6*(-2*w10 + 5*w5) - 5*w6*(1 - 2*w13));
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = cosf((1.0F/5.0F)*phi);
+        const float w4 = 1.0F/w3;
+        const float w5 = 1.0F/s;
+        const float w6 = sinf(phi);
+        const float w7 = 5*w6;
+        const float w8 = cosf(phi);
+        const float w9 = 10*w3*w5;
+        const float w10 = w4/(s*s*s);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = w0*(-2*w2*w5*cosf(w1) + w4);
+        c_H_1_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/10.0F)*w10*(w7 - w9*(1 - w8));
+        c_H_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F : (1.0F/50.0F)*w10*(s/(w3*w3) + 25*w0*w3*w6 - 25*w5*w8 - w9*(5*w4 - w5*w7));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2989,12 +2936,12 @@ static inline void symrot_sine_m5_tangent_inverse_derivative_f(const float p[3],
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 2.78761, else (1 - cos(phi))/(25*sin(phi/5)**2)
- * H_2: Horner degree 9 in x below x = 5.16615, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
- * H_1_x: Horner degree 8 in x below x = 5.16615, else (-4*(1 - 2*sin(phi/10)**2)*sin(phi/2)**2/sin(phi/5) + 5*sin(phi))/(1250*(1 - 2*sin(phi/10)**2)*sin(phi/5)**3)
- * H_2_x: Horner degree 10 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 227 */
+ * H_1_x: Horner degree 8 in x below x = 5.16615, else (5*sin(phi) - 10*(1 - cos(phi))*cos(phi/5)/s)/(10*s**3*cos(phi/5))
+ * H_2_x: Horner degree 10 in x below x = 5.16615, else (s/cos(phi/5)**2 + 25*sin(phi)*cos(phi/5)/x - 10*(5/cos(phi/5) - 5*sin(phi)/s)*cos(phi/5)/s - 25*cos(phi)/s)/(50*s**3*cos(phi/5))
+ * ops: 205 */
 static inline void symrot_sine_m5_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3009,29 +2956,27 @@ static inline void symrot_sine_m5_angular_acceleration_f(const float p[3], const
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     if (x < 2.7876132F) {
         c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
-        const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = 1.0F/(w1*w1);
-        const float w3 = (1.0F/25.0F)*w2;
-        const float w4 = cosf(w0);
-        const float w5 = 1.0F/w4;
-        const float w6 = 1.0F/w1;
-        const float w7 = (1.0F/2.0F)*phi;
-        const float w8 = cosf(w7);
-        const float w9 = sinf(w7);
-        const float w10 = w6*w8*w9;
-        const float w11 = 1.0F/(w1*w1*w1);
-        const float w12 = 1 - 2*powf(sinf((1.0F/10.0F)*phi), 2);
-        const float w13 = (w9*w9);
-        c_H_1 = w3*(1 - cosf(phi));
-        c_H_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*((1.84756e-15F)*x + 4.862e-14F) + 1.287e-12F) + 3.432e-11F) + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F : w3*(-2.0F/5.0F*w10 + w5);
-        c_H_1_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/1250.0F)*w11*(-4*w12*w13*w6 + 5*sinf(phi))/w12;
-        c_H_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F : (1.0F/6250.0F)*w11*w5*(5*w1/(w4*w4) + 2*w2*w4*w8*w9 - 2*w4*w6*(-2*w10 + 5*w5) - 5*w6*(1 - 2*w13));
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = cosf((1.0F/5.0F)*phi);
+        const float w4 = 1.0F/w3;
+        const float w5 = 1.0F/s;
+        const float w6 = sinf(phi);
+        const float w7 = 5*w6;
+        const float w8 = cosf(phi);
+        const float w9 = 10*w3*w5;
+        const float w10 = w4/(s*s*s);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = w0*(-2*w2*w5*cosf(w1) + w4);
+        c_H_1_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*((8.28828e-15F)*x + 2.3408e-13F) + 6.783e-12F) + 2.04e-10F) + 6.5e-09F) + 2.288e-07F) + 99.0F/10000000.0F) + 21.0F/25000.0F) - 7.0F/200.0F : (1.0F/10.0F)*w10*(w7 - w9*(1 - w8));
+        c_H_2_x = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((2.9745716e-17F)*x + 7.05432e-16F) + 1.662804e-14F) + 3.8896e-13F) + 9.009e-12F) + 2.0592e-10F) + 4.62e-09F) + 1.008e-07F) + 21.0F/10000000.0F) + 1.0F/25000.0F) - 113.0F/25000.0F : (1.0F/50.0F)*w10*(s/(w3*w3) + 25*w0*w3*w6 - 25*w5*w8 - w9*(5*w4 - w5*w7));
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

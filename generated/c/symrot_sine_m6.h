@@ -426,8 +426,8 @@ static inline double symrot_sine_m6_tangent_det(const double p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
- * G_2: Horner degree 10 in x below x = 1.48742, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
- * ops: 81 */
+ * G_2: Horner degree 7 in x below x = 0.407121, else 2*sin(phi/4)**2/x
+ * ops: 72 */
 static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -445,11 +445,11 @@ static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = 1.0/2.0 - 1.0/54.0*x;
     double c_G_2;
-    if (x < 1.4874214491843358) {
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+    if (x < 0.4071212524285563) {
+        c_G_2 = x*(x*(x*(x*(x*(x*((-1.820598476104429e-14)*x - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        c_G_2 = (1.0/36.0)*(1 - cos((1.0/2.0)*phi))/pow(sin((1.0/6.0)*phi), 2);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -479,7 +479,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0) || x < 1.4874214491843358) {
+            if (!(x < 27.0) || x < 0.05760039934430118) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -495,7 +495,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/6.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -505,20 +505,9 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_G_1_lanes[k] = 1.0/2.0 - 1.0/54.0*x;
-            c_G_2_lanes[k] = (1.0/36.0)*(1 - cos1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_G_2_lanes[k] = x*(x*(x*(x*((-91.0/2229025112064.0)*x - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -528,7 +517,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 27.0) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 1.4874214491843358 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.05760039934430118 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 27.0) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -550,9 +539,9 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
 /* symrot_sine_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 3/sqrt(36 - x) (algebraic in x)
- * K_1: Horner degree 10 in x below x = 1.48742, else (1 - cos(phi/2))/(36*sin(phi/6)**2)
- * K_2: Horner degree 10 in x below x = 1.48742, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(216*(1 - 2*sin(phi/12)**2)*sin(phi/6)**2)
- * ops: 113 */
+ * K_1: Horner degree 7 in x below x = 0.407121, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 7 in x below x = 0.407121, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(6*x*(1 - 2*sin(phi/12)**2))
+ * ops: 95 */
 static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -570,15 +559,16 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
     }
     const double c_K_0 = 3/sqrt(36 - x);
     double c_K_1, c_K_2;
-    if (x < 1.4874214491843358) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*((6.389071489848162e-19)*x + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
+    if (x < 0.4071212524285563) {
+        c_K_1 = x*(x*(x*(x*(x*(x*((-1.820598476104429e-14)*x - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*((3.4805559101996437e-14)*x + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        const double w0 = pow(sin((1.0/6.0)*phi), -2);
-        const double w1 = pow(sin((1.0/12.0)*phi), 2);
-        c_K_1 = (1.0/36.0)*w0*(1 - cos((1.0/2.0)*phi));
-        c_K_2 = (1.0/216.0)*w0*(4*w1 + 2*pow(sin((1.0/4.0)*phi), 2))/(1 - 2*w1);
+        const double w0 = 1.0/x;
+        const double w1 = 2*pow(sin((1.0/4.0)*phi), 2);
+        const double w2 = pow(sin((1.0/12.0)*phi), 2);
+        c_K_1 = w0*w1;
+        c_K_2 = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -629,7 +619,7 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/6.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -639,7 +629,7 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = (1.0/12.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -648,35 +638,15 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double a2_a = (1.0/12.0)*phi;
-            const double a2_q = rint(a2_a*0.6366197723675814);
-            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
-            const double a2_z = a2_r*a2_r;
-            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
-            const double a2_h = rint(0.5*a2_j - 0.25);
-            const double a2_odd = a2_j - 2*a2_h;
-            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const double a3_a = (1.0/4.0)*phi;
-            const double a3_q = rint(a3_a*0.6366197723675814);
-            const double a3_r = ((a3_a - a3_q*1.5707963267341256) - a3_q*6.077100506303966e-11) - a3_q*2.0222662487959506e-21;
-            const double a3_z = a3_r*a3_r;
-            const double a3_s = a3_r + (a3_r*a3_z)*(a3_z*(a3_z*(a3_z*(a3_z*(a3_z*(a3_z*((1.0/355687428096000.0)*a3_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a3_c = 1 + a3_z*(a3_z*(a3_z*(a3_z*(a3_z*(a3_z*(a3_z*((1.0/20922789888000.0)*a3_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a3_j = a3_q - 4*rint(0.25*a3_q - 0.375);
-            const double a3_h = rint(0.5*a3_j - 0.25);
-            const double a3_odd = a3_j - 2*a3_h;
-            const double sin3 = (1 - 2*a3_h)*((1 - a3_odd)*a3_s + a3_odd*a3_c);
-            const double w0 = 1.0/(sin0*sin0);
-            const double w1 = (sin2*sin2);
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double w0 = 1.0/x;
+            const double w1 = 2*(sin0*sin0);
+            const double w2 = (sin1*sin1);
             c_K_0_lanes[k] = 3*u0;
-            c_K_1_lanes[k] = (1.0/36.0)*w0*(1 - cos1);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.2097540491204167e-19)*x - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/216.0)*w0*(2*(sin3*sin3) + 4*w1)/(1 - 2*w1);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*((6.389071489848162e-19)*x + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
+            c_K_1_lanes[k] = w0*w1;
+            poly_K_1_lanes[k] = x*(x*(x*(x*((-91.0/2229025112064.0)*x - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
+            poly_K_2_lanes[k] = (1.0/6912.0)*x + 11.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -685,11 +655,11 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 27.0) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 1.4874214491843358 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.05760039934430118 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 27.0) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 1.4874214491843358 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 3.4444713740739134e-10 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 27.0) ? (double)NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1842,7 +1812,7 @@ static inline float symrot_sine_m6_tangent_det_f(const float p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
- * G_2: Horner degree 6 in x below x = 5.28621, else sin(phi/4)**2/(18*sin(phi/6)**2)
+ * G_2: Horner degree 6 in x below x = 5.28621, else 2*sin(phi/4)**2/x
  * ops: 69 */
 static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
 {
@@ -1865,7 +1835,7 @@ static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
         c_G_2 = x*(x*(x*(x*(x*((-8.411749e-13F)*x - 4.0825024e-11F) - 2.1318738e-09F) - 1.0F/7962624.0F) - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
-        c_G_2 = (1.0F/18.0F)*powf(sinf((1.0F/4.0F)*phi), 2)/powf(sinf((1.0F/6.0F)*phi), 2);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1895,7 +1865,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0F) || x < 0.77943236F) {
+            if (!(x < 27.0F) || x < 0.2122961F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1911,7 +1881,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/6.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1921,19 +1891,9 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/4.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = 1.0F/2.0F - 1.0F/54.0F*x;
-            c_G_2_lanes[k] = (1.0F/18.0F)*(sin1*sin1)/(sin0*sin0);
-            poly_G_2_lanes[k] = x*(x*((-1.0F/7962624.0F)*x - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_G_2_lanes[k] = x*((-7.0F/746496.0F)*x - 5.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1943,7 +1903,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             c_G_1_lanes[k] = !(x < 27.0F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.77943236F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.2122961F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 27.0F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1965,7 +1925,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
 /* symrot_sine_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 3/sqrt(36 - x) (algebraic in x)
- * K_1: Horner degree 6 in x below x = 5.28621, else sin(phi/4)**2/(18*sin(phi/6)**2)
+ * K_1: Horner degree 6 in x below x = 5.28621, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 7 in x below x = 5.28621, else (-2*cos(phi/6) - cos(phi/2) + 3)/(216*sin(phi/6)**2*cos(phi/6))
  * ops: 92 */
 static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
@@ -1991,10 +1951,9 @@ static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
     } else {
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
         const float w0 = (1.0F/6.0F)*phi;
-        const float w1 = powf(sinf(w0), -2);
-        const float w2 = cosf(w0);
-        c_K_1 = (1.0F/18.0F)*w1*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = (1.0F/216.0F)*w1*(-2*w2 - cosf((1.0F/2.0F)*phi) + 3)/w2;
+        const float w1 = cosf(w0);
+        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
+        c_K_2 = (1.0F/216.0F)*(-2*w1 - cosf((1.0F/2.0F)*phi) + 3)/(w1*powf(sinf(w0), 2));
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2045,7 +2004,7 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/6.0F)*phi;
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2055,9 +2014,7 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_a = (1.0F/6.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -2067,6 +2024,8 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float a2_a = (1.0F/2.0F)*phi;
             const float a2_q = rintf(a2_a*0.63661975F);
             const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
@@ -2078,11 +2037,10 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float a2_odd = a2_j - 2*a2_h;
             const float a2_up = fabsf(a2_j - 1.5F) - 0.5F;
             const float cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
-            const float w0 = 1.0F/(sin0*sin0);
             c_K_0_lanes[k] = 3*u0;
-            c_K_1_lanes[k] = (1.0F/18.0F)*(sin1*sin1)*w0;
-            poly_K_1_lanes[k] = x*(x*((-1.0F/7962624.0F)*x - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/216.0F)*w0*(-2*cos0 - cos2 + 3)/cos0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_K_1_lanes[k] = x*((-7.0F/746496.0F)*x - 5.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/216.0F)*(-2*cos1 - cos2 + 3)/(cos1*(sin1*sin1));
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.480556e-14F)*x + 1.3365334e-12F) + 5.1816374e-11F) + 2.0349704e-09F) + 8.139882e-08F) + 5.0F/1492992.0F) + 1.0F/6912.0F) + 11.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2092,7 +2050,7 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             c_K_0_lanes[k] = !(x < 27.0F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.77943236F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.2122961F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 27.0F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

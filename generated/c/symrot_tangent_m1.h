@@ -391,7 +391,7 @@ static inline double symrot_tangent_m1_tangent_det(const double p[3])
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
- * G_2: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/s**2
+ * G_2: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/x
  * ops: 83 */
 static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
 {
@@ -414,8 +414,7 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
         c_G_2 = x*(x*(x*(x*(x*(x*(1308365.0/33554432.0 + (-76546627.0/2147483648.0)*x) - 181215.0/4194304.0) + 12767.0/262144.0) - 1843.0/32768.0) + 69.0/1024.0) - 11.0/128.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m1__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -432,12 +431,12 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
+ * Scalar pass: phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -446,7 +445,6 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -455,7 +453,6 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
                 const double phi = symrot_tangent_m1__phi(s);
                 const double u0 = pow(x + 1, -1.0/4.0);
                 const double u1 = 1.0/sqrt(sqrt(x + 1) + 1);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -463,7 +460,6 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -471,7 +467,6 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
@@ -486,7 +481,7 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.7071067811865476*u0*u1;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_G_2_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -521,8 +516,8 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_0 = 1/(2*(x + 1)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/s**2
- * K_2: Horner degree 18 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
+ * K_1: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 18 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/x
  * ops: 128 */
 static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9])
 {
@@ -547,7 +542,7 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
     } else {
         const double phi = symrot_tangent_m1__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
+        const double w0 = 1.0/x;
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
         c_K_2 = x < 0.13182630716008584 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*((1.0/2.0)/(x + 1) - sin((1.0/2.0)*phi)/s);
     }
@@ -620,7 +615,7 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = (1.0/2.0)/(x + 1);
-            const double w1 = 1.0/(s*s);
+            const double w1 = 1.0/x;
             c_K_0_lanes[k] = w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
             poly_K_1_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
@@ -1723,7 +1718,7 @@ static inline float symrot_tangent_m1_tangent_det_f(const float p[3])
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
- * G_2: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/s**2
+ * G_2: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/x
  * ops: 83 */
 static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
 {
@@ -1746,8 +1741,7 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
         c_G_2 = x*(x*(x*(x*(x*(x*(0.038992316F + (-0.0356448F)*x) - 181215.0F/4194304.0F) + 12767.0F/262144.0F) - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -1764,12 +1758,12 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
+ * Scalar pass: phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1778,7 +1772,6 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1787,7 +1780,6 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
                 const float phi = symrot_tangent_m1__phi_f(s);
                 const float u0 = powf(x + 1, -1.0F/4.0F);
                 const float u1 = 1.0F/sqrtf(sqrtf(x + 1) + 1);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -1795,7 +1787,6 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -1803,7 +1794,6 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
@@ -1818,7 +1808,7 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.70710677F*u0*u1;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/(s*s);
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_G_2_lanes[k] = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1829,7 +1819,7 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.0017890878F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.0009788593F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1853,8 +1843,8 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_0 = 1/(2*(x + 1)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/s**2
- * K_2: Horner degree 13 in x below x = 0.258954, else (1/(2*(x + 1)) - sin(phi/2)/s)/s**2
+ * K_1: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 13 in x below x = 0.258954, else (1/(2*(x + 1)) - sin(phi/2)/s)/x
  * ops: 112 */
 static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9])
 {
@@ -1879,7 +1869,7 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
     } else {
         const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
+        const float w0 = 1.0F/x;
         c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
         c_K_2 = x < 0.2589544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F : w0*((1.0F/2.0F)/(x + 1) - sinf((1.0F/2.0F)*phi)/s);
     }
@@ -1911,7 +1901,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F) || x < 0.0017890878F) {
+            if (!(x < 9.223372e+18F) || x < 0.0009788593F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1952,7 +1942,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = (1.0F/2.0F)/(x + 1);
-            const float w1 = 1.0F/(s*s);
+            const float w1 = 1.0F/x;
             c_K_0_lanes[k] = w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
             poly_K_1_lanes[k] = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
@@ -1966,7 +1956,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.0017890878F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.0009788593F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

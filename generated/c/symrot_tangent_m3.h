@@ -79,9 +79,9 @@ static inline double symrot_tangent_m3_angle(const double p[3])
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
- * R_2: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
- * ops: 97 */
+ * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
+ * ops: 91 */
 static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -100,12 +100,14 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
     double c_R_1, c_R_2;
     if (x < 0.06877716192024325) {
         c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        c_R_1 = sin(phi)/s;
-        c_R_2 = x < 0.13136065202211897 ? x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        c_R_1 = 2*w1*cos(w0)/s;
+        c_R_2 = 2*(w1*w1)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -155,7 +157,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -165,20 +167,12 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_R_1_lanes[k] = sin0/s;
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1 + (-11.0/54.0)*x;
-            c_R_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -190,7 +184,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             c_R_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.13136065202211897 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.00021086444550021482 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -214,9 +208,9 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 90 */
+ * ops: 84 */
 static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -235,12 +229,11 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
     const double c_H_0 = 9/(x + 9);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1;
-    if (x < 0.13136065202211897) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    if (x < 0.06877716192024325) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -257,12 +250,12 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
+ * Scalar pass: phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -271,7 +264,6 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -280,7 +272,6 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
                 const double phi = symrot_tangent_m3__phi(s);
                 const double u0 = sqrt(x + 9);
                 const double u1 = pow(x + 9, -3.0/2.0);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -288,7 +279,6 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -296,7 +286,6 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
@@ -311,8 +300,8 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_H_0_lanes[k] = 9/(x + 9);
-            c_H_1_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_H_1_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -322,7 +311,7 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             c_H_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.13136065202211897 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.00021086444550021482 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_2;
@@ -443,8 +432,8 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * det_H: Horner degree 9 in x below x = 0.131361, else 36*sin(phi/2)**2/(s**2*(x + 9))
- * ops: 35 */
+ * det_H: Horner degree 18 in x below x = 0.956738, else 36*sin(phi/2)**2/(x*(x + 9))
+ * ops: 61 */
 static inline double symrot_tangent_m3_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -452,12 +441,11 @@ static inline double symrot_tangent_m3_tangent_det(const double p[3])
         return (double)NAN;
     }
     double c_det_H;
-    if (x < 0.13136065202211897) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(5708089.0/12694994583552.0 + (-26573665.0/457019805007872.0)*x) - 2410387.0/705277476864.0) + 124507.0/4897760256.0) - 50027.0/272097792.0) + 9677.0/7558272.0) - 3547.0/419904.0) + 299.0/5832.0) - 29.0/108.0) + 1;
+    if (x < 0.9567381777096958) {
+        c_det_H = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.8212842713050953e-16)*x - 3.1770071801893965e-15) + 2.629665899601555e-14) - 2.165846397497391e-13) + 1.7738919755319346e-12) - 1.4436824186225691e-11) + 1.1664401623984765e-10) - 9.345602752961522e-10) + 60995261.0/8226356490141696.0) - 26573665.0/457019805007872.0) + 5708089.0/12694994583552.0) - 2410387.0/705277476864.0) + 124507.0/4897760256.0) - 50027.0/272097792.0) + 9677.0/7558272.0) - 3547.0/419904.0) + 299.0/5832.0) - 29.0/108.0) + 1;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_det_H = 36*pow(sin((1.0/2.0)*phi), 2)/((s*s)*(x + 9));
+        c_det_H = 36*pow(sin((1.0/2.0)*phi), 2)/(x*(x + 9));
     }
     return c_det_H;
 }
@@ -468,7 +456,7 @@ static inline double symrot_tangent_m3_tangent_det(const double p[3])
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.0687772, else sin(phi/2)/s
- * G_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/s**2
+ * G_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/x
  * ops: 92 */
 static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
 {
@@ -493,7 +481,7 @@ static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
         c_G_1 = sin((1.0/2.0)*phi)/s;
-        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/(s*s);
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -565,8 +553,8 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0/2.0 + (-17.0/432.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*(x*(893.0/746496.0 + (-8881.0/71663616.0)*x) - 41.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -578,7 +566,7 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             c_G_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.01895808389350374 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.000762210562920323 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -602,8 +590,8 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/s**2
- * K_2: Horner degree 21 in x below x = 1.93909, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
+ * K_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 21 in x below x = 1.93909, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*x)
  * ops: 136 */
 static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9])
 {
@@ -628,7 +616,7 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
+        const double w0 = 1.0/x;
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
         c_K_2 = x < 1.9390924142768158 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0 : (1.0/6.0)*w0*(27/(x + 9) - 6*sin((1.0/2.0)*phi)/s);
     }
@@ -660,7 +648,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 6.703903964971299e+153) || x < 0.01895808389350374) {
+            if (!(x < 6.703903964971299e+153) || x < 0.000762210562920323) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -701,10 +689,10 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = 1.0/(x + 9);
-            const double w1 = 1.0/(s*s);
+            const double w1 = 1.0/x;
             c_K_0_lanes[k] = (9.0/2.0)*w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(67261.0/5159780352.0 + (-3086575.0/2229025112064.0)*x) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
+            poly_K_1_lanes[k] = x*(x*(893.0/746496.0 + (-8881.0/71663616.0)*x) - 41.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/6.0)*w1*(27*w0 - 6*sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
         }
@@ -715,7 +703,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.01895808389350374 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.000762210562920323 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -770,9 +758,9 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 84 */
+ * ops: 78 */
 static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -785,12 +773,11 @@ static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[
     const double c_H_0 = 9/(x + 9);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1;
-    if (x < 0.13136065202211897) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    if (x < 0.06877716192024325) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(s*s);
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -966,12 +953,12 @@ static inline int symrot_tangent_m3_rescale(const double p[3], double q[3])
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
- * R_2: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 6*(s**2/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 9))
  * R_2_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
- * ops: 295 */
+ * ops: 284 */
 static inline void symrot_tangent_m3_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -990,25 +977,25 @@ static inline void symrot_tangent_m3_rotation_derivative(const double p[3], cons
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 0.06877716192024325) {
         c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = 1.0/s;
-        const double w1 = (s*s);
-        const double w2 = 1.0/w1;
-        const double w3 = (1.0/2.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = (w4*w4);
-        const double w6 = 6*w4*cos(w3);
-        const double w7 = w0*((1.0/9.0)*w1 + 1);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = w2*cos(w1);
+        const double w4 = (w2*w2);
+        const double w5 = (s*s);
+        const double w6 = 6*w3;
+        const double w7 = w0*((1.0/9.0)*w5 + 1);
         const double w8 = (3.0/2.0)/(x + 9);
-        c_R_1 = w0*sin(phi);
-        c_R_2 = x < 0.13136065202211897 ? x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : 2*w2*w5;
-        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w2*w8*(-6*w5 - w6*w7 + 3);
-        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w5*w7 + w6)/(s*s*s);
+        c_R_1 = 2*w0*w3;
+        c_R_2 = 2*w4/x;
+        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w8*(-6*w4 - w6*w7 + 3)/w5;
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w4*w7 + w6)/(s*s*s);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1052,12 +1039,12 @@ static inline void symrot_tangent_m3_rotation_derivative(const double p[3], cons
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
- * R_2: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 6*(s**2/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 9))
  * R_2_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
- * ops: 296 */
+ * ops: 285 */
 static inline void symrot_tangent_m3_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1076,25 +1063,25 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative(const double 
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 0.06877716192024325) {
         c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = 1.0/s;
-        const double w1 = (s*s);
-        const double w2 = 1.0/w1;
-        const double w3 = (1.0/2.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = (w4*w4);
-        const double w6 = 6*w4*cos(w3);
-        const double w7 = w0*((1.0/9.0)*w1 + 1);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = w2*cos(w1);
+        const double w4 = (w2*w2);
+        const double w5 = (s*s);
+        const double w6 = 6*w3;
+        const double w7 = w0*((1.0/9.0)*w5 + 1);
         const double w8 = (3.0/2.0)/(x + 9);
-        c_R_1 = w0*sin(phi);
-        c_R_2 = x < 0.13136065202211897 ? x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0 : 2*w2*w5;
-        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w2*w8*(-6*w5 - w6*w7 + 3);
-        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w5*w7 + w6)/(s*s*s);
+        c_R_1 = 2*w0*w3;
+        c_R_2 = 2*w4/x;
+        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w8*(-6*w4 - w6*w7 + 3)/w5;
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w4*w7 + w6)/(s*s*s);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1136,12 +1123,12 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative(const double 
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * H_0_x = -9/(x + 9)**2 (algebraic in x)
  * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 283 */
+ * ops: 277 */
 static inline void symrot_tangent_m3_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1161,18 +1148,17 @@ static inline void symrot_tangent_m3_tangent_derivative(const double p[3], const
     const double c_H_0_x = -9/pow(x + 9, 2);
     const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1, c_H_1_x;
-    if (x < 0.13136065202211897) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    if (x < 0.06877716192024325) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = (w2*w2);
-        c_H_1 = 2*w3/w0;
-        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w2*cos(w1) - 12*w3*((1.0/9.0)*w0 + 1)/s)/((s*s*s)*(x + 9));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_H_1 = 2*w2/x;
+        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w1*cos(w0) - 12*w2*((1.0/9.0)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1219,12 +1205,12 @@ static inline void symrot_tangent_m3_tangent_derivative(const double p[3], const
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * H_0_x = -9/(x + 9)**2 (algebraic in x)
  * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 289 */
+ * ops: 283 */
 static inline void symrot_tangent_m3_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1244,18 +1230,17 @@ static inline void symrot_tangent_m3_tangent_transpose_derivative(const double p
     const double c_H_0_x = -9/pow(x + 9, 2);
     const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1, c_H_1_x;
-    if (x < 0.13136065202211897) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    if (x < 0.06877716192024325) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = (w2*w2);
-        c_H_1 = 2*w3/w0;
-        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w2*cos(w1) - 12*w3*((1.0/9.0)*w0 + 1)/s)/((s*s*s)*(x + 9));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_H_1 = 2*w2/x;
+        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w1*cos(w0) - 12*w2*((1.0/9.0)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1370,12 +1355,12 @@ static inline void symrot_tangent_m3_tangent_inverse_derivative(const double p[3
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 9 in x below x = 0.131361, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * H_0_x = -9/(x + 9)**2 (algebraic in x)
  * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 246 */
+ * ops: 240 */
 static inline void symrot_tangent_m3_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1390,18 +1375,17 @@ static inline void symrot_tangent_m3_angular_acceleration(const double p[3], con
     const double c_H_0_x = -9/pow(x + 9, 2);
     const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1, c_H_1_x;
-    if (x < 0.13136065202211897) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(887315.0/25389989167104.0 + (-46189.0/11284439629824.0)*x) - 46475.0/156728328192.0) + 2717.0/1088391168.0) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
+    if (x < 0.06877716192024325) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = (w2*w2);
-        c_H_1 = 2*w3/w0;
-        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w2*cos(w1) - 12*w3*((1.0/9.0)*w0 + 1)/s)/((s*s*s)*(x + 9));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_H_1 = 2*w2/x;
+        c_H_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w1*cos(w0) - 12*w2*((1.0/9.0)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1578,7 +1562,7 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * ops: 83 */
 static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R[9])
 {
@@ -1603,8 +1587,9 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
-        c_R_1 = 2*sinf(w0)*cosf(w0)/s;
-        c_R_2 = (1 - cosf(phi))/(s*s);
+        const float w1 = sinf(w0);
+        c_R_1 = 2*w1*cosf(w0)/s;
+        c_R_2 = 2*(w1*w1)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1666,21 +1651,10 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = (1 - cos1)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1692,7 +1666,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             c_R_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 0.48711845F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.036088683F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1716,7 +1690,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * ops: 80 */
 static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
@@ -1741,8 +1715,7 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_H_1 = (1 - cosf(phi))/(s*s);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1759,12 +1732,12 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
+ * Scalar pass: phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1773,7 +1746,6 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1782,7 +1754,6 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
                 const float phi = symrot_tangent_m3__phi_f(s);
                 const float u0 = sqrtf(x + 9);
                 const float u1 = powf(x + 9, -3.0F/2.0F);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -1790,7 +1761,6 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -1798,11 +1768,10 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1811,11 +1780,10 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_H_0_lanes[k] = 9/(x + 9);
-            c_H_1_lanes[k] = (1 - cos0)/(s*s);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_H_1_lanes[k] = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1825,7 +1793,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             c_H_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 0.48711845F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.036088683F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_2;
@@ -1946,7 +1914,7 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * det_H: Horner degree 6 in x below x = 0.487118, else 36*sin(phi/2)**2/(s**2*(x + 9))
+ * det_H: Horner degree 6 in x below x = 0.487118, else 36*sin(phi/2)**2/(x*(x + 9))
  * ops: 25 */
 static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
 {
@@ -1959,8 +1927,7 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
         c_det_H = x*(x*(x*(x*(x*((2.5421212e-05F)*x - 0.0001838567F) + 9677.0F/7558272.0F) - 3547.0F/419904.0F) + 299.0F/5832.0F) - 29.0F/108.0F) + 1;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_det_H = 36*powf(sinf((1.0F/2.0F)*phi), 2)/((s*s)*(x + 9));
+        c_det_H = 36*powf(sinf((1.0F/2.0F)*phi), 2)/(x*(x + 9));
     }
     return c_det_H;
 }
@@ -1971,7 +1938,7 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.956738, else sin(phi/2)/s
- * G_2: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/s**2
+ * G_2: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/x
  * ops: 92 */
 static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
 {
@@ -1996,7 +1963,7 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         c_G_1 = sinf((1.0F/2.0F)*phi)/s;
-        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -2068,8 +2035,8 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2081,7 +2048,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.95673823F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.00996503F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2105,8 +2072,8 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/s**2
- * K_2: Horner degree 21 in x below x = 4.19813, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*s**2)
+ * K_1: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 21 in x below x = 4.19813, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*x)
  * ops: 136 */
 static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9])
 {
@@ -2131,7 +2098,7 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
+        const float w0 = 1.0F/x;
         c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
         c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w0*(27/(x + 9) - 6*sinf((1.0F/2.0F)*phi)/s);
     }
@@ -2163,7 +2130,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F) || x < 0.95673823F) {
+            if (!(x < 9.223372e+18F) || x < 0.00996503F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -2204,10 +2171,10 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = 1.0F/(x + 9);
-            const float w1 = 1.0F/(s*s);
+            const float w1 = 1.0F/x;
             c_K_0_lanes[k] = (9.0F/2.0F)*w0;
             c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+            poly_K_1_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (1.0F/6.0F)*w1*(27*w0 - 6*sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
         }
@@ -2218,7 +2185,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.95673823F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.00996503F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -2273,7 +2240,7 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * ops: 74 */
 static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
@@ -2292,8 +2259,7 @@ static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_H_1 = (1 - cosf(phi))/(s*s);
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2470,11 +2436,11 @@ static inline int symrot_tangent_m3_rescale_f(const float p[3], float q[3])
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 3*(s**2/9 + 1)*sin(phi)/s)/(2*s**2*(x + 9))
- * R_2_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
- * ops: 244 */
+ * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 6*(x/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*x*(x + 9))
+ * R_2_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * ops: 232 */
 static inline void symrot_tangent_m3_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2495,23 +2461,21 @@ static inline void symrot_tangent_m3_rotation_derivative_f(const float p[3], con
         c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F;
-        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/s;
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
-        const float w3 = (s*s);
-        const float w4 = 1.0F/w3;
-        const float w5 = 1 - cosf(phi);
-        const float w6 = 3*sinf(phi);
-        const float w7 = w0*((1.0F/9.0F)*w3 + 1);
-        const float w8 = (3.0F/2.0F)/(x + 9);
-        c_R_1 = 2*w0*w2*cosf(w1);
-        c_R_2 = w4*w5;
-        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w4*w8*(-6*(w2*w2) - w6*w7 + 3);
-        c_R_2_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w8*(-6*w5*w7 + w6)/(s*s*s);
+        const float w3 = w0*w2*cosf(w1);
+        const float w4 = 1.0F/x;
+        const float w5 = (w2*w2);
+        const float w6 = (3.0F/2.0F)/(x + 9);
+        c_R_1 = 2*w3;
+        c_R_2 = 2*w4*w5;
+        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w4*w6*(-6*w3*((1.0F/9.0F)*x + 1) - 6*w5 + 3);
+        c_R_2_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w6*(-6*w0*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1) + 3*sinf(phi))/(s*s*s);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2556,11 +2520,11 @@ static inline void symrot_tangent_m3_rotation_derivative_f(const float p[3], con
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * R_2: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 3*(s**2/9 + 1)*sin(phi)/s)/(2*s**2*(x + 9))
- * R_2_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
- * ops: 245 */
+ * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 6*(x/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*x*(x + 9))
+ * R_2_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * ops: 233 */
 static inline void symrot_tangent_m3_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2581,23 +2545,21 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative_f(const float
         c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F;
-        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/s;
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
-        const float w3 = (s*s);
-        const float w4 = 1.0F/w3;
-        const float w5 = 1 - cosf(phi);
-        const float w6 = 3*sinf(phi);
-        const float w7 = w0*((1.0F/9.0F)*w3 + 1);
-        const float w8 = (3.0F/2.0F)/(x + 9);
-        c_R_1 = 2*w0*w2*cosf(w1);
-        c_R_2 = w4*w5;
-        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w4*w8*(-6*(w2*w2) - w6*w7 + 3);
-        c_R_2_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w8*(-6*w5*w7 + w6)/(s*s*s);
+        const float w3 = w0*w2*cosf(w1);
+        const float w4 = 1.0F/x;
+        const float w5 = (w2*w2);
+        const float w6 = (3.0F/2.0F)/(x + 9);
+        c_R_1 = 2*w3;
+        c_R_2 = 2*w4*w5;
+        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w4*w6*(-6*w3*((1.0F/9.0F)*x + 1) - 6*w5 + 3);
+        c_R_2_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w6*(-6*w0*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1) + 3*sinf(phi))/(s*s*s);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2639,12 +2601,12 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative_f(const float
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * H_0_x = -9/(x + 9)**2 (algebraic in x)
- * H_1_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * H_1_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 257 */
+ * ops: 245 */
 static inline void symrot_tangent_m3_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2666,14 +2628,12 @@ static inline void symrot_tangent_m3_tangent_derivative_f(const float p[3], cons
     float c_H_1, c_H_1_x;
     if (x < 0.48711845F) {
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
-        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = 1 - cosf(phi);
-        c_H_1 = w1/w0;
-        c_H_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*w1*((1.0F/9.0F)*w0 + 1)/s)/((s*s*s)*(x + 9));
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        c_H_1_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2720,12 +2680,12 @@ static inline void symrot_tangent_m3_tangent_derivative_f(const float p[3], cons
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * H_0_x = -9/(x + 9)**2 (algebraic in x)
- * H_1_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * H_1_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 263 */
+ * ops: 251 */
 static inline void symrot_tangent_m3_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2747,14 +2707,12 @@ static inline void symrot_tangent_m3_tangent_transpose_derivative_f(const float 
     float c_H_1, c_H_1_x;
     if (x < 0.48711845F) {
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
-        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = 1 - cosf(phi);
-        c_H_1 = w1/w0;
-        c_H_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*w1*((1.0F/9.0F)*w0 + 1)/s)/((s*s*s)*(x + 9));
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        c_H_1_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2869,12 +2827,12 @@ static inline void symrot_tangent_m3_tangent_inverse_derivative_f(const float p[
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 9/(x + 9) (algebraic in x)
- * H_1: Horner degree 6 in x below x = 0.487118, else (1 - cos(phi))/s**2
+ * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
  * H_0_x = -9/(x + 9)**2 (algebraic in x)
- * H_1_x: Horner degree 13 in x below x = 1.93909, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
+ * H_1_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 220 */
+ * ops: 208 */
 static inline void symrot_tangent_m3_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2891,14 +2849,12 @@ static inline void symrot_tangent_m3_angular_acceleration_f(const float p[3], co
     float c_H_1, c_H_1_x;
     if (x < 0.48711845F) {
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
-        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = 1 - cosf(phi);
-        c_H_1 = w1/w0;
-        c_H_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1886028e-12F)*x - 9.5964564e-12F) + 7.6823915e-11F) - 6.089283e-10F) + 4.769992e-09F) - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*w1*((1.0F/9.0F)*w0 + 1)/s)/((s*s*s)*(x + 9));
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        c_H_1_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

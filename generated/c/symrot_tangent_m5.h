@@ -76,8 +76,8 @@ static inline double symrot_tangent_m5_angle(const double p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
- * ops: 93 */
+ * R_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
+ * ops: 91 */
 static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -96,14 +96,14 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
     double c_R_1, c_R_2;
     if (x < 0.11104807041853587) {
         c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
         c_R_1 = 2*w1*cos(w0)/s;
-        c_R_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : 2*(w1*w1)/(s*s);
+        c_R_2 = 2*(w1*w1)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -167,8 +167,8 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1 + (-9.0/50.0)*x;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = 1.0/2.0 + (-11.0/200.0)*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -180,7 +180,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             c_R_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.21392718170599553 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 3.327466630718667e-08 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -202,9 +202,9 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
 /* symrot_tangent_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 134 */
+ * ops: 132 */
 static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -222,17 +222,16 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
     }
     const double c_H_0 = 25/(x + 25);
     double c_H_1, c_H_2;
-    if (x < 0.21392718170599553) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+    if (x < 0.11104807041853587) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*w2*cos(w1)/s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        c_H_1 = 2*(w1*w1)/x;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25/(x + 25) - 2*w1*cos(w0)/s)/(s*s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -262,7 +261,7 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 0.21392718170599553) {
+            if (!(x <= 236.80339887498948) || x < 3.327466630718667e-08) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -295,11 +294,10 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double w0 = 1.0/(x + 25);
-            const double w1 = 1.0/(s*s);
             c_H_0_lanes[k] = 25*w0;
-            c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
-            c_H_2_lanes[k] = w1*(-2*cos0*sin0/s + 25*w0);
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_H_1_lanes[k] = 1.0/2.0 + (-11.0/200.0)*x;
+            c_H_2_lanes[k] = (-2*cos0*sin0/s + 25*w0)/(s*s);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -309,7 +307,7 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             c_H_0_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : closed_H_0;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 0.21392718170599553 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 3.327466630718667e-08 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -336,8 +334,8 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
- * ops: 104 */
+ * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
+ * ops: 86 */
 static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -355,14 +353,13 @@ static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double H
     }
     const double c_H_inverse_0 = (1.0/25.0)*x + 1;
     double c_H_inverse_2;
-    if (x < 6.511791226584059) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+    if (x < 3.1374537386488126) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = (1.0/2.0)*phi;
-        c_H_inverse_2 = (-1.0/2.0*s*cos(w1)/sin(w1) + (1.0/25.0)*w0 + 1)/w0;
+        const double w0 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (-1.0/2.0*s*cos(w0)/sin(w0) + (1.0/25.0)*x + 1)/x;
     }
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -392,7 +389,7 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 6.511791226584059) {
+            if (!(x <= 236.80339887498948) || x < 3.1374537386488126) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -424,10 +421,10 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double w0 = (s*s);
-            c_H_inverse_0_lanes[k] = (1.0/25.0)*x + 1;
-            c_H_inverse_2_lanes[k] = (-1.0/2.0*cos0*s/sin0 + (1.0/25.0)*w0 + 1)/w0;
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+            const double w0 = (1.0/25.0)*x + 1;
+            c_H_inverse_0_lanes[k] = w0;
+            c_H_inverse_2_lanes[k] = (-1.0/2.0*cos0*s/sin0 + w0)/x;
+            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -437,7 +434,7 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             c_H_inverse_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
-            const double v_H_inverse_2 = x < 6.511791226584059 ? poly_H_inverse_2 : closed_H_inverse_2;
+            const double v_H_inverse_2 = x < 3.1374537386488126 ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
@@ -458,8 +455,8 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
 
 /* symrot_tangent_m5_tangent_det: det H = mu nu^2 (eq 24).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 8 in x below x = 0.213927, else 100*sin(phi/2)**2/(s**2*(x + 25))
- * ops: 31 */
+ * det_H: Horner degree 7 in x below x = 0.111048, else 100*sin(phi/2)**2/(x*(x + 25))
+ * ops: 29 */
 static inline double symrot_tangent_m5_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -467,12 +464,11 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
         return (double)NAN;
     }
     double c_det_H;
-    if (x < 0.21392718170599553) {
-        c_det_H = x*(x*(x*(x*(x*(x*(x*((7.01918024e-10)*x - 33216019.0/2500000000000000.0) + 1517899.0/6250000000000.0) - 530507.0/125000000000.0) + 87293.0/1250000000.0) - 5279.0/5000000.0) + 351.0/25000.0) - 3.0/20.0) + 1;
+    if (x < 0.11104807041853587) {
+        c_det_H = x*(x*(x*(x*(x*(x*(1517899.0/6250000000000.0 + (-33216019.0/2500000000000000.0)*x) - 530507.0/125000000000.0) + 87293.0/1250000000.0) - 5279.0/5000000.0) + 351.0/25000.0) - 3.0/20.0) + 1;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_det_H = 100*pow(sin((1.0/2.0)*phi), 2)/((s*s)*(x + 25));
+        c_det_H = 100*pow(sin((1.0/2.0)*phi), 2)/(x*(x + 25));
     }
     return c_det_H;
 }
@@ -481,8 +477,8 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.111048, else sin(phi/2)/s
- * G_2: Horner degree 18 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
- * ops: 124 */
+ * G_2: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/x
+ * ops: 92 */
 static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -501,13 +497,12 @@ static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
     double c_G_1, c_G_2;
     if (x < 0.11104807041853587) {
         c_G_1 = x*(x*(x*(x*(x*(x*(8357819.0/2048000000000000.0 + (-1.6919252294921874e-10)*x) - 500957.0/5120000000000.0) + 59547.0/25600000000.0) - 1747.0/32000000.0) + 1003.0/800000.0) - 11.0/400.0) + 1.0/2.0;
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        c_G_1 = sin(w0)/s;
-        c_G_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : (1 - cos(w0))/(s*s);
+        c_G_1 = sin((1.0/2.0)*phi)/s;
+        c_G_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -567,12 +562,20 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
-            c_G_2_lanes[k] = (1 - cos0)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -584,7 +587,7 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             c_G_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 3.1374537386488126 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 4.3791113590493824e-05 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -606,9 +609,9 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
 /* symrot_tangent_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 18 in x below x = 3.13745, else (1 - cos(phi/2))/s**2
+ * K_1: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 18 in x below x = 3.13745, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
- * ops: 159 */
+ * ops: 127 */
 static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -626,16 +629,14 @@ static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9]
     }
     const double c_K_0 = (25.0/2.0)/(x + 25);
     double c_K_1, c_K_2;
-    if (x < 3.1374537386488126) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+    if (x < 0.21392718170599553) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = (1.0/2.0)*phi;
-        c_K_1 = w0*(1 - cos(w1));
-        c_K_2 = (1.0/10.0)*w0*(125/(x + 25) - 10*sin(w1)/s);
+        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
+        c_K_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0 : (1.0/10.0)*(125/(x + 25) - 10*sin((1.0/2.0)*phi)/s)/(s*s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -665,7 +666,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 3.1374537386488126) {
+            if (!(x <= 236.80339887498948) || x < 4.3791113590493824e-05) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -685,7 +686,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -695,14 +696,21 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = 1.0/(x + 25);
-            const double w1 = 1.0/(s*s);
             c_K_0_lanes[k] = (25.0/2.0)*w0;
-            c_K_1_lanes[k] = w1*(1 - cos0);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/10.0)*w1*(125*w0 - 10*sin0/s);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_K_1_lanes[k] = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/10.0)*(125*w0 - 10*sin1/s)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -712,7 +720,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             c_K_0_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 3.1374537386488126 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 4.3791113590493824e-05 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -739,8 +747,8 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
- * ops: 98 */
+ * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
+ * ops: 80 */
 static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -752,14 +760,13 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
     }
     const double c_H_inverse_0 = (1.0/25.0)*x + 1;
     double c_H_inverse_2;
-    if (x < 6.511791226584059) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+    if (x < 3.1374537386488126) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = (1.0/2.0)*phi;
-        c_H_inverse_2 = (-1.0/2.0*s*cos(w1)/sin(w1) + (1.0/25.0)*w0 + 1)/w0;
+        const double w0 = (1.0/2.0)*phi;
+        c_H_inverse_2 = (-1.0/2.0*s*cos(w0)/sin(w0) + (1.0/25.0)*x + 1)/x;
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -772,9 +779,9 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
 /* symrot_tangent_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 128 */
+ * ops: 126 */
 static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -786,17 +793,16 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
     }
     const double c_H_0 = 25/(x + 25);
     double c_H_1, c_H_2;
-    if (x < 0.21392718170599553) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+    if (x < 0.11104807041853587) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/(s*s);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25/(x + 25) - 2*w2*cos(w1)/s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        c_H_1 = 2*(w1*w1)/x;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25/(x + 25) - 2*w1*cos(w0)/s)/(s*s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -969,11 +975,11 @@ static inline int symrot_tangent_m5_rescale(const double p[3], double q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * R_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 25))
- * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * ops: 306 */
+ * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(x/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*x*(x + 25))
+ * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * ops: 300 */
 static inline void symrot_tangent_m5_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -992,7 +998,7 @@ static inline void symrot_tangent_m5_rotation_derivative(const double p[3], cons
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 0.11104807041853587) {
         c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
     } else {
@@ -1001,16 +1007,15 @@ static inline void symrot_tangent_m5_rotation_derivative(const double p[3], cons
         const double w0 = 1.0/s;
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = w0*w2*cos(w1);
-        const double w4 = (s*s);
-        const double w5 = 1.0/w4;
-        const double w6 = (w2*w2);
-        const double w7 = (2.0/5.0)*w4 + 10;
-        const double w8 = (5.0/2.0)/(x + 25);
-        c_R_1 = 2*w3;
-        c_R_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : 2*w5*w6;
-        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w5*w8*(-w3*w7 - 10*w6 + 5);
-        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w8*(-w0*w7*(1 - cos(phi)) + 5*sin(phi))/(s*s*s);
+        const double w3 = w2*cos(w1);
+        const double w4 = 1.0/x;
+        const double w5 = (w2*w2);
+        const double w6 = 10*w3;
+        const double w7 = (5.0/2.0)/(x + 25);
+        c_R_1 = 2*w0*w3;
+        c_R_2 = 2*w4*w5;
+        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w4*w7*(-w0*w6*((1.0/25.0)*x + 1) - 10*w5 + 5);
+        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w7*(-20*w0*w5*((1.0/25.0)*(s*s) + 1) + w6)/(s*s*s);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1053,11 +1058,11 @@ static inline void symrot_tangent_m5_rotation_derivative(const double p[3], cons
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * R_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 25))
- * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * ops: 307 */
+ * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(x/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*x*(x + 25))
+ * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * ops: 301 */
 static inline void symrot_tangent_m5_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1076,7 +1081,7 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative(const double 
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 0.11104807041853587) {
         c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+        c_R_2 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
     } else {
@@ -1085,16 +1090,15 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative(const double 
         const double w0 = 1.0/s;
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = w0*w2*cos(w1);
-        const double w4 = (s*s);
-        const double w5 = 1.0/w4;
-        const double w6 = (w2*w2);
-        const double w7 = (2.0/5.0)*w4 + 10;
-        const double w8 = (5.0/2.0)/(x + 25);
-        c_R_1 = 2*w3;
-        c_R_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0 : 2*w5*w6;
-        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w5*w8*(-w3*w7 - 10*w6 + 5);
-        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w8*(-w0*w7*(1 - cos(phi)) + 5*sin(phi))/(s*s*s);
+        const double w3 = w2*cos(w1);
+        const double w4 = 1.0/x;
+        const double w5 = (w2*w2);
+        const double w6 = 10*w3;
+        const double w7 = (5.0/2.0)/(x + 25);
+        c_R_1 = 2*w0*w3;
+        c_R_2 = 2*w4*w5;
+        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w4*w7*(-w0*w6*((1.0/25.0)*x + 1) - 10*w5 + 5);
+        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w7*(-20*w0*w5*((1.0/25.0)*(s*s) + 1) + w6)/(s*s*s);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1134,12 +1138,12 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative(const double 
 /* symrot_tangent_m5_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
- * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + 50*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s**2)/(2*s**3*(x + 25))
- * ops: 363 */
+ * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 25*(1 - 2*sin(phi/2)**2)/s - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s)/(2*s**3*(x + 25))
+ * ops: 361 */
 static inline void symrot_tangent_m5_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1157,30 +1161,31 @@ static inline void symrot_tangent_m5_tangent_derivative(const double p[3], const
     }
     const double c_H_0_x = -25/pow(x + 25, 2);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.21392718170599553) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+    if (x < 0.11104807041853587) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = 1.0/w0;
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = 2*(w3*w3);
-        const double w5 = 1.0/(x + 25);
-        const double w6 = 1.0/s;
-        const double w7 = cos(w2);
-        const double w8 = w3*w6*w7;
-        const double w9 = (1.0/25.0)*w0 + 1;
-        const double w10 = 10*w6*w9;
-        const double w11 = w5/(s*s*s);
-        c_H_1 = w1*w4;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w1*(25*w5 - 2*w8);
-        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(-w10*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w5 + 50*w1*w3*w7*w9 - w10*(125*w5 - 10*w8) - 25*w6*(1 - w4));
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 2*w3;
+        const double w5 = (s*s);
+        const double w6 = 1.0/(x + 25);
+        const double w7 = 1.0/s;
+        const double w8 = cos(w1);
+        const double w9 = w2*w8;
+        const double w10 = 10*w9;
+        const double w11 = w6/(s*s*s);
+        const double w12 = (1.0/25.0)*x + 1;
+        c_H_1 = w0*w4;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25*w6 - 2*w7*w9)/w5;
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(w10 - 20*w3*w7*((1.0/25.0)*w5 + 1));
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w6 + 50*w0*w12*w2*w8 - 10*w12*w7*(-w10*w7 + 125*w6) - 25*w7*(1 - w4));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1225,12 +1230,12 @@ static inline void symrot_tangent_m5_tangent_derivative(const double p[3], const
 /* symrot_tangent_m5_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
- * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + 50*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s**2)/(2*s**3*(x + 25))
- * ops: 369 */
+ * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 25*(1 - 2*sin(phi/2)**2)/s - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s)/(2*s**3*(x + 25))
+ * ops: 367 */
 static inline void symrot_tangent_m5_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1248,30 +1253,31 @@ static inline void symrot_tangent_m5_tangent_transpose_derivative(const double p
     }
     const double c_H_0_x = -25/pow(x + 25, 2);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.21392718170599553) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+    if (x < 0.11104807041853587) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = 1.0/w0;
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = 2*(w3*w3);
-        const double w5 = 1.0/(x + 25);
-        const double w6 = 1.0/s;
-        const double w7 = cos(w2);
-        const double w8 = w3*w6*w7;
-        const double w9 = (1.0/25.0)*w0 + 1;
-        const double w10 = 10*w6*w9;
-        const double w11 = w5/(s*s*s);
-        c_H_1 = w1*w4;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w1*(25*w5 - 2*w8);
-        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(-w10*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w5 + 50*w1*w3*w7*w9 - w10*(125*w5 - 10*w8) - 25*w6*(1 - w4));
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 2*w3;
+        const double w5 = (s*s);
+        const double w6 = 1.0/(x + 25);
+        const double w7 = 1.0/s;
+        const double w8 = cos(w1);
+        const double w9 = w2*w8;
+        const double w10 = 10*w9;
+        const double w11 = w6/(s*s*s);
+        const double w12 = (1.0/25.0)*x + 1;
+        c_H_1 = w0*w4;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25*w6 - 2*w7*w9)/w5;
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(w10 - 20*w3*w7*((1.0/25.0)*w5 + 1));
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w6 + 50*w0*w12*w2*w8 - 10*w12*w7*(-w10*w7 + 125*w6) - 25*w7*(1 - w4));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1319,11 +1325,11 @@ static inline void symrot_tangent_m5_tangent_transpose_derivative(const double p
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
+ * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
  * H_inverse_0_x = 1/25 (algebraic in x)
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 6.51179, else 5*(-5*s*(1 - 2*sin(phi/2)**2)/(2*sin(phi/2)**2) + 4*s*(s**2/25 + 1)/5 + 5*s*cos(phi/2)**2/sin(phi/2)**2 - 5*(s**2/25 + 1)*cos(phi/2)/sin(phi/2) - 10*(s**2/25 + 1)*(2*s**2/25 - s*cos(phi/2)/sin(phi/2) + 2)/s)/(4*s**3*(x + 25))
- * ops: 243 */
+ * ops: 225 */
 static inline void symrot_tangent_m5_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1341,23 +1347,23 @@ static inline void symrot_tangent_m5_tangent_inverse_derivative(const double p[3
     }
     const double c_H_inverse_0_x = 1.0/25.0;
     double c_H_inverse_2, c_H_inverse_2_x;
-    if (x < 6.511791226584059) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+    if (x < 3.1374537386488126) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
         c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.322761367777524e-35 + (-4.7283264209457356e-37)*x) - 3.7200737055323752e-34) + 1.0523099660610621e-32) - 2.995843178059776e-31) + 8.589770227948544e-30) - 2.48248932851712e-28) + 7.238659410816e-27) - 2.132050450432e-25) + 6.35205036544e-24) - 1.9175728128e-22) + 5.878086016e-21) - 1.8345344e-19) + 5.8500288e-18) - 1.9136e-16) + 6.48368e-15) - 351.0/1562500000000000.0) + 113.0/12500000000000.0) - 7.0/31250000000.0) + 87.0/2500000000.0) + 3.0/1250000.0) + 21.0/50000.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = cos(w1);
-        const double w4 = w3/w2;
-        const double w5 = s*w4;
-        const double w6 = (1.0/25.0)*w0 + 1;
-        const double w7 = (w2*w2);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = cos(w0);
+        const double w3 = w2/w1;
+        const double w4 = s*w3;
+        const double w5 = (s*s);
+        const double w6 = (1.0/25.0)*w5 + 1;
+        const double w7 = (w1*w1);
         const double w8 = 1.0/w7;
-        c_H_inverse_2 = (-1.0/2.0*w5 + w6)/w0;
-        c_H_inverse_2_x = (5.0/4.0)*(5*s*(w3*w3)*w8 + (4.0/5.0)*s*w6 - 5.0/2.0*s*w8*(1 - 2*w7) - 5*w4*w6 - 10*w6*((2.0/25.0)*w0 - w5 + 2)/s)/((s*s*s)*(x + 25));
+        c_H_inverse_2 = (-1.0/2.0*w4 + (1.0/25.0)*x + 1)/x;
+        c_H_inverse_2_x = x < 6.511791226584059 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.322761367777524e-35 + (-4.7283264209457356e-37)*x) - 3.7200737055323752e-34) + 1.0523099660610621e-32) - 2.995843178059776e-31) + 8.589770227948544e-30) - 2.48248932851712e-28) + 7.238659410816e-27) - 2.132050450432e-25) + 6.35205036544e-24) - 1.9175728128e-22) + 5.878086016e-21) - 1.8345344e-19) + 5.8500288e-18) - 1.9136e-16) + 6.48368e-15) - 351.0/1562500000000000.0) + 113.0/12500000000000.0) - 7.0/31250000000.0) + 87.0/2500000000.0) + 3.0/1250000.0) + 21.0/50000.0 : (5.0/4.0)*(5*s*(w2*w2)*w8 + (4.0/5.0)*s*w6 - 5.0/2.0*s*w8*(1 - 2*w7) - 5*w3*w6 - 10*w6*(-w4 + (2.0/25.0)*w5 + 2)/s)/((s*s*s)*(x + 25));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_inverse_0_x;
@@ -1399,12 +1405,12 @@ static inline void symrot_tangent_m5_tangent_inverse_derivative(const double p[3
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 8 in x below x = 0.213927, else 2*sin(phi/2)**2/s**2
+ * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
- * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + 50*(s**2/25 + 1)*sin(phi/2)*cos(phi/2)/s**2)/(2*s**3*(x + 25))
- * ops: 326 */
+ * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 25*(1 - 2*sin(phi/2)**2)/s - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s)/(2*s**3*(x + 25))
+ * ops: 324 */
 static inline void symrot_tangent_m5_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1417,30 +1423,31 @@ static inline void symrot_tangent_m5_angular_acceleration(const double p[3], con
     const double c_H_0 = 25/(x + 25);
     const double c_H_0_x = -25/pow(x + 25, 2);
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.21392718170599553) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((8.523086e-11)*x - 1785927.0/1000000000000000.0) + 91377.0/2500000000000.0) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
+    if (x < 0.11104807041853587) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (s*s);
-        const double w1 = 1.0/w0;
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = 2*(w3*w3);
-        const double w5 = 1.0/(x + 25);
-        const double w6 = 1.0/s;
-        const double w7 = cos(w2);
-        const double w8 = w3*w6*w7;
-        const double w9 = (1.0/25.0)*w0 + 1;
-        const double w10 = 10*w6*w9;
-        const double w11 = w5/(s*s*s);
-        c_H_1 = w1*w4;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w1*(25*w5 - 2*w8);
-        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(-w10*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w5 + 50*w1*w3*w7*w9 - w10*(125*w5 - 10*w8) - 25*w6*(1 - w4));
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 2*w3;
+        const double w5 = (s*s);
+        const double w6 = 1.0/(x + 25);
+        const double w7 = 1.0/s;
+        const double w8 = cos(w1);
+        const double w9 = w2*w8;
+        const double w10 = 10*w9;
+        const double w11 = w6/(s*s*s);
+        const double w12 = (1.0/25.0)*x + 1;
+        c_H_1 = w0*w4;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25*w6 - 2*w7*w9)/w5;
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(w10 - 20*w3*w7*((1.0/25.0)*w5 + 1));
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w6 + 50*w0*w12*w2*w8 - 10*w12*w7*(-w10*w7 + 125*w6) - 25*w7*(1 - w4));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1612,8 +1619,8 @@ static inline float symrot_tangent_m5_angle_f(const float p[3])
 /* symrot_tangent_m5_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 1.57118, else sin(phi)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
  * ops: 91 */
 static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R[9])
 {
@@ -1637,8 +1644,10 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_R_1 = sinf(phi)/s;
-        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(s*s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_1 = 2*w1*cosf(w0)/s;
+        c_R_2 = 2*(w1*w1)/x;
     }
     R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1688,7 +1697,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1698,20 +1707,12 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_R_1_lanes[k] = sin0/s;
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_R_2_lanes[k] = x*(x*(201.0F/50000.0F + (-2471.0F/10000000.0F)*x) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            poly_R_2_lanes[k] = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1723,7 +1724,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             c_R_1_lanes[k] = !(x < 236.8034F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 0.111048065F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.0081290705F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 236.8034F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1745,9 +1746,9 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
 /* symrot_tangent_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 118 */
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 100 */
 static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1767,15 +1768,15 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
     float c_H_1, c_H_2;
     if (x < 1.5711837F) {
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
+        const float w0 = 1.0F/x;
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
         c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1805,7 +1806,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 0.111048065F) {
+            if (!(x < 236.8034F) || x < 0.0081290705F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1838,12 +1839,12 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const float w0 = 1.0F/(x + 25);
-            const float w1 = 1.0F/(s*s);
+            const float w1 = 1.0F/x;
             c_H_0_lanes[k] = 25*w0;
             c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_H_1_lanes[k] = x*(x*(201.0F/50000.0F + (-2471.0F/10000000.0F)*x) - 11.0F/200.0F) + 1.0F/2.0F;
+            poly_H_1_lanes[k] = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = w1*(-2*cos0*sin0/s + 25*w0);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1852,11 +1853,11 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             c_H_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_H_0;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 0.111048065F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.0081290705F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x < 236.8034F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
-            const float v_H_2 = x < 6.5117908F ? poly_H_2 : closed_H_2;
+            const float v_H_2 = x < 3.1374536F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 236.8034F) ? NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1879,7 +1880,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
  * ops: 68 */
 static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float Hinv[9])
 {
@@ -1903,9 +1904,8 @@ static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float H
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = (1.0F/2.0F)*phi;
-        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w1)/sinf(w1) + (1.0F/25.0F)*w0 + 1)/w0;
+        const float w0 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w0)/sinf(w0) + (1.0F/25.0F)*x + 1)/x;
     }
     Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -1967,9 +1967,9 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = (s*s);
-            c_H_inverse_0_lanes[k] = (1.0F/25.0F)*x + 1;
-            c_H_inverse_2_lanes[k] = (-1.0F/2.0F*cos0*s/sin0 + (1.0F/25.0F)*w0 + 1)/w0;
+            const float w0 = (1.0F/25.0F)*x + 1;
+            c_H_inverse_0_lanes[k] = w0;
+            c_H_inverse_2_lanes[k] = (-1.0F/2.0F*cos0*s/sin0 + w0)/x;
             poly_H_inverse_2_lanes[k] = x*(x*(x*(1.16e-08F + (-5.6e-11F)*x) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2001,7 +2001,7 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
 
 /* symrot_tangent_m5_tangent_det_f: det H = mu nu^2 (eq 24).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * det_H: Horner degree 7 in x below x = 1.57118, else 100*sin(phi/2)**2/(s**2*(x + 25))
+ * det_H: Horner degree 7 in x below x = 1.57118, else 100*sin(phi/2)**2/(x*(x + 25))
  * ops: 29 */
 static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
 {
@@ -2014,8 +2014,7 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
         c_det_H = x*(x*(x*(x*(x*(x*(2.4286385e-07F + (-1.32864075e-08F)*x) - 4.244056e-06F) + 6.98344e-05F) - 5279.0F/5000000.0F) + 351.0F/25000.0F) - 3.0F/20.0F) + 1;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_det_H = 100*powf(sinf((1.0F/2.0F)*phi), 2)/((s*s)*(x + 25));
+        c_det_H = 100*powf(sinf((1.0F/2.0F)*phi), 2)/(x*(x + 25));
     }
     return c_det_H;
 }
@@ -2024,8 +2023,8 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.57118, else sin(phi/2)/s
- * G_2: Horner degree 8 in x below x = 3.13745, else 2*sin(phi/4)**2/s**2
- * ops: 90 */
+ * G_2: Horner degree 6 in x below x = 1.57118, else 2*sin(phi/4)**2/x
+ * ops: 84 */
 static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2044,12 +2043,12 @@ static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
     float c_G_1, c_G_2;
     if (x < 1.5711837F) {
         c_G_1 = x*(x*(x*(x*(x*((4.0809662e-09F)*x - 9.784316e-08F) + 2.3260548e-06F) - 5.459375e-05F) + 1003.0F/800000.0F) - 11.0F/400.0F) + 1.0F/2.0F;
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
+        c_G_2 = x*(x*(x*(x*(x*((8.315707e-10F)*x - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         c_G_1 = sinf((1.0F/2.0F)*phi)/s;
-        c_G_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F : 2*powf(sinf((1.0F/4.0F)*phi), 2)/(s*s);
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -2121,8 +2120,8 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(s*s);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*((841.0F/3200000.0F)*x - 19.0F/3200.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2134,7 +2133,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             c_G_1_lanes[k] = !(x < 236.8034F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 3.1374536F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.0081290705F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 236.8034F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2156,9 +2155,9 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
 /* symrot_tangent_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 8 in x below x = 3.13745, else 2*sin(phi/4)**2/s**2
+ * K_1: Horner degree 6 in x below x = 1.57118, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 14 in x below x = 6.51179, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
- * ops: 117 */
+ * ops: 111 */
 static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2176,15 +2175,14 @@ static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9]
     }
     const float c_K_0 = (25.0F/2.0F)/(x + 25);
     float c_K_1, c_K_2;
-    if (x < 3.1374536F) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
+    if (x < 1.5711837F) {
+        c_K_1 = x*(x*(x*(x*(x*((8.315707e-10F)*x - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
-        c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*w0*(125/(x + 25) - 10*sinf((1.0F/2.0F)*phi)/s);
+        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
+        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*(125/(x + 25) - 10*sinf((1.0F/2.0F)*phi)/s)/(s*s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2214,7 +2212,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 3.1374536F) {
+            if (!(x < 236.8034F) || x < 0.0081290705F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -2255,11 +2253,10 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = 1.0F/(x + 25);
-            const float w1 = 1.0F/(s*s);
             c_K_0_lanes[k] = (25.0F/2.0F)*w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.4168085e-12F)*x - 3.4392243e-11F) + 8.315707e-10F) - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/10.0F)*w1*(125*w0 - 10*sin1/s);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            poly_K_1_lanes[k] = x*((841.0F/3200000.0F)*x - 19.0F/3200.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/10.0F)*(125*w0 - 10*sin1/s)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2269,7 +2266,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             c_K_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 3.1374536F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.0081290705F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 236.8034F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -2296,7 +2293,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_0 = (x + 25)/25 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
  * ops: 62 */
 static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
@@ -2314,9 +2311,8 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = (1.0F/2.0F)*phi;
-        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w1)/sinf(w1) + (1.0F/25.0F)*w0 + 1)/w0;
+        const float w0 = (1.0F/2.0F)*phi;
+        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w0)/sinf(w0) + (1.0F/25.0F)*x + 1)/x;
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -2329,9 +2325,9 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
 /* symrot_tangent_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 112 */
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 94 */
 static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2345,15 +2341,15 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
     float c_H_1, c_H_2;
     if (x < 1.5711837F) {
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/(s*s);
+        const float w0 = 1.0F/x;
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
         c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2525,12 +2521,12 @@ static inline int symrot_tangent_m5_rescale_f(const float p[3], float q[3])
 /* symrot_tangent_m5_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 1.57118, else sin(phi)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 11 in x below x = 3.13745, else 5*(5*cos(phi) - 5*(s**2/25 + 1)*sin(phi)/s)/(2*s**2*(x + 25))
- * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * ops: 258 */
+ * R_1_x: Horner degree 8 in x below x = 1.57118, else 5*(5*cos(phi) - 5*(x/25 + 1)*sin(phi)/s)/(2*x*(x + 25))
+ * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * ops: 250 */
 static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2550,23 +2546,22 @@ static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], con
     if (x < 1.5711837F) {
         c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(3.1292977e-09F + (-1.6636792e-10F)*x) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = sinf(phi);
-        const float w1 = 1.0F/s;
-        const float w2 = w0*w1;
-        const float w3 = (s*s);
-        const float w4 = 1.0F/w3;
-        const float w5 = cosf(phi);
-        const float w6 = (1.0F/25.0F)*w3 + 1;
-        const float w7 = (5.0F/2.0F)/(x + 25);
-        c_R_1 = w2;
-        c_R_2 = 2*w4*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_R_1_x = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F : w4*w7*(-5*w2*w6 + 5*w5);
-        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w7*(5*w0 - 10*w1*w6*(1 - w5))/(s*s*s);
+        const float w0 = 1.0F/s;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = w2*cosf(w1);
+        const float w4 = 1.0F/x;
+        const float w5 = (w2*w2);
+        const float w6 = (5.0F/2.0F)/(x + 25);
+        c_R_1 = 2*w0*w3;
+        c_R_2 = 2*w4*w5;
+        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*cosf(phi));
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*w5*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2608,12 +2603,12 @@ static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], con
 /* symrot_tangent_m5_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 1.57118, else sin(phi)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
+ * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 11 in x below x = 3.13745, else 5*(5*cos(phi) - 5*(s**2/25 + 1)*sin(phi)/s)/(2*s**2*(x + 25))
- * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * ops: 259 */
+ * R_1_x: Horner degree 8 in x below x = 1.57118, else 5*(5*cos(phi) - 5*(x/25 + 1)*sin(phi)/s)/(2*x*(x + 25))
+ * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * ops: 251 */
 static inline void symrot_tangent_m5_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2633,23 +2628,22 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative_f(const float
     if (x < 1.5711837F) {
         c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(3.1292977e-09F + (-1.6636792e-10F)*x) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = sinf(phi);
-        const float w1 = 1.0F/s;
-        const float w2 = w0*w1;
-        const float w3 = (s*s);
-        const float w4 = 1.0F/w3;
-        const float w5 = cosf(phi);
-        const float w6 = (1.0F/25.0F)*w3 + 1;
-        const float w7 = (5.0F/2.0F)/(x + 25);
-        c_R_1 = w2;
-        c_R_2 = 2*w4*powf(sinf((1.0F/2.0F)*phi), 2);
-        c_R_1_x = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.1423406e-14F)*x - 4.3325283e-13F) + 8.591154e-12F) - 1.6636792e-10F) + 3.1292977e-09F) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F : w4*w7*(-5*w2*w6 + 5*w5);
-        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w7*(5*w0 - 10*w1*w6*(1 - w5))/(s*s*s);
+        const float w0 = 1.0F/s;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = w2*cosf(w1);
+        const float w4 = 1.0F/x;
+        const float w5 = (w2*w2);
+        const float w6 = (5.0F/2.0F)/(x + 25);
+        c_R_1 = 2*w0*w3;
+        c_R_2 = 2*w4*w5;
+        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*cosf(phi));
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*w5*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2689,12 +2683,12 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative_f(const float
 /* symrot_tangent_m5_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
- * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s - 25*cos(phi)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
- * ops: 325 */
+ * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
+ * ops: 306 */
 static inline void symrot_tangent_m5_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2714,28 +2708,29 @@ static inline void symrot_tangent_m5_tangent_derivative_f(const float p[3], cons
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     if (x < 1.5711837F) {
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = 1.0F/w0;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = 1.0F/(x + 25);
-        const float w5 = 1.0F/s;
-        const float w6 = sinf(phi);
-        const float w7 = 5*w6;
-        const float w8 = cosf(phi);
-        const float w9 = (1.0F/25.0F)*w0 + 1;
-        const float w10 = 10*w5*w9;
-        const float w11 = w4/(s*s*s);
-        c_H_1 = 2*w1*(w3*w3);
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w1*(-2*w3*w5*cosf(w2) + 25*w4);
-        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-w10*(1 - w8) + w7);
-        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w4 + 25*w1*w6*w9 - w10*(125*w4 - w5*w7) - 25*w5*w8);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 2*w3;
+        const float w5 = 1.0F/(x + 25);
+        const float w6 = 1.0F/s;
+        const float w7 = w2*cosf(w1);
+        const float w8 = (s*s);
+        const float w9 = (1.0F/25.0F)*w8 + 1;
+        const float w10 = w6*w9;
+        const float w11 = w5/(s*s*s);
+        const float w12 = sinf(phi);
+        c_H_1 = w0*w4;
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25*w5 - 2*w6*w7);
+        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-20*w10*w3 + 10*w7);
+        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w5 - 10*w10*(-5*w12*w6 + 125*w5) + 25*w12*w9/w8 - 25*w6*(1 - w4));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2780,12 +2775,12 @@ static inline void symrot_tangent_m5_tangent_derivative_f(const float p[3], cons
 /* symrot_tangent_m5_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
- * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s - 25*cos(phi)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
- * ops: 331 */
+ * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
+ * ops: 312 */
 static inline void symrot_tangent_m5_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2805,28 +2800,29 @@ static inline void symrot_tangent_m5_tangent_transpose_derivative_f(const float 
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     if (x < 1.5711837F) {
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = 1.0F/w0;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = 1.0F/(x + 25);
-        const float w5 = 1.0F/s;
-        const float w6 = sinf(phi);
-        const float w7 = 5*w6;
-        const float w8 = cosf(phi);
-        const float w9 = (1.0F/25.0F)*w0 + 1;
-        const float w10 = 10*w5*w9;
-        const float w11 = w4/(s*s*s);
-        c_H_1 = 2*w1*(w3*w3);
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w1*(-2*w3*w5*cosf(w2) + 25*w4);
-        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-w10*(1 - w8) + w7);
-        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w4 + 25*w1*w6*w9 - w10*(125*w4 - w5*w7) - 25*w5*w8);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 2*w3;
+        const float w5 = 1.0F/(x + 25);
+        const float w6 = 1.0F/s;
+        const float w7 = w2*cosf(w1);
+        const float w8 = (s*s);
+        const float w9 = (1.0F/25.0F)*w8 + 1;
+        const float w10 = w6*w9;
+        const float w11 = w5/(s*s*s);
+        const float w12 = sinf(phi);
+        c_H_1 = w0*w4;
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25*w5 - 2*w6*w7);
+        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-20*w10*w3 + 10*w7);
+        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w5 - 10*w10*(-5*w12*w6 + 125*w5) + 25*w12*w9/w8 - 25*w6*(1 - w4));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2874,11 +2870,11 @@ static inline void symrot_tangent_m5_tangent_transpose_derivative_f(const float 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (s**2/25 - s*cos(phi/2)/(2*sin(phi/2)) + 1)/s**2
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
  * H_inverse_0_x = 1/25 (algebraic in x)
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 8 in x below x = 6.51179, else 5*(-5*s*(1 - 2*sin(phi/2)**2)/(2*sin(phi/2)**2) + 4*s*(s**2/25 + 1)/5 + 5*s*cos(phi/2)**2/sin(phi/2)**2 - 5*(s**2/25 + 1)*cos(phi/2)/sin(phi/2) - 10*(s**2/25 + 1)*(2*s**2/25 - s*cos(phi/2)/sin(phi/2) + 2)/s)/(4*s**3*(x + 25))
- * ops: 172 */
+ * ops: 174 */
 static inline void symrot_tangent_m5_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2902,17 +2898,17 @@ static inline void symrot_tangent_m5_tangent_inverse_derivative_f(const float p[
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = cosf(w1);
-        const float w4 = w3/w2;
-        const float w5 = s*w4;
-        const float w6 = (1.0F/25.0F)*w0 + 1;
-        const float w7 = (w2*w2);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = cosf(w0);
+        const float w3 = w2/w1;
+        const float w4 = s*w3;
+        const float w5 = (s*s);
+        const float w6 = (1.0F/25.0F)*w5 + 1;
+        const float w7 = (w1*w1);
         const float w8 = 1.0F/w7;
-        c_H_inverse_2 = (-1.0F/2.0F*w5 + w6)/w0;
-        c_H_inverse_2_x = (5.0F/4.0F)*(5*s*(w3*w3)*w8 + (4.0F/5.0F)*s*w6 - 5.0F/2.0F*s*w8*(1 - 2*w7) - 5*w4*w6 - 10*w6*((2.0F/25.0F)*w0 - w5 + 2)/s)/((s*s*s)*(x + 25));
+        c_H_inverse_2 = (-1.0F/2.0F*w4 + (1.0F/25.0F)*x + 1)/x;
+        c_H_inverse_2_x = (5.0F/4.0F)*(5*s*(w2*w2)*w8 + (4.0F/5.0F)*s*w6 - 5.0F/2.0F*s*w8*(1 - 2*w7) - 5*w3*w6 - 10*w6*(-w4 + (2.0F/25.0F)*w5 + 2)/s)/((s*s*s)*(x + 25));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_inverse_0_x;
@@ -2954,12 +2950,12 @@ static inline void symrot_tangent_m5_tangent_inverse_derivative_f(const float p[
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
- * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/s**2
- * H_2: Horner degree 15 in x below x = 6.51179, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
+ * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
- * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(5*sin(phi) - 10*(1 - cos(phi))*(s**2/25 + 1)/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s - 25*cos(phi)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
- * ops: 288 */
+ * H_1_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
+ * H_2_x: Horner degree 17 in x below x = 6.51179, else (-50*s/(x + 25) - 25*(1 - 2*sin(phi/2)**2)/s - 10*(s**2/25 + 1)*(125/(x + 25) - 5*sin(phi)/s)/s + 25*(s**2/25 + 1)*sin(phi)/s**2)/(2*s**3*(x + 25))
+ * ops: 269 */
 static inline void symrot_tangent_m5_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2974,28 +2970,29 @@ static inline void symrot_tangent_m5_angular_acceleration_f(const float p[3], co
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     if (x < 1.5711837F) {
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (s*s);
-        const float w1 = 1.0F/w0;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = 1.0F/(x + 25);
-        const float w5 = 1.0F/s;
-        const float w6 = sinf(phi);
-        const float w7 = 5*w6;
-        const float w8 = cosf(phi);
-        const float w9 = (1.0F/25.0F)*w0 + 1;
-        const float w10 = 10*w5*w9;
-        const float w11 = w4/(s*s*s);
-        c_H_1 = 2*w1*(w3*w3);
-        c_H_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.5668078e-19F + (-6.887507e-21F)*x) - 3.541662e-18F) + 7.947594e-17F) - 1.7685065e-15F) + 3.896719e-14F) - 8.4862965e-13F) + 1.822318e-11F) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w1*(-2*w3*w5*cosf(w2) + 25*w4);
-        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-w10*(1 - w8) + w7);
-        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w4 + 25*w1*w6*w9 - w10*(125*w4 - w5*w7) - 25*w5*w8);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 2*w3;
+        const float w5 = 1.0F/(x + 25);
+        const float w6 = 1.0F/s;
+        const float w7 = w2*cosf(w1);
+        const float w8 = (s*s);
+        const float w9 = (1.0F/25.0F)*w8 + 1;
+        const float w10 = w6*w9;
+        const float w11 = w5/(s*s*s);
+        const float w12 = sinf(phi);
+        c_H_1 = w0*w4;
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25*w5 - 2*w6*w7);
+        c_H_1_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*w11*(-20*w10*w3 + 10*w7);
+        c_H_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0207576e-23F)*x - 2.2262642e-22F) + 4.817203e-21F) - 1.0331261e-19F) + 2.1935308e-18F) - 4.6041604e-17F) + 9.537112e-16F) - 1.9453572e-14F) + 3.8967188e-13F) - 7.6376665e-12F) + 1.4578544e-10F) - 2.6922602e-09F) + 4.7655263e-08F) - 7.9726e-07F) + 1.23248e-05F) - 0.00016914F) + 237.0F/125000.0F) - 343.0F/25000.0F : (1.0F/2.0F)*w11*(-50*s*w5 - 10*w10*(-5*w12*w6 + 125*w5) + 25*w12*w9/w8 - 25*w6*(1 - w4));
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

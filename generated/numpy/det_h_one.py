@@ -171,9 +171,13 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
         t = x
-        series = 5.253841918550812e-15
+        series = 3.0039990891728625e-19
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
         series = 6.068442620832808e-14 + t * series
         series = 7.02588589607731e-13 + t * series
         series = 8.157249203307483e-12 + t * series
@@ -188,13 +192,17 @@ def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.4342812090283275
     if small.any():
         t = x[small]
-        series = 5.253841918550812e-15
+        series = 3.0039990891728625e-19
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
         series = 6.068442620832808e-14 + t * series
         series = 7.02588589607731e-13 + t * series
         series = 8.157249203307483e-12 + t * series
@@ -308,9 +316,13 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
         t = x
-        series = 5.253841918550812e-15
+        series = 3.0039990891728625e-19
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
         series = 6.068442620832808e-14 + t * series
         series = 7.02588589607731e-13 + t * series
         series = 8.157249203307483e-12 + t * series
@@ -325,13 +337,17 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.4342812090283275
     if small.any():
         t = x[small]
-        series = 5.253841918550812e-15
+        series = 3.0039990891728625e-19
+        series = 3.447054794682197e-18 + t * series
+        series = 3.960693739938103e-17 + t * series
+        series = 4.557728891739657e-16 + t * series
+        series = 5.253841918550812e-15 + t * series
         series = 6.068442620832808e-14 + t * series
         series = 7.02588589607731e-13 + t * series
         series = 8.157249203307483e-12 + t * series
@@ -656,9 +672,13 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
         t = x
-        series = 2.626920959275406e-15
+        series = 1.5019995445864313e-19
+        series = 1.7235273973410984e-18 + t * series
+        series = 1.9803468699690516e-17 + t * series
+        series = 2.2788644458698284e-16 + t * series
+        series = 2.626920959275406e-15 + t * series
         series = 3.034221310416404e-14 + t * series
         series = 3.512942948038655e-13 + t * series
         series = 4.078624601653741e-12 + t * series
@@ -673,13 +693,17 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray((0.125)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.4342812090283275
     if small.any():
         t = x[small]
-        series = 2.626920959275406e-15
+        series = 1.5019995445864313e-19
+        series = 1.7235273973410984e-18 + t * series
+        series = 1.9803468699690516e-17 + t * series
+        series = 2.2788644458698284e-16 + t * series
+        series = 2.626920959275406e-15 + t * series
         series = 3.034221310416404e-14 + t * series
         series = 3.512942948038655e-13 + t * series
         series = 4.078624601653741e-12 + t * series
@@ -1412,7 +1436,7 @@ def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.025 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-2*sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi), dtype=x.dtype)
+    out = numpy.asarray(2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
     if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
     small = x < 0.7648242161335777
@@ -1481,7 +1505,7 @@ def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478
@@ -1600,7 +1624,7 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478
@@ -1815,7 +1839,7 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.0125 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-sin_half/numpy.cbrt(12*cos_half*sin_half - 6*phi), dtype=x.dtype)
+    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
     if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
     small = x < 0.7648242161335777
@@ -1886,7 +1910,7 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.125)*numpy.cbrt(6*phi - 6*numpy.sin(phi))**2/sin_half**2, dtype=x.dtype)
+    out = numpy.asarray((0.125)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478
@@ -2590,7 +2614,7 @@ _USES_PHI = {
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 0.764824235244299, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 0.764824235244299, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 1.4342812090283275, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 0.764824235244299, 'K_1': 1.4342812090283275, 'K_2': 2.6302227241416043, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
+    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 1.4342812090283275, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 1.4342812090283275, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 1.4342812090283275, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 1.4342812090283275, 'K_1': 1.4342812090283275, 'K_2': 2.6302227241416043, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
     "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 2.630222574480542, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 2.630222574480542, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 4.619481091176478, 'K_1': 2.630222574480542, 'K_2': 4.619481091176478, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold

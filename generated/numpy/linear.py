@@ -130,9 +130,12 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0649445220708132:  # every lane on the polynomial
+    if span is not None and span[1] < 0.116472206314816:  # every lane on the polynomial
         t = x
-        series = 0.002159137935754174
+        series = 0.0015769325991740776
+        series = 0.0017386131018401613 + t * series
+        series = 0.0019299437302723321 + t * series
+        series = 0.002159137935754174 + t * series
         series = 0.00243758516411674 + t * series
         series = 0.002781492528356466 + t * series
         series = 0.0032146330158866476 + t * series
@@ -146,13 +149,16 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.0390625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/s**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0649445220708132:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.116472206314816:  # every lane on the closed form
         return out
-    small = x < 0.0649445220708132
+    small = x < 0.116472206314816
     if small.any():
         t = x[small]
-        series = 0.002159137935754174
+        series = 0.0015769325991740776
+        series = 0.0017386131018401613 + t * series
+        series = 0.0019299437302723321 + t * series
+        series = 0.002159137935754174 + t * series
         series = 0.00243758516411674 + t * series
         series = 0.002781492528356466 + t * series
         series = 0.0032146330158866476 + t * series
@@ -174,9 +180,12 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0649445220708132:  # every lane on the polynomial
+    if span is not None and span[1] < 0.116472206314816:  # every lane on the polynomial
         t = x
-        series = 0.002159137935754174
+        series = 0.0015769325991740776
+        series = 0.0017386131018401613 + t * series
+        series = 0.0019299437302723321 + t * series
+        series = 0.002159137935754174 + t * series
         series = 0.00243758516411674 + t * series
         series = 0.002781492528356466 + t * series
         series = 0.0032146330158866476 + t * series
@@ -190,13 +199,16 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.0390625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/s**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0649445220708132:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.116472206314816:  # every lane on the closed form
         return out
-    small = x < 0.0649445220708132
+    small = x < 0.116472206314816
     if small.any():
         t = x[small]
-        series = 0.002159137935754174
+        series = 0.0015769325991740776
+        series = 0.0017386131018401613 + t * series
+        series = 0.0019299437302723321 + t * series
+        series = 0.002159137935754174 + t * series
         series = 0.00243758516411674 + t * series
         series = 0.002781492528356466 + t * series
         series = 0.0032146330158866476 + t * series
@@ -234,7 +246,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.16015625 + t * series
         series = 0.1875 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(((0.5)/numpy.sqrt(d) - (0.5)/cos_half)/s**2, dtype=x.dtype)
+    out = numpy.asarray(((0.5)/numpy.sqrt(d) - (0.5)/cos_half)/x, dtype=x.dtype)
     if span is not None and span[0] >= 0.116472206314816:  # every lane on the closed form
         return out
     small = x < 0.116472206314816
@@ -282,54 +294,20 @@ def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.116472206314816:  # every lane on the polynomial
+    if span is not None and span[1] < 9.999999999999965e-15:  # every lane on the polynomial
         t = x
-        series = 2.382043064772006
-        series = 2.3145357714383863 + t * series
-        series = 2.245030192716513 + t * series
-        series = 2.1733401529490948 + t * series
-        series = 2.0992490113712847 + t * series
-        series = 2.0225022733211517 + t * series
-        series = 1.9427977502346039 + t * series
-        series = 1.8597722053527832 + t * series
-        series = 1.7729828357696533 + t * series
-        series = 1.6818809509277344 + t * series
-        series = 1.5857734680175781 + t * series
-        series = 1.4837646484375 + t * series
-        series = 1.374664306640625 + t * series
-        series = 1.2568359375 + t * series
-        series = 1.1279296875 + t * series
-        series = 0.984375 + t * series
-        series = 0.8203125 + t * series
-        series = 0.625 + t * series
+        series = 0.625
         series = 0.375 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     w0 = numpy.sqrt(d)
     w1 = (w0 + 1)**(-1.0)
     out = numpy.asarray((0.5)*w1*(w1 + w0**(-1.0))/d, dtype=x.dtype)
-    if span is not None and span[0] >= 0.116472206314816:  # every lane on the closed form
+    if span is not None and span[0] >= 9.999999999999965e-15:  # every lane on the closed form
         return out
-    small = x < 0.116472206314816
+    small = x < 9.999999999999965e-15
     if small.any():
         t = x[small]
-        series = 2.382043064772006
-        series = 2.3145357714383863 + t * series
-        series = 2.245030192716513 + t * series
-        series = 2.1733401529490948 + t * series
-        series = 2.0992490113712847 + t * series
-        series = 2.0225022733211517 + t * series
-        series = 1.9427977502346039 + t * series
-        series = 1.8597722053527832 + t * series
-        series = 1.7729828357696533 + t * series
-        series = 1.6818809509277344 + t * series
-        series = 1.5857734680175781 + t * series
-        series = 1.4837646484375 + t * series
-        series = 1.374664306640625 + t * series
-        series = 1.2568359375 + t * series
-        series = 1.1279296875 + t * series
-        series = 0.984375 + t * series
-        series = 0.8203125 + t * series
-        series = 0.625 + t * series
+        series = 0.625
         series = 0.375 + t * series
         out[small] = series
     return out
@@ -478,20 +456,18 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0032607575010940625:  # every lane on the polynomial
+    if span is not None and span[1] < 7.888950669946805e-06:  # every lane on the polynomial
         t = x
-        series = 0.0205078125
-        series = 0.0390625 + t * series
+        series = 0.0390625
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/s**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0032607575010940625:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 7.888950669946805e-06:  # every lane on the closed form
         return out
-    small = x < 0.0032607575010940625
+    small = x < 7.888950669946805e-06
     if small.any():
         t = x[small]
-        series = 0.0205078125
-        series = 0.0390625 + t * series
+        series = 0.0390625
         series = 0.125 + t * series
         out[small] = series
     return out
@@ -504,20 +480,18 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0032607575010940625:  # every lane on the polynomial
+    if span is not None and span[1] < 7.888950669946805e-06:  # every lane on the polynomial
         t = x
-        series = 0.0205078125
-        series = 0.0390625 + t * series
+        series = 0.0390625
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/s**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0032607575010940625:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 7.888950669946805e-06:  # every lane on the closed form
         return out
-    small = x < 0.0032607575010940625
+    small = x < 7.888950669946805e-06
     if small.any():
         t = x[small]
-        series = 0.0205078125
-        series = 0.0390625 + t * series
+        series = 0.0390625
         series = 0.125 + t * series
         out[small] = series
     return out
@@ -543,7 +517,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.16015625 + t * series
         series = 0.1875 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(((0.5)/numpy.sqrt(d) - (0.5)/cos_half)/s**2, dtype=x.dtype)
+    out = numpy.asarray((0.25)*((0.5)/numpy.sqrt(d) - (0.5)/cos_half)/(cos_half**2*sin_half**2), dtype=x.dtype)
     if span is not None and span[0] >= 0.35302036314032237:  # every lane on the closed form
         return out
     small = x < 0.35302036314032237
@@ -596,22 +570,20 @@ def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0017858926047607296:  # every lane on the polynomial
+    if span is not None and span[1] < 2.3641004067379935e-06:  # every lane on the polynomial
         t = x
-        series = 0.8203125
-        series = 0.625 + t * series
+        series = 0.625
         series = 0.375 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     w0 = numpy.sqrt(d)
     w1 = (w0 + 1)**(-1.0)
     out = numpy.asarray((0.5)*w1*(w1 + w0**(-1.0))/d, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0017858926047607296:  # every lane on the closed form
+    if span is not None and span[0] >= 2.3641004067379935e-06:  # every lane on the closed form
         return out
-    small = x < 0.0017858926047607296
+    small = x < 2.3641004067379935e-06
     if small.any():
         t = x[small]
-        series = 0.8203125
-        series = 0.625 + t * series
+        series = 0.625
         series = 0.375 + t * series
         out[small] = series
     return out
@@ -728,8 +700,8 @@ _USES_PHI = {
     "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'det_H': 9.999999999999965e-15, 'G_2': 0.0649445220708132, 'K_1': 0.0649445220708132, 'K_2': 0.116472206314816, 'e_0': 9.999999999999965e-15},
-    "32": {'det_H': 1.0000000233721917e-14, 'G_2': 0.0032607575010940625, 'K_1': 0.0032607575010940625, 'K_2': 0.35302036314032237, 'e_0': 1.0000000233721917e-14},
+    "64": {'det_H': 9.999999999999965e-15, 'G_2': 0.116472206314816, 'K_1': 0.116472206314816, 'K_2': 0.116472206314816, 'e_0': 9.999999999999965e-15},
+    "32": {'det_H': 1.0000000233721917e-14, 'G_2': 7.888950669946805e-06, 'K_1': 7.888950669946805e-06, 'K_2': 0.35302036314032237, 'e_0': 1.0000000233721917e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)

@@ -252,9 +252,13 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 5.253841918550812e-15 + 0.0 * x
+    series = 3.0039990891728625e-19 + 0.0 * x
+    series = 3.447054794682197e-18 + t * series
+    series = 3.960693739938103e-17 + t * series
+    series = 4.557728891739657e-16 + t * series
+    series = 5.253841918550812e-15 + t * series
     series = 6.068442620832808e-14 + t * series
     series = 7.02588589607731e-13 + t * series
     series = 8.157249203307483e-12 + t * series
@@ -268,9 +272,10 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0035714285714285713 + t * series
     series = 0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    closed = (0.25)*_cbrt(6*phi - 6*_xp.sin(phi))**2/sin_half**2
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
     return _where(small, series, closed)
 
 
@@ -329,9 +334,13 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 5.253841918550812e-15 + 0.0 * x
+    series = 3.0039990891728625e-19 + 0.0 * x
+    series = 3.447054794682197e-18 + t * series
+    series = 3.960693739938103e-17 + t * series
+    series = 4.557728891739657e-16 + t * series
+    series = 5.253841918550812e-15 + t * series
     series = 6.068442620832808e-14 + t * series
     series = 7.02588589607731e-13 + t * series
     series = 8.157249203307483e-12 + t * series
@@ -345,9 +354,10 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0035714285714285713 + t * series
     series = 0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    closed = (0.25)*_cbrt(6*phi - 6*_xp.sin(phi))**2/sin_half**2
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
     return _where(small, series, closed)
 
 
@@ -522,9 +532,13 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 2.626920959275406e-15 + 0.0 * x
+    series = 1.5019995445864313e-19 + 0.0 * x
+    series = 1.7235273973410984e-18 + t * series
+    series = 1.9803468699690516e-17 + t * series
+    series = 2.2788644458698284e-16 + t * series
+    series = 2.626920959275406e-15 + t * series
     series = 3.034221310416404e-14 + t * series
     series = 3.512942948038655e-13 + t * series
     series = 4.078624601653741e-12 + t * series
@@ -538,9 +552,10 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0017857142857142857 + t * series
     series = 0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    closed = (0.125)*_cbrt(6*phi - 6*_xp.sin(phi))**2/sin_half**2
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    closed = (0.125)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
     return _where(small, series, closed)
 
 
@@ -1008,8 +1023,7 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
     series = 1.0 + t * series
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    cos_half = _where(small, 0.8173046507362676, cos_half)
-    closed = -2*sin_half/_cbrt(12*cos_half*sin_half - 6*phi)
+    closed = 2*sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
     return _where(small, series, closed)
 
 
@@ -1053,7 +1067,8 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
     series = 1.0 + t * series
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
-    closed = (0.25)*_cbrt(6*phi - 6*_xp.sin(phi))**2/sin_half**2
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
     return _where(small, series, closed)
 
 
@@ -1124,7 +1139,8 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half):
     series = 1.0 + t * series
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
-    closed = (0.25)*_cbrt(6*phi - 6*_xp.sin(phi))**2/sin_half**2
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
     return _where(small, series, closed)
 
 
@@ -1246,8 +1262,7 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
     series = 0.5 + t * series
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    cos_half = _where(small, 0.8173046507362676, cos_half)
-    closed = -sin_half/_cbrt(12*cos_half*sin_half - 6*phi)
+    closed = sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
     return _where(small, series, closed)
 
 
@@ -1293,7 +1308,8 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
     series = 0.5 + t * series
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
-    closed = (0.125)*_cbrt(6*phi - 6*_xp.sin(phi))**2/sin_half**2
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (0.125)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
     return _where(small, series, closed)
 
 

@@ -209,9 +209,12 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.0649445220708132
+    small = x < 0.116472206314816
     t = _where(small, x, 0.0)
-    series = 0.002159137935754174 + 0.0 * x
+    series = 0.0015769325991740776 + 0.0 * x
+    series = 0.0017386131018401613 + t * series
+    series = 0.0019299437302723321 + t * series
+    series = 0.002159137935754174 + t * series
     series = 0.00243758516411674 + t * series
     series = 0.002781492528356466 + t * series
     series = 0.0032146330158866476 + t * series
@@ -224,9 +227,9 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0205078125 + t * series
     series = 0.0390625 + t * series
     series = 0.125 + t * series
-    phi = _where(small, 0.25768446128134054, phi)
-    s = _where(small, 0.2548421512835214, s)
-    closed = 2*_xp.sin((0.25)*phi)**2/s**2
+    phi = _where(small, 0.34827858083060304, phi)
+    x = _where(small, 0.116472206314816, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
@@ -235,9 +238,12 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.0649445220708132
+    small = x < 0.116472206314816
     t = _where(small, x, 0.0)
-    series = 0.002159137935754174 + 0.0 * x
+    series = 0.0015769325991740776 + 0.0 * x
+    series = 0.0017386131018401613 + t * series
+    series = 0.0019299437302723321 + t * series
+    series = 0.002159137935754174 + t * series
     series = 0.00243758516411674 + t * series
     series = 0.002781492528356466 + t * series
     series = 0.0032146330158866476 + t * series
@@ -250,9 +256,9 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0205078125 + t * series
     series = 0.0390625 + t * series
     series = 0.125 + t * series
-    phi = _where(small, 0.25768446128134054, phi)
-    s = _where(small, 0.2548421512835214, s)
-    closed = 2*_xp.sin((0.25)*phi)**2/s**2
+    phi = _where(small, 0.34827858083060304, phi)
+    x = _where(small, 0.116472206314816, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
@@ -276,10 +282,10 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.14013671875 + t * series
     series = 0.16015625 + t * series
     series = 0.1875 + t * series
-    s = _where(small, 0.34128024600731877, s)
+    x = _where(small, 0.116472206314816, x)
     cos_half = _where(small, 0.9848760306762097, cos_half)
     d = _where(small, 0.883527793685184, d)
-    closed = ((0.5)/_xp.sqrt(d) - (0.5)/cos_half)/s**2
+    closed = ((0.5)/_xp.sqrt(d) - (0.5)/cos_half)/x
     return _where(small, series, closed)
 
 
@@ -304,20 +310,9 @@ def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.116472206314816
+    small = x < 0.005951203046330052
     t = _where(small, x, 0.0)
-    series = 2.382043064772006 + 0.0 * x
-    series = 2.3145357714383863 + t * series
-    series = 2.245030192716513 + t * series
-    series = 2.1733401529490948 + t * series
-    series = 2.0992490113712847 + t * series
-    series = 2.0225022733211517 + t * series
-    series = 1.9427977502346039 + t * series
-    series = 1.8597722053527832 + t * series
-    series = 1.7729828357696533 + t * series
-    series = 1.6818809509277344 + t * series
-    series = 1.5857734680175781 + t * series
-    series = 1.4837646484375 + t * series
+    series = 1.4837646484375 + 0.0 * x
     series = 1.374664306640625 + t * series
     series = 1.2568359375 + t * series
     series = 1.1279296875 + t * series
@@ -325,7 +320,7 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     series = 0.8203125 + t * series
     series = 0.625 + t * series
     series = 0.375 + t * series
-    d = _where(small, 0.883527793685184, d)
+    d = _where(small, 0.99404879695367, d)
     w0 = _xp.sqrt(d)
     w1 = (w0 + 1)**(-1.0)
     closed = (0.5)*w1*(w1 + w0**(-1.0))/d
@@ -485,8 +480,8 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0390625 + t * series
     series = 0.125 + t * series
     phi = _where(small, 0.34827858083060304, phi)
-    s = _where(small, 0.34128024719683714, s)
-    closed = 2*_xp.sin((0.25)*phi)**2/s**2
+    x = _where(small, 0.11647220712673427, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
@@ -507,8 +502,8 @@ def _K_1_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0390625 + t * series
     series = 0.125 + t * series
     phi = _where(small, 0.34827858083060304, phi)
-    s = _where(small, 0.34128024719683714, s)
-    closed = 2*_xp.sin((0.25)*phi)**2/s**2
+    x = _where(small, 0.11647220712673427, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
@@ -531,10 +526,10 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.14013671875 + t * series
     series = 0.16015625 + t * series
     series = 0.1875 + t * series
-    s = _where(small, 0.5941551675617426, s)
+    sin_half = _where(small, 0.3127695234097699, sin_half)
     cos_half = _where(small, 0.9498290505275281, cos_half)
     d = _where(small, 0.6469796368596776, d)
-    closed = ((0.5)/_xp.sqrt(d) - (0.5)/cos_half)/s**2
+    closed = (0.25)*((0.5)/_xp.sqrt(d) - (0.5)/cos_half)/(cos_half**2*sin_half**2)
     return _where(small, series, closed)
 
 

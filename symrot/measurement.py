@@ -1,0 +1,157 @@
+"""Where and against what the plan measures candidate forms (:mod:`symrot.plan`).
+
+The grid of angles (log-spaced towards 0, plus points approaching φ_max), the inputs the backends
+have there (x = |p|² rounded, s = √x, the angle φ̂ they compute from s, the fold complement d),
+the exact angle θ of each rounded input, and the 60-digit reference values of a coefficient at
+those angles. Forms are evaluated on these inputs by :mod:`symrot.evaluation`; the error model
+that turns the errors into switches and degrees is :func:`symrot.plan.plan_branch`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from functools import lru_cache
+from typing import Any, NamedTuple
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from .algebraic import S, X
+from .evaluation import log_grid
+from .functions import mpmath_namespace
+from .parsing import PHI
+
+GRID_POINTS = 56
+EDGE_POINTS = 12
+JITTER = 0.0137
+JITTER_SAMPLES = 6
+REFERENCE_DIGITS = 60
+OFF_GRID = mpmath.mpf("0.37")
+"""Where between two neighbouring angles of the format the measured inputs lie: an angle that the
+format holds exactly would hide the rounding of φ̂ (θ of its rounded x is within 10⁻¹² of it
+where p′ is large)."""
+
+
+def angle_grid(phi_max: float) -> np.ndarray:
+    """Log grid towards 0 plus points approaching the edge of the range (φ_max − 10⁻ᵏ φ_max)."""
+    end = min(phi_max, 4 * np.pi)
+    edge = end * (1 - log_grid(0.25, 1e-6, EDGE_POINTS))
+    return np.unique(np.concatenate([log_grid(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
+
+
+class MeasuredInputs(NamedTuple):
+    """Where a coefficient's forms are measured, per grid angle (:func:`_angle_grid`): the rounded
+    angles φ̂ the backends compute, the exact angles θ of the reference (mpmath numbers) and x = p²,
+    s = √x, d = k² − x (the fold complement, 0 without one) as the backends have them."""
+
+    angles: tuple[np.ndarray, ...]
+    exact: tuple[tuple[object, ...], ...]
+    squares: tuple[np.ndarray, ...]
+    lengths: tuple[np.ndarray, ...]
+    complements: tuple[np.ndarray, ...]
+
+
+@lru_cache(maxsize=16)
+def measured_inputs(argument: sp.Expr, phi_max: float, dtype: type,
+                    complement: sp.Rational | None = None) -> MeasuredInputs:
+    """The points of :class:`MeasuredInputs` for a coefficient of s = ``argument``(φ).
+
+    Each grid angle contributes a few nearby arguments (JITTER): rounding errors fluctuate from one
+    argument to the next, and a cancellation must not hide behind one lucky grid point. At each,
+    x = p(φ)² rounded is the input; the reference is taken at the exact θ with p(θ) = √x, and
+    every form gets φ̂ = θ rounded, as the backends compute it from s: the input's own rounding is
+    not charged to a form, the rounding of φ̂ is (near an edge where p′ → ∞, √(1 − φ²/4) from φ̂
+    loses every digit; cos(s/2) none). For ``argument`` = φ (Newton's ratio and slope, the
+    quaternion scale) the input is the angle itself."""
+    epsilon = float(np.finfo(dtype).eps)
+    p_of = sp.lambdify(PHI, argument, modules=[mpmath_namespace(), "mpmath"])
+    slope_of = sp.lambdify(PHI, sp.diff(argument, PHI), modules=[mpmath_namespace(), "mpmath"])
+    from_length = argument != PHI
+    k2 = mpmath.mpf(complement.p) / complement.q if complement is not None else None
+    angles: list[np.ndarray] = []
+    exact: list[tuple[object, ...]] = []
+    squares: list[np.ndarray] = []
+    complements: list[np.ndarray] = []
+    with mpmath.workdps(40):
+        for angle in angle_grid(phi_max):
+            samples: np.ndarray = np.unique(np.asarray(angle * (1 - JITTER * np.arange(JITTER_SAMPLES)),
+                                                       dtype=dtype))
+            samples = samples[samples.astype(np.float64) < phi_max * (1 - 2 * epsilon)]  # rounded inside
+            kept_phi, kept_theta, kept_x, kept_d = [], [], [], []
+            for sample in samples:
+                phi = mpmath.mpf(float(sample))
+                if from_length:  # an angle between two numbers of the format, as from a generic p
+                    phi += OFF_GRID * mpmath.mpf(float(np.spacing(sample)))
+                value = p_of(phi)
+                square = dtype(float(value**2)) if mpmath.isfinite(value) else dtype(np.inf)
+                theta = _exact_angle(p_of, slope_of, phi, square) if from_length else phi
+                if theta is None:
+                    continue
+                kept_phi.append(dtype(float(theta)))
+                kept_theta.append(theta)
+                kept_x.append(square)
+                kept_d.append(dtype(float(k2 - mpmath.mpf(float(square)))) if k2 is not None else dtype(0))
+            angles.append(np.asarray(kept_phi, dtype=dtype))
+            exact.append(tuple(kept_theta))
+            squares.append(np.asarray(kept_x, dtype=dtype))
+            complements.append(np.asarray(kept_d, dtype=dtype))
+    with np.errstate(all="ignore"):
+        lengths = tuple(np.sqrt(x) for x in squares)
+    return MeasuredInputs(tuple(angles), tuple(exact), tuple(squares), lengths, tuple(complements))
+
+
+def _exact_angle(p_of: Callable[..., Any], slope_of: Callable[..., Any], phi: Any, square: Any) -> Any:
+    """θ with p(θ) = √x by Newton from φ (x is p(φ)² rounded, so θ is within a few ulp of φ: four
+    steps reach 40 digits), or None when x is not finite and positive or Newton does not converge
+    (no real θ: past a fold)."""
+    if not np.isfinite(square) or square <= 0:
+        return None
+    target, theta = mpmath.sqrt(mpmath.mpf(float(square))), phi
+    for _ in range(4):
+        slope = slope_of(theta)
+        if not mpmath.isfinite(slope) or slope == 0:
+            return None
+        theta = theta - (p_of(theta) - target) / slope
+    residual = p_of(theta) - target
+    if not mpmath.isfinite(residual) or abs(residual) > mpmath.mpf(10) ** -30 * target:
+        return None
+    return theta
+
+
+def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
+    """``expr`` with p(φ) (and p's non-constant factor g, p = c·g) written as s = |p| and p² as x,
+    which the backends have as rounded input: 4 atanh(φ/4) recomputed from φ̂ cancels near φ = 4."""
+    if argument == PHI:
+        return expr
+    coefficient, rest = argument.as_coeff_Mul()
+    rules: dict[sp.Expr, sp.Expr] = {argument**2: X, argument**-2: 1 / X, argument: S}
+    if rest != argument and rest.has(PHI) and coefficient != 0:
+        rules.update({rest**2: X / coefficient**2, rest**-2: coefficient**2 / X, rest: S / coefficient})
+    return expr.xreplace(rules)
+
+
+@lru_cache(maxsize=8)
+def reference_values(forms: tuple[sp.Expr, ...], argument: sp.Expr, phi_max: float, dtype: type,
+                      complement: sp.Rational | None) -> tuple[np.ndarray, ...]:
+    """The coefficient at the exact angles of :func:`measured_inputs` at REFERENCE_DIGITS (float64
+    of the result), from the first of ``forms`` that is not 0/0 there (NaN if none): 60 digits are
+    enough for forms that cancel 40 near φ = 10⁻⁷ (slopes of K), so one reference serves every
+    equivalent form of a coefficient."""
+    inputs = measured_inputs(argument, phi_max, dtype, complement)
+    with mpmath.workdps(REFERENCE_DIGITS):
+        functions = [sp.lambdify(PHI, form, modules=[mpmath_namespace(), "mpmath"]) for form in forms]
+        values = []
+        for thetas in inputs.exact:
+            row = []
+            for theta in thetas:
+                row.append(math.nan)
+                for function in functions:
+                    try:
+                        row[-1] = float(function(theta))
+                        break
+                    except ZeroDivisionError:
+                        continue
+            values.append(np.asarray(row, dtype=np.float64))
+    return tuple(values)
