@@ -176,3 +176,65 @@ def _series_switch(f: object, series: tuple[sp.Expr, ...], phi_max: float) -> fl
             break
         switch = float(s)
     return switch
+
+
+MAX_ITERATIONS = 64
+
+
+def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], far: FarStart,
+                        angles: np.ndarray, phi_max: float, dtype: type,
+                        printed: tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]
+                        ) -> int:
+    """Steps the printed safeguarded Newton iteration needs, counted by running it.
+
+    At every angle θ of ``angles`` the input s = p(θ) is rounded to ``dtype``; the start (reverted
+    series below ``far.switch``, the Chebyshev far start above) and the bracketed Newton steps are
+    evaluated as the backends do, with ``printed`` = (p(φ)/φ, p′(φ)) as the plan's branches print
+    them (evaluated with the ideal libm of :mod:`symrot.evaluation`).
+    The result is one more than the first step count after which every lane is within 2 ε of the
+    exact angle of its rounded s, plus what one ε of s moves that angle (next to a fold Newton
+    converges only to there), or ``MAX_ITERATIONS`` if no count is. Near a pole of p where φ(s)
+    flattens (2 cos(2φ) atanh(3φ/2)/3 at φ = 2/3) the far start is poor in relative terms and Newton
+    falls back on bisection: nine steps left the angle 10⁻³ off there."""
+    epsilon = float(np.finfo(dtype).eps)
+    ratio_model, slope_model = printed
+    f, f_slope = _p_function(p), _p_function(slope)
+    sizes, exact, tolerance = [], [], []
+    with mpmath.workdps(DIGITS):
+        for angle in angles:
+            s = dtype(float(f(mpmath.mpf(float(angle)))))  # type: ignore[operator]
+            if not (np.isfinite(s) and s > 0):
+                continue
+            theta = _phi_of_s(f, mpmath.mpf(float(s)), mpmath.mpf(phi_max))
+            rate = abs(f_slope(theta))  # type: ignore[operator]
+            # 2 ε of the angle, plus what one ε of s moves it (large next to a fold, p′ → 0)
+            spread = float(s) / float(rate) if rate > 0 else math.inf
+            sizes.append(s)
+            exact.append(float(theta))
+            tolerance.append(2 * epsilon * (float(theta) + spread))
+    if not sizes:
+        return 0
+    s_values: np.ndarray = np.asarray(sizes, dtype=dtype)
+    theta, limit = np.asarray(exact), np.asarray(tolerance)
+    coefficients = [float(c) for c in start]
+    with np.errstate(all="ignore"):
+        series = np.zeros_like(s_values)
+        for c in coefficients[::-1]:
+            series = (dtype(c) + s_values * s_values * series).astype(dtype)
+        y = 2.0 * v_of_s(far.kind, far.scale, far.order, s_values) - 1.0
+        far_value: np.ndarray = np.asarray(clenshaw(np.asarray(far.chebyshev), y), dtype=dtype)
+        phi = np.clip(np.where(s_values < far.switch, s_values * series, far_value), 0.0, phi_max)
+        phi = phi.astype(dtype)
+        low, high = np.zeros_like(s_values), np.full_like(s_values, phi_max)
+        for step_count in range(1, MAX_ITERATIONS + 1):
+            residual = phi * np.asarray(ratio_model(phi), dtype=dtype) - s_values
+            high = np.where(residual > 0, phi, high)
+            low = np.where(residual <= 0, phi, low)
+            derivative: np.ndarray = np.asarray(slope_model(phi), dtype=dtype)
+            safe = derivative > 0
+            step = phi - residual / np.where(safe, derivative, 1.0)
+            inside = safe & (step >= low) & (step <= high)
+            phi = np.where(inside, step, 0.5 * (low + high)).astype(dtype)
+            if np.all(np.abs(phi.astype(np.float64) - theta) <= limit):
+                return min(step_count + 1, MAX_ITERATIONS)
+    return MAX_ITERATIONS

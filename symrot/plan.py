@@ -30,6 +30,7 @@ trigonometric arguments (sin a and cos a: one sincos).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 from functools import lru_cache
 
@@ -65,7 +66,7 @@ from .measurement import (
     reference_values,
     with_length,
 )
-from .newton_start import START_TOLERANCE, far_start
+from .newton_start import START_TOLERANCE, far_start, measured_iterations
 from .newton_start import FarStart as FarStart
 from .parsing import PHI
 from .plan_ir import (
@@ -520,8 +521,29 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
     reverted = derivation.phi_of_p(2 * START_TERMS)
     start = tuple(reverted[1::2][:START_TERMS])
     far = _far_start(p, p_max, phi_max, start)
-    return NewtonAngle(start, ratio, slope, newton_iterations(far.measured, float(np.finfo(dtype).eps)),
-                       phi_max, far)
+    grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
+    printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
+    iterations = max(newton_iterations(far.measured, float(np.finfo(dtype).eps)),
+                     measured_iterations(p, derivation.scalars["p_prime"], start, far, grid, phi_max, dtype,
+                                         printed))
+    return NewtonAngle(start, ratio, slope, iterations, phi_max, far)
+
+
+def _branch_model(branch: Branch, dtype: type) -> Callable[[np.ndarray], np.ndarray]:
+    """A Branch in t = φ² as the backends evaluate it (Horner below the switch, the closed form
+    above, with the ideal libm), as a function of φ."""
+    closed = model_function(branch.closed, [PHI])
+    coefficients = [dtype(float(c)) for c in branch.horner]
+
+    def evaluate(phi: np.ndarray) -> np.ndarray:
+        t = (phi * phi).astype(dtype)
+        series = np.zeros_like(t)
+        for c in coefficients[::-1]:
+            series = (c + t * series).astype(dtype)
+        with np.errstate(all="ignore"):
+            return np.where(t < branch.threshold, series, np.asarray(closed(phi), dtype=dtype)).astype(dtype)
+
+    return evaluate
 
 
 def newton_iterations(start_error: float, epsilon: float) -> int:

@@ -129,3 +129,29 @@ def test_forms_near_an_edge_where_p_prime_grows_use_s_not_phi() -> None:
             assert np.abs(rotation - exact).max() <= 4 * eps, (expression, gap)
             axial = float(namespace["tangent_inverse"](vector)[0, 0])  # type: ignore[index, operator]
             assert abs(axial - slope) <= 4 * eps * abs(slope), (expression, gap, axial, slope)
+
+
+def test_newton_steps_are_counted_by_running_the_printed_iteration() -> None:
+    """2 cos(2φ) atanh(3φ/2)/3 has no closed inverse and a pole at φ = 2/3 where φ(s) flattens:
+    the far start is poor in relative terms there and the bracketed Newton falls back on bisection.
+    Nine steps (from the far start's measured error) left the angle 10⁻³ off (6.7e12 ulp) at
+    φ = 2/3 − 10⁻³; the plan now counts the steps by running the printed iteration."""
+    from symrot.backends.numpy_backend import module_source
+
+    expression = "2*cos(2*phi)*atanh(3*phi/2)/3"
+    plan = evaluation_plan(derive(expression).derivation, "pole")
+    namespace: dict[str, object] = {}
+    exec(compile(module_source(plan), "<pole>", "exec"), namespace)
+    p_of = sp.lambdify(PHI, sp.sympify(expression), "mpmath")
+    top = mpmath.mpf(2) / 3
+    for dtype in (np.float64, np.float32):
+        for gap in ("1e-2", "1e-3", "1e-4", "1e-5", "1e-6"):
+            with mpmath.workdps(40):
+                size = dtype(float(p_of(top - mpmath.mpf(gap))))
+                low, high = mpmath.mpf(0), top
+                for _ in range(140):  # bisection: the exact angle of the rounded size
+                    middle = (low + high) / 2
+                    low, high = (middle, high) if p_of(middle) < float(size) else (low, middle)
+                exact = float((low + high) / 2)
+            got = float(namespace["angle"](np.array([size, 0, 0], dtype=dtype)))  # type: ignore[operator]
+            assert abs(got - exact) <= 4 * float(np.finfo(dtype).eps) * exact, (dtype, gap, got, exact)
