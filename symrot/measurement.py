@@ -42,7 +42,7 @@ def angle_grid(phi_max: float) -> np.ndarray:
 
 
 class MeasuredInputs(NamedTuple):
-    """Where a coefficient's forms are measured, per grid angle (:func:`_angle_grid`): the rounded
+    """Where a coefficient's forms are measured, per grid angle (:func:`angle_grid`): the rounded
     angles φ̂ the backends compute, the exact angles θ of the reference (mpmath numbers) and x = p²,
     s = √x, d = k² − x (the fold complement, 0 without one) as the backends have them."""
 

@@ -23,8 +23,9 @@ the grid point minimising the worse of the two, moved up for speed as far as a p
 the target.  Among equivalent closed forms (as derived, half-angle forms of cos φ, everything in
 sin(φ/2), cos(φ/2), p written as s and p² as x, algebraic parts such as p′ written through the
 closed inverse φ(s)) the plan takes the one whose worst error is smallest, then the shortest
-polynomial at the smallest switch the accuracy allows, then a form in s, then the fewest distinct
-trigonometric arguments (sin a and cos a: one sincos).
+polynomial at the smallest switch the accuracy allows, then a form in φ alone (one in s or x is
+taken where it is measurably more accurate), then the fewest distinct trigonometric arguments
+(sin a and cos a: one sincos).
 """
 
 from __future__ import annotations
