@@ -235,10 +235,12 @@ INVERSE_REWRITE_OPS = 16
 simplifies: trigsimp of such parts takes milliseconds, so the plan never depends on machine load."""
 
 
+@lru_cache(maxsize=512)
 def with_inverse(expr: sp.Expr, inverse: sp.Expr) -> sp.Expr:
     """``expr`` with every maximal part free of sin, cos and tan but not of φ (p′, 1 − φ²/4 …)
-    written through φ = φ(s) and trigsimp'ed, when that removes φ from it: near an edge where p′ → ∞
-    (p = 2 asin(φ/2)), √(1 − φ²/4) recomputed from a rounded φ loses every digit, cos(s/2) none."""
+    written through φ = φ(s) and trigsimp'ed when that removes φ from it: near an edge where p′ → ∞
+    (p = 2 asin(φ/2)), √(1 − φ²/4) recomputed from a rounded φ loses every digit, cos(s/2) none.
+    Cached: both precisions of a plan ask for the same forms."""
     def rewrite(part: sp.Expr) -> sp.Expr:
         if not part.has(PHI) or part == PHI:
             return part
