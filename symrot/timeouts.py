@@ -11,7 +11,10 @@ An expiry can land while the interpreter runs a callback whose exceptions it swa
 ignored in ...": a garbage-collector callback such as JAX's ``_xla_gc_callback``, a ``__del__``,
 a weakref callback). The limit would then be lost and the body run unbounded (a 0.5 s bound on a
 simplification that took over 20 minutes in a process that had imported JAX). The timer
-therefore repeats every :data:`RETRY_SECONDS` after it first expires, until the body ends.
+therefore repeats every :data:`RETRY_SECONDS` after it first expires, until the body ends. While
+the limit is armed, ``sys.unraisablehook`` is wrapped: an expiry the interpreter dropped is not
+reported (the repeat raises it again), and no expiry is raised while the hook reports anything
+else (pytest's hook formats tracebacks; an expiry inside it broke the report and failed a test).
 
 A fallback taken because a step ran out of *time* makes the result depend on the machine's speed
 and load. Steps whose result feeds code generation are therefore gated by deterministic size caps
@@ -25,6 +28,7 @@ generation fails loudly.
 from __future__ import annotations
 
 import signal
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -40,6 +44,7 @@ RETRY_SECONDS = 0.05
 SAFETY_FACTOR = 10.0
 """How much wider the time bounds of :func:`bounded` are under :func:`deterministic`."""
 _deterministic = threading.local()
+_reporting_unraisable = threading.local()
 
 
 @contextmanager
@@ -72,10 +77,27 @@ def alarm(seconds: float, error: Callable[[], BaseException]) -> Iterator[None]:
         yield  # the outer limit expires first and is reported as the outer one
         return
 
+    raised: list[BaseException] = []  # the latest expiry: the one a swallowing callback drops
+
     def _on_alarm(signum: int, frame: object) -> None:
-        raise error()
+        if getattr(_reporting_unraisable, "depth", 0):
+            return  # the repeat raises it once the report is done
+        raised[:] = [error()]
+        raise raised[0]
+
+    previous_hook = sys.unraisablehook
+
+    def _report_unraisable(unraisable: Any) -> None:
+        if any(unraisable.exc_value is expiry for expiry in raised):
+            return  # dropped where the interpreter swallows exceptions; the repeat raises it again
+        _reporting_unraisable.depth = getattr(_reporting_unraisable, "depth", 0) + 1
+        try:
+            previous_hook(unraisable)
+        finally:
+            _reporting_unraisable.depth -= 1
 
     previous = signal.signal(signal.SIGALRM, _on_alarm)
+    sys.unraisablehook = _report_unraisable
     started = time.monotonic()
     signal.setitimer(signal.ITIMER_REAL, seconds, RETRY_SECONDS)
     try:
@@ -83,6 +105,7 @@ def alarm(seconds: float, error: Callable[[], BaseException]) -> Iterator[None]:
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+        sys.unraisablehook = previous_hook
         if outer_remaining:
             elapsed = time.monotonic() - started
             signal.setitimer(signal.ITIMER_REAL, max(outer_remaining - elapsed, 1e-3), RETRY_SECONDS)

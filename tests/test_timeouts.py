@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 
 import pytest
@@ -85,3 +86,35 @@ def test_bounded_falls_back_when_its_expiry_is_swallowed() -> None:
     started = time.monotonic()
     assert bounded(0.1, "fallback", slow) == "fallback"
     assert time.monotonic() - started < 1.0
+
+
+class _FailingFinalizer:
+    """An object whose ``__del__`` raises: the interpreter reports it through ``sys.unraisablehook``."""
+
+    def __del__(self) -> None:
+        raise ValueError("reported by the hook")
+
+
+def test_no_expiry_lands_in_the_unraisable_hook_and_dropped_expiries_are_not_reported(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """pytest's hook formats a traceback when a finalizer fails; an expiry raised inside it broke
+    the report ("Failed to process unraisable exception") and failed an unrelated CI test."""
+    reported: list[BaseException | None] = []
+
+    def slow_hook(unraisable: object) -> None:
+        deadline = time.monotonic() + 0.4  # several repeat intervals
+        while time.monotonic() < deadline:
+            pass
+        reported.append(getattr(unraisable, "exc_value", None))
+
+    monkeypatch.setattr(sys, "unraisablehook", slow_hook)
+    started = time.monotonic()
+    with pytest.raises(SymrotTimeout), time_limit(0.05):
+        _FailingFinalizer()  # its report spans the expiry
+        _SlowFinalizer()  # an expiry dropped here is not reported, and raised again
+        while time.monotonic() - started < 3.0:
+            pass
+    assert time.monotonic() - started < 1.5
+    assert len(reported) == 1 and isinstance(reported[0], ValueError)
+    assert sys.unraisablehook is slow_hook
