@@ -240,7 +240,8 @@ def with_inverse(expr: sp.Expr, inverse: sp.Expr) -> sp.Expr:
     """``expr`` with every maximal part free of sin, cos and tan but not of φ (p′, 1 − φ²/4 …)
     written through φ = φ(s) and trigsimp'ed when that removes φ from it: near an edge where p′ → ∞
     (p = 2 asin(φ/2)), √(1 − φ²/4) recomputed from a rounded φ loses every digit, cos(s/2) none.
-    Cached: both precisions of a plan ask for the same forms."""
+    Cached, as is each part (:func:`_part_with_inverse`): both precisions of a plan ask for the
+    same forms, and the forms of one plan share most of their parts."""
     def rewrite(part: sp.Expr) -> sp.Expr:
         if not part.has(PHI) or part == PHI:
             return part
@@ -248,13 +249,19 @@ def with_inverse(expr: sp.Expr, inverse: sp.Expr) -> sp.Expr:
             return part
         if part.has(sp.sin, sp.cos, sp.tan):
             return part.func(*[rewrite(a) for a in part.args])
-        substituted = part.xreplace({PHI: inverse})
-        if sp.count_ops(substituted) > INVERSE_REWRITE_OPS:
-            return part
-        simplified = sp.powdenest(sp.trigsimp(substituted), force=True)
-        return simplified if not simplified.has(sp.I, sp.nan, sp.zoo) else part
+        return _part_with_inverse(part, inverse)
 
     return rewrite(expr)
+
+
+@lru_cache(maxsize=4096)
+def _part_with_inverse(part: sp.Expr, inverse: sp.Expr) -> sp.Expr:
+    """One part of :func:`with_inverse`: φ → φ(s) and trigsimp, kept only when small and real."""
+    substituted = part.xreplace({PHI: inverse})
+    if sp.count_ops(substituted) > INVERSE_REWRITE_OPS:
+        return part
+    simplified = sp.powdenest(sp.trigsimp(substituted), force=True)
+    return simplified if not simplified.has(sp.I, sp.nan, sp.zoo) else part
 
 
 def _replace_base_trig(closed: sp.Expr, angle: sp.Expr, sine: sp.Expr, cosine: sp.Expr) -> sp.Expr:

@@ -74,14 +74,14 @@ def _cached(name: str, arguments: tuple[float, ...], single: bool) -> float:
 
 def _elementwise(name: str) -> Callable[..., Any]:
     def apply(*arguments: Any) -> Any:
-        arrays = np.broadcast_arrays(*(np.asarray(a) for a in arguments))
         dtype = np.result_type(*arguments)  # Python numbers are weak: float32 stays float32
         if dtype not in (np.float32, np.float64):
             dtype = np.dtype(np.float64)
         single = dtype == np.float32
-        out = np.empty(arrays[0].shape, dtype=dtype)
-        for index in np.ndindex(out.shape):
-            out[index] = _cached(name, tuple(float(a[index]) for a in arrays), single)
+        arrays = np.broadcast_arrays(*(np.asarray(a) for a in arguments))
+        lanes = zip(*(a.ravel().tolist() for a in arrays), strict=True)  # Python floats, exact
+        values = [_cached(name, tuple(lane), single) for lane in lanes]
+        out = np.array(values, dtype=dtype).reshape(arrays[0].shape)
         return out if out.ndim else out[()]
 
     apply.__name__ = name
