@@ -5,12 +5,32 @@ Bauchau & Trainelli, "The Vectorial Parameterization of Rotation", Nonlinear Dyn
 >>> import symrot
 >>> symrot.derive("4*tan(phi/4)").nu
 cos(phi/4)**2
+
+The names below are imported on first use (PEP 562), so that the commands can fix the hash seed
+(:mod:`symrot.entry`) before SymPy is loaded.
 """
 
-from .api import DerivationResult, derive
-from .errors import SymrotError
-from .parsing import PHI, parse_expression
-from .registry import lookup
+from __future__ import annotations
+
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .api import DerivationResult, derive
+    from .errors import SymrotError
+    from .parsing import PHI, parse_expression
+    from .registry import lookup
 
 __all__ = ["PHI", "DerivationResult", "SymrotError", "derive", "lookup", "parse_expression"]
 __version__ = "0.1.0"
+
+_HOME = {"DerivationResult": "api", "derive": "api", "SymrotError": "errors", "PHI": "parsing",
+         "parse_expression": "parsing", "lookup": "registry"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _HOME:
+        value = getattr(import_module(f".{_HOME[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,5 +1,5 @@
 """``python -m symrot`` is the ``symrot`` command."""
 
-from .cli import main
+from .entry import command
 
-raise SystemExit(main())
+raise SystemExit(command())

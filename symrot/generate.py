@@ -261,4 +261,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    from .entry import run_with_fixed_hash_seed
+
+    run_with_fixed_hash_seed("symrot.generate")  # the same files on every run (symrot.entry)
     raise SystemExit(main())

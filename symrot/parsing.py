@@ -32,6 +32,12 @@ import sympy as sp
 from .errors import ParseError
 from .functions import RealCbrt
 
+DUMMY_BASE = 5_000_000
+"""SymPy numbers its ``Dummy`` symbols from a base drawn at random per process; their hashes order
+the sets its algorithms iterate, and so the forms they return. Fixed when symrot is imported, so
+that equal input gives equal forms (with a fixed ``PYTHONHASHSEED``, see :mod:`symrot.entry`)."""
+sp.Dummy._base_dummy_index = DUMMY_BASE
+
 PHI = sp.Symbol("phi", real=True)
 """The rotation angle symbol used throughout symrot."""
 

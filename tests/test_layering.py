@@ -23,6 +23,7 @@ LAYER_OF_PREFIX: dict[str, str] = {
     "symrot.__main__": "app",
     "symrot.api": "app",
     "symrot.cli": "app",
+    "symrot.entry": "app",
     "symrot.generate": "app",
     "symrot.audit": "audit",
     "symrot.backends": "backends",

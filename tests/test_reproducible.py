@@ -108,3 +108,35 @@ def test_chebyshev_interpolant_reproduces_a_polynomial_exactly() -> None:
     assert np.allclose(coefficients, [1, 0.25, 0, 0.75, 0, 0], atol=1e-15)
     y = np.linspace(-1, 1, 7)
     assert np.allclose(clenshaw(coefficients, y), 1 - 2 * y + 3 * y**3, atol=1e-15)
+
+
+def test_symrot_fixes_the_dummy_base_when_imported() -> None:
+    """SymPy draws the base of its Dummy numbering at random per process (symrot.entry)."""
+    from symrot.parsing import DUMMY_BASE
+
+    assert sp.Dummy._base_dummy_index == DUMMY_BASE
+
+
+def test_the_commands_run_with_a_fixed_hash_seed(tmp_path: Path) -> None:
+    (tmp_path / "print_seed.py").write_text("import os\nprint(os.environ['PYTHONHASHSEED'])\n")
+    driver = "from symrot.entry import run_with_fixed_hash_seed\nrun_with_fixed_hash_seed('print_seed')\n"
+    for seed in ("random", "7"):
+        environment = {**os.environ, "PYTHONHASHSEED": seed,
+                       "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
+        done = subprocess.run([sys.executable, "-c", driver], env=environment, capture_output=True,
+                              text=True, timeout=60, check=True)
+        assert done.stdout.strip() == "0"
+
+
+@pytest.mark.slow
+def test_a_user_module_is_the_same_whatever_the_hash_seed(tmp_path: Path) -> None:
+    """sinh(phi) has equally accurate forms that differ only in sign arrangement; which one SymPy
+    returned followed the process's hash seed and Dummy base: 4 different modules in 16 runs."""
+    runs = {seed: subprocess.Popen(
+        [sys.executable, "-m", "symrot", "derive", "sinh(phi)", "--emit", "numpy", "--out",
+         str(tmp_path / seed), "-q"], env={**os.environ, "PYTHONHASHSEED": seed},
+        stdout=subprocess.DEVNULL) for seed in ("1", "2")}
+    for run in runs.values():
+        assert run.wait(timeout=300) == 0
+    first, second = ((tmp_path / seed / "rotation.py").read_bytes() for seed in runs)
+    assert first == second
