@@ -34,11 +34,15 @@ format holds exactly would hide the rounding of φ̂ (θ of its rounded x is wit
 where p′ is large)."""
 
 
+@lru_cache(maxsize=16)
 def angle_grid(phi_max: float) -> np.ndarray:
-    """Log grid towards 0 plus points approaching the edge of the range (φ_max − 10⁻ᵏ φ_max)."""
+    """Log grid towards 0 plus points approaching the edge of the range (φ_max − 10⁻ᵏ φ_max);
+    computed once per φ_max (every form of every coefficient is measured there), read-only."""
     end = min(phi_max, 4 * np.pi)
     edge = end * (1 - log_grid(0.25, 1e-6, EDGE_POINTS))
-    return np.unique(np.concatenate([log_grid(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
+    grid = np.unique(np.concatenate([log_grid(1e-7, end * (1 - 1e-6), GRID_POINTS), edge]))
+    grid.setflags(write=False)
+    return grid
 
 
 class MeasuredInputs(NamedTuple):

@@ -267,24 +267,20 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                 dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...]) -> Branch:
     epsilon = float(np.finfo(dtype).eps)
     model_closed = model_function(closed, [PHI, S, X, D])
-    to_t = sp.lambdify(PHI, variable_of_phi, modules=[mpmath_namespace(), "mpmath"])
     angles = angle_grid(phi_max)
+    t_values = _switch_values(variable_of_phi, phi_max, dtype)
     scale0 = abs(float(series[0])) or 1.0
     closed_error = np.zeros(len(angles))
-    t_values = np.zeros(len(angles))
-    with mpmath.workdps(30):
-        for k, angle in enumerate(angles):
-            t_values[k] = float(to_t(mpmath.mpf(float(dtype(angle)))))
-            if not len(inputs.angles[k]):
-                continue
-            printed = model_closed(inputs.angles[k], inputs.lengths[k], inputs.squares[k],
-                                   inputs.complements[k])
-            values = np.broadcast_to(np.asarray(printed, dtype=np.float64), inputs.angles[k].shape)
-            exact = reference[k]
-            with np.errstate(all="ignore"):
-                errors = np.abs(values - exact) / (np.maximum(np.abs(exact), scale0) * epsilon)
-            errors = np.where(np.isfinite(values), np.where(np.isnan(exact), 0.0, errors), np.inf)
-            closed_error[k] = float(np.max(errors))
+    for k in range(len(angles)):
+        if not len(inputs.angles[k]):
+            continue
+        printed = model_closed(inputs.angles[k], inputs.lengths[k], inputs.squares[k], inputs.complements[k])
+        values = np.broadcast_to(np.asarray(printed, dtype=np.float64), inputs.angles[k].shape)
+        exact = reference[k]
+        with np.errstate(all="ignore"):
+            errors = np.abs(values - exact) / (np.maximum(np.abs(exact), scale0) * epsilon)
+        errors = np.where(np.isfinite(values), np.where(np.isnan(exact), 0.0, errors), np.inf)
+        closed_error[k] = float(np.max(errors))
     floats = [_magnitude(c) for c in series]
     # every Horner coefficient must be finite in the format (e.g. 1000 tan(φ/1000) has a
     # coefficient 1.1e42 of x in H⁻¹, beyond float32): the polynomial keeps only the leading terms
@@ -333,6 +329,18 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     edge = float(np.max(closed_error[near_zero:])) if near_zero < len(angles) else 0.0
     return Branch(threshold, tuple(series[:degree]), closed, float(angles[best_k]), best, edge,
                   accurate_threshold, accurate_terms)
+
+
+@lru_cache(maxsize=16)
+def _switch_values(variable_of_phi: sp.Expr, phi_max: float, dtype: type) -> np.ndarray:
+    """The candidate switches: the variable t(φ) of the series (x = p² or φ²) at the angles of
+    :func:`angle_grid` rounded to ``dtype``, 30 digits. The same for every form of every
+    coefficient of a plan: computed once (read-only)."""
+    to_t = sp.lambdify(PHI, variable_of_phi, modules=[mpmath_namespace(), "mpmath"])
+    with mpmath.workdps(30):
+        values = np.array([float(to_t(mpmath.mpf(float(dtype(angle))))) for angle in angle_grid(phi_max)])
+    values.setflags(write=False)
+    return values
 
 
 @lru_cache(maxsize=64)
