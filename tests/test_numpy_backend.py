@@ -122,3 +122,26 @@ def test_operations_accuracy_on_a_small_grid() -> None:
     assert not misses, misses
     assert {k[0] for k in worst} == {"to_quaternion", "from_quaternion", "from_rotation_matrix", "compose",
                                      "rescale"}
+
+
+@pytest.mark.parametrize("name", ["rotation_vector", "wiener_milenkovic", "euler_rodrigues", "det_h_one"])
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_batch_size_does_not_change_the_bits(name: str, dtype: type) -> None:
+    """_tensor takes scalar arithmetic for a few vectors, gathered NumPy calls up to _SMALL and
+    4096-vector blocks above: the same rows give the same bits on every path, also across the
+    coefficients' series switches and with |p| from 1e-30 to the edge of the range."""
+    module = load(ROOT / "generated" / "numpy" / f"{name}.py", f"gen_{name}_sizes")
+    rng = np.random.default_rng(11)
+    axes = rng.normal(size=(300, 3))
+    axes /= np.linalg.norm(axes, axis=1)[:, None]
+    top = min(0.999 * module.P_MAX, 1e6)  # |p| (unbounded for Wiener-Milenkovic)
+    angles = np.concatenate([10.0 ** rng.uniform(-30, 0, 100), rng.uniform(0, top, 200)])
+    p = (axes * angles[:, None]).astype(dtype)
+    few = module._FEW[np.dtype(dtype).char]
+    assert 1 <= few < module._SMALL < len(p)
+    for function in (module.rotation_matrix, module.tangent, module.tangent_inverse, module.root_matrix):
+        whole = function(p)  # blocks
+        assert np.isfinite(whole).all()
+        for size in (1, few, few + 1, module._SMALL):
+            parts = np.concatenate([function(p[start:start + size]) for start in range(0, len(p), size)])
+            assert np.array_equal(parts, whole), (function.__name__, size)

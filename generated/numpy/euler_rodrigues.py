@@ -429,6 +429,7 @@ _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
+_FEW = {"d": 16, "f": 6}  # up to this many vectors (by dtype character): entries as scalar arithmetic
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
@@ -589,7 +590,9 @@ def _tensor(p, name):
     shape = p.shape[:-1]
     flat = p.reshape(-1, 3)
     out = numpy.empty((flat.shape[0], 9), dtype=p.dtype)
-    if flat.shape[0] <= _SMALL:
+    if flat.shape[0] <= _FEW[p.dtype.char]:
+        _tensor_few(flat, name, out)
+    elif flat.shape[0] <= _SMALL:
         _tensor_small(flat, name, out)
     else:
         for start in range(0, flat.shape[0], _BLOCK):
@@ -610,12 +613,35 @@ _OTHER_2 = numpy.array([2, 2, 1])
 _DIAGONAL = numpy.array([0, 4, 8])
 
 
-def _tensor_small(p, name, out):
+def _coefficients(p, name):
+    """p, c0, c1, c2, valid, suffix of T = c0 I + c1 (p x) + c2 (p x)^2 for the (n, 3) rows p."""
     p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
     table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](*state)
-    b = table[name + "_1"](*state)
-    c = table[name + "_2"](*state)
+    return p, table[name + "_0"](*state), table[name + "_1"](*state), table[name + "_2"](*state), valid, suffix
+
+
+def _tensor_few(p, name, out):
+    """_tensor_block's operations on scalars, row by row: for a few vectors, the nine entries cost
+    less as scalar arithmetic (float64 rows as Python floats, the same IEEE double operations;
+    float32 rows as numpy.float32 scalars) than as NumPy calls on tiny arrays."""
+    p, a, b, c, valid, suffix = _coefficients(p, name)
+    columns = (p, a, b, c) if suffix == "32" else (p.tolist(), a.tolist(), b.tolist(), c.tolist())
+    entries = []
+    for (p0, p1, p2), a_k, b_k, c_k in zip(*columns, strict=True):
+        c0, c1 = c_k * p0, c_k * p1
+        b0, b1, b2 = b_k * p0, b_k * p1, b_k * p2
+        s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
+        q01, q02, q12 = c0 * p1, c0 * p2, c1 * p2
+        entries += (a_k - c_k * (s1 + s2), q01 - b2, q02 + b1,
+                    q01 + b2, a_k - c_k * (s0 + s2), q12 - b0,
+                    q02 - b1, q12 + b0, a_k - c_k * (s0 + s1))
+    out.reshape(-1)[:] = entries  # out is the contiguous (n, 9) result of _tensor
+    if valid is not numpy.True_:
+        out[~valid] = numpy.nan
+
+
+def _tensor_small(p, name, out):
+    p, a, b, c, valid, suffix = _coefficients(p, name)
     numpy.multiply((c[:, None] * p)[:, _I], p[:, _J], out=out)
     out += (b[:, None] * p)[:, _K] * _SIGN[suffix]
     square = p * p
@@ -625,11 +651,7 @@ def _tensor_small(p, name, out):
 
 
 def _tensor_block(p, name, out):
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
-    table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](*state)
-    b = table[name + "_1"](*state)
-    c = table[name + "_2"](*state)
+    p, a, b, c, valid, _suffix = _coefficients(p, name)
     p0, p1, p2 = p.T.copy()  # contiguous components
     c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
@@ -659,10 +681,18 @@ def _apply(p, v, name):
     a = table[name + "_0"](*state)[..., None]
     b = table[name + "_1"](*state)[..., None]
     c = table[name + "_2"](*state)[..., None]
-    p_cross_v = numpy.cross(p, v)
+    p_cross_v = _cross(p, v)
     p_dot_v = numpy.einsum("...i,...i->...", p, v)[..., None]
     result = a * v + b * p_cross_v + c * (p * p_dot_v - x[..., None] * v)
     return numpy.where(valid[..., None], result, numpy.nan).astype(p.dtype)
+
+
+def _cross(u, v):
+    """u x v over the last axis, broadcast: numpy.cross's products and differences (the same bits)
+    without its axis handling, which costs four times the arithmetic for a few vectors."""
+    u0, u1, u2 = u[..., 0], u[..., 1], u[..., 2]
+    v0, v1, v2 = v[..., 0], v[..., 1], v[..., 2]
+    return numpy.stack([u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0], axis=-1)
 
 
 def _skew(v):
@@ -676,8 +706,8 @@ def _skew(v):
 
 def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
     """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.derivatives)."""
-    pa = numpy.cross(p, a)
-    ppa = numpy.cross(p, pa)
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
     u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
     out = u[..., :, None] * p[..., None, :]
     out = out + (-c1)[..., None, None] * (_skew(a))
@@ -688,10 +718,10 @@ def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
 
 def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
     """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.derivatives)."""
-    pa = numpy.cross(p, a)
-    ppa = numpy.cross(p, pa)
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
     pta = numpy.einsum('...i,...i->...', p, a)
-    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * numpy.cross(pa, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
 
 
 def _with_slopes(p, a, name, sign):
@@ -805,8 +835,8 @@ def angular_acceleration(p, pdot, pddot):
     p, v, scalars, valid = _with_slopes(p, pdot, "H", 1)
     w = pddot.astype(p.dtype)
     c0, c1, c2 = scalars[:3]
-    pw = numpy.cross(p, w)
-    first = c0[..., None] * w + c1[..., None] * pw + c2[..., None] * numpy.cross(p, pw)
+    pw = _cross(p, w)
+    first = c0[..., None] * w + c1[..., None] * pw + c2[..., None] * _cross(p, pw)
     out = first + _rate_vector(*scalars, p, v)
     return numpy.where(valid[..., None], out, numpy.nan).astype(p.dtype)
 
@@ -877,7 +907,7 @@ def from_rotation_matrix(R):
     r = _as_float(R, "R", (3, 3))
     suffix = "32" if r.dtype == numpy.float32 else "64"
     gram = numpy.einsum("...ki,...kj->...ij", r, r) - numpy.eye(3, dtype=r.dtype)
-    det = numpy.einsum("...i,...i->...", r[..., 0, :], numpy.cross(r[..., 1, :], r[..., 2, :]))
+    det = numpy.einsum("...i,...i->...", r[..., 0, :], _cross(r[..., 1, :], r[..., 2, :]))
     # NaN compares false: non-finite R (and R whose products overflow) is refused here too
     finite = numpy.all(numpy.abs(gram) <= _ROTATION_TOLERANCE[suffix], axis=(-2, -1)) & (det > 0)
     r = numpy.where(finite[..., None, None], r, 0.0).astype(r.dtype)
@@ -909,7 +939,7 @@ def compose(p1, p2):
     if a.dtype != b.dtype:
         raise ValueError("compose: p1 and p2 must have the same dtype")
     e0 = a0 * b0 - numpy.einsum("...i,...i->...", a, b)
-    e = a0[..., None] * b + b0[..., None] * a + numpy.cross(b, a)
+    e = a0[..., None] * b + b0[..., None] * a + _cross(b, a)
     valid = valid1 & valid2
     e0 = numpy.where(valid, e0, 1.0).astype(a.dtype)
     e = numpy.where(valid[..., None], e, 0.0).astype(a.dtype)

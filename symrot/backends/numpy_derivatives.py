@@ -19,8 +19,8 @@ _OUTER_VECTORS = {"a*p": "a", "(p x a)*p": "pa", "(p x (p x a))*p": "ppa"}
 """Basis tensors u ⊗ p = u pᵀ by their vector u."""
 _MATRICES = {"[a x]": "_skew(a)", "[(p x a) x]": "_skew(pa)", "[p x][a x]": "_skew(p) @ _skew(a)"}
 _VECTORS = {"a (p.a)": "a * pta[..., None]", "(p x a) (p.a)": "pa * pta[..., None]",
-            "(p x (p x a)) (p.a)": "ppa * pta[..., None]", "(p x a) x a": "numpy.cross(pa, a)"}
-_PREAMBLE = ["pa = numpy.cross(p, a)", "ppa = numpy.cross(p, pa)"]
+            "(p x (p x a)) (p.a)": "ppa * pta[..., None]", "(p x a) x a": "_cross(pa, a)"}
+_PREAMBLE = ["pa = _cross(p, a)", "ppa = _cross(p, pa)"]
 _DOT = "pta = numpy.einsum('...i,...i->...', p, a)"
 
 
