@@ -31,6 +31,7 @@ taken where it is measurably more accurate), then the fewest distinct trigonomet
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from dataclasses import replace
 from functools import lru_cache
@@ -208,7 +209,7 @@ class UnplannableCoefficient(SymrotError):
 
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type, argument: sp.Expr = PHI, inverse: sp.Expr | None = None,
-                complement: sp.Rational | None = None) -> Branch:
+                complement: sp.Rational | None = None, power: int = 0) -> Branch:
     """Choose the form, the switch t₀ and the Horner degree for one coefficient in one precision.
 
     The coefficient is evaluated from s = ``argument``(φ) (p for the coefficients of x, φ itself
@@ -216,7 +217,9 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     (:func:`with_length`) and, given the closed ``inverse`` φ(s), with their algebraic parts written
     through it (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of
     the tangent family, fold complement d of the sine family), measured on the inputs of
-    :func:`measured_inputs` against one reference at REFERENCE_DIGITS."""
+    :func:`measured_inputs` against one reference at REFERENCE_DIGITS. ``power`` k > 0: the
+    coefficient multiplies |p|^k in its tensor, and its error counts relative to c(0)/|p|^k beyond
+    |p| = 1, not c(0) (:func:`_branch_for`)."""
     forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
     forms += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
     plain = tuple(dict.fromkeys([closed, *forms]))
@@ -231,7 +234,8 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     branches = []
     for form in dict.fromkeys(forms):
         try:
-            branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype, inputs, reference))
+            branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype, inputs, reference,
+                                        power))
         except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
             continue
     if not branches:
@@ -242,6 +246,16 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     return min(branches, key=lambda b: (max(_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
                                         len(b.smallest_switch[1]), b.closed.has(S, X),
                                         trig_arguments(b.closed), b.edge_ulp, b.measured_ulp))
+
+
+def root_power(coefficient: str) -> int:
+    """k of a coefficient c_k of G or K (eqs 81, 83: c_0 I + c_1 (p x) + c_2 (p x)^2), else 0.
+
+    Only the root tensors are measured as they enter the tensor: for R, H and H⁻¹ the same floor
+    picks forms of c_2 in s and x whose rounding no longer follows c_0's (both functions of the
+    same rounded φ), and ω = H ṗ, where c_0 − c_2 x cancels next to 2π, lost up to 6 ε (sine_m5)."""
+    match = re.fullmatch(r"(?:G|K)_([012])", coefficient)
+    return int(match.group(1)) if match else 0
 
 
 def _error_class(ulp: float) -> float:
@@ -264,7 +278,8 @@ def _magnitude(coefficient: sp.Expr) -> float:
 
 
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
-                dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...]) -> Branch:
+                dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...],
+                power: int = 0) -> Branch:
     epsilon = float(np.finfo(dtype).eps)
     model_closed = model_function(closed, [PHI, S, X, D])
     angles = angle_grid(phi_max)
@@ -278,7 +293,10 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         values = np.broadcast_to(np.asarray(printed, dtype=np.float64), inputs.angles[k].shape)
         exact = reference[k]
         with np.errstate(all="ignore"):
-            errors = np.abs(values - exact) / (np.maximum(np.abs(exact), scale0) * epsilon)
+            # c_k enters its tensor as c_k |p|^k: G_2 ~ 2/x next to 2 pi, where G_2 x is an entry of
+            # order 1 and c(0) = 1/8 would hide any relative error of G_2 itself
+            floor = scale0 / np.maximum(1.0, inputs.squares[k].astype(np.float64)) ** (power / 2)
+            errors = np.abs(values - exact) / (np.maximum(np.abs(exact), floor) * epsilon)
         errors = np.where(np.isfinite(values), np.where(np.isnan(exact), 0.0, errors), np.inf)
         closed_error[k] = float(np.max(errors))
     floats = [_magnitude(c) for c in series]
@@ -396,7 +414,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             series = derivation.series_in_x(coefficient, MAX_TERMS)
             simplest_form = derivation.simplified_form(coefficient)
             coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
-                                                    inverse, complement)
+                                                    inverse, complement, root_power(coefficient))
         coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
                                                              dtype)
         scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)

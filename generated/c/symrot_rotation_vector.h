@@ -460,7 +460,7 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 1.50837, else sin(phi/2)/phi
- * G_2: Horner degree 7 in x below x = 2.89787, else 2*sin(phi/4)**2/phi**2
+ * G_2: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
  * ops: 90 */
 static inline void symrot_rotation_vector_root_matrix(const double p[3], double G[9])
 {
@@ -483,8 +483,9 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
         c_G_2 = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        c_G_1 = sin((1.0/2.0)*phi)/phi;
-        c_G_2 = x < 2.897865491219683 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
+        const double w0 = (1.0/2.0)*phi;
+        c_G_1 = sin(w0)/phi;
+        c_G_2 = x < 2.897865491219683 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : (1 - cos(w0))/(phi*phi);
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -540,20 +541,12 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/4.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/phi;
             poly_G_1_lanes[k] = 1.0/2.0 + (-1.0/48.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(phi*phi);
-            poly_G_2_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
+            c_G_2_lanes[k] = (1 - cos0)/(phi*phi);
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -565,7 +558,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             c_G_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 1.8559287093218047e-12 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 1.5083706105984371 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -587,7 +580,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
 /* symrot_rotation_vector_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
- * K_1: Horner degree 7 in x below x = 2.89787, else 2*sin(phi/4)**2/phi**2
+ * K_1: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
  * K_2: Horner degree 8 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
  * ops: 95 */
 static inline void symrot_rotation_vector_root_tangent(const double p[3], double K[9])
@@ -611,8 +604,9 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         c_K_2 = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
-        c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
+        const double w0 = (1.0/2.0)*phi;
+        c_K_1 = (1 - cos(w0))/(phi*phi);
+        c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin(w0))/(phi*phi*phi);
     }
     K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0/2.0;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -642,7 +636,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 1.8559287093218047e-12) {
+            if (!(x <= 39.47841760435743) || x < 1.5083706105984371) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -658,7 +652,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -668,19 +662,11 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_K_1_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
-            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin1)/(phi*phi*phi);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_K_1_lanes[k] = (1 - cos0)/(phi*phi);
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
+            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin0)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -689,7 +675,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             c_K_0_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : 1.0/2.0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 1.8559287093218047e-12 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 1.5083706105984371 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];

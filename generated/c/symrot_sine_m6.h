@@ -426,8 +426,8 @@ static inline double symrot_sine_m6_tangent_det(const double p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
- * G_2: Horner degree 7 in x below x = 0.407121, else 2*sin(phi/4)**2/x
- * ops: 72 */
+ * G_2: Horner degree 12 in x below x = 2.82094, else (1 - cos(phi/2))/x
+ * ops: 87 */
 static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -445,11 +445,11 @@ static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
     }
     const double c_G_1 = 1.0/2.0 - 1.0/54.0*x;
     double c_G_2;
-    if (x < 0.4071212524285563) {
-        c_G_2 = x*(x*(x*(x*(x*(x*((-1.820598476104429e-14)*x - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+    if (x < 2.8209394684181164) {
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
+        c_G_2 = (1 - cos((1.0/2.0)*phi))/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -479,7 +479,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0) || x < 0.05760039934430118) {
+            if (!(x < 27.0) || x < 2.8209394684181164) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -495,7 +495,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -504,10 +504,11 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = 1.0/2.0 - 1.0/54.0*x;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*((-91.0/2229025112064.0)*x - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            c_G_2_lanes[k] = (1 - cos0)/x;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -517,7 +518,7 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             c_G_1_lanes[k] = !(x < 27.0) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 0.05760039934430118 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 2.8209394684181164 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 27.0) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -539,9 +540,9 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
 /* symrot_sine_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 3/sqrt(36 - x) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.407121, else 2*sin(phi/4)**2/x
+ * K_1: Horner degree 12 in x below x = 2.82094, else (1 - cos(phi/2))/x
  * K_2: Horner degree 7 in x below x = 0.407121, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(6*x*(1 - 2*sin(phi/12)**2))
- * ops: 95 */
+ * ops: 110 */
 static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -560,15 +561,14 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
     const double c_K_0 = 3/sqrt(36 - x);
     double c_K_1, c_K_2;
     if (x < 0.4071212524285563) {
-        c_K_1 = x*(x*(x*(x*(x*(x*((-1.820598476104429e-14)*x - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*((3.4805559101996437e-14)*x + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
         const double w0 = 1.0/x;
-        const double w1 = 2*pow(sin((1.0/4.0)*phi), 2);
-        const double w2 = pow(sin((1.0/12.0)*phi), 2);
-        c_K_1 = w0*w1;
-        c_K_2 = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
+        const double w1 = pow(sin((1.0/12.0)*phi), 2);
+        c_K_1 = x < 2.8209394684181164 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0 : w0*(1 - cos((1.0/2.0)*phi));
+        c_K_2 = (1.0/6.0)*w0*(4*w1 + 2*pow(sin((1.0/4.0)*phi), 2))/(1 - 2*w1);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -619,7 +619,7 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -628,7 +628,8 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double a1_a = (1.0/12.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
@@ -639,13 +640,22 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a2_a = (1.0/4.0)*phi;
+            const double a2_q = rint(a2_a*0.6366197723675814);
+            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
+            const double a2_z = a2_r*a2_r;
+            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
+            const double a2_h = rint(0.5*a2_j - 0.25);
+            const double a2_odd = a2_j - 2*a2_h;
+            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             const double w0 = 1.0/x;
-            const double w1 = 2*(sin0*sin0);
-            const double w2 = (sin1*sin1);
+            const double w1 = (sin1*sin1);
             c_K_0_lanes[k] = 3*u0;
-            c_K_1_lanes[k] = w0*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*((-91.0/2229025112064.0)*x - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
+            c_K_1_lanes[k] = w0*(1 - cos0);
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/6.0)*w0*(2*(sin2*sin2) + 4*w1)/(1 - 2*w1);
             poly_K_2_lanes[k] = (1.0/6912.0)*x + 11.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -655,7 +665,7 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             c_K_0_lanes[k] = !(x < 27.0) ? (double)NAN : closed_K_0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 0.05760039934430118 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 2.8209394684181164 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 27.0) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];

@@ -1938,8 +1938,8 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.956738, else sin(phi/2)/s
- * G_2: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/x
- * ops: 92 */
+ * G_2: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/x
+ * ops: 104 */
 static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1958,12 +1958,13 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
     float c_G_1, c_G_2;
     if (x < 0.95673823F) {
         c_G_1 = x*(x*(x*(x*(x*(x*(4.5426026e-07F + (-4.8680302e-08F)*x) - 4.265201e-06F) + 4.0399394e-05F) - 193.0F/497664.0F) + 79.0F/20736.0F) - 17.0F/432.0F) + 1.0F/2.0F;
-        c_G_2 = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        c_G_1 = sinf((1.0F/2.0F)*phi)/s;
-        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
+        const float w0 = (1.0F/2.0F)*phi;
+        c_G_1 = sinf(w0)/s;
+        c_G_2 = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F : (1 - cosf(w0))/x;
     }
     G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
@@ -2023,20 +2024,12 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/4.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = (1 - cos0)/x;
+            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2048,7 +2041,7 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 0.00996503F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 1.9390924F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2072,9 +2065,9 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/x
+ * K_1: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/x
  * K_2: Horner degree 21 in x below x = 4.19813, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*x)
- * ops: 136 */
+ * ops: 148 */
 static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2092,15 +2085,16 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
     }
     const float c_K_0 = (9.0F/2.0F)/(x + 9);
     float c_K_1, c_K_2;
-    if (x < 0.95673823F) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+    if (x < 1.9390924F) {
+        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = 1.0F/x;
-        c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
-        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w0*(27/(x + 9) - 6*sinf((1.0F/2.0F)*phi)/s);
+        const float w1 = (1.0F/2.0F)*phi;
+        c_K_1 = w0*(1 - cosf(w1));
+        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w0*(27/(x + 9) - 6*sinf(w1)/s);
     }
     K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2130,7 +2124,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F) || x < 0.00996503F) {
+            if (!(x < 9.223372e+18F) || x < 1.9390924F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -2150,7 +2144,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2160,22 +2154,14 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const float w0 = 1.0F/(x + 9);
             const float w1 = 1.0F/x;
             c_K_0_lanes[k] = (9.0F/2.0F)*w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
-            poly_K_1_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(27*w0 - 6*sin1/s);
+            c_K_1_lanes[k] = w1*(1 - cos0);
+            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(27*w0 - 6*sin0/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2185,7 +2171,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 0.00996503F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 1.9390924F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];

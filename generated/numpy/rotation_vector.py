@@ -273,18 +273,30 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.8559287093218047e-12:  # every lane on the polynomial
+    if span is not None and span[1] < 1.5083706105984371:  # every lane on the polynomial
         t = x
-        series = -0.0026041666666666665
+        series = -7.292903644389931e-19
+        series = 7.001187498614334e-16 + t * series
+        series = -5.096864498991235e-13 + t * series
+        series = 2.691144455467372e-10 + t * series
+        series = -9.68812003968254e-08 + t * series
+        series = 2.170138888888889e-05 + t * series
+        series = -0.0026041666666666665 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
+    out = numpy.asarray((1 - cos_half)/phi**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.5083706105984371:  # every lane on the closed form
         return out
-    small = x < 1.8559287093218047e-12
+    small = x < 1.5083706105984371
     if small.any():
         t = x[small]
-        series = -0.0026041666666666665
+        series = -7.292903644389931e-19
+        series = 7.001187498614334e-16 + t * series
+        series = -5.096864498991235e-13 + t * series
+        series = 2.691144455467372e-10 + t * series
+        series = -9.68812003968254e-08 + t * series
+        series = 2.170138888888889e-05 + t * series
+        series = -0.0026041666666666665 + t * series
         series = 0.125 + t * series
         out[small] = series
     return out
@@ -295,18 +307,30 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.8559287093218047e-12:  # every lane on the polynomial
+    if span is not None and span[1] < 1.5083706105984371:  # every lane on the polynomial
         t = x
-        series = -0.0026041666666666665
+        series = -7.292903644389931e-19
+        series = 7.001187498614334e-16 + t * series
+        series = -5.096864498991235e-13 + t * series
+        series = 2.691144455467372e-10 + t * series
+        series = -9.68812003968254e-08 + t * series
+        series = 2.170138888888889e-05 + t * series
+        series = -0.0026041666666666665 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
+    out = numpy.asarray((1 - cos_half)/phi**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.5083706105984371:  # every lane on the closed form
         return out
-    small = x < 1.8559287093218047e-12
+    small = x < 1.5083706105984371
     if small.any():
         t = x[small]
-        series = -0.0026041666666666665
+        series = -7.292903644389931e-19
+        series = 7.001187498614334e-16 + t * series
+        series = -5.096864498991235e-13 + t * series
+        series = 2.691144455467372e-10 + t * series
+        series = -9.68812003968254e-08 + t * series
+        series = 2.170138888888889e-05 + t * series
+        series = -0.0026041666666666665 + t * series
         series = 0.125 + t * series
         out[small] = series
     return out
@@ -1097,7 +1121,7 @@ _USES_PHI = {
     "32": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': False, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'nu': 1.8559287093218047e-12, 'epsilon': 1.9211893090849678e-14, 'det_H': 5.028297529613116e-13, 'R_1': 5.028297529613116e-13, 'R_2': 5.028297529613116e-13, 'H_1': 5.028297529613116e-13, 'H_2': 0.7851233626304374, 'H_inverse_2': 5.5673482008975155, 'G_1': 1.8559287093218047e-12, 'G_2': 1.8559287093218047e-12, 'K_1': 1.8559287093218047e-12, 'K_2': 5.5673482008975155, 'R_1_x': 0.7851233626304374, 'R_2_x': 5.5673482008975155, 'H_1_x': 5.5673482008975155, 'H_2_x': 5.5673482008975155, 'H_inverse_2_x': 5.5673482008975155, 'e_0': 1.8559287093218047e-12},
+    "64": {'nu': 1.8559287093218047e-12, 'epsilon': 1.9211893090849678e-14, 'det_H': 5.028297529613116e-13, 'R_1': 5.028297529613116e-13, 'R_2': 5.028297529613116e-13, 'H_1': 5.028297529613116e-13, 'H_2': 0.7851233626304374, 'H_inverse_2': 5.5673482008975155, 'G_1': 1.8559287093218047e-12, 'G_2': 1.5083706105984371, 'K_1': 1.5083706105984371, 'K_2': 5.5673482008975155, 'R_1_x': 0.7851233626304374, 'R_2_x': 5.5673482008975155, 'H_1_x': 5.5673482008975155, 'H_2_x': 5.5673482008975155, 'H_inverse_2_x': 5.5673482008975155, 'e_0': 1.8559287093218047e-12},
     "32": {'nu': 1.855928654006444e-12, 'epsilon': 1.9211894444362143e-14, 'det_H': 5.028297329387876e-13, 'R_1': 5.028297329387876e-13, 'R_2': 5.028297329387876e-13, 'H_1': 5.028297329387876e-13, 'H_2': 1.5083706018396157, 'H_inverse_2': 5.567347935831094, 'G_1': 1.855928654006444e-12, 'G_2': 1.855928654006444e-12, 'K_1': 1.855928654006444e-12, 'K_2': 5.567347935831094, 'R_1_x': 1.5083706018396157, 'R_2_x': 5.567347935831094, 'H_1_x': 5.567347935831094, 'H_2_x': 5.567347935831094, 'H_inverse_2_x': 5.567347935831094, 'e_0': 1.855928654006444e-12},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold

@@ -322,7 +322,8 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0026041666666666665 + t * series
     series = 0.125 + t * series
     phi = _where(small, 1.7023118078717785, phi)
-    closed = 2*_xp.sin((0.25)*phi)**2/phi**2
+    cos_half = _where(small, 0.6591142971948246, cos_half)
+    closed = (1 - cos_half)/phi**2
     return _where(small, series, closed)
 
 
@@ -342,7 +343,8 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0026041666666666665 + t * series
     series = 0.125 + t * series
     phi = _where(small, 1.7023118078717785, phi)
-    closed = 2*_xp.sin((0.25)*phi)**2/phi**2
+    cos_half = _where(small, 0.6591142971948246, cos_half)
+    closed = (1 - cos_half)/phi**2
     return _where(small, series, closed)
 
 
