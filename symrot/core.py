@@ -67,6 +67,18 @@ class Tensor:
         return (f"{self.name}_0", f"{self.name}_1", f"{self.name}_2")
 
     @property
+    def across_name(self) -> str:
+        """Name of c₀ − c₂|p|², the coefficient of I in T = (c₀ − c₂|p|²) I + c₁ (p×) + c₂ p pᵀ."""
+        return f"{self.name}_across"
+
+    @property
+    def across(self) -> sp.Expr:
+        """c₀ − c₂|p|² in φ (raw): the real part of T's eigenvalues across the axis, a − c in the
+        u-basis (the planar entry of eqs 17, 23, 27). Planned as a coefficient of its own: next to
+        2π, c₀ and c₂|p|² nearly cancel (ν → 0) and their difference is what ω across the axis is."""
+        return self.u_basis.planar[0]
+
+    @property
     def eigenvalues(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         axial = self.canonical[0, 0]
         real, imag = self.canonical[1, 1], self.canonical[2, 1]
@@ -108,9 +120,15 @@ class Derivation:
             out.update(zip(tensor.coefficient_names(), tensor.simplified, strict=True))
         return out
 
+    def across_expressions(self) -> dict[str, sp.Expr]:
+        """c₀ − c₂|p|² of every tensor (:attr:`Tensor.across`), raw, by name (``R_across`` …)."""
+        return {tensor.across_name: tensor.across for tensor in self.tensors.values()}
+
     def planned_expressions(self) -> dict[str, sp.Expr]:
-        """The coefficients and the slopes of :mod:`symrot.derivatives`: everything a plan evaluates."""
-        return {**self.coefficient_expressions(), **{n: raw for n, (_, raw) in self.slopes.items()}}
+        """The coefficients, their across-axis combinations and the slopes of :mod:`symrot.derivatives`:
+        everything a plan evaluates."""
+        return {**self.coefficient_expressions(), **self.across_expressions(),
+                **{n: raw for n, (_, raw) in self.slopes.items()}}
 
     def simplified_planned(self) -> dict[str, sp.Expr]:
         """Simplified forms of :meth:`planned_expressions` (see :meth:`simplified_form`)."""
@@ -120,6 +138,9 @@ class Derivation:
         """The simplified form of one planned expression; a slope is the derivative of its parent's
         simplified form over dx/dφ = 2 p p′ with common factors pulled out (``factor_terms``): no
         time-bounded step, so that the printed form cannot depend on how loaded the machine is."""
+        across = {t.across_name: t for t in self.tensors.values()}
+        if name in across:
+            return across[name].canonical[1, 1]
         if name not in self.slopes:
             return self.simplified_coefficients()[name]
         if name not in self._slopes_simplified:

@@ -130,10 +130,17 @@ def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
     if argument == PHI:
         return expr
     coefficient, rest = argument.as_coeff_Mul()
+    if argument.is_Add:  # sin(φ)/2 + sinh(φ)/2 = (sin φ + sinh φ)/2
+        coefficient, rest = argument.as_content_primitive()
     rules: dict[sp.Expr, sp.Expr] = {argument**2: X, argument**-2: 1 / X, argument: S}
     if rest != argument and rest.has(PHI) and coefficient != 0:
         rules.update({rest**2: X / coefficient**2, rest**-2: coefficient**2 / X, rest: S / coefficient})
-    return expr.xreplace(rules)
+    written = expr.xreplace(rules)
+    if argument.is_Mul and len(argument.args) > 1 and written.has(*argument.args):
+        # p = sinh(φ) cosh(φ): 1/p² is the factors sinh⁻² cosh⁻² of a larger product, no subtree
+        # that xreplace could match; subs matches such sub-products (an exact substitution still)
+        written = written.subs([(argument**2, X), (argument, S)])
+    return written
 
 
 @lru_cache(maxsize=8)

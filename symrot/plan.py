@@ -31,10 +31,10 @@ taken where it is measurably more accurate), then the fewest distinct trigonomet
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable
 from dataclasses import replace
 from functools import lru_cache
+from typing import NamedTuple
 
 import mpmath
 import numpy as np
@@ -209,7 +209,8 @@ class UnplannableCoefficient(SymrotError):
 
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type, argument: sp.Expr = PHI, inverse: sp.Expr | None = None,
-                complement: sp.Rational | None = None, power: int = 0) -> Branch:
+                complement: sp.Rational | None = None, part: TensorPart | None = None,
+                extra_forms: tuple[sp.Expr, ...] = ()) -> Branch:
     """Choose the form, the switch t₀ and the Horner degree for one coefficient in one precision.
 
     The coefficient is evaluated from s = ``argument``(φ) (p for the coefficients of x, φ itself
@@ -217,9 +218,10 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     (:func:`with_length`) and, given the closed ``inverse`` φ(s), with their algebraic parts written
     through it (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of
     the tangent family, fold complement d of the sine family), measured on the inputs of
-    :func:`measured_inputs` against one reference at REFERENCE_DIGITS. ``power`` k > 0: the
-    coefficient multiplies |p|^k in its tensor, and its error counts relative to c(0)/|p|^k beyond
-    |p| = 1, not c(0) (:func:`_branch_for`)."""
+    :func:`measured_inputs` against one reference at REFERENCE_DIGITS. A coefficient of a tensor
+    (``part``) is measured as it enters the tensor: relative to ‖T‖/|p|^k where that is below c(0)
+    (:func:`_branch_for`). ``extra_forms``: more candidates, already in the backends' variables
+    (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part)."""
     forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
     forms += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
     plain = tuple(dict.fromkeys([closed, *forms]))
@@ -229,13 +231,15 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         forms = [closed_with_base_angle(form, inverse) for form in forms]
         if complement is not None:
             forms = [closed_with_complement(form, inverse, complement) for form in forms]
+    forms += extra_forms
     inputs = measured_inputs(argument, phi_max, dtype, complement)
     reference = reference_values(plain, argument, phi_max, dtype, complement)
+    floors = None if part is None else tensor_floors(part, argument, phi_max, dtype, complement)
     branches = []
     for form in dict.fromkeys(forms):
         try:
             branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype, inputs, reference,
-                                        power))
+                                        floors))
         except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
             continue
     if not branches:
@@ -248,14 +252,46 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                                         trig_arguments(b.closed), b.edge_ulp, b.measured_ulp))
 
 
-def root_power(coefficient: str) -> int:
-    """k of a coefficient c_k of G or K (eqs 81, 83: c_0 I + c_1 (p x) + c_2 (p x)^2), else 0.
+class TensorPart(NamedTuple):
+    """Where a coefficient enters its tensor T = c₀ I + c₁ (p×) + c₂ (p×)²: as c_k |p|^k (``power``;
+    0 for the across-axis part c₀ − c₂|p|²), in a tensor of norm ``norm`` (an expression in φ)."""
 
-    Only the root tensors are measured as they enter the tensor: for R, H and H⁻¹ the same floor
-    picks forms of c_2 in s and x whose rounding no longer follows c_0's (both functions of the
-    same rounded φ), and ω = H ṗ, where c_0 − c_2 x cancels next to 2π, lost up to 6 ε (sine_m5)."""
-    match = re.fullmatch(r"(?:G|K)_([012])", coefficient)
-    return int(match.group(1)) if match else 0
+    norm: sp.Expr
+    power: int
+
+
+def tensor_part(derivation: Derivation, coefficient: str) -> TensorPart | None:
+    """The :class:`TensorPart` of a coefficient of R, H, H⁻¹, G or K (or of its across-axis part),
+    None for the scalars and slopes. The norm is the largest eigenvalue modulus, max(|a|, |a − c|,
+    |b|) of the u-basis a I + b U + c U² (axial a, across the axis (a − c) ± i b; eqs 17, 23, 27)."""
+    for tensor in derivation.tensors.values():
+        names = (*tensor.coefficient_names(), tensor.across_name)
+        if coefficient in names:
+            u = tensor.u_basis
+            norm = sp.Max(sp.Abs(u.a), sp.Abs(u.a - u.c), sp.Abs(u.b))
+            return TensorPart(norm, 0 if coefficient == tensor.across_name else names.index(coefficient))
+    return None
+
+
+@lru_cache(maxsize=64)
+def tensor_floors(part: TensorPart, argument: sp.Expr, phi_max: float, dtype: type,
+                  complement: sp.Rational | None) -> tuple[np.ndarray, ...]:
+    """‖T‖/|p|^k at the exact angles of :func:`measured_inputs` (30 digits, NaN where it cannot be
+    evaluated): the size of the error of c_k that the tensor can absorb."""
+    inputs = measured_inputs(argument, phi_max, dtype, complement)
+    norm = sp.lambdify(PHI, part.norm, modules=[mpmath_namespace(), "mpmath"])
+    p_of = sp.lambdify(PHI, argument, modules=[mpmath_namespace(), "mpmath"])
+    values = []
+    with mpmath.workdps(30):
+        for thetas in inputs.exact:
+            row = []
+            for theta in thetas:
+                try:
+                    row.append(float(norm(theta) / abs(p_of(theta)) ** part.power))
+                except (ZeroDivisionError, OverflowError, ValueError, TypeError):
+                    row.append(math.nan)
+            values.append(np.asarray(row, dtype=np.float64))
+    return tuple(values)
 
 
 def _error_class(ulp: float) -> float:
@@ -279,12 +315,15 @@ def _magnitude(coefficient: sp.Expr) -> float:
 
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...],
-                power: int = 0) -> Branch:
+                floors: tuple[np.ndarray, ...] | None = None) -> Branch:
     epsilon = float(np.finfo(dtype).eps)
     model_closed = model_function(closed, [PHI, S, X, D])
     angles = angle_grid(phi_max)
     t_values = _switch_values(variable_of_phi, phi_max, dtype)
     scale0 = abs(float(series[0])) or 1.0
+    # a coefficient of a tensor counts relative to what it adds to the tensor where that is below
+    # c(0): G_2 ~ 2/x next to 2 pi (G_2 x is of order 1, c(0) = 1/8 would hide any relative error of
+    # G_2 itself); H_across ~ mu next to 2 pi for phi + phi^3/6 (~ 0.05, with c(0) = 1)
     closed_error = np.zeros(len(angles))
     for k in range(len(angles)):
         if not len(inputs.angles[k]):
@@ -293,9 +332,7 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         values = np.broadcast_to(np.asarray(printed, dtype=np.float64), inputs.angles[k].shape)
         exact = reference[k]
         with np.errstate(all="ignore"):
-            # c_k enters its tensor as c_k |p|^k: G_2 ~ 2/x next to 2 pi, where G_2 x is an entry of
-            # order 1 and c(0) = 1/8 would hide any relative error of G_2 itself
-            floor = scale0 / np.maximum(1.0, inputs.squares[k].astype(np.float64)) ** (power / 2)
+            floor = scale0 if floors is None else np.fmin(scale0, floors[k])
             errors = np.abs(values - exact) / (np.maximum(np.abs(exact), floor) * epsilon)
         errors = np.where(np.isfinite(values), np.where(np.isnan(exact), 0.0, errors), np.inf)
         closed_error[k] = float(np.max(errors))
@@ -379,10 +416,14 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     algebraic_work = 0
     algebraic_forms: dict[str, sp.Expr | None] = {}
     precisions = {}
+    across = {t.across_name: name for name, t in derivation.tensors.items()}
     for label, dtype in PRECISIONS.items():
         coefficients: dict[str, Coefficient] = {}
         slopes_unrepresentable = False
         for coefficient, closed in derivation.planned_expressions().items():
+            tensor = across.get(coefficient)
+            if tensor is not None and isinstance(coefficients[tensor + "_0"], Constant):
+                continue  # c_0 exact: T_ii = c_0 - c_2 (p_j^2 + p_k^2) loses nothing (the backends)
             constant = derivation.constant_value(coefficient)
             if constant is not None:
                 coefficients[coefficient] = Constant(constant)
@@ -413,8 +454,10 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                     continue
             series = derivation.series_in_x(coefficient, MAX_TERMS)
             simplest_form = derivation.simplified_form(coefficient)
+            extra = difference_forms(coefficients, tensor, complement) if tensor is not None else ()
             coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
-                                                    inverse, complement, root_power(coefficient))
+                                                    inverse, complement, tensor_part(derivation, coefficient),
+                                                    extra)
         coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
                                                              dtype)
         scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
@@ -438,6 +481,31 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                                           limit, slope_limit)
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
                           _p_max_squared(p, limits.phi_max, p_max))
+
+
+def difference_forms(coefficients: dict[str, Coefficient], tensor: str,
+                     complement: sp.Rational | None) -> tuple[sp.Expr, ...]:
+    """c₀ − c₂ x (as printed and cancelled) when both are algebraic in x: candidates for the
+    across-axis part t = c₀ − c₂ x of ``tensor``. Next to 2π for 6 tan(φ/6), t = (p/2) cot(φ/2) in
+    φ inherits the angle's rounding through the pole of cot (2·10⁵ ulp); 9 (x − 12)/(x − 108) does not.
+    With a fold complement, k² − x is written as d (as :func:`_use_complement` does for c₀ and c₂)."""
+    values = [_algebraic_value(coefficients[f"{tensor}_{k}"]) for k in (0, 2)]
+    if values[0] is None or values[1] is None:
+        return ()
+    difference = values[0] - values[1] * X
+    forms = (sp.cancel(difference), difference)
+    if complement is not None:
+        forms = tuple(with_complement(form, complement) for form in forms)
+    return tuple(dict.fromkeys(forms))
+
+
+def _algebraic_value(coefficient: Coefficient) -> sp.Expr | None:
+    """A coefficient's expression in x (and d) when it has no branch, else None."""
+    if isinstance(coefficient, Algebraic):
+        return coefficient.expression
+    if isinstance(coefficient, Constant):
+        return sp.sympify(coefficient.value)
+    return None
 
 
 def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coefficient], phi_max: float,

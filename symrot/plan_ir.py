@@ -146,6 +146,15 @@ class EvaluationPlan:
     p_max_squared_exact: sp.Float | None = None
     """p_max² at 50 digits (None when p is unbounded): see :meth:`boundary`."""
 
+    def across_tensors(self) -> tuple[str, ...]:
+        """The tensors T whose across-axis part t = c₀ − c₂|p|² is a coefficient of the plan
+        (``T_across``, in every precision): backends write T = t I + c₁ (p×) + c₂ p pᵀ with it, and
+        with t = c₀ − c₂|p|² computed from c₀ and c₂ for the others (whose c₀ is a constant)."""
+        names = [n.removesuffix("_across") for n in self.precisions["float64"].coefficients
+                 if n.endswith("_across")]
+        return tuple(n for n in names
+                     if all(n + "_across" in plan.coefficients for plan in self.precisions.values()))
+
     def boundary(self, mantissa_bits: int) -> tuple[float, bool]:
         """(B, inclusive) for a binary type with that many mantissa bits: B = p_max² rounded to the
         type; inclusive when B lies below the exact p_max², so that x = |p|² ≤ B is inside the range

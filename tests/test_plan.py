@@ -89,3 +89,55 @@ def test_small_rotations_take_short_polynomials_not_library_calls(label: str, dt
         with mpmath.workdps(60):
             exact = derivation.evaluate(name, mpmath.sqrt(mpmath.mpf(float(x))), 50)
         assert abs(float(value) - float(exact)) <= 1.0 * epsilon * abs(float(exact)), name
+
+
+def test_across_axis_part_is_planned_where_c0_is_not_constant(det_h_one_plan) -> None:
+    """T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T with t = c0 - c2 |p|^2: t is
+    derived (the planar part a - c of the u-basis) and planned as a coefficient of its own where c0
+    varies (H = mu I + ... of det_h_one), while R and G (c0 = 1) compute t from c2."""
+    from symrot.validation import evaluate
+
+    derivation = derive("det_h_one").derivation
+    for tensor in derivation.tensors.values():
+        c0, _, c2 = tensor.coefficients
+        for angle in ("0.31", "1.7", "2.9"):
+            expected = evaluate(c0 - c2 * derivation.p**2, angle)
+            assert abs(derivation.evaluate(tensor.across_name, angle) - expected) < \
+                mpmath.mpf(10) ** -40 * max(1, abs(expected))
+    across = det_h_one_plan.across_tensors()
+    assert "H" in across and "K" in across
+    assert "R" not in across and "G" not in across
+    for precision in det_h_one_plan.precisions.values():
+        assert "R_across" not in precision.coefficients
+        assert not isinstance(precision.coefficients["H_across"], Constant)
+
+
+def test_forms_in_s_and_x_are_found_inside_products_and_sums() -> None:
+    """p = sinh(phi) cosh(phi): 1/p^2 appears as sinh^-2 cosh^-2 inside a larger product, which
+    must still become 1/x (the form that does not amplify the angle's rounding)."""
+    from symrot.algebraic import S
+    from symrot.measurement import with_length
+    from symrot.parsing import PHI
+
+    product = sp.sinh(PHI) * sp.cosh(PHI)
+    assert with_length(2 * sp.sin(PHI / 4) ** 2 / product**2, product) == 2 * sp.sin(PHI / 4) ** 2 / X
+    assert with_length(sp.sin(PHI / 2) / product, product) == sp.sin(PHI / 2) / S
+    total = sp.sin(PHI) / 2 + sp.sinh(PHI) / 2
+    assert with_length(8 * sp.sin(PHI / 4) ** 2 / (sp.sin(PHI) + sp.sinh(PHI)) ** 2, total) == \
+        2 * sp.sin(PHI / 4) ** 2 / X
+
+
+def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
+    """G_2 of sinh(phi) cosh(phi) next to 2 pi is ~ 2/x, far below G_2(0) = 1/8: measured relative
+    to 1/8 its form in phi (sinh amplifies the float32 angle's rounding 4 times, 6 ulp of G_2 x)
+    would tie with 2 sin^2(phi/4)/x; measured relative to |G| / |p|^2 it must lose."""
+    from symrot.plan import MAX_TERMS, closed_inverse, plan_branch, tensor_part
+    from symrot.singularities import validity
+
+    derivation = derive("sinh(phi)*cosh(phi)").derivation
+    phi_max = float(validity(derivation).phi_max_float)
+    branch = plan_branch(derivation.simplified_form("G_2"), derivation.series_in_x("G_2", MAX_TERMS),
+                         derivation.p ** 2, phi_max, np.float32, derivation.p,
+                         closed_inverse(derivation.p, derivation.kappa), None, tensor_part(derivation, "G_2"))
+    assert branch.closed.has(X)
+    assert branch.edge_ulp <= 1.5

@@ -81,7 +81,7 @@ static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
- * ops: 49 */
+ * ops: 45 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -99,15 +99,16 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[
     }
     const double c_R_1 = 4/(x + 4);
     const double c_R_2 = 2/(x + 4);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_batch: symrot_cayley_gibbs_rodrigues_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -147,16 +148,17 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -165,7 +167,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
  * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 4/(x + 4) (algebraic in x)
+ * H_across = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
  * ops: 19 */
@@ -184,17 +186,17 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent(const double p[3], doub
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 4/(x + 4);
+    const double c_H_across = 4/(x + 4);
     const double c_H_1 = 2/(x + 4);
-    H[0] = c_H_0;
+    H[0] = c_H_across;
     H[1] = -c_H_1*p[2];
     H[2] = c_H_1*p[1];
     H[3] = c_H_1*p[2];
-    H[4] = c_H_0;
+    H[4] = c_H_across;
     H[5] = -c_H_1*p[0];
     H[6] = -c_H_1*p[1];
     H[7] = c_H_1*p[0];
-    H[8] = c_H_0;
+    H[8] = c_H_across;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_batch: symrot_cayley_gibbs_rodrigues_tangent for n vectors p[3*k..3*k+2] into
@@ -204,7 +206,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent(const double p[3], doub
  */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -220,14 +222,14 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double w0 = 1.0/(x + 4);
-            c_H_0_lanes[k] = 4*w0;
+            c_H_across_lanes[k] = 4*w0;
             c_H_1_lanes[k] = 2*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_1;
             c_H_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 0;
@@ -235,15 +237,15 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -252,10 +254,10 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
  * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 4)/4 (algebraic in x)
+ * H_inverse_across = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
- * ops: 50 */
+ * ops: 39 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -271,16 +273,15 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/4.0)*x + 1;
-    Hinv[0] = c_H_inverse_0 - 1.0/4.0*(p[1]*p[1]) - 1.0/4.0*(p[2]*p[2]);
+    Hinv[0] = (1.0/4.0)*(p[0]*p[0]) + 1;
     Hinv[1] = (1.0/4.0)*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = (1.0/4.0)*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = (1.0/4.0)*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - 1.0/4.0*(p[0]*p[0]) - 1.0/4.0*(p[2]*p[2]);
+    Hinv[4] = (1.0/4.0)*(p[1]*p[1]) + 1;
     Hinv[5] = (1.0/2.0)*p[0] + (1.0/4.0)*p[1]*p[2];
     Hinv[6] = (1.0/4.0)*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = -1.0/2.0*p[0] + (1.0/4.0)*p[1]*p[2];
-    Hinv[8] = c_H_inverse_0 - 1.0/4.0*(p[0]*p[0]) - 1.0/4.0*(p[1]*p[1]);
+    Hinv[8] = (1.0/4.0)*(p[2]*p[2]) + 1;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_batch: symrot_cayley_gibbs_rodrigues_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -290,7 +291,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[
  */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -302,31 +303,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n,
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
         }
-        /* every candidate value, unconditionally */
-        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0/4.0)*x + 1;
-        }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_0;
+            c_H_inverse_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
             c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1.0/4.0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -354,7 +349,7 @@ static inline double symrot_cayley_gibbs_rodrigues_tangent_det(const double p[3]
  * G_0 = 1 (constant)
  * G_1 = 1/sqrt(x + 4) (algebraic in x)
  * G_2 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
- * ops: 56 */
+ * ops: 52 */
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -372,15 +367,16 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], 
     }
     const double c_G_1 = 1.0/sqrt(x + 4);
     const double c_G_2 = 1.0/(x + 2*sqrt(x + 4) + 4);
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_batch: symrot_cayley_gibbs_rodrigues_root_matrix for n vectors p[3*k..3*k+2] into
@@ -433,16 +429,17 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -451,10 +448,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
  * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 2/(x + 4) (algebraic in x)
+ * K_across = 1/sqrt(x + 4) (algebraic in x)
  * K_1 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
  * K_2 = -1/((x + 4)*(sqrt(x + 4) + 2)) (algebraic in x)
- * ops: 62 */
+ * ops: 58 */
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -470,29 +467,29 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3],
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = 2/(x + 4);
+    const double c_K_across = 1.0/sqrt(x + 4);
     const double c_K_1 = 1.0/(x + 2*sqrt(x + 4) + 4);
     const double c_K_2 = -1/((x + 4)*(sqrt(x + 4) + 2));
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_batch: symrot_cayley_gibbs_rodrigues_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(x + 4).
+ * Scalar pass: u0 = 1/sqrt(x + 4), u1 = sqrt(x + 4).
  */
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -502,30 +499,34 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
-                const double u0 = sqrt(x + 4);
+                const double u0 = 1.0/sqrt(x + 4);
+                const double u1 = sqrt(x + 4);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
             const double w0 = x + 4;
-            const double w1 = 1.0/w0;
-            c_K_0_lanes[k] = 2*w1;
-            c_K_1_lanes[k] = 1.0/(2*u0 + w0);
-            c_K_2_lanes[k] = -w1/(u0 + 2);
+            c_K_across_lanes[k] = u0;
+            c_K_1_lanes[k] = 1.0/(2*u1 + w0);
+            c_K_2_lanes[k] = -1/(w0*(u1 + 2));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             c_K_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
@@ -534,15 +535,15 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -551,10 +552,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
  * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 4)/4 (algebraic in x)
+ * H_inverse_across = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
- * ops: 44 */
+ * ops: 35 */
 static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -564,20 +565,20 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const d
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/4.0)*x + 1;
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + (1.0/4.0)*p[1]*w2 - 1.0/4.0*p[2]*w1 - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] - 1.0/4.0*p[0]*w2 + (1.0/4.0)*p[2]*w0 - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + (1.0/4.0)*p[0]*w1 - 1.0/4.0*p[1]*w0 - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = omega[0] + (1.0/4.0)*p[0]*p_dot_v - 1.0/2.0*w0;
+    pdot[1] = omega[1] + (1.0/4.0)*p[1]*p_dot_v - 1.0/2.0*w1;
+    pdot[2] = omega[2] + (1.0/4.0)*p[2]*p_dot_v - 1.0/2.0*w2;
 }
 
 /* symrot_cayley_gibbs_rodrigues_omega: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 4/(x + 4) (algebraic in x)
+ * H_across = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
  * ops: 28 */
@@ -590,14 +591,14 @@ static inline void symrot_cayley_gibbs_rodrigues_omega(const double p[3], const 
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 4/(x + 4);
+    const double c_H_across = 4/(x + 4);
     const double c_H_1 = 2/(x + 4);
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0;
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1;
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2;
+    omega[0] = c_H_1*w0 + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_across*pdot[2];
 }
 
 /* symrot_cayley_gibbs_rodrigues_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1235,7 +1236,7 @@ static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
- * ops: 49 */
+ * ops: 45 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1253,15 +1254,16 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p
     }
     const float c_R_1 = 4/(x + 4);
     const float c_R_2 = 2/(x + 4);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch: symrot_cayley_gibbs_rodrigues_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1301,16 +1303,17 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1319,7 +1322,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
  * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 4/(x + 4) (algebraic in x)
+ * H_across = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
  * ops: 19 */
@@ -1338,17 +1341,17 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f(const float p[3], flo
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 4/(x + 4);
+    const float c_H_across = 4/(x + 4);
     const float c_H_1 = 2/(x + 4);
-    H[0] = c_H_0;
+    H[0] = c_H_across;
     H[1] = -c_H_1*p[2];
     H[2] = c_H_1*p[1];
     H[3] = c_H_1*p[2];
-    H[4] = c_H_0;
+    H[4] = c_H_across;
     H[5] = -c_H_1*p[0];
     H[6] = -c_H_1*p[1];
     H[7] = c_H_1*p[0];
-    H[8] = c_H_0;
+    H[8] = c_H_across;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_f_batch: symrot_cayley_gibbs_rodrigues_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1358,7 +1361,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f(const float p[3], flo
  */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1374,14 +1377,14 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float w0 = 1.0F/(x + 4);
-            c_H_0_lanes[k] = 4*w0;
+            c_H_across_lanes[k] = 4*w0;
             c_H_1_lanes[k] = 2*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_1;
             c_H_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : 0;
@@ -1389,15 +1392,15 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -1406,10 +1409,10 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
  * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 4)/4 (algebraic in x)
+ * H_inverse_across = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
- * ops: 50 */
+ * ops: 39 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1425,16 +1428,15 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/4.0F)*x + 1;
-    Hinv[0] = c_H_inverse_0 - 1.0F/4.0F*(p[1]*p[1]) - 1.0F/4.0F*(p[2]*p[2]);
+    Hinv[0] = (1.0F/4.0F)*(p[0]*p[0]) + 1;
     Hinv[1] = (1.0F/4.0F)*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = (1.0F/4.0F)*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = (1.0F/4.0F)*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - 1.0F/4.0F*(p[0]*p[0]) - 1.0F/4.0F*(p[2]*p[2]);
+    Hinv[4] = (1.0F/4.0F)*(p[1]*p[1]) + 1;
     Hinv[5] = (1.0F/2.0F)*p[0] + (1.0F/4.0F)*p[1]*p[2];
     Hinv[6] = (1.0F/4.0F)*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = -1.0F/2.0F*p[0] + (1.0F/4.0F)*p[1]*p[2];
-    Hinv[8] = c_H_inverse_0 - 1.0F/4.0F*(p[0]*p[0]) - 1.0F/4.0F*(p[1]*p[1]);
+    Hinv[8] = (1.0F/4.0F)*(p[2]*p[2]) + 1;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch: symrot_cayley_gibbs_rodrigues_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1444,7 +1446,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p
  */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1456,31 +1458,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t 
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
         }
-        /* every candidate value, unconditionally */
-        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0F/4.0F)*x + 1;
-        }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_0;
+            c_H_inverse_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
             c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1.0F/4.0F;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1508,7 +1504,7 @@ static inline float symrot_cayley_gibbs_rodrigues_tangent_det_f(const float p[3]
  * G_0 = 1 (constant)
  * G_1 = 1/sqrt(x + 4) (algebraic in x)
  * G_2 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
- * ops: 56 */
+ * ops: 52 */
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1526,15 +1522,16 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3],
     }
     const float c_G_1 = 1.0F/sqrtf(x + 4);
     const float c_G_2 = 1.0F/(x + 2*sqrtf(x + 4) + 4);
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_f_batch: symrot_cayley_gibbs_rodrigues_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1587,16 +1584,17 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1605,10 +1603,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
  * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 2/(x + 4) (algebraic in x)
+ * K_across = 1/sqrt(x + 4) (algebraic in x)
  * K_1 = 1/(x + 2*sqrt(x + 4) + 4) (algebraic in x)
  * K_2 = -1/((x + 4)*(sqrt(x + 4) + 2)) (algebraic in x)
- * ops: 62 */
+ * ops: 58 */
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1624,29 +1622,29 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3]
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 2/(x + 4);
+    const float c_K_across = 1.0F/sqrtf(x + 4);
     const float c_K_1 = 1.0F/(x + 2*sqrtf(x + 4) + 4);
     const float c_K_2 = -1/((x + 4)*(sqrtf(x + 4) + 2));
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_f_batch: symrot_cayley_gibbs_rodrigues_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(x + 4).
+ * Scalar pass: u0 = 1/sqrt(x + 4), u1 = sqrt(x + 4).
  */
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1656,30 +1654,34 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
-                const float u0 = sqrtf(x + 4);
+                const float u0 = 1.0F/sqrtf(x + 4);
+                const float u1 = sqrtf(x + 4);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
             const float w0 = x + 4;
-            const float w1 = 1.0F/w0;
-            c_K_0_lanes[k] = 2*w1;
-            c_K_1_lanes[k] = 1.0F/(2*u0 + w0);
-            c_K_2_lanes[k] = -w1/(u0 + 2);
+            c_K_across_lanes[k] = u0;
+            c_K_1_lanes[k] = 1.0F/(2*u1 + w0);
+            c_K_2_lanes[k] = -1/(w0*(u1 + 2));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
@@ -1688,15 +1690,15 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -1705,10 +1707,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
  * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 4)/4 (algebraic in x)
+ * H_inverse_across = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/4 (constant)
- * ops: 44 */
+ * ops: 35 */
 static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1718,20 +1720,20 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const 
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/4.0F)*x + 1;
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + (1.0F/4.0F)*p[1]*w2 - 1.0F/4.0F*p[2]*w1 - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] - 1.0F/4.0F*p[0]*w2 + (1.0F/4.0F)*p[2]*w0 - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + (1.0F/4.0F)*p[0]*w1 - 1.0F/4.0F*p[1]*w0 - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = omega[0] + (1.0F/4.0F)*p[0]*p_dot_v - 1.0F/2.0F*w0;
+    pdot[1] = omega[1] + (1.0F/4.0F)*p[1]*p_dot_v - 1.0F/2.0F*w1;
+    pdot[2] = omega[2] + (1.0F/4.0F)*p[2]*p_dot_v - 1.0F/2.0F*w2;
 }
 
 /* symrot_cayley_gibbs_rodrigues_omega_f: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 4/(x + 4) (algebraic in x)
+ * H_across = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
  * ops: 28 */
@@ -1744,14 +1746,14 @@ static inline void symrot_cayley_gibbs_rodrigues_omega_f(const float p[3], const
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 4/(x + 4);
+    const float c_H_across = 4/(x + 4);
     const float c_H_1 = 2/(x + 4);
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0;
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1;
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2;
+    omega[0] = c_H_1*w0 + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_across*pdot[2];
 }
 
 /* symrot_cayley_gibbs_rodrigues_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

@@ -119,7 +119,7 @@ static inline double symrot_det_h_one_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * R_2: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
- * ops: 577 */
+ * ops: 573 */
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -146,15 +146,16 @@ static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[
         c_R_1 = w0/w1;
         c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_det_h_one_rotation_matrix_batch: symrot_det_h_one_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -227,26 +228,27 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_det_h_one_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 17 in x below x = 1.43428, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(4*sin(phi/2)**2)
+ * H_across: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 609 */
+ * ops: 640 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -262,42 +264,43 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    double c_H_0, c_H_1, c_H_2;
-    if (x < 1.4342812090283275) {
-        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.0039990891728625e-19)*x + 3.447054794682197e-18) + 3.960693739938103e-17) + 4.557728891739657e-16) + 5.253841918550812e-15) + 6.068442620832808e-14) + 7.02588589607731e-13) + 8.157249203307483e-12) + 9.503025504854477e-11) + 1.111738558870201e-09) + 99681.0/7623616000000.0) + 151439.0/977961600000.0) + 1213.0/655200000.0) + 387.0/17248000.0) + 1.0/3600.0) + 1.0/280.0) + 1.0/20.0) + 1;
+    double c_H_across, c_H_1, c_H_2;
+    if (x < 0.764824235244299) {
+        c_H_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = w1*cos(w0);
-        c_H_0 = (1.0/4.0)*w2*pow(cbrt(6*phi - 12*w3), 2);
-        c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w2*(3*phi - 8*w3 + (1.0/2.0)*sin(2*phi))/(phi - 2*w3);
+        const double w0 = sin(phi);
+        const double w1 = cbrt(6*phi - 6*w0);
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = w3*cos(w2);
+        c_H_across = w0/w1;
+        c_H_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w4 + (1.0/2.0)*sin(2*phi))/((w3*w3)*(phi - 2*w4));
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_det_h_one_tangent_batch: symrot_det_h_one_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)), u1 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_0_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -305,15 +308,175 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 1.4342812090283275) {
+            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const double s = sqrt(x);
+                const double phi = symrot_det_h_one__phi(s);
+                const double u0 = cbrt(6*(phi - sin(phi)));
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double a0_a = phi;
+            const double a0_q = rint(a0_a*0.6366197723675814);
+            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
+            const double a0_z = a0_r*a0_r;
+            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
+            const double a0_h = rint(0.5*a0_j - 0.25);
+            const double a0_odd = a0_j - 2*a0_h;
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const double a2_a = 2*phi;
+            const double a2_q = rint(a2_a*0.6366197723675814);
+            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
+            const double a2_z = a2_r*a2_r;
+            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
+            const double a2_h = rint(0.5*a2_j - 0.25);
+            const double a2_odd = a2_j - 2*a2_h;
+            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const double w0 = cos1*sin1;
+            c_H_across_lanes[k] = sin0/u0;
+            poly_H_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+            c_H_1_lanes[k] = (1 - cos0)/(u0*u0);
+            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+            c_H_2_lanes[k] = (1.0/12.0)*(3*phi + (1.0/2.0)*sin2 - 8*w0)/((sin1*sin1)*(phi - 2*w0));
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
+            const double closed_H_across = c_H_across_lanes[k];
+            const double poly_H_across = poly_H_across_lanes[k];
+            const double v_H_across = x < 0.764824235244299 ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_across;
+            const double closed_H_1 = c_H_1_lanes[k];
+            const double poly_H_1 = poly_H_1_lanes[k];
+            const double v_H_1 = x < 1.4342812090283275 ? poly_H_1 : closed_H_1;
+            c_H_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_1;
+            const double closed_H_2 = c_H_2_lanes[k];
+            const double poly_H_2 = poly_H_2_lanes[k];
+            const double v_H_2 = x < 2.6302227241416043 ? poly_H_2 : closed_H_2;
+            c_H_2_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            double *const out = H + 9 * (start + k);
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+        }
+    }
+}
+
+/* symrot_det_h_one_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_inverse_across: Horner degree 12 in x below x = 0.764824, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
+ * H_inverse_1 = -1/2 (constant)
+ * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
+ * ops: 597 */
+static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
+{
+    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.243134665607636)) {
+        Hinv[0] = (double)NAN;
+        Hinv[1] = (double)NAN;
+        Hinv[2] = (double)NAN;
+        Hinv[3] = (double)NAN;
+        Hinv[4] = (double)NAN;
+        Hinv[5] = (double)NAN;
+        Hinv[6] = (double)NAN;
+        Hinv[7] = (double)NAN;
+        Hinv[8] = (double)NAN;
+        return;
+    }
+    double c_H_inverse_across, c_H_inverse_2;
+    if (x < 0.764824235244299) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.847696164362506e-14)*x - 2.227352392712e-13) - 2.7052088947240463e-12) - 3.316097701005811e-11) - 4.112699899093853e-10) - 11192989.0/2161295136000000.0) - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
+    } else {
+        const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double w0 = sin(phi);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 1.0/w3;
+        const double w5 = 6*phi;
+        const double w6 = w2*cos(w1);
+        c_H_inverse_across = (1.0/4.0)*w0*w4*cbrt(6*phi - 6*w0);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w4*(-8*w3 + w5*w6 + pow(1 - 2*w3, 2) - 1)/pow(cbrt(w5 - 12*w6), 4);
+    }
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
+    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
+    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
+    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+}
+
+/* symrot_det_h_one_tangent_inverse_batch: symrot_det_h_one_tangent_inverse for n vectors p[3*k..3*k+2] into
+ * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
+static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
+{
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const double *const pk = p + 3 * (start + k);
+            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
-                const double u1 = cbrt(6*(phi - sin(phi)));
+                const double u0 = cbrt(6*(phi - sin(phi)));
+                const double u1 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -352,184 +515,21 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double a2_a = 2*phi;
-            const double a2_q = rint(a2_a*0.6366197723675814);
-            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
-            const double a2_z = a2_r*a2_r;
-            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
-            const double a2_h = rint(0.5*a2_j - 0.25);
-            const double a2_odd = a2_j - 2*a2_h;
-            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const double w0 = 1.0/(sin0*sin0);
-            const double w1 = cos0*sin0;
-            c_H_0_lanes[k] = (1.0/4.0)*(u0*u0)*w0;
-            poly_H_0_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.0039990891728625e-19)*x + 3.447054794682197e-18) + 3.960693739938103e-17) + 4.557728891739657e-16) + 5.253841918550812e-15) + 6.068442620832808e-14) + 7.02588589607731e-13) + 8.157249203307483e-12) + 9.503025504854477e-11) + 1.111738558870201e-09) + 99681.0/7623616000000.0) + 151439.0/977961600000.0) + 1213.0/655200000.0) + 387.0/17248000.0) + 1.0/3600.0) + 1.0/280.0) + 1.0/20.0) + 1;
-            c_H_1_lanes[k] = (1 - cos1)/(u1*u1);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-            c_H_2_lanes[k] = (1.0/12.0)*w0*(3*phi + (1.0/2.0)*sin2 - 8*w1)/(phi - 2*w1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
-        }
-        /* select: polynomial below the threshold, NaN outside the range */
-        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            const double poly_H_0 = poly_H_0_lanes[k];
-            const double v_H_0 = x < 1.4342812090283275 ? poly_H_0 : closed_H_0;
-            c_H_0_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_0;
-            const double closed_H_1 = c_H_1_lanes[k];
-            const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 1.4342812090283275 ? poly_H_1 : closed_H_1;
-            c_H_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_1;
-            const double closed_H_2 = c_H_2_lanes[k];
-            const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 2.6302227241416043 ? poly_H_2 : closed_H_2;
-            c_H_2_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_2;
-        }
-        for (k = 0; k < m; ++k) {
-            const double *const pk = p + 3 * (start + k);
-            double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
-        }
-    }
-}
-
-/* symrot_det_h_one_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0: Horner degree 15 in x below x = 1.43428, else 2*(1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
- * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 603 */
-static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
-{
-    const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 11.243134665607636)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
-        return;
-    }
-    double c_H_inverse_0, c_H_inverse_2;
-    if (x < 1.4342812090283275) {
-        c_H_inverse_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-6.816125240403192e-19)*x - 8.626941850237128e-18) - 1.1016217975387359e-16) - 1.4213047418173123e-15) - 1.8561269939266666e-14) - 2.4592808133854967e-13) - 3.3160977010058107e-12) - 4.569666554548725e-11) - 6.473542653639692e-10) - 604523.0/63567504000000.0) - 3293.0/22422400000.0) - 947.0/388080000.0) - 23.0/504000.0) - 3.0/2800.0) - 1.0/20.0) + 1;
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
-    } else {
-        const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 6*phi;
-        const double w4 = w1*cos(w0);
-        c_H_inverse_0 = 2*(1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*(-8*w2 + w3*w4 + pow(1 - 2*w2, 2) - 1)/(w2*pow(cbrt(w3 - 12*w4), 4));
-    }
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
-}
-
-/* symrot_det_h_one_tangent_inverse_batch: symrot_det_h_one_tangent_inverse for n vectors p[3*k..3*k+2] into
- * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
- * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
- * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
- */
-static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
-{
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
-        for (k = 0; k < m; ++k) {
-            const double *const pk = p + 3 * (start + k);
-            const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
-            x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 1.4342812090283275) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
-            } else {
-                const double s = sqrt(x);
-                const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*(phi - sin(phi)));
-                const double u1 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
-                phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
-            }
-        }
-        for (; k < SYMROT_BATCH_BLOCK; ++k) {
-            x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
-        }
-        /* every candidate value, unconditionally */
-        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
-            const double a0_a = phi;
-            const double a0_q = rint(a0_a*0.6366197723675814);
-            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
-            const double a0_z = a0_r*a0_r;
-            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
-            const double a0_h = rint(0.5*a0_j - 0.25);
-            const double a0_odd = a0_j - 2*a0_h;
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double w0 = (sin1*sin1);
-            c_H_inverse_0_lanes[k] = 2*(1 - cos0)/(u0*u0);
-            poly_H_inverse_0_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-6.816125240403192e-19)*x - 8.626941850237128e-18) - 1.1016217975387359e-16) - 1.4213047418173123e-15) - 1.8561269939266666e-14) - 2.4592808133854967e-13) - 3.3160977010058107e-12) - 4.569666554548725e-11) - 6.473542653639692e-10) - 604523.0/63567504000000.0) - 3293.0/22422400000.0) - 947.0/388080000.0) - 23.0/504000.0) - 3.0/2800.0) - 1.0/20.0) + 1;
-            c_H_inverse_2_lanes[k] = -1.0/2.0*(6*cos1*phi*sin1 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/((u1*u1*u1*u1)*w0);
+            const double w0 = (sin0*sin0);
+            const double w1 = 1.0/w0;
+            c_H_inverse_across_lanes[k] = (1.0/4.0)*sin1*u0*w1;
+            poly_H_inverse_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.847696164362506e-14)*x - 2.227352392712e-13) - 2.7052088947240463e-12) - 3.316097701005811e-11) - 4.112699899093853e-10) - 11192989.0/2161295136000000.0) - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
+            c_H_inverse_2_lanes[k] = -1.0/2.0*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u1*u1*u1*u1);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            const double poly_H_inverse_0 = poly_H_inverse_0_lanes[k];
-            const double v_H_inverse_0 = x < 1.4342812090283275 ? poly_H_inverse_0 : closed_H_inverse_0;
-            c_H_inverse_0_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const double v_H_inverse_across = x < 0.764824235244299 ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
@@ -539,15 +539,15 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -570,7 +570,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 12 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * G_2: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
- * ops: 577 */
+ * ops: 573 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -596,15 +596,16 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
         c_G_1 = sin((1.0/2.0)*phi)/w0;
         c_G_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w0*w0);
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_det_h_one_root_matrix_batch: symrot_det_h_one_root_matrix for n vectors p[3*k..3*k+2] into
@@ -685,26 +686,27 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_det_h_one_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0: Horner degree 17 in x below x = 1.43428, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2)
+ * K_across: Horner degree 12 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * K_1: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
  * K_2: Horner degree 21 in x below x = 2.63022, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 611 */
+ * ops: 643 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -720,43 +722,43 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
         K[8] = (double)NAN;
         return;
     }
-    double c_K_0, c_K_1, c_K_2;
-    if (x < 1.4342812090283275) {
-        c_K_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5019995445864313e-19)*x + 1.7235273973410984e-18) + 1.9803468699690516e-17) + 2.2788644458698284e-16) + 2.626920959275406e-15) + 3.034221310416404e-14) + 3.512942948038655e-13) + 4.078624601653741e-12) + 4.7515127524272383e-11) + 5.558692794351005e-10) + 99681.0/15247232000000.0) + 151439.0/1955923200000.0) + 1213.0/1310400000.0) + 387.0/34496000.0) + 1.0/7200.0) + 1.0/560.0) + 1.0/40.0) + 1.0/2.0;
+    double c_K_across, c_K_1, c_K_2;
+    if (x < 0.764824235244299) {
+        c_K_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
         c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
+        const double w2 = cbrt(6*(phi - sin(phi)));
         const double w3 = cbrt(6*phi - 12*w1*cos(w0));
         const double w4 = (w3*w3);
-        c_K_0 = (1.0/8.0)*w2*w4;
-        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_K_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0 : (-w1/w3 + (1.0/8.0)*w2*w4)/w4;
+        c_K_across = w1/w2;
+        c_K_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w2*w2);
+        c_K_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0 : (-w1/w3 + (1.0/8.0)*w4/(w1*w1))/w4;
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_det_h_one_root_tangent_batch: symrot_det_h_one_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)), u1 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_0_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -764,15 +766,15 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 1.4342812090283275) {
+            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
-                const double u1 = cbrt(6*(phi - sin(phi)));
+                const double u0 = cbrt(6*(phi - sin(phi)));
+                const double u1 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -810,22 +812,21 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = 1.0/(sin0*sin0);
-            const double w1 = (u0*u0);
-            c_K_0_lanes[k] = (1.0/8.0)*w0*w1;
-            poly_K_0_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.5019995445864313e-19)*x + 1.7235273973410984e-18) + 1.9803468699690516e-17) + 2.2788644458698284e-16) + 2.626920959275406e-15) + 3.034221310416404e-14) + 3.512942948038655e-13) + 4.078624601653741e-12) + 4.7515127524272383e-11) + 5.558692794351005e-10) + 99681.0/15247232000000.0) + 151439.0/1955923200000.0) + 1213.0/1310400000.0) + 387.0/34496000.0) + 1.0/7200.0) + 1.0/560.0) + 1.0/40.0) + 1.0/2.0;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/(u1*u1);
+            const double w0 = (u1*u1);
+            c_K_across_lanes[k] = sin0/u0;
+            poly_K_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/(u0*u0);
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (-sin0/u0 + (1.0/8.0)*w0*w1)/w1;
+            c_K_2_lanes[k] = (-sin0/u1 + (1.0/8.0)*w0/(sin0*sin0))/w0;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            const double poly_K_0 = poly_K_0_lanes[k];
-            const double v_K_0 = x < 1.4342812090283275 ? poly_K_0 : closed_K_0;
-            c_K_0_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            const double poly_K_across = poly_K_across_lanes[k];
+            const double v_K_across = x < 0.764824235244299 ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 1.4342812090283275 ? poly_K_1 : closed_K_1;
@@ -838,25 +839,25 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_det_h_one_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0: Horner degree 15 in x below x = 1.43428, else 2*(1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_inverse_across: Horner degree 12 in x below x = 0.764824, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 597 */
+ * ops: 596 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -866,34 +867,37 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
         pdot[2] = (double)NAN;
         return;
     }
-    double c_H_inverse_0, c_H_inverse_2;
-    if (x < 1.4342812090283275) {
-        c_H_inverse_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-6.816125240403192e-19)*x - 8.626941850237128e-18) - 1.1016217975387359e-16) - 1.4213047418173123e-15) - 1.8561269939266666e-14) - 2.4592808133854967e-13) - 3.3160977010058107e-12) - 4.569666554548725e-11) - 6.473542653639692e-10) - 604523.0/63567504000000.0) - 3293.0/22422400000.0) - 947.0/388080000.0) - 23.0/504000.0) - 3.0/2800.0) - 1.0/20.0) + 1;
+    double c_H_inverse_across, c_H_inverse_2;
+    if (x < 0.764824235244299) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.847696164362506e-14)*x - 2.227352392712e-13) - 2.7052088947240463e-12) - 3.316097701005811e-11) - 4.112699899093853e-10) - 11192989.0/2161295136000000.0) - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 6*phi;
-        const double w4 = w1*cos(w0);
-        c_H_inverse_0 = 2*(1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*(-8*w2 + w3*w4 + pow(1 - 2*w2, 2) - 1)/(w2*pow(cbrt(w3 - 12*w4), 4));
+        const double w0 = sin(phi);
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 1.0/w3;
+        const double w5 = 6*phi;
+        const double w6 = w2*cos(w1);
+        c_H_inverse_across = (1.0/4.0)*w0*w4*cbrt(6*phi - 6*w0);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w4*(-8*w3 + w5*w6 + pow(1 - 2*w3, 2) - 1)/pow(cbrt(w5 - 12*w6), 4);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_det_h_one_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 17 in x below x = 1.43428, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(4*sin(phi/2)**2)
+ * H_across: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 603 */
+ * ops: 639 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -903,27 +907,29 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
         omega[2] = (double)NAN;
         return;
     }
-    double c_H_0, c_H_1, c_H_2;
-    if (x < 1.4342812090283275) {
-        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.0039990891728625e-19)*x + 3.447054794682197e-18) + 3.960693739938103e-17) + 4.557728891739657e-16) + 5.253841918550812e-15) + 6.068442620832808e-14) + 7.02588589607731e-13) + 8.157249203307483e-12) + 9.503025504854477e-11) + 1.111738558870201e-09) + 99681.0/7623616000000.0) + 151439.0/977961600000.0) + 1213.0/655200000.0) + 387.0/17248000.0) + 1.0/3600.0) + 1.0/280.0) + 1.0/20.0) + 1;
+    double c_H_across, c_H_1, c_H_2;
+    if (x < 0.764824235244299) {
+        c_H_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = 1.0/(w1*w1);
-        const double w3 = w1*cos(w0);
-        c_H_0 = (1.0/4.0)*w2*pow(cbrt(6*phi - 12*w3), 2);
-        c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w2*(3*phi - 8*w3 + (1.0/2.0)*sin(2*phi))/(phi - 2*w3);
+        const double w0 = sin(phi);
+        const double w1 = cbrt(6*phi - 6*w0);
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = w3*cos(w2);
+        c_H_across = w0/w1;
+        c_H_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w4 + (1.0/2.0)*sin(2*phi))/((w3*w3)*(phi - 2*w4));
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_det_h_one_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1799,8 +1805,8 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 462 */
+ * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * ops: 433 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1819,36 +1825,169 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
     float c_R_1, c_R_2;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        c_R_1 = w0/cbrtf(6*phi - 6*w0);
-        c_R_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*(w2*w2)/powf(cbrtf(6*phi - 12*w2*cosf(w1)), 2);
+        const float w1 = cbrtf(6*phi - 6*w0);
+        c_R_1 = w0/w1;
+        c_R_2 = (1 - cosf(phi))/(w1*w1);
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_det_h_one_rotation_matrix_f_batch: symrot_det_h_one_rotation_matrix_f for n vectors p[3*k..3*k+2] into
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    size_t start, k;
+    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
+        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
+            x_lanes[k] = x;
+            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+                phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+            } else {
+                const float s = sqrtf(x);
+                const float phi = symrot_det_h_one__phi_f(s);
+                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+            }
+        }
+        for (; k < SYMROT_BATCH_BLOCK; ++k) {
+            x_lanes[k] = 0;
+            phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+        }
+        /* every candidate value, unconditionally */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float a0_a = phi;
+            const float a0_q = rintf(a0_a*0.63661975F);
+            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
+            const float a0_z = a0_r*a0_r;
+            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
+            const float a0_h = rintf(0.5F*a0_j - 0.25F);
+            const float a0_odd = a0_j - 2*a0_h;
+            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_R_1_lanes[k] = sin0/u0;
+            poly_R_1_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
+            c_R_2_lanes[k] = (1 - cos0)/(u0*u0);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        }
+        /* select: polynomial below the threshold, NaN outside the range */
+        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
+            c_R_0_lanes[k] = !(x <= 11.2431345F) ? NAN : 1;
+            const float closed_R_1 = c_R_1_lanes[k];
+            const float poly_R_1 = poly_R_1_lanes[k];
+            const float v_R_1 = x < 0.7648242F ? poly_R_1 : closed_R_1;
+            c_R_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_1;
+            const float closed_R_2 = c_R_2_lanes[k];
+            const float poly_R_2 = poly_R_2_lanes[k];
+            const float v_R_2 = x < 1.4342812F ? poly_R_2 : closed_R_2;
+            c_R_2_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_2;
+        }
+        for (k = 0; k < m; ++k) {
+            const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
+            float *const out = R + 9 * (start + k);
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
+            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
+            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
+            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+        }
+    }
+}
+
+/* symrot_det_h_one_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
+ * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
+ * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 512 */
+static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
+{
+    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
+    if (!(x <= 11.2431345F)) {
+        H[0] = NAN;
+        H[1] = NAN;
+        H[2] = NAN;
+        H[3] = NAN;
+        H[4] = NAN;
+        H[5] = NAN;
+        H[6] = NAN;
+        H[7] = NAN;
+        H[8] = NAN;
+        return;
+    }
+    float c_H_across, c_H_1, c_H_2;
+    if (x < 1.4342812F) {
+        c_H_across = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
+        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
+    } else {
+        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float w0 = sinf(phi);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = w2*cosf(w1);
+        c_H_across = w0/cbrtf(6*phi - 6*w0);
+        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w3/powf(cbrtf(6*phi - 12*w4), 2);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(w3*(phi - 2*w4));
+    }
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
+    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
+    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+}
+
+/* symrot_det_h_one_tangent_f_batch: symrot_det_h_one_tangent_f for n vectors p[3*k..3*k+2] into
+ * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
+ * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
+ * (sin/cos by the polynomial kernel), then the entries.
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ */
+static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, float *H)
+{
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1902,167 +2041,34 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_R_1_lanes[k] = sin0/u0;
-            poly_R_1_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-            c_R_2_lanes[k] = 2*(sin1*sin1)/(u1*u1);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
-        }
-        /* select: polynomial below the threshold, NaN outside the range */
-        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
-            c_R_0_lanes[k] = !(x <= 11.2431345F) ? NAN : 1;
-            const float closed_R_1 = c_R_1_lanes[k];
-            const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 0.7648242F ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_1;
-            const float closed_R_2 = c_R_2_lanes[k];
-            const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 2.6302226F ? poly_R_2 : closed_R_2;
-            c_R_2_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_2;
-        }
-        for (k = 0; k < m; ++k) {
-            const float *const pk = p + 3 * (start + k);
-            float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
-        }
-    }
-}
-
-/* symrot_det_h_one_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(4*sin(phi/2)**2)
- * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 548 */
-static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
-{
-    const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x <= 11.2431345F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
-        return;
-    }
-    float c_H_0, c_H_1, c_H_2;
-    if (x < 2.6302226F) {
-        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
-    } else {
-        const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 1.0F/w2;
-        const float w4 = w1*cosf(w0);
-        const float w5 = powf(cbrtf(6*phi - 12*w4), 2);
-        c_H_0 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1 : (1.0F/4.0F)*w3*w5;
-        c_H_1 = 2*w2/w5;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w3*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(phi - 2*w4);
-    }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
-}
-
-/* symrot_det_h_one_tangent_f_batch: symrot_det_h_one_tangent_f for n vectors p[3*k..3*k+2] into
- * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
- * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
- * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
- */
-static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, float *H)
-{
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_0_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
-        for (k = 0; k < m; ++k) {
-            const float *const pk = p + 3 * (start + k);
-            const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
-            x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 2.6302226F) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-            } else {
-                const float s = sqrtf(x);
-                const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
-                phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
-            }
-        }
-        for (; k < SYMROT_BATCH_BLOCK; ++k) {
-            x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-        }
-        /* every candidate value, unconditionally */
-        for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
-            const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
-            const float a0_q = rintf(a0_a*0.63661975F);
-            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
-            const float a0_z = a0_r*a0_r;
-            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
-            const float a0_h = rintf(0.5F*a0_j - 0.25F);
-            const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = 2*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float w0 = (sin0*sin0);
-            const float w1 = 1.0F/w0;
-            const float w2 = (u0*u0);
-            const float w3 = cos0*sin0;
-            c_H_0_lanes[k] = (1.0F/4.0F)*w1*w2;
-            poly_H_0_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
-            c_H_1_lanes[k] = 2*w0/w2;
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const float a2_a = 2*phi;
+            const float a2_q = rintf(a2_a*0.63661975F);
+            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
+            const float a2_z = a2_r*a2_r;
+            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
+            const float a2_h = rintf(0.5F*a2_j - 0.25F);
+            const float a2_odd = a2_j - 2*a2_h;
+            const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const float w0 = (sin1*sin1);
+            const float w1 = cos1*sin1;
+            c_H_across_lanes[k] = sin0/u0;
+            poly_H_across_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
+            c_H_1_lanes[k] = 2*w0/(u1*u1);
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = (1.0F/12.0F)*w1*(3*phi + (1.0F/2.0F)*sin1 - 8*w3)/(phi - 2*w3);
+            c_H_2_lanes[k] = (1.0F/12.0F)*(3*phi + (1.0F/2.0F)*sin2 - 8*w1)/(w0*(phi - 2*w1));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            const float poly_H_0 = poly_H_0_lanes[k];
-            const float v_H_0 = x < 4.619481F ? poly_H_0 : closed_H_0;
-            c_H_0_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            const float poly_H_across = poly_H_across_lanes[k];
+            const float v_H_across = x < 0.7648242F ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 2.6302226F ? poly_H_1 : closed_H_1;
@@ -2075,25 +2081,25 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_det_h_one_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0: Horner degree 8 in x below x = 2.63022, else 4*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 492 */
+ * ops: 489 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2109,42 +2115,43 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
         Hinv[8] = NAN;
         return;
     }
-    float c_H_inverse_0, c_H_inverse_2;
-    if (x < 2.6302226F) {
-        c_H_inverse_0 = x*(x*(x*(x*(x*(x*(x*((-4.5696665e-11F)*x - 6.473543e-10F) - 9.509938e-09F) - 1.4686206e-07F) - 2.4402186e-06F) - 23.0F/504000.0F) - 3.0F/2800.0F) - 1.0F/20.0F) + 1;
+    float c_H_inverse_across, c_H_inverse_2;
+    if (x < 1.4342812F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-5.1788343e-09F)*x - 6.656956e-08F) - 8.811724e-07F) - 1.2201092e-05F) - 23.0F/126000.0F) - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 6*phi;
-        const float w4 = w1*cosf(w0);
-        const float w5 = cbrtf(w3 - 12*w4);
-        c_H_inverse_0 = 4*w2/(w5*w5);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*(-8*w2 + w3*w4 + powf(1 - 2*w2, 2) - 1)/(w2*(w5*w5*w5*w5));
+        const float w0 = sinf(phi);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 1.0F/w3;
+        const float w5 = 6*phi;
+        const float w6 = w2*cosf(w1);
+        c_H_inverse_across = (1.0F/4.0F)*w0*w4*cbrtf(6*phi - 6*w0);
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
     }
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_det_h_one_tangent_inverse_f_batch: symrot_det_h_one_tangent_inverse_f for n vectors p[3*k..3*k+2] into
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2152,27 +2159,32 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 2.6302226F) {
+            if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -2185,19 +2197,30 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = (sin0*sin0);
-            c_H_inverse_0_lanes[k] = 4*w0/(u0*u0);
-            poly_H_inverse_0_lanes[k] = x*(x*(x*(x*(x*(x*(x*((-4.5696665e-11F)*x - 6.473543e-10F) - 9.509938e-09F) - 1.4686206e-07F) - 2.4402186e-06F) - 23.0F/504000.0F) - 3.0F/2800.0F) - 1.0F/20.0F) + 1;
-            c_H_inverse_2_lanes[k] = -1.0F/2.0F*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/((u0*u0*u0*u0)*w0);
+            const float w1 = 1.0F/w0;
+            c_H_inverse_across_lanes[k] = (1.0F/4.0F)*sin1*u0*w1;
+            poly_H_inverse_across_lanes[k] = x*(x*(x*(x*((-8.811724e-07F)*x - 1.2201092e-05F) - 23.0F/126000.0F) - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
+            c_H_inverse_2_lanes[k] = -1.0F/2.0F*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u1*u1*u1*u1);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            const float poly_H_inverse_0 = poly_H_inverse_0_lanes[k];
-            const float v_H_inverse_0 = x < 2.6302226F ? poly_H_inverse_0 : closed_H_inverse_0;
-            c_H_inverse_0_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const float v_H_inverse_across = x < 0.7648242F ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x <= 11.2431345F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const float poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
@@ -2207,15 +2230,15 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -2238,7 +2261,7 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * G_2: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
- * ops: 460 */
+ * ops: 456 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2265,15 +2288,16 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
         c_G_1 = sinf(w0)/w1;
         c_G_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - cosf(w0))/(w1*w1);
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_det_h_one_root_matrix_f_batch: symrot_det_h_one_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2346,26 +2370,27 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_det_h_one_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2)
+ * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * K_1: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 557 */
+ * ops: 517 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2381,44 +2406,44 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    float c_K_0, c_K_1, c_K_2;
-    if (x < 2.6302226F) {
-        c_K_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.31047955e-20F)*x + 1.5019996e-19F) + 1.7235274e-18F) + 1.9803468e-17F) + 2.2788643e-16F) + 2.6269209e-15F) + 3.0342214e-14F) + 3.512943e-13F) + 4.0786246e-12F) + 4.7515127e-11F) + 5.558693e-10F) + 6.5376455e-09F) + 7.742584e-08F) + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
+    float c_K_across, c_K_1, c_K_2;
+    if (x < 1.4342812F) {
+        c_K_across = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
         c_K_1 = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = 1.0F/(w1*w1);
+        const float w2 = cbrtf(6*(phi - sinf(phi)));
         const float w3 = cosf(w0);
         const float w4 = cbrtf(6*phi - 12*w1*w3);
         const float w5 = (w4*w4);
-        c_K_0 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.31047955e-20F)*x + 1.5019996e-19F) + 1.7235274e-18F) + 1.9803468e-17F) + 2.2788643e-16F) + 2.6269209e-15F) + 3.0342214e-14F) + 3.512943e-13F) + 4.0786246e-12F) + 4.7515127e-11F) + 5.558693e-10F) + 6.5376455e-09F) + 7.742584e-08F) + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F : (1.0F/8.0F)*w2*w5;
-        c_K_1 = (1 - w3)/powf(cbrtf(6*(phi - sinf(phi))), 2);
-        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w4 + (1.0F/8.0F)*w2*w5)/w5;
+        c_K_across = w1/w2;
+        c_K_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - w3)/(w2*w2);
+        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w4 + (1.0F/8.0F)*w5/(w1*w1))/w5;
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_det_h_one_root_tangent_f_batch: symrot_det_h_one_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)), u1 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_0_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2426,15 +2451,15 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 2.6302226F) {
+            if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
-                const float u1 = cbrtf(6*(phi - sinf(phi)));
+                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -2464,22 +2489,21 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = 1.0F/(sin0*sin0);
-            const float w1 = (u0*u0);
-            c_K_0_lanes[k] = (1.0F/8.0F)*w0*w1;
-            poly_K_0_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.31047955e-20F)*x + 1.5019996e-19F) + 1.7235274e-18F) + 1.9803468e-17F) + 2.2788643e-16F) + 2.6269209e-15F) + 3.0342214e-14F) + 3.512943e-13F) + 4.0786246e-12F) + 4.7515127e-11F) + 5.558693e-10F) + 6.5376455e-09F) + 7.742584e-08F) + 9.2567154e-07F) + 1.1218692e-05F) + 1.0F/7200.0F) + 1.0F/560.0F) + 1.0F/40.0F) + 1.0F/2.0F;
-            c_K_1_lanes[k] = (1 - cos0)/(u1*u1);
+            const float w0 = (u1*u1);
+            c_K_across_lanes[k] = sin0/u0;
+            poly_K_across_lanes[k] = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
+            c_K_1_lanes[k] = (1 - cos0)/(u0*u0);
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (-sin0/u0 + (1.0F/8.0F)*w0*w1)/w1;
+            c_K_2_lanes[k] = (-sin0/u1 + (1.0F/8.0F)*w0/(sin0*sin0))/w0;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            const float poly_K_0 = poly_K_0_lanes[k];
-            const float v_K_0 = x < 4.619481F ? poly_K_0 : closed_K_0;
-            c_K_0_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            const float poly_K_across = poly_K_across_lanes[k];
+            const float v_K_across = x < 0.7648242F ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 2.6302226F ? poly_K_1 : closed_K_1;
@@ -2492,25 +2516,25 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_det_h_one_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0: Horner degree 8 in x below x = 2.63022, else 4*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 486 */
+ * ops: 488 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2520,35 +2544,37 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
         pdot[2] = NAN;
         return;
     }
-    float c_H_inverse_0, c_H_inverse_2;
-    if (x < 2.6302226F) {
-        c_H_inverse_0 = x*(x*(x*(x*(x*(x*(x*((-4.5696665e-11F)*x - 6.473543e-10F) - 9.509938e-09F) - 1.4686206e-07F) - 2.4402186e-06F) - 23.0F/504000.0F) - 3.0F/2800.0F) - 1.0F/20.0F) + 1;
+    float c_H_inverse_across, c_H_inverse_2;
+    if (x < 1.4342812F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-5.1788343e-09F)*x - 6.656956e-08F) - 8.811724e-07F) - 1.2201092e-05F) - 23.0F/126000.0F) - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 6*phi;
-        const float w4 = w1*cosf(w0);
-        const float w5 = cbrtf(w3 - 12*w4);
-        c_H_inverse_0 = 4*w2/(w5*w5);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*(-8*w2 + w3*w4 + powf(1 - 2*w2, 2) - 1)/(w2*(w5*w5*w5*w5));
+        const float w0 = sinf(phi);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 1.0F/w3;
+        const float w5 = 6*phi;
+        const float w6 = w2*cosf(w1);
+        c_H_inverse_across = (1.0F/4.0F)*w0*w4*cbrtf(6*phi - 6*w0);
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_det_h_one_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(4*sin(phi/2)**2)
+ * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 542 */
+ * ops: 511 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2558,29 +2584,29 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
         omega[2] = NAN;
         return;
     }
-    float c_H_0, c_H_1, c_H_2;
-    if (x < 2.6302226F) {
-        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
+    float c_H_across, c_H_1, c_H_2;
+    if (x < 1.4342812F) {
+        c_H_across = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 1.0F/w2;
-        const float w4 = w1*cosf(w0);
-        const float w5 = powf(cbrtf(6*phi - 12*w4), 2);
-        c_H_0 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1 : (1.0F/4.0F)*w3*w5;
-        c_H_1 = 2*w2/w5;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w3*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(phi - 2*w4);
+        const float w0 = sinf(phi);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = w2*cosf(w1);
+        c_H_across = w0/cbrtf(6*phi - 6*w0);
+        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w3/powf(cbrtf(6*phi - 12*w4), 2);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(w3*(phi - 2*w4));
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_det_h_one_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -2747,11 +2773,11 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 639 */
+ * ops: 611 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2770,25 +2796,24 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
         const float w1 = phi - w0;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = w3*cosf(w2);
-        const float w5 = cbrtf(6*phi - 12*w4);
-        const float w6 = (w3*w3);
-        const float w7 = 2*w6;
-        const float w8 = (1.0F/8.0F)/w6;
-        const float w9 = 2*w4;
-        c_R_1 = w0/cbrtf(6*w1);
-        c_R_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
+        const float w2 = cbrtf(6*w1);
+        const float w3 = (1.0F/2.0F)*phi;
+        const float w4 = sinf(w3);
+        const float w5 = (w4*w4);
+        const float w6 = (1.0F/8.0F)/w5;
+        const float w7 = w4*cosf(w3);
+        const float w8 = 2*w7;
+        c_R_1 = w0/w2;
+        c_R_2 = (1 - cosf(phi))/(w2*w2);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w6*(-2.0F/3.0F*w0*w5/w1 - 2*w5 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w6*(-8.0F/3.0F*(w4*w4*w4*w4)/(phi - w8) + w8)/cbrtf(6*phi - 12*w7);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2831,11 +2856,11 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 640 */
+ * ops: 612 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2854,25 +2879,24 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
         const float w1 = phi - w0;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = w3*cosf(w2);
-        const float w5 = cbrtf(6*phi - 12*w4);
-        const float w6 = (w3*w3);
-        const float w7 = 2*w6;
-        const float w8 = (1.0F/8.0F)/w6;
-        const float w9 = 2*w4;
-        c_R_1 = w0/cbrtf(6*w1);
-        c_R_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
+        const float w2 = cbrtf(6*w1);
+        const float w3 = (1.0F/2.0F)*phi;
+        const float w4 = sinf(w3);
+        const float w5 = (w4*w4);
+        const float w6 = (1.0F/8.0F)/w5;
+        const float w7 = w4*cosf(w3);
+        const float w8 = 2*w7;
+        c_R_1 = w0/w2;
+        c_R_2 = (1 - cosf(phi))/(w2*w2);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w6*(-2.0F/3.0F*w0*w5/w1 - 2*w5 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w6*(-8.0F/3.0F*(w4*w4*w4*w4)/(phi - w8) + w8)/cbrtf(6*phi - 12*w7);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];

@@ -102,7 +102,7 @@ static inline double symrot_euler_rodrigues_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1 = sqrt(d)/2 (algebraic in x)
  * R_2 = 1/2 (constant)
- * ops: 71 */
+ * ops: 64 */
 static inline void symrot_euler_rodrigues_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -120,15 +120,16 @@ static inline void symrot_euler_rodrigues_rotation_matrix(const double p[3], dou
         return;
     }
     const double c_R_1 = (1.0/2.0)*sqrt(d);
-    R[0] = -1.0/2.0*(p[1]*p[1]) - 1.0/2.0*(p[2]*p[2]) + 1;
+    const double t = 1 - 1.0/2.0*x;
+    R[0] = (1.0/2.0)*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + (1.0/2.0)*p[0]*p[1];
     R[2] = c_R_1*p[1] + (1.0/2.0)*p[0]*p[2];
     R[3] = c_R_1*p[2] + (1.0/2.0)*p[0]*p[1];
-    R[4] = -1.0/2.0*(p[0]*p[0]) - 1.0/2.0*(p[2]*p[2]) + 1;
+    R[4] = (1.0/2.0)*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + (1.0/2.0)*p[1]*p[2];
     R[6] = -c_R_1*p[1] + (1.0/2.0)*p[0]*p[2];
     R[7] = c_R_1*p[0] + (1.0/2.0)*p[1]*p[2];
-    R[8] = -1.0/2.0*(p[0]*p[0]) - 1.0/2.0*(p[1]*p[1]) + 1;
+    R[8] = (1.0/2.0)*(p[2]*p[2]) + t;
 }
 
 /* symrot_euler_rodrigues_rotation_matrix_batch: symrot_euler_rodrigues_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -174,26 +175,27 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_euler_rodrigues_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_0 = 2/sqrt(d) (algebraic in x)
+ * H_across = sqrt(d)/2 (algebraic in x)
  * H_1 = 1/2 (constant)
  * H_2 = 1/(2*sqrt(d)) (algebraic in x)
- * ops: 72 */
+ * ops: 66 */
 static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -210,28 +212,28 @@ static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9]
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 2/sqrt(d);
+    const double c_H_across = (1.0/2.0)*sqrt(d);
     const double c_H_2 = (1.0/2.0)/sqrt(d);
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = c_H_2*p[0]*p[1] - 1.0/2.0*p[2];
     H[2] = c_H_2*p[0]*p[2] + (1.0/2.0)*p[1];
     H[3] = c_H_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = c_H_2*p[1]*p[2] - 1.0/2.0*p[0];
     H[6] = c_H_2*p[0]*p[2] - 1.0/2.0*p[1];
     H[7] = c_H_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_euler_rodrigues_tangent_batch: symrot_euler_rodrigues_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -241,27 +243,32 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
             x_lanes[k] = x;
             if (!(x < 4.0)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const double d = symrot_euler_rodrigues__complement(pk, x);
-                const double u0 = 1.0/sqrt(d);
+                const double u0 = sqrt(d);
+                const double u1 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double u0 = u0_lanes[k];
-            c_H_0_lanes[k] = 2*u0;
-            c_H_2_lanes[k] = (1.0/2.0)*u0;
+            const double u1 = u1_lanes[k];
+            c_H_across_lanes[k] = (1.0/2.0)*u0;
+            c_H_2_lanes[k] = (1.0/2.0)*u1;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.0) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 4.0) ? (double)NAN : closed_H_across;
             c_H_1_lanes[k] = !(x < 4.0) ? (double)NAN : 1.0/2.0;
             const double closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 4.0) ? (double)NAN : closed_H_2;
@@ -269,22 +276,22 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_euler_rodrigues_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/2 (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 0 (constant)
  * ops: 38 */
@@ -304,16 +311,16 @@ static inline void symrot_euler_rodrigues_tangent_inverse(const double p[3], dou
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/2.0)*sqrt(d);
-    Hinv[0] = c_H_inverse_0;
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(d);
+    Hinv[0] = c_H_inverse_across;
     Hinv[1] = (1.0/2.0)*p[2];
     Hinv[2] = -1.0/2.0*p[1];
     Hinv[3] = -1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0;
+    Hinv[4] = c_H_inverse_across;
     Hinv[5] = (1.0/2.0)*p[0];
     Hinv[6] = (1.0/2.0)*p[1];
     Hinv[7] = -1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0;
+    Hinv[8] = c_H_inverse_across;
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_batch: symrot_euler_rodrigues_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -324,7 +331,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse(const double p[3], dou
  */
 static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -347,28 +354,28 @@ static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const 
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0/2.0)*u0;
+            c_H_inverse_across_lanes[k] = (1.0/2.0)*u0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.0) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 4.0) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 4.0) ? (double)NAN : -1.0/2.0;
             c_H_inverse_2_lanes[k] = !(x < 4.0) ? (double)NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -393,7 +400,7 @@ static inline double symrot_euler_rodrigues_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1 = 1/2 (constant)
  * G_2 = 1/(2*(sqrt(d) + 2)) (algebraic in x)
- * ops: 70 */
+ * ops: 66 */
 static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -411,15 +418,16 @@ static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double 
         return;
     }
     const double c_G_2 = (1.0/2.0)/(sqrt(d) + 2);
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = c_G_2*p[0]*p[1] - 1.0/2.0*p[2];
     G[2] = c_G_2*p[0]*p[2] + (1.0/2.0)*p[1];
     G[3] = c_G_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = c_G_2*p[1]*p[2] - 1.0/2.0*p[0];
     G[6] = c_G_2*p[0]*p[2] - 1.0/2.0*p[1];
     G[7] = c_G_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_euler_rodrigues_root_matrix_batch: symrot_euler_rodrigues_root_matrix for n vectors p[3*k..3*k+2] into
@@ -465,26 +473,27 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_euler_rodrigues_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * K_0 = 1/sqrt(d) (algebraic in x)
+ * K_across = 1/2 (constant)
  * K_1 = 1/(2*(sqrt(d) + 2)) (algebraic in x)
  * K_2: Horner degree 7 in x below x = 0.0346281, else 1/(4*sqrt(d)*(sqrt(d)/2 + 1))
- * ops: 96 */
+ * ops: 90 */
 static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -501,7 +510,6 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = 1.0/sqrt(d);
     const double c_K_1 = (1.0/2.0)/(sqrt(d) + 2);
     double c_K_2;
     if (x < 0.03462813501506714) {
@@ -510,26 +518,26 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
         const double w0 = sqrt(d);
         c_K_2 = (1.0/4.0)/(w0*((1.0/2.0)*w0 + 1));
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + 1.0/2.0;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + 1.0/2.0;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + 1.0/2.0;
 }
 
 /* symrot_euler_rodrigues_root_tangent_batch: symrot_euler_rodrigues_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d), u1 = sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -542,8 +550,8 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
                 u1_lanes[k] = 0;
             } else {
                 const double d = symrot_euler_rodrigues__complement(pk, x);
-                const double u0 = 1.0/sqrt(d);
-                const double u1 = sqrt(d);
+                const double u0 = sqrt(d);
+                const double u1 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -558,16 +566,14 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            c_K_0_lanes[k] = u0;
-            c_K_1_lanes[k] = (1.0/2.0)/(u1 + 2);
-            c_K_2_lanes[k] = (1.0/4.0)*u0/((1.0/2.0)*u1 + 1);
+            c_K_1_lanes[k] = (1.0/2.0)/(u0 + 2);
+            c_K_2_lanes[k] = (1.0/4.0)*u1/((1.0/2.0)*u0 + 1);
             poly_K_2_lanes[k] = (3.0/256.0)*x + 1.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.0) ? (double)NAN : closed_K_0;
+            c_K_across_lanes[k] = !(x < 4.0) ? (double)NAN : 1.0/2.0;
             const double closed_K_1 = c_K_1_lanes[k];
             c_K_1_lanes[k] = !(x < 4.0) ? (double)NAN : closed_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
@@ -578,22 +584,22 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_euler_rodrigues_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/2 (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 0 (constant)
  * ops: 47 */
@@ -607,21 +613,21 @@ static inline void symrot_euler_rodrigues_pdot(const double p[3], const double o
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/2.0)*sqrt(d);
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(d);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] - 1.0/2.0*w2;
+    pdot[0] = c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_euler_rodrigues_omega: omega = H pdot (eq 20).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_0 = 2/sqrt(d) (algebraic in x)
+ * H_across = sqrt(d)/2 (algebraic in x)
  * H_1 = 1/2 (constant)
  * H_2 = 1/(2*sqrt(d)) (algebraic in x)
- * ops: 66 */
+ * ops: 65 */
 static inline void symrot_euler_rodrigues_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -632,14 +638,15 @@ static inline void symrot_euler_rodrigues_omega(const double p[3], const double 
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 2/sqrt(d);
+    const double c_H_across = (1.0/2.0)*sqrt(d);
     const double c_H_2 = (1.0/2.0)/sqrt(d);
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_2*(p[1]*w2 - p[2]*w1) + (1.0/2.0)*w0;
-    omega[1] = c_H_0*pdot[1] + c_H_2*(-p[0]*w2 + p[2]*w0) + (1.0/2.0)*w1;
-    omega[2] = c_H_0*pdot[2] + c_H_2*(p[0]*w1 - p[1]*w0) + (1.0/2.0)*w2;
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_2*p[0]*p_dot_v + c_H_across*pdot[0] + (1.0/2.0)*w0;
+    omega[1] = c_H_2*p[1]*p_dot_v + c_H_across*pdot[1] + (1.0/2.0)*w1;
+    omega[2] = c_H_2*p[2]*p_dot_v + c_H_across*pdot[2] + (1.0/2.0)*w2;
 }
 
 /* symrot_euler_rodrigues_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1294,7 +1301,7 @@ static inline float symrot_euler_rodrigues_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = sqrt(d)/2 (algebraic in x)
  * R_2 = 1/2 (constant)
- * ops: 71 */
+ * ops: 64 */
 static inline void symrot_euler_rodrigues_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1312,15 +1319,16 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f(const float p[3], fl
         return;
     }
     const float c_R_1 = (1.0F/2.0F)*sqrtf(d);
-    R[0] = -1.0F/2.0F*(p[1]*p[1]) - 1.0F/2.0F*(p[2]*p[2]) + 1;
+    const float t = 1 - 1.0F/2.0F*x;
+    R[0] = (1.0F/2.0F)*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + (1.0F/2.0F)*p[0]*p[1];
     R[2] = c_R_1*p[1] + (1.0F/2.0F)*p[0]*p[2];
     R[3] = c_R_1*p[2] + (1.0F/2.0F)*p[0]*p[1];
-    R[4] = -1.0F/2.0F*(p[0]*p[0]) - 1.0F/2.0F*(p[2]*p[2]) + 1;
+    R[4] = (1.0F/2.0F)*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + (1.0F/2.0F)*p[1]*p[2];
     R[6] = -c_R_1*p[1] + (1.0F/2.0F)*p[0]*p[2];
     R[7] = c_R_1*p[0] + (1.0F/2.0F)*p[1]*p[2];
-    R[8] = -1.0F/2.0F*(p[0]*p[0]) - 1.0F/2.0F*(p[1]*p[1]) + 1;
+    R[8] = (1.0F/2.0F)*(p[2]*p[2]) + t;
 }
 
 /* symrot_euler_rodrigues_rotation_matrix_f_batch: symrot_euler_rodrigues_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1366,26 +1374,27 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_euler_rodrigues_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_0 = 2/sqrt(d) (algebraic in x)
+ * H_across = sqrt(d)/2 (algebraic in x)
  * H_1 = 1/2 (constant)
  * H_2 = 1/(2*sqrt(d)) (algebraic in x)
- * ops: 72 */
+ * ops: 66 */
 static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1402,28 +1411,28 @@ static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9]
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 2/sqrtf(d);
+    const float c_H_across = (1.0F/2.0F)*sqrtf(d);
     const float c_H_2 = (1.0F/2.0F)/sqrtf(d);
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = c_H_2*p[0]*p[1] - 1.0F/2.0F*p[2];
     H[2] = c_H_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     H[3] = c_H_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = c_H_2*p[1]*p[2] - 1.0F/2.0F*p[0];
     H[6] = c_H_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     H[7] = c_H_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_euler_rodrigues_tangent_f_batch: symrot_euler_rodrigues_tangent_f for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1433,27 +1442,32 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
             x_lanes[k] = x;
             if (!(x < 4.0F)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float d = symrot_euler_rodrigues__complement_f(pk, x);
-                const float u0 = 1.0F/sqrtf(d);
+                const float u0 = sqrtf(d);
+                const float u1 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
-            c_H_0_lanes[k] = 2*u0;
-            c_H_2_lanes[k] = (1.0F/2.0F)*u0;
+            const float u1 = u1_lanes[k];
+            c_H_across_lanes[k] = (1.0F/2.0F)*u0;
+            c_H_2_lanes[k] = (1.0F/2.0F)*u1;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.0F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 4.0F) ? NAN : closed_H_across;
             c_H_1_lanes[k] = !(x < 4.0F) ? NAN : 1.0F/2.0F;
             const float closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 4.0F) ? NAN : closed_H_2;
@@ -1461,22 +1475,22 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/2 (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 0 (constant)
  * ops: 38 */
@@ -1496,16 +1510,16 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f(const float p[3], fl
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/2.0F)*sqrtf(d);
-    Hinv[0] = c_H_inverse_0;
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(d);
+    Hinv[0] = c_H_inverse_across;
     Hinv[1] = (1.0F/2.0F)*p[2];
     Hinv[2] = -1.0F/2.0F*p[1];
     Hinv[3] = -1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0;
+    Hinv[4] = c_H_inverse_across;
     Hinv[5] = (1.0F/2.0F)*p[0];
     Hinv[6] = (1.0F/2.0F)*p[1];
     Hinv[7] = -1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0;
+    Hinv[8] = c_H_inverse_across;
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_f_batch: symrot_euler_rodrigues_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1516,7 +1530,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f(const float p[3], fl
  */
 static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1539,28 +1553,28 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, cons
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0F/2.0F)*u0;
+            c_H_inverse_across_lanes[k] = (1.0F/2.0F)*u0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.0F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 4.0F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 4.0F) ? NAN : -1.0F/2.0F;
             c_H_inverse_2_lanes[k] = !(x < 4.0F) ? NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1585,7 +1599,7 @@ static inline float symrot_euler_rodrigues_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1 = 1/2 (constant)
  * G_2 = 1/(2*(sqrt(d) + 2)) (algebraic in x)
- * ops: 70 */
+ * ops: 66 */
 static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1603,15 +1617,16 @@ static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float 
         return;
     }
     const float c_G_2 = (1.0F/2.0F)/(sqrtf(d) + 2);
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = c_G_2*p[0]*p[1] - 1.0F/2.0F*p[2];
     G[2] = c_G_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     G[3] = c_G_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = c_G_2*p[1]*p[2] - 1.0F/2.0F*p[0];
     G[6] = c_G_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     G[7] = c_G_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_euler_rodrigues_root_matrix_f_batch: symrot_euler_rodrigues_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1657,26 +1672,27 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_euler_rodrigues_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * K_0 = 1/sqrt(d) (algebraic in x)
+ * K_across = 1/2 (constant)
  * K_1 = 1/(2*(sqrt(d) + 2)) (algebraic in x)
  * K_2: Horner degree 7 in x below x = 0.41271, else 1/(4*sqrt(d)*(sqrt(d)/2 + 1))
- * ops: 96 */
+ * ops: 90 */
 static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1693,7 +1709,6 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 1.0F/sqrtf(d);
     const float c_K_1 = (1.0F/2.0F)/(sqrtf(d) + 2);
     float c_K_2;
     if (x < 0.4127098F) {
@@ -1702,26 +1717,26 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
         const float w0 = sqrtf(d);
         c_K_2 = (1.0F/4.0F)/(w0*((1.0F/2.0F)*w0 + 1));
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + 1.0F/2.0F;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + 1.0F/2.0F;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + 1.0F/2.0F;
 }
 
 /* symrot_euler_rodrigues_root_tangent_f_batch: symrot_euler_rodrigues_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d), u1 = sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1734,8 +1749,8 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
                 u1_lanes[k] = 0;
             } else {
                 const float d = symrot_euler_rodrigues__complement_f(pk, x);
-                const float u0 = 1.0F/sqrtf(d);
-                const float u1 = sqrtf(d);
+                const float u0 = sqrtf(d);
+                const float u1 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -1749,16 +1764,14 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            c_K_0_lanes[k] = u0;
-            c_K_1_lanes[k] = (1.0F/2.0F)/(u1 + 2);
-            c_K_2_lanes[k] = (1.0F/4.0F)*u0/((1.0F/2.0F)*u1 + 1);
+            c_K_1_lanes[k] = (1.0F/2.0F)/(u0 + 2);
+            c_K_2_lanes[k] = (1.0F/4.0F)*u1/((1.0F/2.0F)*u0 + 1);
             poly_K_2_lanes[k] = 1.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.0F) ? NAN : closed_K_0;
+            c_K_across_lanes[k] = !(x < 4.0F) ? NAN : 1.0F/2.0F;
             const float closed_K_1 = c_K_1_lanes[k];
             c_K_1_lanes[k] = !(x < 4.0F) ? NAN : closed_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
@@ -1769,22 +1782,22 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_euler_rodrigues_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/2 (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 0 (constant)
  * ops: 47 */
@@ -1798,21 +1811,21 @@ static inline void symrot_euler_rodrigues_pdot_f(const float p[3], const float o
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/2.0F)*sqrtf(d);
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(d);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] - 1.0F/2.0F*w2;
+    pdot[0] = c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_euler_rodrigues_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
- * H_0 = 2/sqrt(d) (algebraic in x)
+ * H_across = sqrt(d)/2 (algebraic in x)
  * H_1 = 1/2 (constant)
  * H_2 = 1/(2*sqrt(d)) (algebraic in x)
- * ops: 66 */
+ * ops: 65 */
 static inline void symrot_euler_rodrigues_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1823,14 +1836,15 @@ static inline void symrot_euler_rodrigues_omega_f(const float p[3], const float 
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 2/sqrtf(d);
+    const float c_H_across = (1.0F/2.0F)*sqrtf(d);
     const float c_H_2 = (1.0F/2.0F)/sqrtf(d);
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_2*(p[1]*w2 - p[2]*w1) + (1.0F/2.0F)*w0;
-    omega[1] = c_H_0*pdot[1] + c_H_2*(-p[0]*w2 + p[2]*w0) + (1.0F/2.0F)*w1;
-    omega[2] = c_H_0*pdot[2] + c_H_2*(p[0]*w1 - p[1]*w0) + (1.0F/2.0F)*w2;
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_2*p[0]*p_dot_v + c_H_across*pdot[0] + (1.0F/2.0F)*w0;
+    omega[1] = c_H_2*p[1]*p_dot_v + c_H_across*pdot[1] + (1.0F/2.0F)*w1;
+    omega[2] = c_H_2*p[2]*p_dot_v + c_H_across*pdot[2] + (1.0F/2.0F)*w2;
 }
 
 /* symrot_euler_rodrigues_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

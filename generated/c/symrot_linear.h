@@ -102,7 +102,7 @@ static inline double symrot_linear_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1 = 1 (constant)
  * R_2 = 1/(sqrt(d) + 1) (algebraic in x)
- * ops: 63 */
+ * ops: 59 */
 static inline void symrot_linear_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -120,15 +120,16 @@ static inline void symrot_linear_rotation_matrix(const double p[3], double R[9])
         return;
     }
     const double c_R_2 = 1.0/(sqrt(d) + 1);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = c_R_2*p[0]*p[1] - p[2];
     R[2] = c_R_2*p[0]*p[2] + p[1];
     R[3] = c_R_2*p[0]*p[1] + p[2];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = c_R_2*p[1]*p[2] - p[0];
     R[6] = c_R_2*p[0]*p[2] - p[1];
     R[7] = c_R_2*p[1]*p[2] + p[0];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_linear_rotation_matrix_batch: symrot_linear_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -174,26 +175,27 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_linear_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_across = 1 (constant)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
  * H_2: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 95 */
+ * ops: 86 */
 static inline void symrot_linear_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -210,7 +212,6 @@ static inline void symrot_linear_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 1.0/sqrt(d);
     const double c_H_1 = 1.0/(sqrt(d) + 1);
     double c_H_2;
     if (x < 0.005951203046330052) {
@@ -219,26 +220,26 @@ static inline void symrot_linear_tangent(const double p[3], double H[9])
         const double w0 = sqrt(d);
         c_H_2 = 1/(w0*(w0 + 1));
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + 1;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + 1;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + 1;
 }
 
 /* symrot_linear_tangent_batch: symrot_linear_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d), u1 = sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_linear_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -251,8 +252,8 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
                 u1_lanes[k] = 0;
             } else {
                 const double d = symrot_linear__complement(pk, x);
-                const double u0 = 1.0/sqrt(d);
-                const double u1 = sqrt(d);
+                const double u0 = sqrt(d);
+                const double u1 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -267,17 +268,15 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double w0 = 1.0/(u1 + 1);
-            c_H_0_lanes[k] = u0;
+            const double w0 = 1.0/(u0 + 1);
             c_H_1_lanes[k] = w0;
-            c_H_2_lanes[k] = u0*w0;
+            c_H_2_lanes[k] = u1*w0;
             poly_H_2_lanes[k] = (3.0/8.0)*x + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_0;
+            c_H_across_lanes[k] = !(x < 1.0) ? (double)NAN : 1;
             const double closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
@@ -288,25 +287,25 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_linear_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d) (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 + 1/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
- * ops: 73 */
+ * ops: 70 */
 static inline void symrot_linear_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -323,17 +322,17 @@ static inline void symrot_linear_tangent_inverse(const double p[3], double Hinv[
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = sqrt(d);
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(d) + 1.0/2.0;
     const double c_H_inverse_2 = -(1.0/2.0)/(sqrt(d) + 1);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_linear_tangent_inverse_batch: symrot_linear_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -344,7 +343,7 @@ static inline void symrot_linear_tangent_inverse(const double p[3], double Hinv[
  */
 static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -367,14 +366,14 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = u0;
+            c_H_inverse_across_lanes[k] = (1.0/2.0)*u0 + 1.0/2.0;
             c_H_inverse_2_lanes[k] = -(1.0/2.0)/(u0 + 1);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 1.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 1.0) ? (double)NAN : closed_H_inverse_2;
@@ -382,15 +381,15 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -421,7 +420,7 @@ static inline double symrot_linear_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
  * G_2: Horner degree 15 in x below x = 0.116472, else 2*sin(phi/4)**2/x
- * ops: 121 */
+ * ops: 117 */
 static inline void symrot_linear_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -446,15 +445,16 @@ static inline void symrot_linear_root_matrix(const double p[3], double G[9])
         const double phi = symrot_linear__phi(sqrt(x), d);
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_linear_root_matrix_batch: symrot_linear_root_matrix for n vectors p[3*k..3*k+2] into
@@ -523,26 +523,27 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_linear_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * K_0 = 1/(2*sqrt(d)) (algebraic in x)
+ * K_across = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
  * K_1: Horner degree 15 in x below x = 0.116472, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 16 in x below x = 0.116472, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/x
- * ops: 165 */
+ * ops: 164 */
 static inline void symrot_linear_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -559,7 +560,7 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = (1.0/2.0)/sqrt(d);
+    const double c_K_across = (1.0/2.0)*sqrt(2)/sqrt(sqrt(d) + 1);
     double c_K_1, c_K_2;
     if (x < 0.116472206314816) {
         c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
@@ -570,27 +571,27 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
         c_K_2 = w0*(-(1.0/2.0)/cos((1.0/2.0)*phi) + (1.0/2.0)/sqrt(d));
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_linear_root_tangent_batch: symrot_linear_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(d).
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(d) + 1), u1 = 1/sqrt(d).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -601,25 +602,30 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             if (!(x < 1.0)) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const double d = symrot_linear__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_linear__phi(s, d);
-                const double u0 = 1.0/sqrt(d);
+                const double u0 = 1.0/sqrt(sqrt(d) + 1);
+                const double u1 = 1.0/sqrt(d);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -641,19 +647,18 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             const double a1_odd = a1_j - 2*a1_h;
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double w0 = (1.0/2.0)*u0;
-            const double w1 = 1.0/x;
-            c_K_0_lanes[k] = w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
+            const double w0 = 1.0/x;
+            c_K_across_lanes[k] = 0.7071067811865476*u0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
-            c_K_2_lanes[k] = w1*(w0 - (1.0/2.0)/cos1);
+            c_K_2_lanes[k] = w0*((1.0/2.0)*u1 - (1.0/2.0)/cos1);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06653969900370939)*x + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 1.0) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 1.0) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 0.116472206314816 ? poly_K_1 : closed_K_1;
@@ -666,25 +671,25 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_linear_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d) (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 + 1/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
- * ops: 67 */
+ * ops: 69 */
 static inline void symrot_linear_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -695,22 +700,23 @@ static inline void symrot_linear_pdot(const double p[3], const double omega[3], 
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = sqrt(d);
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(d) + 1.0/2.0;
     const double c_H_inverse_2 = -(1.0/2.0)/(sqrt(d) + 1);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_linear_omega: omega = H pdot (eq 20).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_across = 1 (constant)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
  * H_2: Horner degree 7 in x below x = 0.0059512, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 89 */
+ * ops: 82 */
 static inline void symrot_linear_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -721,7 +727,6 @@ static inline void symrot_linear_omega(const double p[3], const double pdot[3], 
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 1.0/sqrt(d);
     const double c_H_1 = 1.0/(sqrt(d) + 1);
     double c_H_2;
     if (x < 0.005951203046330052) {
@@ -733,9 +738,10 @@ static inline void symrot_linear_omega(const double p[3], const double pdot[3], 
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + pdot[2];
 }
 
 /* symrot_linear_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1459,7 +1465,7 @@ static inline float symrot_linear_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = 1 (constant)
  * R_2 = 1/(sqrt(d) + 1) (algebraic in x)
- * ops: 63 */
+ * ops: 59 */
 static inline void symrot_linear_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1477,15 +1483,16 @@ static inline void symrot_linear_rotation_matrix_f(const float p[3], float R[9])
         return;
     }
     const float c_R_2 = 1.0F/(sqrtf(d) + 1);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = c_R_2*p[0]*p[1] - p[2];
     R[2] = c_R_2*p[0]*p[2] + p[1];
     R[3] = c_R_2*p[0]*p[1] + p[2];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = c_R_2*p[1]*p[2] - p[0];
     R[6] = c_R_2*p[0]*p[2] - p[1];
     R[7] = c_R_2*p[1]*p[2] + p[0];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_linear_rotation_matrix_f_batch: symrot_linear_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1531,26 +1538,27 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_linear_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_across = 1 (constant)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
  * H_2: Horner degree 7 in x below x = 0.116472, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 95 */
+ * ops: 86 */
 static inline void symrot_linear_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1567,7 +1575,6 @@ static inline void symrot_linear_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 1.0F/sqrtf(d);
     const float c_H_1 = 1.0F/(sqrtf(d) + 1);
     float c_H_2;
     if (x < 0.11647221F) {
@@ -1576,26 +1583,26 @@ static inline void symrot_linear_tangent_f(const float p[3], float H[9])
         const float w0 = sqrtf(d);
         c_H_2 = 1/(w0*(w0 + 1));
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + 1;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + 1;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + 1;
 }
 
 /* symrot_linear_tangent_f_batch: symrot_linear_tangent_f for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d), u1 = sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1608,8 +1615,8 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
                 u1_lanes[k] = 0;
             } else {
                 const float d = symrot_linear__complement_f(pk, x);
-                const float u0 = 1.0F/sqrtf(d);
-                const float u1 = sqrtf(d);
+                const float u0 = sqrtf(d);
+                const float u1 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -1623,17 +1630,15 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float w0 = 1.0F/(u1 + 1);
-            c_H_0_lanes[k] = u0;
+            const float w0 = 1.0F/(u0 + 1);
             c_H_1_lanes[k] = w0;
-            c_H_2_lanes[k] = u0*w0;
+            c_H_2_lanes[k] = u1*w0;
             poly_H_2_lanes[k] = 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 1.0F) ? NAN : closed_H_0;
+            c_H_across_lanes[k] = !(x < 1.0F) ? NAN : 1;
             const float closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 1.0F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
@@ -1644,25 +1649,25 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_linear_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d) (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 + 1/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
- * ops: 73 */
+ * ops: 70 */
 static inline void symrot_linear_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1679,17 +1684,17 @@ static inline void symrot_linear_tangent_inverse_f(const float p[3], float Hinv[
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = sqrtf(d);
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(d) + 1.0F/2.0F;
     const float c_H_inverse_2 = -(1.0F/2.0F)/(sqrtf(d) + 1);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_linear_tangent_inverse_f_batch: symrot_linear_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1700,7 +1705,7 @@ static inline void symrot_linear_tangent_inverse_f(const float p[3], float Hinv[
  */
 static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1723,14 +1728,14 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = u0;
+            c_H_inverse_across_lanes[k] = (1.0F/2.0F)*u0 + 1.0F/2.0F;
             c_H_inverse_2_lanes[k] = -(1.0F/2.0F)/(u0 + 1);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 1.0F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 1.0F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 1.0F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 1.0F) ? NAN : closed_H_inverse_2;
@@ -1738,15 +1743,15 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1777,7 +1782,7 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
  * G_2: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/x
- * ops: 94 */
+ * ops: 90 */
 static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1802,15 +1807,16 @@ static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
         const float phi = symrot_linear__phi_f(sqrtf(x), d);
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_linear_root_matrix_f_batch: symrot_linear_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1879,26 +1885,27 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_linear_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * K_0 = 1/(2*sqrt(d)) (algebraic in x)
+ * K_across = sqrt(2)/(2*sqrt(sqrt(d) + 1)) (algebraic in x)
  * K_1: Horner degree 6 in x below x = 0.116472, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 15 in x below x = 0.35302, else (-1/(2*cos(phi/2)) + 1/(2*sqrt(d)))/(4*sin(phi/2)**2*cos(phi/2)**2)
- * ops: 135 */
+ * ops: 134 */
 static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1915,7 +1922,7 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (1.0F/2.0F)/sqrtf(d);
+    const float c_K_across = (1.0F/2.0F)*sqrtf(2)/sqrtf(sqrtf(d) + 1);
     float c_K_1, c_K_2;
     if (x < 0.11647221F) {
         c_K_1 = x*(x*(x*(x*(x*((0.0055350363F)*x + 29393.0F/4194304.0F) + 2431.0F/262144.0F) + 429.0F/32768.0F) + 21.0F/1024.0F) + 5.0F/128.0F) + 1.0F/8.0F;
@@ -1927,27 +1934,27 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = x < 0.35302037F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F : (1.0F/4.0F)*(-(1.0F/2.0F)/w1 + (1.0F/2.0F)/sqrtf(d))/((w1*w1)*powf(sinf(w0), 2));
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_linear_root_tangent_f_batch: symrot_linear_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(d).
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(d) + 1), u1 = 1/sqrt(d).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1958,25 +1965,30 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             if (!(x < 1.0F)) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float d = symrot_linear__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_linear__phi_f(s, d);
-                const float u0 = 1.0F/sqrtf(d);
+                const float u0 = 1.0F/sqrtf(sqrtf(d) + 1);
+                const float u1 = 1.0F/sqrtf(d);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1999,18 +2011,17 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float w0 = (1.0F/2.0F)*u0;
-            c_K_0_lanes[k] = w0;
+            c_K_across_lanes[k] = 0.70710677F*u0;
             c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = (5.0F/128.0F)*x + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/4.0F)*(w0 - (1.0F/2.0F)/cos1)/((cos1*cos1)*(sin1*sin1));
+            c_K_2_lanes[k] = (1.0F/4.0F)*((1.0F/2.0F)*u1 - (1.0F/2.0F)/cos1)/((cos1*cos1)*(sin1*sin1));
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 1.0F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 1.0F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 7.888951e-06F ? poly_K_1 : closed_K_1;
@@ -2023,25 +2034,25 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_linear_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d) (algebraic in x)
+ * H_inverse_across = sqrt(d)/2 + 1/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -1/(2*(sqrt(d) + 1)) (algebraic in x)
- * ops: 67 */
+ * ops: 69 */
 static inline void symrot_linear_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2052,22 +2063,23 @@ static inline void symrot_linear_pdot_f(const float p[3], const float omega[3], 
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = sqrtf(d);
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(d) + 1.0F/2.0F;
     const float c_H_inverse_2 = -(1.0F/2.0F)/(sqrtf(d) + 1);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_linear_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
- * H_0 = 1/sqrt(d) (algebraic in x)
+ * H_across = 1 (constant)
  * H_1 = 1/(sqrt(d) + 1) (algebraic in x)
  * H_2: Horner degree 7 in x below x = 0.116472, else 1/(sqrt(d)*(sqrt(d) + 1))
- * ops: 89 */
+ * ops: 82 */
 static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2078,7 +2090,6 @@ static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], 
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 1.0F/sqrtf(d);
     const float c_H_1 = 1.0F/(sqrtf(d) + 1);
     float c_H_2;
     if (x < 0.11647221F) {
@@ -2090,9 +2101,10 @@ static inline void symrot_linear_omega_f(const float p[3], const float pdot[3], 
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + pdot[2];
 }
 
 /* symrot_linear_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

@@ -77,7 +77,7 @@ static inline double symrot_rotation_vector_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.408665, else 2*sin(phi/2)*cos(phi/2)/phi
  * R_2: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * ops: 89 */
+ * ops: 85 */
 static inline void symrot_rotation_vector_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -104,15 +104,16 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
         c_R_1 = 2*w1*cos(w0)/phi;
         c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*(w1*w1)/(phi*phi);
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_rotation_matrix_batch: symrot_rotation_vector_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -180,16 +181,17 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -199,7 +201,7 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
  * H_0 = 1 (constant)
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
  * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
- * ops: 90 */
+ * ops: 86 */
 static inline void symrot_rotation_vector_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -224,15 +226,16 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
         c_H_2 = -(-phi + sin(phi))/(phi*phi*phi);
     }
-    H[0] = -c_H_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_H_2*x + 1;
+    H[0] = c_H_2*(p[0]*p[0]) + t;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = -c_H_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    H[4] = c_H_2*(p[1]*p[1]) + t;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = -c_H_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    H[8] = c_H_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_tangent_batch: symrot_rotation_vector_tangent for n vectors p[3*k..3*k+2] into
@@ -308,16 +311,17 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_H_0_lanes[k] - c_H_2_lanes[k]*x_lanes[k];
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -327,7 +331,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 18 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
- * ops: 101 */
+ * ops: 97 */
 static inline void symrot_rotation_vector_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -351,15 +355,16 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
         const double w0 = (1.0/2.0)*phi;
         c_H_inverse_2 = (-w0*cos(w0)/sin(w0) + 1)/(phi*phi);
     }
-    Hinv[0] = -c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_H_inverse_2*x + 1;
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + t;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = -c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + t;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = -c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_tangent_inverse_batch: symrot_rotation_vector_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -422,16 +427,17 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*x_lanes[k];
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -460,8 +466,8 @@ static inline double symrot_rotation_vector_tangent_det(const double p[3])
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 1.50837, else sin(phi/2)/phi
- * G_2: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
- * ops: 90 */
+ * G_2: Horner degree 7 in x below x = 2.89787, else 2*sin(phi/4)**2/phi**2
+ * ops: 86 */
 static inline void symrot_rotation_vector_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -483,19 +489,19 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
         c_G_2 = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        c_G_1 = sin(w0)/phi;
-        c_G_2 = x < 2.897865491219683 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : (1 - cos(w0))/(phi*phi);
+        c_G_1 = sin((1.0/2.0)*phi)/phi;
+        c_G_2 = x < 2.897865491219683 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_root_matrix_batch: symrot_rotation_vector_root_matrix for n vectors p[3*k..3*k+2] into
@@ -541,12 +547,20 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/phi;
             poly_G_1_lanes[k] = 1.0/2.0 + (-1.0/48.0)*x;
-            c_G_2_lanes[k] = (1 - cos0)/(phi*phi);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/(phi*phi);
+            poly_G_2_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -558,21 +572,22 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             c_G_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 1.5083706105984371 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 1.8559287093218047e-12 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -580,9 +595,9 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
 /* symrot_rotation_vector_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
- * K_1: Horner degree 7 in x below x = 2.89787, else (1 - cos(phi/2))/phi**2
+ * K_1: Horner degree 7 in x below x = 2.89787, else 2*sin(phi/4)**2/phi**2
  * K_2: Horner degree 8 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
- * ops: 95 */
+ * ops: 89 */
 static inline void symrot_rotation_vector_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -604,19 +619,19 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         c_K_2 = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        c_K_1 = (1 - cos(w0))/(phi*phi);
-        c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin(w0))/(phi*phi*phi);
+        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
+        c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
     }
-    K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0/2.0;
+    const double t = -c_K_2*x + 1.0/2.0;
+    K[0] = c_K_2*(p[0]*p[0]) + t;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = -c_K_2*((p[0]*p[0]) + (p[2]*p[2])) + 1.0/2.0;
+    K[4] = c_K_2*(p[1]*p[1]) + t;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = -c_K_2*((p[0]*p[0]) + (p[1]*p[1])) + 1.0/2.0;
+    K[8] = c_K_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_root_tangent_batch: symrot_rotation_vector_root_tangent for n vectors p[3*k..3*k+2] into
@@ -636,7 +651,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 39.47841760435743) || x < 1.5083706105984371) {
+            if (!(x <= 39.47841760435743) || x < 1.8559287093218047e-12) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -652,7 +667,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -662,11 +677,19 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_K_1_lanes[k] = (1 - cos0)/(phi*phi);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0;
-            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin0)/(phi*phi*phi);
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
+            poly_K_1_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
+            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin1)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -675,7 +698,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             c_K_0_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : 1.0/2.0;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 1.5083706105984371 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 1.8559287093218047e-12 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -684,16 +707,17 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_K_0_lanes[k] - c_K_2_lanes[k]*x_lanes[k];
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -703,7 +727,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 18 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
- * ops: 92 */
+ * ops: 96 */
 static inline void symrot_rotation_vector_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -721,12 +745,14 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
         const double w0 = (1.0/2.0)*phi;
         c_H_inverse_2 = (-w0*cos(w0)/sin(w0) + 1)/(phi*phi);
     }
+    const double t = -c_H_inverse_2*x + 1;
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_2*(p[1]*w2 - p[2]*w1) + omega[0] - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_2*(-p[0]*w2 + p[2]*w0) + omega[1] - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_2*(p[0]*w1 - p[1]*w0) + omega[2] - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + omega[0]*t - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + omega[1]*t - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + omega[2]*t - 1.0/2.0*w2;
 }
 
 /* symrot_rotation_vector_omega: omega = H pdot (eq 20).
@@ -734,7 +760,7 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
  * H_0 = 1 (constant)
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
  * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
- * ops: 81 */
+ * ops: 85 */
 static inline void symrot_rotation_vector_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -753,12 +779,14 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
         c_H_2 = -(-phi + sin(phi))/(phi*phi*phi);
     }
+    const double t = -c_H_2*x + 1;
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1) + pdot[0];
-    omega[1] = c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0) + pdot[1];
-    omega[2] = c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0) + pdot[2];
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + pdot[0]*t;
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + pdot[1]*t;
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + pdot[2]*t;
 }
 
 /* symrot_rotation_vector_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1513,7 +1541,7 @@ static inline float symrot_rotation_vector_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 5.56735, else 2*sin(phi/2)*cos(phi/2)/phi
  * R_2: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * ops: 85 */
+ * ops: 81 */
 static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1540,15 +1568,16 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
         c_R_1 = 2*w1*cosf(w0)/phi;
         c_R_2 = 2*(w1*w1)/(phi*phi);
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_rotation_matrix_f_batch: symrot_rotation_vector_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1615,16 +1644,17 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1634,7 +1664,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
  * H_0 = 1 (constant)
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
  * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
- * ops: 82 */
+ * ops: 78 */
 static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1659,15 +1689,16 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
         c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
         c_H_2 = -(-phi + sinf(phi))/(phi*phi*phi);
     }
-    H[0] = -c_H_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_H_2*x + 1;
+    H[0] = c_H_2*(p[0]*p[0]) + t;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = -c_H_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    H[4] = c_H_2*(p[1]*p[1]) + t;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = -c_H_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    H[8] = c_H_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_tangent_f_batch: symrot_rotation_vector_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1743,16 +1774,17 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_H_0_lanes[k] - c_H_2_lanes[k]*x_lanes[k];
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1762,7 +1794,7 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 8 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
- * ops: 71 */
+ * ops: 67 */
 static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1786,15 +1818,16 @@ static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], fl
         const float w0 = (1.0F/2.0F)*phi;
         c_H_inverse_2 = (-w0*cosf(w0)/sinf(w0) + 1)/(phi*phi);
     }
-    Hinv[0] = -c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_H_inverse_2*x + 1;
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + t;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = -c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + t;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = -c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_tangent_inverse_f_batch: symrot_rotation_vector_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1857,16 +1890,17 @@ static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, cons
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*x_lanes[k];
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1896,7 +1930,7 @@ static inline float symrot_rotation_vector_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 5 in x below x = 5.56735, else sin(phi/2)/phi
  * G_2: Horner degree 4 in x below x = 5.56735, else 2*sin(phi/4)**2/phi**2
- * ops: 74 */
+ * ops: 70 */
 static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1921,15 +1955,16 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
         c_G_1 = sinf((1.0F/2.0F)*phi)/phi;
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_root_matrix_f_batch: symrot_rotation_vector_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2004,16 +2039,17 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -2023,7 +2059,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
  * K_0 = 1/2 (constant)
  * K_1: Horner degree 4 in x below x = 5.56735, else 2*sin(phi/4)**2/phi**2
  * K_2: Horner degree 4 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
- * ops: 73 */
+ * ops: 67 */
 static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2048,15 +2084,16 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
         c_K_2 = -1.0F/2.0F*(-phi + 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
     }
-    K[0] = -c_K_2*((p[1]*p[1]) + (p[2]*p[2])) + 1.0F/2.0F;
+    const float t = -c_K_2*x + 1.0F/2.0F;
+    K[0] = c_K_2*(p[0]*p[0]) + t;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = -c_K_2*((p[0]*p[0]) + (p[2]*p[2])) + 1.0F/2.0F;
+    K[4] = c_K_2*(p[1]*p[1]) + t;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = -c_K_2*((p[0]*p[0]) + (p[1]*p[1])) + 1.0F/2.0F;
+    K[8] = c_K_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_rotation_vector_root_tangent_f_batch: symrot_rotation_vector_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2132,16 +2169,17 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_K_0_lanes[k] - c_K_2_lanes[k]*x_lanes[k];
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -2151,7 +2189,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
  * H_inverse_0 = 1 (constant)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 8 in x below x = 5.56735, else (-phi*cos(phi/2)/(2*sin(phi/2)) + 1)/phi**2
- * ops: 62 */
+ * ops: 66 */
 static inline void symrot_rotation_vector_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2169,12 +2207,14 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
         const float w0 = (1.0F/2.0F)*phi;
         c_H_inverse_2 = (-w0*cosf(w0)/sinf(w0) + 1)/(phi*phi);
     }
+    const float t = -c_H_inverse_2*x + 1;
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_2*(p[1]*w2 - p[2]*w1) + omega[0] - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_2*(-p[0]*w2 + p[2]*w0) + omega[1] - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_2*(p[0]*w1 - p[1]*w0) + omega[2] - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + omega[0]*t - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + omega[1]*t - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + omega[2]*t - 1.0F/2.0F*w2;
 }
 
 /* symrot_rotation_vector_omega_f: omega = H pdot (eq 20).
@@ -2182,7 +2222,7 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
  * H_0 = 1 (constant)
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
  * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
- * ops: 73 */
+ * ops: 77 */
 static inline void symrot_rotation_vector_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2201,12 +2241,14 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
         c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
         c_H_2 = -(-phi + sinf(phi))/(phi*phi*phi);
     }
+    const float t = -c_H_2*x + 1;
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1) + pdot[0];
-    omega[1] = c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0) + pdot[1];
-    omega[2] = c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0) + pdot[2];
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + pdot[0]*t;
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + pdot[1]*t;
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + pdot[2]*t;
 }
 
 /* symrot_rotation_vector_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

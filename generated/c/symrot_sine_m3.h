@@ -102,7 +102,7 @@ static inline double symrot_sine_m3_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
- * ops: 92 */
+ * ops: 88 */
 static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -127,15 +127,16 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m3_rotation_matrix_batch: symrot_sine_m3_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -199,26 +200,27 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_across = -(4*x - 27)/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
- * ops: 117 */
+ * ops: 111 */
 static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -235,7 +237,7 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 3/sqrt(d);
+    const double c_H_across = 1 - 4.0/27.0*x;
     double c_H_1, c_H_2;
     if (x < 0.1294709423110197) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
@@ -247,15 +249,15 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
         c_H_1 = w0*w1;
         c_H_2 = w0*(w1 + 4*pow(sin((1.0/6.0)*phi), 2))/sqrt(d);
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m3_tangent_batch: symrot_sine_m3_tangent for n vectors p[3*k..3*k+2] into
@@ -267,7 +269,7 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
  */
 static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -275,7 +277,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0)) {
+            if (!(x < 9.0) || x < 0.1294709423110197) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
@@ -319,7 +321,7 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = 1.0/x;
             const double w1 = 2*(sin0*sin0);
-            c_H_0_lanes[k] = 3*u0;
+            c_H_across_lanes[k] = 1 - 4.0/27.0*x;
             c_H_1_lanes[k] = w0*w1;
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + w1);
@@ -328,8 +330,8 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 9.0) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 9.0) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.1294709423110197 ? poly_H_1 : closed_H_1;
@@ -342,25 +344,25 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m3_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/3 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.0682556, else sqrt(d)/3 + x*(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
- * ops: 80 */
+ * ops: 94 */
 static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -377,17 +379,23 @@ static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/3.0)*sqrt(d);
     const double c_H_inverse_2 = -1.0/6.0*(2*sqrt(d) + 9)/(-9*sqrt(d) + 2*x - 27);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    double c_H_inverse_across;
+    if (x < 0.06825555929208893) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-462875.0/42845606719488.0)*x - 94765.0/793437161472.0) - 10069.0/7346640384.0) - 2261.0/136048896.0) - 139.0/629856.0) - 41.0/11664.0) - 11.0/108.0) + 1;
+    } else {
+        const double w0 = sqrt(d);
+        c_H_inverse_across = (1.0/3.0)*w0 + (1.0/6.0)*x*(2*w0 + 9)/(-9*w0 + 2*x - 27);
+    }
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m3_tangent_inverse_batch: symrot_sine_m3_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -398,7 +406,7 @@ static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv
  */
 static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -422,14 +430,18 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0/3.0)*u0;
-            c_H_inverse_2_lanes[k] = -1.0/6.0*(2*u0 + 9)/(-9*u0 + 2*x - 27);
+            const double w0 = (1.0/6.0)*(2*u0 + 9)/(-9*u0 + 2*x - 27);
+            c_H_inverse_across_lanes[k] = (1.0/3.0)*u0 + w0*x;
+            poly_H_inverse_across_lanes[k] = 1 + (-11.0/108.0)*x;
+            c_H_inverse_2_lanes[k] = -w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 9.0) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const double v_H_inverse_across = x < 1.9011961863057287e-14 ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 9.0) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 9.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.0) ? (double)NAN : closed_H_inverse_2;
@@ -437,15 +449,15 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -476,7 +488,7 @@ static inline double symrot_sine_m3_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.129471, else sin(phi/2)/s
  * G_2: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/x
- * ops: 129 */
+ * ops: 125 */
 static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -503,15 +515,16 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
         c_G_1 = sin((1.0/2.0)*phi)/s;
         c_G_2 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m3_root_matrix_batch: symrot_sine_m3_root_matrix for n vectors p[3*k..3*k+2] into
@@ -592,26 +605,27 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m3_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/(2*sqrt(d)) (algebraic in x)
+ * K_across: Horner degree 7 in x below x = 0.129471, else sin(phi/2)/s
  * K_1: Horner degree 13 in x below x = 0.864806, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 20 in x below x = 1.59536, else (-6*sin(phi/2)/s + 9/sqrt(d))/(6*s**2)
- * ops: 171 */
+ * ops: 184 */
 static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -628,26 +642,28 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = (3.0/2.0)/sqrt(d);
-    double c_K_1, c_K_2;
-    if (x < 0.8648056668462011) {
+    double c_K_across, c_K_1, c_K_2;
+    if (x < 0.1294709423110197) {
+        c_K_across = x*(x*(x*(x*(x*(x*((-1077205.0/962938848411648.0)*x - 56525.0/4458050224128.0) - 1547.0/10319560704.0) - 2431.0/1289945088.0) - 13.0/497664.0) - 1.0/2304.0) - 5.0/432.0) + 1.0/2.0;
         c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
         const double s = sqrt(x);
-        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
-        c_K_2 = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*(-6*sin((1.0/2.0)*phi)/s + 9/sqrt(d))/(s*s);
+        const double w0 = sin((1.0/2.0)*phi)/s;
+        c_K_across = w0;
+        c_K_1 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
+        c_K_2 = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*(-6*w0 + 9/sqrt(d))/(s*s);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m3_root_tangent_batch: symrot_sine_m3_root_tangent for n vectors p[3*k..3*k+2] into
@@ -659,7 +675,7 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
  */
 static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -667,7 +683,7 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0)) {
+            if (!(x < 9.0) || x < 1.9011961863057287e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
@@ -693,7 +709,7 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -703,7 +719,7 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = (1.0/4.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -713,17 +729,21 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_K_0_lanes[k] = (3.0/2.0)*u0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            const double w0 = sin0/s;
+            c_K_across_lanes[k] = w0;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-5.0/432.0)*x;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/6.0)*(9*u0 - 6*sin1/s)/(s*s);
+            c_K_2_lanes[k] = (1.0/6.0)*(9*u0 - 6*w0)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 9.0) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            const double poly_K_across = poly_K_across_lanes[k];
+            const double v_K_across = x < 1.9011961863057287e-14 ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x < 9.0) ? (double)NAN : v_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 0.8648056668462011 ? poly_K_1 : closed_K_1;
@@ -736,25 +756,25 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m3_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/3 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.0682556, else sqrt(d)/3 + x*(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
- * ops: 74 */
+ * ops: 93 */
 static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -765,22 +785,29 @@ static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3],
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/3.0)*sqrt(d);
     const double c_H_inverse_2 = -1.0/6.0*(2*sqrt(d) + 9)/(-9*sqrt(d) + 2*x - 27);
+    double c_H_inverse_across;
+    if (x < 0.06825555929208893) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-462875.0/42845606719488.0)*x - 94765.0/793437161472.0) - 10069.0/7346640384.0) - 2261.0/136048896.0) - 139.0/629856.0) - 41.0/11664.0) - 11.0/108.0) + 1;
+    } else {
+        const double w0 = sqrt(d);
+        c_H_inverse_across = (1.0/3.0)*w0 + (1.0/6.0)*x*(2*w0 + 9)/(-9*w0 + 2*x - 27);
+    }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_sine_m3_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_across = -(4*x - 27)/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
- * ops: 111 */
+ * ops: 110 */
 static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -791,7 +818,7 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 3/sqrt(d);
+    const double c_H_across = 1 - 4.0/27.0*x;
     double c_H_1, c_H_2;
     if (x < 0.1294709423110197) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
@@ -806,9 +833,10 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1614,7 +1642,7 @@ static inline float symrot_sine_m3_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = -(4*x - 27)/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
- * ops: 92 */
+ * ops: 88 */
 static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1639,15 +1667,16 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m3_rotation_matrix_f_batch: symrot_sine_m3_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1711,26 +1740,27 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_across = -(4*x - 27)/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
- * ops: 132 */
+ * ops: 126 */
 static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1747,7 +1777,7 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 3/sqrtf(d);
+    const float c_H_across = 1 - 4.0F/27.0F*x;
     float c_H_1, c_H_2;
     if (x < 1.5953637F) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
@@ -1760,15 +1790,15 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
         c_H_1 = w0*w1;
         c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w0*(w1 - 2.0F/3.0F*w2 + 2)/w2;
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m3_tangent_f_batch: symrot_sine_m3_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1780,7 +1810,7 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1788,7 +1818,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0F)) {
+            if (!(x < 9.0F) || x < 0.03594455F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1827,7 +1857,7 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float w0 = 1.0F/x;
             const float w1 = 2*(sin0*sin0);
-            c_H_0_lanes[k] = 3*u0;
+            c_H_across_lanes[k] = 1 - 4.0F/27.0F*x;
             c_H_1_lanes[k] = w0*w1;
             poly_H_1_lanes[k] = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u0*w0*(-2.0F/3.0F*u1 + w1 + 2);
@@ -1836,8 +1866,8 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 9.0F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 9.0F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.03594455F ? poly_H_1 : closed_H_1;
@@ -1850,25 +1880,25 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m3_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/3 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 0.864806, else sqrt(d)/3 + x*(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
- * ops: 80 */
+ * ops: 91 */
 static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1885,17 +1915,23 @@ static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/3.0F)*sqrtf(d);
     const float c_H_inverse_2 = -1.0F/6.0F*(2*sqrtf(d) + 9)/(-9*sqrtf(d) + 2*x - 27);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    float c_H_inverse_across;
+    if (x < 0.8648057F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*((-1.1943605e-07F)*x - 1.3705585e-06F) - 1.6619026e-05F) - 139.0F/629856.0F) - 41.0F/11664.0F) - 11.0F/108.0F) + 1;
+    } else {
+        const float w0 = sqrtf(d);
+        c_H_inverse_across = (1.0F/3.0F)*w0 + (1.0F/6.0F)*x*(2*w0 + 9)/(-9*w0 + 2*x - 27);
+    }
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m3_tangent_inverse_f_batch: symrot_sine_m3_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1906,7 +1942,7 @@ static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv
  */
 static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1930,14 +1966,18 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0F/3.0F)*u0;
-            c_H_inverse_2_lanes[k] = -1.0F/6.0F*(2*u0 + 9)/(-9*u0 + 2*x - 27);
+            const float w0 = (1.0F/6.0F)*(2*u0 + 9)/(-9*u0 + 2*x - 27);
+            c_H_inverse_across_lanes[k] = (1.0F/3.0F)*u0 + w0*x;
+            poly_H_inverse_across_lanes[k] = 1;
+            c_H_inverse_2_lanes[k] = -w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 9.0F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const float v_H_inverse_across = x < 1.9011963e-14F ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 9.0F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 9.0F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.0F) ? NAN : closed_H_inverse_2;
@@ -1945,15 +1985,15 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1984,7 +2024,7 @@ static inline float symrot_sine_m3_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 1.59536, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/4)**2/x
- * ops: 111 */
+ * ops: 107 */
 static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2011,15 +2051,16 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
         c_G_1 = sinf((1.0F/2.0F)*phi)/s;
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m3_root_matrix_f_batch: symrot_sine_m3_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2100,26 +2141,27 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m3_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/(2*sqrt(d)) (algebraic in x)
+ * K_across: Horner degree 7 in x below x = 1.59536, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 13 in x below x = 2.86277, else (-6*sin(phi/2)/s + 9/sqrt(d))/(6*s**2)
- * ops: 132 */
+ * ops: 145 */
 static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2136,26 +2178,28 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (3.0F/2.0F)/sqrtf(d);
-    float c_K_1, c_K_2;
+    float c_K_across, c_K_1, c_K_2;
     if (x < 1.5953637F) {
+        c_K_across = x*(x*(x*(x*(x*(x*((-1.1186639e-09F)*x - 1.267931e-08F) - 1.4990948e-07F) - 1.8845764e-06F) - 13.0F/497664.0F) - 1.0F/2304.0F) - 5.0F/432.0F) + 1.0F/2.0F;
         c_K_1 = x*(x*(x*(x*(x*(x*((3.3632247e-10F)*x + 3.749453e-09F) + 4.3327013e-08F) + 5.265728e-07F) + 55.0F/7962624.0F) + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
         const float s = sqrtf(x);
+        const float w0 = sinf((1.0F/2.0F)*phi)/s;
+        c_K_across = w0;
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
-        c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (1.0F/6.0F)*(-6*sinf((1.0F/2.0F)*phi)/s + 9/sqrtf(d))/(s*s);
+        c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (1.0F/6.0F)*(-6*w0 + 9/sqrtf(d))/(s*s);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m3_root_tangent_f_batch: symrot_sine_m3_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2167,7 +2211,7 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
  */
 static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2175,7 +2219,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.0F)) {
+            if (!(x < 9.0F) || x < 1.9011963e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
@@ -2201,7 +2245,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2211,7 +2255,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = (1.0F/4.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -2221,17 +2265,21 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_K_0_lanes[k] = (3.0F/2.0F)*u0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            const float w0 = sin0/s;
+            c_K_across_lanes[k] = w0;
+            poly_K_across_lanes[k] = 1.0F/2.0F;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
             poly_K_1_lanes[k] = x*(x*((55.0F/7962624.0F)*x + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/6.0F)*(9*u0 - 6*sin1/s)/(s*s);
+            c_K_2_lanes[k] = (1.0F/6.0F)*(9*u0 - 6*w0)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 9.0F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            const float poly_K_across = poly_K_across_lanes[k];
+            const float v_K_across = x < 1.9011963e-14F ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x < 9.0F) ? NAN : v_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.24508163F ? poly_K_1 : closed_K_1;
@@ -2244,25 +2292,25 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m3_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/3 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 0.864806, else sqrt(d)/3 + x*(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -(2*sqrt(d) + 9)/(6*(-9*sqrt(d) + 2*x - 27)) (algebraic in x)
- * ops: 74 */
+ * ops: 90 */
 static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2273,22 +2321,29 @@ static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3],
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/3.0F)*sqrtf(d);
     const float c_H_inverse_2 = -1.0F/6.0F*(2*sqrtf(d) + 9)/(-9*sqrtf(d) + 2*x - 27);
+    float c_H_inverse_across;
+    if (x < 0.8648057F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*((-1.1943605e-07F)*x - 1.3705585e-06F) - 1.6619026e-05F) - 139.0F/629856.0F) - 41.0F/11664.0F) - 11.0F/108.0F) + 1;
+    } else {
+        const float w0 = sqrtf(d);
+        c_H_inverse_across = (1.0F/3.0F)*w0 + (1.0F/6.0F)*x*(2*w0 + 9)/(-9*w0 + 2*x - 27);
+    }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_sine_m3_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_0 = 3/sqrt(d) (algebraic in x)
+ * H_across = -(4*x - 27)/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
- * ops: 126 */
+ * ops: 125 */
 static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2299,7 +2354,7 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 3/sqrtf(d);
+    const float c_H_across = 1 - 4.0F/27.0F*x;
     float c_H_1, c_H_2;
     if (x < 1.5953637F) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-1.1931475e-09F)*x - 1.37818095e-08F) - 1.672193e-07F) - 11.0F/5038848.0F) - 1.0F/31104.0F) - 7.0F/11664.0F) - 5.0F/216.0F) + 1.0F/2.0F;
@@ -2315,9 +2370,10 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -2638,8 +2694,8 @@ static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[
  * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
- * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/x + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*x)
- * ops: 322 */
+ * H_2_x: Horner degree 16 in x below x = 2.86277, else ((12*sqrt(d) + 18*cos(phi) - 54)/x + 9*(-2*sqrt(d)/3 - cos(phi) + 3)/d + 3*(2*s + 9*sin(phi))/(sqrt(d)*s))/(18*sqrt(d)*x)
+ * ops: 320 */
 static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2672,15 +2728,15 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
         const float w3 = (w2*w2);
         const float w4 = 2*w3;
         const float w5 = sqrtf(d);
-        const float w6 = 1.0F/w5;
-        const float w7 = w4 - 2.0F/3.0F*w5 + 2;
+        const float w6 = (2.0F/3.0F)*w5;
+        const float w7 = 1.0F/w5;
         const float w8 = w0*w7;
-        const float w9 = cosf(w1);
-        const float w10 = 1.0F/s;
+        const float w9 = 1.0F/s;
+        const float w10 = cosf(phi);
         c_H_1 = w0*w4;
-        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w6*w8;
-        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w6*(-4*w10*w3*w5 + 6*w2*w9)/(s*s*s);
-        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w6*(9*w10*w6*((2.0F/3.0F)*s + 6*w2*w9) - 18*w8 + 9*w7/d);
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w8*(w4 - w6 + 2);
+        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w7*(6*w2*cosf(w1) - 4*w3*w5*w9)/(s*s*s);
+        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w8*(w0*(18*w10 + 12*w5 - 54) + 3*w7*w9*(2*s + 9*sinf(phi)) + 9*(-w10 - w6 + 3)/d);
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2729,8 +2785,8 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
  * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
- * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/x + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*x)
- * ops: 328 */
+ * H_2_x: Horner degree 16 in x below x = 2.86277, else ((12*sqrt(d) + 18*cos(phi) - 54)/x + 9*(-2*sqrt(d)/3 - cos(phi) + 3)/d + 3*(2*s + 9*sin(phi))/(sqrt(d)*s))/(18*sqrt(d)*x)
+ * ops: 326 */
 static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2763,15 +2819,15 @@ static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3
         const float w3 = (w2*w2);
         const float w4 = 2*w3;
         const float w5 = sqrtf(d);
-        const float w6 = 1.0F/w5;
-        const float w7 = w4 - 2.0F/3.0F*w5 + 2;
+        const float w6 = (2.0F/3.0F)*w5;
+        const float w7 = 1.0F/w5;
         const float w8 = w0*w7;
-        const float w9 = cosf(w1);
-        const float w10 = 1.0F/s;
+        const float w9 = 1.0F/s;
+        const float w10 = cosf(phi);
         c_H_1 = w0*w4;
-        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w6*w8;
-        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w6*(-4*w10*w3*w5 + 6*w2*w9)/(s*s*s);
-        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w6*(9*w10*w6*((2.0F/3.0F)*s + 6*w2*w9) - 18*w8 + 9*w7/d);
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w8*(w4 - w6 + 2);
+        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w7*(6*w2*cosf(w1) - 4*w3*w5*w9)/(s*s*s);
+        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w8*(w0*(18*w10 + 12*w5 - 54) + 3*w7*w9*(2*s + 9*sinf(phi)) + 9*(-w10 - w6 + 3)/d);
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -2887,8 +2943,8 @@ static inline void symrot_sine_m3_tangent_inverse_derivative_f(const float p[3],
  * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
- * H_2_x: Horner degree 16 in x below x = 2.86277, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/x + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*x)
- * ops: 286 */
+ * H_2_x: Horner degree 16 in x below x = 2.86277, else ((12*sqrt(d) + 18*cos(phi) - 54)/x + 9*(-2*sqrt(d)/3 - cos(phi) + 3)/d + 3*(2*s + 9*sin(phi))/(sqrt(d)*s))/(18*sqrt(d)*x)
+ * ops: 284 */
 static inline void symrot_sine_m3_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2916,15 +2972,15 @@ static inline void symrot_sine_m3_angular_acceleration_f(const float p[3], const
         const float w3 = (w2*w2);
         const float w4 = 2*w3;
         const float w5 = sqrtf(d);
-        const float w6 = 1.0F/w5;
-        const float w7 = w4 - 2.0F/3.0F*w5 + 2;
+        const float w6 = (2.0F/3.0F)*w5;
+        const float w7 = 1.0F/w5;
         const float w8 = w0*w7;
-        const float w9 = cosf(w1);
-        const float w10 = 1.0F/s;
+        const float w9 = 1.0F/s;
+        const float w10 = cosf(phi);
         c_H_1 = w0*w4;
-        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w6*w8;
-        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w6*(-4*w10*w3*w5 + 6*w2*w9)/(s*s*s);
-        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w0*w6*(9*w10*w6*((2.0F/3.0F)*s + 6*w2*w9) - 18*w8 + 9*w7/d);
+        c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w8*(w4 - w6 + 2);
+        c_H_1_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.1667359e-15F)*x - 1.0945811e-14F) - 1.0306811e-13F) - 9.747844e-13F) - 9.26838e-12F) - 8.870622e-11F) - 8.560854e-10F) - 8.352032e-09F) - 8.269086e-08F) - 8.3609643e-07F) - 11.0F/1259712.0F) - 1.0F/10368.0F) - 7.0F/5832.0F) - 5.0F/216.0F : (1.0F/2.0F)*w7*(6*w2*cosf(w1) - 4*w3*w5*w9)/(s*s*s);
+        c_H_2_x = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.495743e-17F)*x + 1.3031819e-16F) + 1.1328798e-15F) + 9.823164e-15F) + 8.49244e-14F) + 7.316563e-13F) + 6.2776112e-12F) + 5.3595416e-11F) + 4.547954e-10F) + 3.829856e-09F) + 3.193424e-08F) + 2.6277317e-07F) + 2.1223987e-06F) + 7.0F/419904.0F) + 35.0F/279936.0F) + 5.0F/5832.0F) + 1.0F/216.0F : (1.0F/18.0F)*w8*(w0*(18*w10 + 12*w5 - 54) + 3*w7*w9*(2*s + 9*sinf(phi)) + 9*(-w10 - w6 + 3)/d);
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

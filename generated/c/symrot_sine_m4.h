@@ -102,7 +102,7 @@ static inline double symrot_sine_m4_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1 = -sqrt(d)*(x - 8)/32 (algebraic in x)
  * R_2 = d/32 (algebraic in x)
- * ops: 72 */
+ * ops: 68 */
 static inline void symrot_sine_m4_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -121,15 +121,16 @@ static inline void symrot_sine_m4_rotation_matrix(const double p[3], double R[9]
     }
     const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
     const double c_R_2 = (1.0/32.0)*d;
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m4_rotation_matrix_batch: symrot_sine_m4_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -182,26 +183,27 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m4_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_across = -sqrt(d)*(x - 8)/32 (algebraic in x)
  * H_1 = d/32 (algebraic in x)
  * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
- * ops: 75 */
+ * ops: 72 */
 static inline void symrot_sine_m4_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -218,29 +220,29 @@ static inline void symrot_sine_m4_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 4/sqrt(d);
+    const double c_H_across = -1.0/32.0*sqrt(d)*(x - 8);
     const double c_H_1 = (1.0/32.0)*d;
     const double c_H_2 = -1.0/32.0*(x - 24)/sqrt(d);
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m4_tangent_batch: symrot_sine_m4_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: d, u0 = 1/sqrt(d).
+ * Scalar pass: d, u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -251,32 +253,37 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
             if (!(x < 16.0)) {
                 d_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
-                const double u0 = 1.0/sqrt(d);
+                const double u0 = sqrt(d);
+                const double u1 = 1.0/sqrt(d);
                 d_lanes[k] = d;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             d_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double d = d_lanes[k];
             const double u0 = u0_lanes[k];
-            c_H_0_lanes[k] = 4*u0;
+            const double u1 = u1_lanes[k];
+            c_H_across_lanes[k] = -1.0/32.0*u0*(x - 8);
             c_H_1_lanes[k] = (1.0/32.0)*d;
-            c_H_2_lanes[k] = -1.0/32.0*u0*(x - 24);
+            c_H_2_lanes[k] = -1.0/32.0*u1*(x - 24);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 16.0) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 16.0) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 16.0) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
@@ -285,25 +292,25 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m4_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/4 (algebraic in x)
+ * H_inverse_across = -(x - 8)/(2*sqrt(d)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
- * ops: 72 */
+ * ops: 69 */
 static inline void symrot_sine_m4_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -320,28 +327,28 @@ static inline void symrot_sine_m4_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/4.0)*sqrt(d);
+    const double c_H_inverse_across = -1.0/2.0*(x - 8)/sqrt(d);
     const double c_H_inverse_2 = (1.0/4.0)/sqrt(d);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m4_tangent_inverse_batch: symrot_sine_m4_tangent_inverse for n vectors p[3*k..3*k+2] into
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
+ * Scalar pass: u0 = 1/sqrt(d).
  */
 static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -351,32 +358,28 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
             x_lanes[k] = x;
             if (!(x < 16.0)) {
                 u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
-                const double u0 = sqrt(d);
-                const double u1 = 1.0/sqrt(d);
+                const double u0 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0/4.0)*u0;
-            c_H_inverse_2_lanes[k] = (1.0/4.0)*u1;
+            c_H_inverse_across_lanes[k] = -1.0/2.0*u0*(x - 8);
+            c_H_inverse_2_lanes[k] = (1.0/4.0)*u0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 16.0) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 16.0) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 16.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 16.0) ? (double)NAN : closed_H_inverse_2;
@@ -384,15 +387,15 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -417,7 +420,7 @@ static inline double symrot_sine_m4_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1 = sqrt(d)/8 (algebraic in x)
  * G_2 = 1/8 (constant)
- * ops: 71 */
+ * ops: 64 */
 static inline void symrot_sine_m4_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -435,15 +438,16 @@ static inline void symrot_sine_m4_root_matrix(const double p[3], double G[9])
         return;
     }
     const double c_G_1 = (1.0/8.0)*sqrt(d);
-    G[0] = -1.0/8.0*(p[1]*p[1]) - 1.0/8.0*(p[2]*p[2]) + 1;
+    const double t = 1 - 1.0/8.0*x;
+    G[0] = (1.0/8.0)*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + (1.0/8.0)*p[0]*p[1];
     G[2] = c_G_1*p[1] + (1.0/8.0)*p[0]*p[2];
     G[3] = c_G_1*p[2] + (1.0/8.0)*p[0]*p[1];
-    G[4] = -1.0/8.0*(p[0]*p[0]) - 1.0/8.0*(p[2]*p[2]) + 1;
+    G[4] = (1.0/8.0)*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + (1.0/8.0)*p[1]*p[2];
     G[6] = -c_G_1*p[1] + (1.0/8.0)*p[0]*p[2];
     G[7] = c_G_1*p[0] + (1.0/8.0)*p[1]*p[2];
-    G[8] = -1.0/8.0*(p[0]*p[0]) - 1.0/8.0*(p[1]*p[1]) + 1;
+    G[8] = (1.0/8.0)*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m4_root_matrix_batch: symrot_sine_m4_root_matrix for n vectors p[3*k..3*k+2] into
@@ -489,26 +493,27 @@ static inline void symrot_sine_m4_root_matrix_batch(size_t n, const double *p, d
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m4_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 2/sqrt(d) (algebraic in x)
+ * K_across = sqrt(d)/8 (algebraic in x)
  * K_1 = 1/8 (constant)
  * K_2 = 1/(8*sqrt(d)) (algebraic in x)
- * ops: 72 */
+ * ops: 66 */
 static inline void symrot_sine_m4_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -525,28 +530,28 @@ static inline void symrot_sine_m4_root_tangent(const double p[3], double K[9])
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = 2/sqrt(d);
+    const double c_K_across = (1.0/8.0)*sqrt(d);
     const double c_K_2 = (1.0/8.0)/sqrt(d);
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = c_K_2*p[0]*p[1] - 1.0/8.0*p[2];
     K[2] = c_K_2*p[0]*p[2] + (1.0/8.0)*p[1];
     K[3] = c_K_2*p[0]*p[1] + (1.0/8.0)*p[2];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = c_K_2*p[1]*p[2] - 1.0/8.0*p[0];
     K[6] = c_K_2*p[0]*p[2] - 1.0/8.0*p[1];
     K[7] = c_K_2*p[1]*p[2] + (1.0/8.0)*p[0];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m4_root_tangent_batch: symrot_sine_m4_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -556,27 +561,32 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
             x_lanes[k] = x;
             if (!(x < 16.0)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
-                const double u0 = 1.0/sqrt(d);
+                const double u0 = sqrt(d);
+                const double u1 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double u0 = u0_lanes[k];
-            c_K_0_lanes[k] = 2*u0;
-            c_K_2_lanes[k] = (1.0/8.0)*u0;
+            const double u1 = u1_lanes[k];
+            c_K_across_lanes[k] = (1.0/8.0)*u0;
+            c_K_2_lanes[k] = (1.0/8.0)*u1;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 16.0) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 16.0) ? (double)NAN : closed_K_across;
             c_K_1_lanes[k] = !(x < 16.0) ? (double)NAN : 1.0/8.0;
             const double closed_K_2 = c_K_2_lanes[k];
             c_K_2_lanes[k] = !(x < 16.0) ? (double)NAN : closed_K_2;
@@ -584,25 +594,25 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m4_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/4 (algebraic in x)
+ * H_inverse_across = -(x - 8)/(2*sqrt(d)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
- * ops: 66 */
+ * ops: 68 */
 static inline void symrot_sine_m4_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -613,22 +623,23 @@ static inline void symrot_sine_m4_pdot(const double p[3], const double omega[3],
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/4.0)*sqrt(d);
+    const double c_H_inverse_across = -1.0/2.0*(x - 8)/sqrt(d);
     const double c_H_inverse_2 = (1.0/4.0)/sqrt(d);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_sine_m4_omega: omega = H pdot (eq 20).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_across = -sqrt(d)*(x - 8)/32 (algebraic in x)
  * H_1 = d/32 (algebraic in x)
  * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
- * ops: 69 */
+ * ops: 71 */
 static inline void symrot_sine_m4_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -639,15 +650,16 @@ static inline void symrot_sine_m4_omega(const double p[3], const double pdot[3],
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 4/sqrt(d);
+    const double c_H_across = -1.0/32.0*sqrt(d)*(x - 8);
     const double c_H_1 = (1.0/32.0)*d;
     const double c_H_2 = -1.0/32.0*(x - 24)/sqrt(d);
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m4_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1338,7 +1350,7 @@ static inline float symrot_sine_m4_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = -sqrt(d)*(x - 8)/32 (algebraic in x)
  * R_2 = d/32 (algebraic in x)
- * ops: 72 */
+ * ops: 68 */
 static inline void symrot_sine_m4_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1357,15 +1369,16 @@ static inline void symrot_sine_m4_rotation_matrix_f(const float p[3], float R[9]
     }
     const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
     const float c_R_2 = (1.0F/32.0F)*d;
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m4_rotation_matrix_f_batch: symrot_sine_m4_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1418,26 +1431,27 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m4_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_across = -sqrt(d)*(x - 8)/32 (algebraic in x)
  * H_1 = d/32 (algebraic in x)
  * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
- * ops: 75 */
+ * ops: 72 */
 static inline void symrot_sine_m4_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1454,29 +1468,29 @@ static inline void symrot_sine_m4_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 4/sqrtf(d);
+    const float c_H_across = -1.0F/32.0F*sqrtf(d)*(x - 8);
     const float c_H_1 = (1.0F/32.0F)*d;
     const float c_H_2 = -1.0F/32.0F*(x - 24)/sqrtf(d);
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m4_tangent_f_batch: symrot_sine_m4_tangent_f for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: d, u0 = 1/sqrt(d).
+ * Scalar pass: d, u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1487,32 +1501,37 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
             if (!(x < 16.0F)) {
                 d_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
-                const float u0 = 1.0F/sqrtf(d);
+                const float u0 = sqrtf(d);
+                const float u1 = 1.0F/sqrtf(d);
                 d_lanes[k] = d;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             d_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float d = d_lanes[k];
             const float u0 = u0_lanes[k];
-            c_H_0_lanes[k] = 4*u0;
+            const float u1 = u1_lanes[k];
+            c_H_across_lanes[k] = -1.0F/32.0F*u0*(x - 8);
             c_H_1_lanes[k] = (1.0F/32.0F)*d;
-            c_H_2_lanes[k] = -1.0F/32.0F*u0*(x - 24);
+            c_H_2_lanes[k] = -1.0F/32.0F*u1*(x - 24);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 16.0F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 16.0F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 16.0F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
@@ -1521,25 +1540,25 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m4_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/4 (algebraic in x)
+ * H_inverse_across = -(x - 8)/(2*sqrt(d)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
- * ops: 72 */
+ * ops: 69 */
 static inline void symrot_sine_m4_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1556,28 +1575,28 @@ static inline void symrot_sine_m4_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/4.0F)*sqrtf(d);
+    const float c_H_inverse_across = -1.0F/2.0F*(x - 8)/sqrtf(d);
     const float c_H_inverse_2 = (1.0F/4.0F)/sqrtf(d);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m4_tangent_inverse_f_batch: symrot_sine_m4_tangent_inverse_f for n vectors p[3*k..3*k+2] into
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
+ * Scalar pass: u0 = 1/sqrt(d).
  */
 static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1587,32 +1606,28 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
             x_lanes[k] = x;
             if (!(x < 16.0F)) {
                 u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
-                const float u0 = sqrtf(d);
-                const float u1 = 1.0F/sqrtf(d);
+                const float u0 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
+            const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0F/4.0F)*u0;
-            c_H_inverse_2_lanes[k] = (1.0F/4.0F)*u1;
+            c_H_inverse_across_lanes[k] = -1.0F/2.0F*u0*(x - 8);
+            c_H_inverse_2_lanes[k] = (1.0F/4.0F)*u0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 16.0F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 16.0F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 16.0F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 16.0F) ? NAN : closed_H_inverse_2;
@@ -1620,15 +1635,15 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1653,7 +1668,7 @@ static inline float symrot_sine_m4_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1 = sqrt(d)/8 (algebraic in x)
  * G_2 = 1/8 (constant)
- * ops: 71 */
+ * ops: 64 */
 static inline void symrot_sine_m4_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1671,15 +1686,16 @@ static inline void symrot_sine_m4_root_matrix_f(const float p[3], float G[9])
         return;
     }
     const float c_G_1 = (1.0F/8.0F)*sqrtf(d);
-    G[0] = -1.0F/8.0F*(p[1]*p[1]) - 1.0F/8.0F*(p[2]*p[2]) + 1;
+    const float t = 1 - 1.0F/8.0F*x;
+    G[0] = (1.0F/8.0F)*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + (1.0F/8.0F)*p[0]*p[1];
     G[2] = c_G_1*p[1] + (1.0F/8.0F)*p[0]*p[2];
     G[3] = c_G_1*p[2] + (1.0F/8.0F)*p[0]*p[1];
-    G[4] = -1.0F/8.0F*(p[0]*p[0]) - 1.0F/8.0F*(p[2]*p[2]) + 1;
+    G[4] = (1.0F/8.0F)*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + (1.0F/8.0F)*p[1]*p[2];
     G[6] = -c_G_1*p[1] + (1.0F/8.0F)*p[0]*p[2];
     G[7] = c_G_1*p[0] + (1.0F/8.0F)*p[1]*p[2];
-    G[8] = -1.0F/8.0F*(p[0]*p[0]) - 1.0F/8.0F*(p[1]*p[1]) + 1;
+    G[8] = (1.0F/8.0F)*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m4_root_matrix_f_batch: symrot_sine_m4_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1725,26 +1741,27 @@ static inline void symrot_sine_m4_root_matrix_f_batch(size_t n, const float *p, 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m4_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 2/sqrt(d) (algebraic in x)
+ * K_across = sqrt(d)/8 (algebraic in x)
  * K_1 = 1/8 (constant)
  * K_2 = 1/(8*sqrt(d)) (algebraic in x)
- * ops: 72 */
+ * ops: 66 */
 static inline void symrot_sine_m4_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1761,28 +1778,28 @@ static inline void symrot_sine_m4_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 2/sqrtf(d);
+    const float c_K_across = (1.0F/8.0F)*sqrtf(d);
     const float c_K_2 = (1.0F/8.0F)/sqrtf(d);
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = c_K_2*p[0]*p[1] - 1.0F/8.0F*p[2];
     K[2] = c_K_2*p[0]*p[2] + (1.0F/8.0F)*p[1];
     K[3] = c_K_2*p[0]*p[1] + (1.0F/8.0F)*p[2];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = c_K_2*p[1]*p[2] - 1.0F/8.0F*p[0];
     K[6] = c_K_2*p[0]*p[2] - 1.0F/8.0F*p[1];
     K[7] = c_K_2*p[1]*p[2] + (1.0F/8.0F)*p[0];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m4_root_tangent_f_batch: symrot_sine_m4_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = 1/sqrt(d).
+ * Scalar pass: u0 = sqrt(d), u1 = 1/sqrt(d).
  */
 static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1792,27 +1809,32 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
             x_lanes[k] = x;
             if (!(x < 16.0F)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
-                const float u0 = 1.0F/sqrtf(d);
+                const float u0 = sqrtf(d);
+                const float u1 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
-            c_K_0_lanes[k] = 2*u0;
-            c_K_2_lanes[k] = (1.0F/8.0F)*u0;
+            const float u1 = u1_lanes[k];
+            c_K_across_lanes[k] = (1.0F/8.0F)*u0;
+            c_K_2_lanes[k] = (1.0F/8.0F)*u1;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 16.0F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 16.0F) ? NAN : closed_K_across;
             c_K_1_lanes[k] = !(x < 16.0F) ? NAN : 1.0F/8.0F;
             const float closed_K_2 = c_K_2_lanes[k];
             c_K_2_lanes[k] = !(x < 16.0F) ? NAN : closed_K_2;
@@ -1820,25 +1842,25 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m4_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(d)/4 (algebraic in x)
+ * H_inverse_across = -(x - 8)/(2*sqrt(d)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/(4*sqrt(d)) (algebraic in x)
- * ops: 66 */
+ * ops: 68 */
 static inline void symrot_sine_m4_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1849,22 +1871,23 @@ static inline void symrot_sine_m4_pdot_f(const float p[3], const float omega[3],
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/4.0F)*sqrtf(d);
+    const float c_H_inverse_across = -1.0F/2.0F*(x - 8)/sqrtf(d);
     const float c_H_inverse_2 = (1.0F/4.0F)/sqrtf(d);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_sine_m4_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 4/sqrt(d) (algebraic in x)
+ * H_across = -sqrt(d)*(x - 8)/32 (algebraic in x)
  * H_1 = d/32 (algebraic in x)
  * H_2 = -(x - 24)/(32*sqrt(d)) (algebraic in x)
- * ops: 69 */
+ * ops: 71 */
 static inline void symrot_sine_m4_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1875,15 +1898,16 @@ static inline void symrot_sine_m4_omega_f(const float p[3], const float pdot[3],
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 4/sqrtf(d);
+    const float c_H_across = -1.0F/32.0F*sqrtf(d)*(x - 8);
     const float c_H_1 = (1.0F/32.0F)*d;
     const float c_H_2 = -1.0F/32.0F*(x - 24)/sqrtf(d);
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m4_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

@@ -76,8 +76,8 @@ static inline double symrot_sine_m5_angle(const double p[3])
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
- * ops: 75 */
+ * R_2: Horner degree 7 in x below x = 0.406443, else (1 - cos(phi))/x
+ * ops: 71 */
 static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -99,17 +99,18 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
         c_R_2 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
+        c_R_2 = (1 - cos(phi))/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m5_rotation_matrix_batch: symrot_sine_m5_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -129,7 +130,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844) || x < 0.000596571734285774) {
+            if (!(x < 22.612712429686844) || x < 0.4064433613155127) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -145,7 +146,7 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -154,10 +155,11 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            c_R_2_lanes[k] = (1 - cos0)/x;
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -167,31 +169,32 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             c_R_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 0.000596571734285774 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.4064433613155127 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_across = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 118 */
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 115 */
 static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -207,41 +210,41 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 5/sqrt(25 - x);
+    const double c_H_across = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     double c_H_1, c_H_2;
     if (x < 0.4064433613155127) {
         c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (1.0/5.0)*phi;
-        const double w3 = sin(w2);
-        c_H_1 = 2*(w1*w1)/x;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*(-2.0/5.0*w1*cos(w0)/w3 + 1.0/cos(w2))/(w3*w3);
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(1.0/cos((1.0/5.0)*phi) - 2*w2*cos(w1)/s);
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m5_tangent_batch: symrot_sine_m5_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -249,27 +252,26 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844)) {
+            if (!(x < 22.612712429686844) || x < 0.000596571734285774) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
-                const double u0 = 1.0/sqrt(25 - x);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -291,20 +293,20 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            c_H_0_lanes[k] = 5*u0;
-            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
+            const double w0 = 1.0/x;
+            c_H_across_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
+            c_H_1_lanes[k] = 2*(sin0*sin0)*w0;
             poly_H_1_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
-            c_H_2_lanes[k] = (1.0/25.0)*(-2.0/5.0*cos0*sin0/sin1 + 1.0/cos1)/(sin1*sin1);
+            c_H_2_lanes[k] = w0*(-2*cos0*sin0/s + 1.0/cos1);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.000596571734285774 ? poly_H_1 : closed_H_1;
@@ -317,25 +319,25 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m5_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*sin(phi)/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
- * ops: 102 */
+ * ops: 114 */
 static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -351,38 +353,41 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/5.0)*sqrt(25 - x);
-    double c_H_inverse_2;
-    if (x < 2.787613413593369) {
+    double c_H_inverse_across, c_H_inverse_2;
+    if (x < 0.21211211978633254) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-691981.0/3125000000000000.0)*x - 320993.0/62500000000000.0) - 15071.0/125000000000.0) - 7229.0/2500000000.0) - 181.0/2500000.0) - 101.0/50000.0) - 9.0/100.0) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = (1.0/2.0)*phi;
-        c_H_inverse_2 = (1.0/25.0)*(-5.0/2.0*w1*cos(w2)/sin(w2) + cos(w0))/(w1*w1);
+        const double w2 = (1.0/5.0)*phi;
+        const double w3 = sin(w2);
+        c_H_inverse_across = (1.0/4.0)*s*sin(phi)/(w1*w1);
+        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(cos(w2) - 5.0/2.0*w3*cos(w0)/w1)/(w3*w3);
     }
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m5_tangent_inverse_batch: symrot_sine_m5_tangent_inverse for n vectors p[3*k..3*k+2] into
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = sqrt(25 - x).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -390,28 +395,27 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844)) {
+            if (!(x < 22.612712429686844) || x < 0.000596571734285774) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
-                const double u0 = sqrt(25 - x);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/5.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -423,7 +427,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -433,17 +437,30 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            c_H_inverse_0_lanes[k] = (1.0/5.0)*u0;
-            c_H_inverse_2_lanes[k] = (1.0/25.0)*(cos0 - 5.0/2.0*cos1*sin0/sin1)/(sin0*sin0);
+            const double a2_a = (1.0/5.0)*phi;
+            const double a2_q = rint(a2_a*0.6366197723675814);
+            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
+            const double a2_z = a2_r*a2_r;
+            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
+            const double a2_h = rint(0.5*a2_j - 0.25);
+            const double a2_odd = a2_j - 2*a2_h;
+            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const double a2_up = fabs(a2_j - 1.5) - 0.5;
+            const double cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
+            c_H_inverse_across_lanes[k] = (1.0/4.0)*s*sin1/(sin0*sin0);
+            poly_H_inverse_across_lanes[k] = x*(x*((-181.0/2500000.0)*x - 101.0/50000.0) - 9.0/100.0) + 1;
+            c_H_inverse_2_lanes[k] = (1.0/25.0)*(-5.0/2.0*cos0*sin2/sin0 + cos2)/(sin2*sin2);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const double v_H_inverse_across = x < 0.000596571734285774 ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
@@ -453,15 +470,15 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -491,7 +508,7 @@ static inline double symrot_sine_m5_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/x
- * ops: 88 */
+ * ops: 84 */
 static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -515,15 +532,16 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
         const double phi = symrot_sine_m5__phi(sqrt(x));
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m5_root_matrix_batch: symrot_sine_m5_root_matrix for n vectors p[3*k..3*k+2] into
@@ -596,26 +614,27 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
+ * K_across = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 21 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
- * ops: 138 */
+ * ops: 146 */
 static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -631,7 +650,7 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = (5.0/2.0)/sqrt(25 - x);
+    const double c_K_across = -1.0/250.0*sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/sqrt(sqrt(25 - x) + 5);
     double c_K_1, c_K_2;
     if (x < 0.4064433613155127) {
         c_K_1 = x*(x*(x*(x*(x*(x*((-1.8080528259277343e-13)*x - 9367.0/1638400000000000.0) - 1547.0/8192000000000.0) - 17017.0/2560000000000.0) - 663.0/2560000000.0) - 39.0/3200000.0) - 3.0/3200.0) + 1.0/8.0;
@@ -643,27 +662,27 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
         c_K_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*(5/cos(w0) - 2*sin((1.0/2.0)*phi)/w1)/(w1*w1);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m5_root_tangent_batch: symrot_sine_m5_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -674,24 +693,29 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             if (!(x < 22.612712429686844)) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
-                const double u0 = 1.0/sqrt(25 - x);
+                const double u0 = 1.0/sqrt(sqrt(25 - x) + 5);
+                const double u1 = sqrt(25 - x);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -724,7 +748,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double a2_h = rint(0.5*a2_j - 0.25);
             const double a2_odd = a2_j - 2*a2_h;
             const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            c_K_0_lanes[k] = (5.0/2.0)*u0;
+            c_K_across_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
             c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = 1.0/8.0 + (-3.0/3200.0)*x;
             c_K_2_lanes[k] = (1.0/250.0)*(-2*sin2/sin1 + 5/cos1)/(sin1*sin1);
@@ -733,8 +757,8 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 4.692488584147999e-09 ? poly_K_1 : closed_K_1;
@@ -747,25 +771,25 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m5_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*sin(phi)/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
- * ops: 96 */
+ * ops: 113 */
 static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -775,31 +799,35 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/5.0)*sqrt(25 - x);
-    double c_H_inverse_2;
-    if (x < 2.787613413593369) {
+    double c_H_inverse_across, c_H_inverse_2;
+    if (x < 0.21211211978633254) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-691981.0/3125000000000000.0)*x - 320993.0/62500000000000.0) - 15071.0/125000000000.0) - 7229.0/2500000000.0) - 181.0/2500000.0) - 101.0/50000.0) - 9.0/100.0) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = (1.0/2.0)*phi;
-        c_H_inverse_2 = (1.0/25.0)*(-5.0/2.0*w1*cos(w2)/sin(w2) + cos(w0))/(w1*w1);
+        const double w2 = (1.0/5.0)*phi;
+        const double w3 = sin(w2);
+        c_H_inverse_across = (1.0/4.0)*s*sin(phi)/(w1*w1);
+        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(cos(w2) - 5.0/2.0*w3*cos(w0)/w1)/(w3*w3);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_sine_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_across = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
- * ops: 112 */
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 114 */
 static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -809,26 +837,27 @@ static inline void symrot_sine_m5_omega(const double p[3], const double pdot[3],
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 5/sqrt(25 - x);
+    const double c_H_across = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
     double c_H_1, c_H_2;
     if (x < 0.4064433613155127) {
         c_H_1 = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (1.0/5.0)*phi;
-        const double w3 = sin(w2);
-        c_H_1 = 2*(w1*w1)/x;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*(-2.0/5.0*w1*cos(w0)/w3 + 1.0/cos(w2))/(w3*w3);
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(1.0/cos((1.0/5.0)*phi) - 2*w2*cos(w1)/s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m5_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -987,7 +1016,7 @@ static inline int symrot_sine_m5_rescale(const double p[3], double q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * R_2: Horner degree 7 in x below x = 0.406443, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)
  * R_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
@@ -1015,11 +1044,12 @@ static inline void symrot_sine_m5_rotation_derivative(const double p[3], const d
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = cos(w0);
-        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
-        c_R_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*(5*sin(phi) - 2*w2*(1 - cos(phi))/w1)/((w1*w1*w1)*w2);
+        const double w0 = 1 - cos(phi);
+        const double w1 = (1.0/5.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = cos(w1);
+        c_R_2 = w0/x;
+        c_R_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*(-2*w0*w3/w2 + 5*sin(phi))/((w2*w2*w2)*w3);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1062,7 +1092,7 @@ static inline void symrot_sine_m5_rotation_derivative(const double p[3], const d
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
- * R_2: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
+ * R_2: Horner degree 7 in x below x = 0.406443, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)
  * R_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
@@ -1090,11 +1120,12 @@ static inline void symrot_sine_m5_rotation_transpose_derivative(const double p[3
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/5.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = cos(w0);
-        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
-        c_R_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*(5*sin(phi) - 2*w2*(1 - cos(phi))/w1)/((w1*w1*w1)*w2);
+        const double w0 = 1 - cos(phi);
+        const double w1 = (1.0/5.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = cos(w1);
+        c_R_2 = w0/x;
+        c_R_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*(-2*w0*w3/w2 + 5*sin(phi))/((w2*w2*w2)*w3);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1135,11 +1166,11 @@ static inline void symrot_sine_m5_rotation_transpose_derivative(const double p[3
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
  * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 347 */
+ * ops: 348 */
 static inline void symrot_sine_m5_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1164,23 +1195,24 @@ static inline void symrot_sine_m5_tangent_derivative(const double p[3], const do
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = 2*(w1*w1);
-        const double w3 = (1.0/5.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = 1.0/(w4*w4);
-        const double w6 = cos(w3);
-        const double w7 = 1.0/w6;
-        const double w8 = 1.0/w4;
-        const double w9 = cos(w0);
-        const double w10 = w1*w8*w9;
-        const double w11 = 2*w6*w8;
-        const double w12 = w7/(w4*w4*w4);
-        c_H_1 = w2/x;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w5*(-2.0/5.0*w10 + w7);
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = 2*(w2*w2);
+        const double w4 = (1.0/5.0)*phi;
+        const double w5 = cos(w4);
+        const double w6 = 1.0/w5;
+        const double w7 = cos(w1);
+        const double w8 = 2*w2*w7;
+        const double w9 = sin(w4);
+        const double w10 = 1.0/w9;
+        const double w11 = 2*w10*w5;
+        const double w12 = w6/(w9*w9*w9);
+        c_H_1 = w0*w3;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w6 - w8/s);
         c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(2*w1*w5*w6*w9 - w11*(-2*w10 + 5*w7) + 5*w4/(w6*w6) - 5*w8*(1 - w2));
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(-5*w10*(1 - w3) - w11*(-w10*w8 + 5*w6) + 2*w2*w5*w7/(w9*w9) + 5*w9/(w5*w5));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1226,11 +1258,11 @@ static inline void symrot_sine_m5_tangent_derivative(const double p[3], const do
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
  * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 353 */
+ * ops: 354 */
 static inline void symrot_sine_m5_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1255,23 +1287,24 @@ static inline void symrot_sine_m5_tangent_transpose_derivative(const double p[3]
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = 2*(w1*w1);
-        const double w3 = (1.0/5.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = 1.0/(w4*w4);
-        const double w6 = cos(w3);
-        const double w7 = 1.0/w6;
-        const double w8 = 1.0/w4;
-        const double w9 = cos(w0);
-        const double w10 = w1*w8*w9;
-        const double w11 = 2*w6*w8;
-        const double w12 = w7/(w4*w4*w4);
-        c_H_1 = w2/x;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w5*(-2.0/5.0*w10 + w7);
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = 2*(w2*w2);
+        const double w4 = (1.0/5.0)*phi;
+        const double w5 = cos(w4);
+        const double w6 = 1.0/w5;
+        const double w7 = cos(w1);
+        const double w8 = 2*w2*w7;
+        const double w9 = sin(w4);
+        const double w10 = 1.0/w9;
+        const double w11 = 2*w10*w5;
+        const double w12 = w6/(w9*w9*w9);
+        c_H_1 = w0*w3;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w6 - w8/s);
         c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(2*w1*w5*w6*w9 - w11*(-2*w10 + 5*w7) + 5*w4/(w6*w6) - 5*w8*(1 - w2));
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(-5*w10*(1 - w3) - w11*(-w10*w8 + 5*w6) + 2*w2*w5*w7/(w9*w9) + 5*w9/(w5*w5));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1400,11 +1433,11 @@ static inline void symrot_sine_m5_tangent_inverse_derivative(const double p[3], 
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 5/sqrt(25 - x) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.406443, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/(5*sin(phi/5)))/(25*sin(phi/5)**2)
+ * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
  * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 312 */
+ * ops: 313 */
 static inline void symrot_sine_m5_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1424,23 +1457,24 @@ static inline void symrot_sine_m5_angular_acceleration(const double p[3], const 
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0;
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = 2*(w1*w1);
-        const double w3 = (1.0/5.0)*phi;
-        const double w4 = sin(w3);
-        const double w5 = 1.0/(w4*w4);
-        const double w6 = cos(w3);
-        const double w7 = 1.0/w6;
-        const double w8 = 1.0/w4;
-        const double w9 = cos(w0);
-        const double w10 = w1*w8*w9;
-        const double w11 = 2*w6*w8;
-        const double w12 = w7/(w4*w4*w4);
-        c_H_1 = w2/x;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : (1.0/25.0)*w5*(-2.0/5.0*w10 + w7);
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = 2*(w2*w2);
+        const double w4 = (1.0/5.0)*phi;
+        const double w5 = cos(w4);
+        const double w6 = 1.0/w5;
+        const double w7 = cos(w1);
+        const double w8 = 2*w2*w7;
+        const double w9 = sin(w4);
+        const double w10 = 1.0/w9;
+        const double w11 = 2*w10*w5;
+        const double w12 = w6/(w9*w9*w9);
+        c_H_1 = w0*w3;
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w6 - w8/s);
         c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(2*w1*w5*w6*w9 - w11*(-2*w10 + 5*w7) + 5*w4/(w6*w6) - 5*w8*(1 - w2));
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(-5*w10*(1 - w3) - w11*(-w10*w8 + 5*w6) + 2*w2*w5*w7/(w9*w9) + 5*w9/(w5*w5));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1614,7 +1648,7 @@ static inline float symrot_sine_m5_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
  * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
- * ops: 72 */
+ * ops: 68 */
 static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1638,15 +1672,16 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m5_rotation_matrix_f_batch: symrot_sine_m5_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1709,26 +1744,27 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_across = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
  * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
- * ops: 88 */
+ * ops: 85 */
 static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1744,7 +1780,7 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 5/sqrtf(25 - x);
+    const float c_H_across = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
     float c_H_1, c_H_2;
     if (x < 2.7876132F) {
         c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
@@ -1758,27 +1794,27 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
         c_H_1 = 2*w0*(w2*w2);
         c_H_2 = w0*(1.0F/cosf((1.0F/5.0F)*phi) - 2*w2*cosf(w1)/s);
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m5_tangent_f_batch: symrot_sine_m5_tangent_f for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = 1/sqrt(25 - x).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1786,31 +1822,26 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612713F)) {
+            if (!(x < 22.612713F) || x < 0.0022018803F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
-                const float u0 = 1.0F/sqrtf(25 - x);
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1835,7 +1866,7 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float w0 = 1.0F/x;
-            c_H_0_lanes[k] = 5*u0;
+            c_H_across_lanes[k] = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
             c_H_1_lanes[k] = 2*(sin0*sin0)*w0;
             poly_H_1_lanes[k] = 1.0F/2.0F + (-7.0F/200.0F)*x;
             c_H_2_lanes[k] = w0*(-2*cos0*sin0/s + 1.0F/cos1);
@@ -1844,8 +1875,8 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 22.612713F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.0022018803F ? poly_H_1 : closed_H_1;
@@ -1858,25 +1889,25 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m5_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 1.47828, else 5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
- * ops: 84 */
+ * ops: 93 */
 static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1892,38 +1923,40 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/5.0F)*sqrtf(25 - x);
-    float c_H_inverse_2;
-    if (x < 5.1661544F) {
+    float c_H_inverse_across, c_H_inverse_2;
+    if (x < 1.4782778F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*((-5.135888e-09F)*x - 1.20568e-07F) - 2.8916e-06F) - 181.0F/2500000.0F) - 101.0F/50000.0F) - 9.0F/100.0F) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         const float w0 = (1.0F/5.0F)*phi;
         const float w1 = sinf(w0);
         const float w2 = (1.0F/2.0F)*phi;
-        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/2.0F*w1*cosf(w2)/sinf(w2) + cosf(w0))/(w1*w1);
+        const float w3 = (5.0F/2.0F)*w1*cosf(w2)/sinf(w2);
+        c_H_inverse_across = w3;
+        c_H_inverse_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F : (1.0F/25.0F)*(-w3 + cosf(w0))/(w1*w1);
     }
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m5_tangent_inverse_f_batch: symrot_sine_m5_tangent_inverse_f for n vectors p[3*k..3*k+2] into
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = sqrt(25 - x).
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1931,27 +1964,22 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612713F)) {
+            if (!(x < 22.612713F) || x < 1.1864381e-05F) {
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
-                const float u0 = sqrtf(25 - x);
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/5.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1976,15 +2004,19 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            c_H_inverse_0_lanes[k] = (1.0F/5.0F)*u0;
-            c_H_inverse_2_lanes[k] = (1.0F/25.0F)*(cos0 - 5.0F/2.0F*cos1*sin0/sin1)/(sin0*sin0);
+            const float w0 = (5.0F/2.0F)*cos1*sin0/sin1;
+            c_H_inverse_across_lanes[k] = w0;
+            poly_H_inverse_across_lanes[k] = 1 + (-9.0F/100.0F)*x;
+            c_H_inverse_2_lanes[k] = (1.0F/25.0F)*(cos0 - w0)/(sin0*sin0);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const float v_H_inverse_across = x < 1.1864381e-05F ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 22.612713F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 22.612713F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const float poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
@@ -1994,15 +2026,15 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -2032,7 +2064,7 @@ static inline float symrot_sine_m5_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1 = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/x
- * ops: 88 */
+ * ops: 84 */
 static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2056,15 +2088,16 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m5_root_matrix_f_batch: symrot_sine_m5_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2137,26 +2170,27 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 5/(2*sqrt(25 - x)) (algebraic in x)
+ * K_across = -sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/(250*sqrt(sqrt(25 - x) + 5)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 5.16615, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 9 in x below x = 5.16615, else (5/cos(phi/5) - 2*sin(phi/2)/sin(phi/5))/(250*sin(phi/5)**2)
- * ops: 102 */
+ * ops: 110 */
 static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2172,7 +2206,7 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (5.0F/2.0F)/sqrtf(25 - x);
+    const float c_K_across = -1.0F/250.0F*sqrtf(10)*(4*x - 10*sqrtf(25 - x) - 75)/sqrtf(sqrtf(25 - x) + 5);
     float c_K_1, c_K_2;
     if (x < 5.1661544F) {
         c_K_1 = x*(x*(x*(x*(x*(x*((-1.8080528e-13F)*x - 5.7171633e-12F) - 1.8884277e-10F) - 6.6472654e-09F) - 2.589844e-07F) - 39.0F/3200000.0F) - 3.0F/3200.0F) + 1.0F/8.0F;
@@ -2184,27 +2218,27 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = (1.0F/250.0F)*(5/cosf(w0) - 2*sinf((1.0F/2.0F)*phi)/w1)/(w1*w1);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m5_root_tangent_f_batch: symrot_sine_m5_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(25 - x).
+ * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2215,24 +2249,29 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             if (!(x < 22.612713F)) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
-                const float u0 = 1.0F/sqrtf(25 - x);
+                const float u0 = 1.0F/sqrtf(sqrtf(25 - x) + 5);
+                const float u1 = sqrtf(25 - x);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -2265,7 +2304,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float a2_h = rintf(0.5F*a2_j - 0.25F);
             const float a2_odd = a2_j - 2*a2_h;
             const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            c_K_0_lanes[k] = (5.0F/2.0F)*u0;
+            c_K_across_lanes[k] = -0.0126491105F*u0*(-10*u1 + 4*x - 75);
             c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = 1.0F/8.0F + (-3.0F/3200.0F)*x;
             c_K_2_lanes[k] = (1.0F/250.0F)*(-2*sin2/sin1 + 5/cos1)/(sin1*sin1);
@@ -2274,8 +2313,8 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 22.612713F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 22.612713F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.008126427F ? poly_K_1 : closed_K_1;
@@ -2288,25 +2327,25 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m5_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(25 - x)/5 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 1.47828, else 5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
- * ops: 78 */
+ * ops: 92 */
 static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2316,31 +2355,34 @@ static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3],
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/5.0F)*sqrtf(25 - x);
-    float c_H_inverse_2;
-    if (x < 5.1661544F) {
+    float c_H_inverse_across, c_H_inverse_2;
+    if (x < 1.4782778F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*((-5.135888e-09F)*x - 1.20568e-07F) - 2.8916e-06F) - 181.0F/2500000.0F) - 101.0F/50000.0F) - 9.0F/100.0F) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
         const float w0 = (1.0F/5.0F)*phi;
         const float w1 = sinf(w0);
         const float w2 = (1.0F/2.0F)*phi;
-        c_H_inverse_2 = (1.0F/25.0F)*(-5.0F/2.0F*w1*cosf(w2)/sinf(w2) + cosf(w0))/(w1*w1);
+        const float w3 = (5.0F/2.0F)*w1*cosf(w2)/sinf(w2);
+        c_H_inverse_across = w3;
+        c_H_inverse_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F : (1.0F/25.0F)*(-w3 + cosf(w0))/(w1*w1);
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_sine_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 5/sqrt(25 - x) (algebraic in x)
+ * H_across = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
  * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
- * ops: 82 */
+ * ops: 84 */
 static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2350,7 +2392,7 @@ static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3],
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 5/sqrtf(25 - x);
+    const float c_H_across = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
     float c_H_1, c_H_2;
     if (x < 2.7876132F) {
         c_H_1 = x*(x*(x*(x*(x*((3.4e-11F)*x + 1.3e-09F) + 5.72e-08F) + 33.0F/10000000.0F) + 21.0F/50000.0F) - 7.0F/200.0F) + 1.0F/2.0F;
@@ -2367,9 +2409,10 @@ static inline void symrot_sine_m5_omega_f(const float p[3], const float pdot[3],
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m5_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

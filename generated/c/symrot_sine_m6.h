@@ -76,8 +76,8 @@ static inline double symrot_sine_m6_angle(const double p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
- * ops: 69 */
+ * R_2: Horner degree 2 in x below x = 5.28621, else (x/9 - 3)**2/18
+ * ops: 59 */
 static inline void symrot_sine_m6_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -98,30 +98,29 @@ static inline void symrot_sine_m6_rotation_matrix(const double p[3], double R[9]
     if (x < 5.286206912907945) {
         c_R_2 = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
     } else {
-        const double phi = symrot_sine_m6__phi(sqrt(x));
-        c_R_2 = (1.0/18.0)*pow(-2*cos((1.0/3.0)*phi) - 1, 2);
+        c_R_2 = (1.0/18.0)*pow((1.0/9.0)*x - 3, 2);
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m6_rotation_matrix_batch: symrot_sine_m6_rotation_matrix for n vectors p[3*k..3*k+2] into
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(36 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * Scalar pass: u0 = 1/sqrt(36 - x).
  */
 static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -130,39 +129,22 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 27.0)) {
-                phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const double s = sqrt(x);
-                const double phi = symrot_sine_m6__phi(s);
                 const double u0 = 1.0/sqrt(36 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/3.0)*phi;
-            const double a0_q = rint(a0_a*0.6366197723675814);
-            const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
-            const double a0_z = a0_r*a0_r;
-            const double a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/355687428096000.0)*a0_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*(a0_z*((1.0/20922789888000.0)*a0_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
-            const double a0_h = rint(0.5*a0_j - 0.25);
-            const double a0_odd = a0_j - 2*a0_h;
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = -1.0/1458.0*u0*(x - 36)*(x - 27)*(x - 9);
-            c_R_2_lanes[k] = (1.0/18.0)*((-2*cos0 - 1)*(-2*cos0 - 1));
+            c_R_2_lanes[k] = (1.0/18.0)*(((1.0/9.0)*x - 3)*((1.0/9.0)*x - 3));
             poly_R_2_lanes[k] = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -178,26 +160,27 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m6_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_across = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
  * H_1: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
  * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
- * ops: 71 */
+ * ops: 72 */
 static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -213,7 +196,7 @@ static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 6/sqrt(36 - x);
+    const double c_H_across = -1.0/1458.0*(x - 36)*(x - 27)*(x - 9)/sqrt(36 - x);
     const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/sqrt(36 - x);
     double c_H_1;
     if (x < 5.286206912907945) {
@@ -222,15 +205,15 @@ static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
         const double phi = symrot_sine_m6__phi(sqrt(x));
         c_H_1 = (1.0/18.0)*pow(-2*cos((1.0/3.0)*phi) - 1, 2);
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m6_tangent_batch: symrot_sine_m6_tangent for n vectors p[3*k..3*k+2] into
@@ -242,7 +225,7 @@ static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
  */
 static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -282,16 +265,17 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
             const double a0_odd = a0_j - 2*a0_h;
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_H_0_lanes[k] = 6*u0;
+            const double w0 = (1.0/1458.0)*u0;
+            c_H_across_lanes[k] = -w0*(x - 36)*(x - 27)*(x - 9);
             c_H_1_lanes[k] = (1.0/18.0)*((-2*cos0 - 1)*(-2*cos0 - 1));
             poly_H_1_lanes[k] = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
-            c_H_2_lanes[k] = (1.0/1458.0)*u0*((x*x) - 72*x + 1539);
+            c_H_2_lanes[k] = w0*((x*x) - 72*x + 1539);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 27.0) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 27.0) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 5.286206912907945 ? poly_H_1 : closed_H_1;
@@ -302,25 +286,25 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m6_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.212296, else (x*sqrt(36 - x) - 9*sqrt(36 - x))/(2*x - 54)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 56 */
+ * ops: 69 */
 static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -336,17 +320,23 @@ static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/6.0)*sqrt(36 - x);
     const double c_H_inverse_2 = -1.0/3.0*sqrt(36 - x)/(x - 27);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    double c_H_inverse_across;
+    if (x < 0.21229610760805032) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.691783157804375e-11)*x - 4289069.0/1624959306694656.0) - 272213.0/3761479876608.0) - 35029.0/17414258688.0) - 1163.0/20155392.0) - 169.0/93312.0) - 19.0/216.0) + 1;
+    } else {
+        const double w0 = sqrt(36 - x);
+        c_H_inverse_across = (w0*x - 9*w0)/(2*x - 54);
+    }
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m6_tangent_inverse_batch: symrot_sine_m6_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -357,7 +347,7 @@ static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv
  */
 static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -380,14 +370,17 @@ static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0/6.0)*u0;
+            c_H_inverse_across_lanes[k] = (u0*x - 9*u0)/(2*x - 54);
+            poly_H_inverse_across_lanes[k] = 1 + (-19.0/216.0)*x;
             c_H_inverse_2_lanes[k] = -1.0/3.0*u0/(x - 27);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 27.0) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const double v_H_inverse_across = x < 3.690968361342376e-14 ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 27.0) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 27.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 27.0) ? (double)NAN : closed_H_inverse_2;
@@ -395,15 +388,15 @@ static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -427,7 +420,7 @@ static inline double symrot_sine_m6_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
  * G_2: Horner degree 12 in x below x = 2.82094, else (1 - cos(phi/2))/x
- * ops: 87 */
+ * ops: 83 */
 static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -451,15 +444,16 @@ static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
         const double phi = symrot_sine_m6__phi(sqrt(x));
         c_G_2 = (1 - cos((1.0/2.0)*phi))/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m6_root_matrix_batch: symrot_sine_m6_root_matrix for n vectors p[3*k..3*k+2] into
@@ -523,26 +517,27 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/sqrt(36 - x) (algebraic in x)
- * K_1: Horner degree 12 in x below x = 2.82094, else (1 - cos(phi/2))/x
+ * K_across = -(x - 27)/54 (algebraic in x)
+ * K_1: Horner degree 7 in x below x = 0.407121, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 7 in x below x = 0.407121, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(6*x*(1 - 2*sin(phi/12)**2))
- * ops: 110 */
+ * ops: 88 */
 static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -558,39 +553,40 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = 3/sqrt(36 - x);
+    const double c_K_across = 1.0/2.0 - 1.0/54.0*x;
     double c_K_1, c_K_2;
     if (x < 0.4071212524285563) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+        c_K_1 = x*(x*(x*(x*(x*(x*((-1.820598476104429e-14)*x - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*((3.4805559101996437e-14)*x + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
         const double w0 = 1.0/x;
-        const double w1 = pow(sin((1.0/12.0)*phi), 2);
-        c_K_1 = x < 2.8209394684181164 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0 : w0*(1 - cos((1.0/2.0)*phi));
-        c_K_2 = (1.0/6.0)*w0*(4*w1 + 2*pow(sin((1.0/4.0)*phi), 2))/(1 - 2*w1);
+        const double w1 = 2*pow(sin((1.0/4.0)*phi), 2);
+        const double w2 = pow(sin((1.0/12.0)*phi), 2);
+        c_K_1 = w0*w1;
+        c_K_2 = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m6_root_tangent_batch: symrot_sine_m6_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(36 - x).
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -598,28 +594,23 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0)) {
+            if (!(x < 27.0) || x < 3.4444713740739134e-10) {
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m6__phi(s);
-                const double u0 = 1.0/sqrt(36 - x);
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -628,8 +619,7 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double a0_j = a0_q - 4*rint(0.25*a0_q - 0.375);
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a1_a = (1.0/12.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
@@ -640,32 +630,23 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a2_a = (1.0/4.0)*phi;
-            const double a2_q = rint(a2_a*0.6366197723675814);
-            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
-            const double a2_z = a2_r*a2_r;
-            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
-            const double a2_h = rint(0.5*a2_j - 0.25);
-            const double a2_odd = a2_j - 2*a2_h;
-            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             const double w0 = 1.0/x;
-            const double w1 = (sin1*sin1);
-            c_K_0_lanes[k] = 3*u0;
-            c_K_1_lanes[k] = w0*(1 - cos0);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/6.0)*w0*(2*(sin2*sin2) + 4*w1)/(1 - 2*w1);
+            const double w1 = 2*(sin0*sin0);
+            const double w2 = (sin1*sin1);
+            c_K_across_lanes[k] = 1.0/2.0 - 1.0/54.0*x;
+            c_K_1_lanes[k] = w0*w1;
+            poly_K_1_lanes[k] = x*(x*(x*(x*((-91.0/2229025112064.0)*x - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
             poly_K_2_lanes[k] = (1.0/6912.0)*x + 11.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 27.0) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 27.0) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 2.8209394684181164 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.05760039934430118 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 27.0) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -675,25 +656,25 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m6_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.212296, else (x*sqrt(36 - x) - 9*sqrt(36 - x))/(2*x - 54)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 50 */
+ * ops: 68 */
 static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -703,22 +684,29 @@ static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3],
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/6.0)*sqrt(36 - x);
     const double c_H_inverse_2 = -1.0/3.0*sqrt(36 - x)/(x - 27);
+    double c_H_inverse_across;
+    if (x < 0.21229610760805032) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.691783157804375e-11)*x - 4289069.0/1624959306694656.0) - 272213.0/3761479876608.0) - 35029.0/17414258688.0) - 1163.0/20155392.0) - 169.0/93312.0) - 19.0/216.0) + 1;
+    } else {
+        const double w0 = sqrt(36 - x);
+        c_H_inverse_across = (w0*x - 9*w0)/(2*x - 54);
+    }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_sine_m6_omega: omega = H pdot (eq 20).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_across = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
  * H_1: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
  * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
- * ops: 65 */
+ * ops: 71 */
 static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -728,7 +716,7 @@ static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3],
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 6/sqrt(36 - x);
+    const double c_H_across = -1.0/1458.0*(x - 36)*(x - 27)*(x - 9)/sqrt(36 - x);
     const double c_H_2 = (1.0/1458.0)*((x*x) - 72*x + 1539)/sqrt(36 - x);
     double c_H_1;
     if (x < 5.286206912907945) {
@@ -740,9 +728,10 @@ static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3],
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m6_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -901,11 +890,11 @@ static inline int symrot_sine_m6_rescale(const double p[3], double q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
+ * R_2: Horner degree 2 in x below x = 5.28621, else (x/9 - 3)**2/18
  * R_0_x = 0 (constant)
  * R_1_x = -(x - 36)*(x - 27)/(1458*sqrt(36 - x)) - (x - 36)*(x - 9)/(1458*sqrt(36 - x)) - (x - 27)*(x - 9)/(1458*sqrt(36 - x)) - (x - 36)*(x - 27)*(x - 9)/(2916*(36 - x)**(3/2)) (algebraic in x)
  * R_2_x: Horner degree 1 in x below x = 5.28621, else -(2*cos(phi/3) + 1)*sin(phi/3)/(162*sin(phi/6)*cos(phi/6))
- * ops: 196 */
+ * ops: 198 */
 static inline void symrot_sine_m6_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -930,10 +919,9 @@ static inline void symrot_sine_m6_rotation_derivative(const double p[3], const d
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
         const double w0 = (1.0/3.0)*phi;
-        const double w1 = 2*cos(w0) + 1;
-        const double w2 = (1.0/6.0)*phi;
-        c_R_2 = (1.0/18.0)*(w1*w1);
-        c_R_2_x = -1.0/162.0*w1*sin(w0)/(sin(w2)*cos(w2));
+        const double w1 = (1.0/6.0)*phi;
+        c_R_2 = (1.0/18.0)*pow((1.0/9.0)*x - 3, 2);
+        c_R_2_x = -1.0/162.0*(2*cos(w0) + 1)*sin(w0)/(sin(w1)*cos(w1));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -976,11 +964,11 @@ static inline void symrot_sine_m6_rotation_derivative(const double p[3], const d
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 5.28621, else (-2*cos(phi/3) - 1)**2/18
+ * R_2: Horner degree 2 in x below x = 5.28621, else (x/9 - 3)**2/18
  * R_0_x = 0 (constant)
  * R_1_x = -(x - 36)*(x - 27)/(1458*sqrt(36 - x)) - (x - 36)*(x - 9)/(1458*sqrt(36 - x)) - (x - 27)*(x - 9)/(1458*sqrt(36 - x)) - (x - 36)*(x - 27)*(x - 9)/(2916*(36 - x)**(3/2)) (algebraic in x)
  * R_2_x: Horner degree 1 in x below x = 5.28621, else -(2*cos(phi/3) + 1)*sin(phi/3)/(162*sin(phi/6)*cos(phi/6))
- * ops: 197 */
+ * ops: 199 */
 static inline void symrot_sine_m6_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1005,10 +993,9 @@ static inline void symrot_sine_m6_rotation_transpose_derivative(const double p[3
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
         const double w0 = (1.0/3.0)*phi;
-        const double w1 = 2*cos(w0) + 1;
-        const double w2 = (1.0/6.0)*phi;
-        c_R_2 = (1.0/18.0)*(w1*w1);
-        c_R_2_x = -1.0/162.0*w1*sin(w0)/(sin(w2)*cos(w2));
+        const double w1 = (1.0/6.0)*phi;
+        c_R_2 = (1.0/18.0)*pow((1.0/9.0)*x - 3, 2);
+        c_R_2_x = -1.0/162.0*(2*cos(w0) + 1)*sin(w0)/(sin(w1)*cos(w1));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1474,8 +1461,8 @@ static inline float symrot_sine_m6_angle_f(const float p[3])
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
- * ops: 69 */
+ * R_2: Horner degree 2 in x below x = 5.28621, else (x/9 - 3)**2/18
+ * ops: 59 */
 static inline void symrot_sine_m6_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1496,30 +1483,29 @@ static inline void symrot_sine_m6_rotation_matrix_f(const float p[3], float R[9]
     if (x < 5.2862067F) {
         c_R_2 = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
     } else {
-        const float phi = symrot_sine_m6__phi_f(sqrtf(x));
-        c_R_2 = (1.0F/18.0F)*powf(4*powf(sinf((1.0F/6.0F)*phi), 2) - 3, 2);
+        c_R_2 = (1.0F/18.0F)*powf((1.0F/9.0F)*x - 3, 2);
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m6_rotation_matrix_f_batch: symrot_sine_m6_rotation_matrix_f for n vectors p[3*k..3*k+2] into
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(36 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * Scalar pass: u0 = 1/sqrt(36 - x).
  */
 static inline void symrot_sine_m6_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1528,38 +1514,22 @@ static inline void symrot_sine_m6_rotation_matrix_f_batch(size_t n, const float 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 27.0F)) {
-                phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
-                const float s = sqrtf(x);
-                const float phi = symrot_sine_m6__phi_f(s);
                 const float u0 = 1.0F/sqrtf(36 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/6.0F)*phi;
-            const float a0_q = rintf(a0_a*0.63661975F);
-            const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
-            const float a0_z = a0_r*a0_r;
-            const float a0_s = a0_r + (a0_r*a0_z)*(a0_z*(a0_z*((1.0F/362880.0F)*a0_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a0_c = 1 + a0_z*(a0_z*(a0_z*(a0_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a0_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
-            const float a0_h = rintf(0.5F*a0_j - 0.25F);
-            const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = -1.0F/1458.0F*u0*(x - 36)*(x - 27)*(x - 9);
-            c_R_2_lanes[k] = (1.0F/18.0F)*((4*(sin0*sin0) - 3)*(4*(sin0*sin0) - 3));
+            c_R_2_lanes[k] = (1.0F/18.0F)*(((1.0F/9.0F)*x - 3)*((1.0F/9.0F)*x - 3));
             poly_R_2_lanes[k] = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1575,26 +1545,27 @@ static inline void symrot_sine_m6_rotation_matrix_f_batch(size_t n, const float 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m6_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_across = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
  * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
  * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
- * ops: 71 */
+ * ops: 72 */
 static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1610,7 +1581,7 @@ static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 6/sqrtf(36 - x);
+    const float c_H_across = -1.0F/1458.0F*(x - 36)*(x - 27)*(x - 9)/sqrtf(36 - x);
     const float c_H_2 = (1.0F/1458.0F)*((x*x) - 72*x + 1539)/sqrtf(36 - x);
     float c_H_1;
     if (x < 5.2862067F) {
@@ -1619,15 +1590,15 @@ static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
         c_H_1 = (1.0F/18.0F)*powf(4*powf(sinf((1.0F/6.0F)*phi), 2) - 3, 2);
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_sine_m6_tangent_f_batch: symrot_sine_m6_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1639,7 +1610,7 @@ static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1678,16 +1649,17 @@ static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, floa
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            c_H_0_lanes[k] = 6*u0;
+            const float w0 = (1.0F/1458.0F)*u0;
+            c_H_across_lanes[k] = -w0*(x - 36)*(x - 27)*(x - 9);
             c_H_1_lanes[k] = (1.0F/18.0F)*((4*(sin0*sin0) - 3)*(4*(sin0*sin0) - 3));
             poly_H_1_lanes[k] = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = (1.0F/1458.0F)*u0*((x*x) - 72*x + 1539);
+            c_H_2_lanes[k] = w0*((x*x) - 72*x + 1539);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 27.0F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 27.0F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 5.2862067F ? poly_H_1 : closed_H_1;
@@ -1698,25 +1670,25 @@ static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, floa
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m6_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 2.82094, else x*sqrt(36 - x)/(3*(x - 27)) + sqrt(36 - x)/6
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 56 */
+ * ops: 69 */
 static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1732,17 +1704,23 @@ static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/6.0F)*sqrtf(36 - x);
     const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(36 - x)/(x - 27);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    float c_H_inverse_across;
+    if (x < 2.8209393F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.6917835e-11F)*x - 2.639493e-09F) - 7.236859e-08F) - 2.0115126e-06F) - 5.770168e-05F) - 169.0F/93312.0F) - 19.0F/216.0F) + 1;
+    } else {
+        const float w0 = sqrtf(36 - x);
+        c_H_inverse_across = (1.0F/3.0F)*w0*x/(x - 27) + (1.0F/6.0F)*w0;
+    }
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_sine_m6_tangent_inverse_f_batch: symrot_sine_m6_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1753,7 +1731,7 @@ static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv
  */
 static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1776,14 +1754,18 @@ static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0F/6.0F)*u0;
-            c_H_inverse_2_lanes[k] = -1.0F/3.0F*u0/(x - 27);
+            const float w0 = (1.0F/3.0F)*u0/(x - 27);
+            c_H_inverse_across_lanes[k] = (1.0F/6.0F)*u0 + w0*x;
+            poly_H_inverse_across_lanes[k] = 1;
+            c_H_inverse_2_lanes[k] = -w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 27.0F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const float v_H_inverse_across = x < 3.6909684e-14F ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 27.0F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 27.0F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 27.0F) ? NAN : closed_H_inverse_2;
@@ -1791,15 +1773,15 @@ static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1823,7 +1805,7 @@ static inline float symrot_sine_m6_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1 = -(x - 27)/54 (algebraic in x)
  * G_2: Horner degree 6 in x below x = 5.28621, else 2*sin(phi/4)**2/x
- * ops: 69 */
+ * ops: 65 */
 static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1847,15 +1829,16 @@ static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_sine_m6_root_matrix_f_batch: symrot_sine_m6_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1918,26 +1901,27 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_sine_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 3/sqrt(36 - x) (algebraic in x)
+ * K_across = -(x - 27)/54 (algebraic in x)
  * K_1: Horner degree 6 in x below x = 5.28621, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 7 in x below x = 5.28621, else (-2*cos(phi/6) - cos(phi/2) + 3)/(216*sin(phi/6)**2*cos(phi/6))
- * ops: 92 */
+ * ops: 85 */
 static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1953,7 +1937,7 @@ static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 3/sqrtf(36 - x);
+    const float c_K_across = 1.0F/2.0F - 1.0F/54.0F*x;
     float c_K_1, c_K_2;
     if (x < 5.2862067F) {
         c_K_1 = x*(x*(x*(x*(x*((-8.411749e-13F)*x - 4.0825024e-11F) - 2.1318738e-09F) - 1.0F/7962624.0F) - 7.0F/746496.0F) - 5.0F/3456.0F) + 1.0F/8.0F;
@@ -1965,27 +1949,27 @@ static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = (1.0F/216.0F)*(-2*w1 - cosf((1.0F/2.0F)*phi) + 3)/(w1*powf(sinf(w0), 2));
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_sine_m6_root_tangent_f_batch: symrot_sine_m6_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = 1/sqrt(36 - x).
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1993,27 +1977,22 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0F)) {
+            if (!(x < 27.0F) || x < 0.2122961F) {
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m6__phi_f(s);
-                const float u0 = 1.0F/sqrtf(36 - x);
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -2047,7 +2026,7 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float a2_odd = a2_j - 2*a2_h;
             const float a2_up = fabsf(a2_j - 1.5F) - 0.5F;
             const float cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
-            c_K_0_lanes[k] = 3*u0;
+            c_K_across_lanes[k] = 1.0F/2.0F - 1.0F/54.0F*x;
             c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = x*((-7.0F/746496.0F)*x - 5.0F/3456.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (1.0F/216.0F)*(-2*cos1 - cos2 + 3)/(cos1*(sin1*sin1));
@@ -2056,8 +2035,8 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 27.0F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 27.0F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.2122961F ? poly_K_1 : closed_K_1;
@@ -2070,25 +2049,25 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_sine_m6_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = sqrt(36 - x)/6 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 2.82094, else x*sqrt(36 - x)/(3*(x - 27)) + sqrt(36 - x)/6
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 50 */
+ * ops: 68 */
 static inline void symrot_sine_m6_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2098,22 +2077,29 @@ static inline void symrot_sine_m6_pdot_f(const float p[3], const float omega[3],
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/6.0F)*sqrtf(36 - x);
     const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(36 - x)/(x - 27);
+    float c_H_inverse_across;
+    if (x < 2.8209393F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.6917835e-11F)*x - 2.639493e-09F) - 7.236859e-08F) - 2.0115126e-06F) - 5.770168e-05F) - 169.0F/93312.0F) - 19.0F/216.0F) + 1;
+    } else {
+        const float w0 = sqrtf(36 - x);
+        c_H_inverse_across = (1.0F/3.0F)*w0*x/(x - 27) + (1.0F/6.0F)*w0;
+    }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_sine_m6_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 6/sqrt(36 - x) (algebraic in x)
+ * H_across = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
  * H_1: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
  * H_2 = (x**2 - 72*x + 1539)/(1458*sqrt(36 - x)) (algebraic in x)
- * ops: 65 */
+ * ops: 71 */
 static inline void symrot_sine_m6_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2123,7 +2109,7 @@ static inline void symrot_sine_m6_omega_f(const float p[3], const float pdot[3],
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 6/sqrtf(36 - x);
+    const float c_H_across = -1.0F/1458.0F*(x - 36)*(x - 27)*(x - 9)/sqrtf(36 - x);
     const float c_H_2 = (1.0F/1458.0F)*((x*x) - 72*x + 1539)/sqrtf(36 - x);
     float c_H_1;
     if (x < 5.2862067F) {
@@ -2135,9 +2121,10 @@ static inline void symrot_sine_m6_omega_f(const float p[3], const float pdot[3],
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_sine_m6_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -2296,11 +2283,11 @@ static inline int symrot_sine_m6_rescale_f(const float p[3], float q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * R_2: Horner degree 2 in x below x = 5.28621, else (x/9 - 3)**2/18
  * R_0_x = 0 (constant)
  * R_1_x = -(x - 36)*(x - 27)/(1458*sqrt(36 - x)) - (x - 36)*(x - 9)/(1458*sqrt(36 - x)) - (x - 27)*(x - 9)/(1458*sqrt(36 - x)) - (x - 36)*(x - 27)*(x - 9)/(2916*(36 - x)**(3/2)) (algebraic in x)
  * R_2_x: Horner degree 1 in x below x = 5.28621, else -(2*cos(phi/3) + 1)*sin(phi/3)/(162*sin(phi/6)*cos(phi/6))
- * ops: 199 */
+ * ops: 198 */
 static inline void symrot_sine_m6_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2324,11 +2311,10 @@ static inline void symrot_sine_m6_rotation_derivative_f(const float p[3], const 
         c_R_2_x = (1.0F/729.0F)*x - 1.0F/27.0F;
     } else {
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
-        const float w0 = (1.0F/6.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (1.0F/3.0F)*phi;
-        c_R_2 = (1.0F/18.0F)*powf(4*(w1*w1) - 3, 2);
-        c_R_2_x = -1.0F/162.0F*(2*cosf(w2) + 1)*sinf(w2)/(w1*cosf(w0));
+        const float w0 = (1.0F/3.0F)*phi;
+        const float w1 = (1.0F/6.0F)*phi;
+        c_R_2 = (1.0F/18.0F)*powf((1.0F/9.0F)*x - 3, 2);
+        c_R_2_x = -1.0F/162.0F*(2*cosf(w0) + 1)*sinf(w0)/(sinf(w1)*cosf(w1));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2371,11 +2357,11 @@ static inline void symrot_sine_m6_rotation_derivative_f(const float p[3], const 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1 = -(x - 36)*(x - 27)*(x - 9)/(1458*sqrt(36 - x)) (algebraic in x)
- * R_2: Horner degree 2 in x below x = 5.28621, else (4*sin(phi/6)**2 - 3)**2/18
+ * R_2: Horner degree 2 in x below x = 5.28621, else (x/9 - 3)**2/18
  * R_0_x = 0 (constant)
  * R_1_x = -(x - 36)*(x - 27)/(1458*sqrt(36 - x)) - (x - 36)*(x - 9)/(1458*sqrt(36 - x)) - (x - 27)*(x - 9)/(1458*sqrt(36 - x)) - (x - 36)*(x - 27)*(x - 9)/(2916*(36 - x)**(3/2)) (algebraic in x)
  * R_2_x: Horner degree 1 in x below x = 5.28621, else -(2*cos(phi/3) + 1)*sin(phi/3)/(162*sin(phi/6)*cos(phi/6))
- * ops: 200 */
+ * ops: 199 */
 static inline void symrot_sine_m6_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2399,11 +2385,10 @@ static inline void symrot_sine_m6_rotation_transpose_derivative_f(const float p[
         c_R_2_x = (1.0F/729.0F)*x - 1.0F/27.0F;
     } else {
         const float phi = symrot_sine_m6__phi_f(sqrtf(x));
-        const float w0 = (1.0F/6.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (1.0F/3.0F)*phi;
-        c_R_2 = (1.0F/18.0F)*powf(4*(w1*w1) - 3, 2);
-        c_R_2_x = -1.0F/162.0F*(2*cosf(w2) + 1)*sinf(w2)/(w1*cosf(w0));
+        const float w0 = (1.0F/3.0F)*phi;
+        const float w1 = (1.0F/6.0F)*phi;
+        c_R_2 = (1.0F/18.0F)*powf((1.0F/9.0F)*x - 3, 2);
+        c_R_2_x = -1.0F/162.0F*(2*cosf(w0) + 1)*sinf(w0)/(sinf(w1)*cosf(w1));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];

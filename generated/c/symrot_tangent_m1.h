@@ -81,7 +81,7 @@ static inline double symrot_tangent_m1_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1 = 1/sqrt(x + 1) (algebraic in x)
  * R_2 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
- * ops: 55 */
+ * ops: 51 */
 static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -99,15 +99,16 @@ static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R
     }
     const double c_R_1 = 1.0/sqrt(x + 1);
     const double c_R_2 = 1.0/(x + sqrt(x + 1) + 1);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m1_rotation_matrix_batch: symrot_tangent_m1_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -160,16 +161,17 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -178,10 +180,10 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
  * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 1/(x + 1) (algebraic in x)
+ * H_across = 1/sqrt(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 61 */
+ * ops: 57 */
 static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -197,29 +199,29 @@ static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 1.0/(x + 1);
+    const double c_H_across = 1.0/sqrt(x + 1);
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
     const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m1_tangent_batch: symrot_tangent_m1_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(x + 1).
+ * Scalar pass: u0 = 1/sqrt(x + 1), u1 = sqrt(x + 1).
  */
 static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -229,30 +231,34 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
-                const double u0 = sqrt(x + 1);
+                const double u0 = 1.0/sqrt(x + 1);
+                const double u1 = sqrt(x + 1);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            const double w0 = x + 1;
-            const double w1 = 1.0/w0;
-            c_H_0_lanes[k] = w1;
-            c_H_1_lanes[k] = 1.0/(u0 + w0);
-            c_H_2_lanes[k] = -w1/(u0 + 1);
+            const double u1 = u1_lanes[k];
+            const double w0 = u1 + 1;
+            c_H_across_lanes[k] = u0;
+            c_H_1_lanes[k] = 1.0/(w0 + x);
+            c_H_2_lanes[k] = -1/(w0*(x + 1));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
@@ -261,15 +267,15 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -278,10 +284,10 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
  * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = x + 1 (algebraic in x)
+ * H_inverse_across = (sqrt(x + 1) + 1)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 57 */
+ * ops: 56 */
 static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -297,17 +303,17 @@ static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double H
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = x + 1;
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(x + 1) + 1.0/2.0;
     const double c_H_inverse_2 = (1.0/2.0)*(2*sqrt(x + 1) + 1)/(sqrt(x + 1) + 1);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m1_tangent_inverse_batch: symrot_tangent_m1_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -318,7 +324,7 @@ static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double H
  */
 static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -339,16 +345,15 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = x + 1;
+            c_H_inverse_across_lanes[k] = (1.0/2.0)*u0 + 1.0/2.0;
             c_H_inverse_2_lanes[k] = (1.0/2.0)*(2*u0 + 1)/(u0 + 1);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_2;
@@ -356,15 +361,15 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -392,7 +397,7 @@ static inline double symrot_tangent_m1_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/x
- * ops: 83 */
+ * ops: 79 */
 static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -416,15 +421,16 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
         const double phi = symrot_tangent_m1__phi(sqrt(x));
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m1_root_matrix_batch: symrot_tangent_m1_root_matrix for n vectors p[3*k..3*k+2] into
@@ -497,16 +503,17 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -515,10 +522,10 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
  * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 1/(2*(x + 1)) (algebraic in x)
+ * K_across = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 18 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/x
- * ops: 128 */
+ * ops: 133 */
 static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -534,7 +541,7 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = (1.0/2.0)/(x + 1);
+    const double c_K_across = (1.0/2.0)*sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
     double c_K_1, c_K_2;
     if (x < 0.005986831898562644) {
         c_K_1 = x*(x*(x*(x*(x*(x*(1308365.0/33554432.0 + (-76546627.0/2147483648.0)*x) - 181215.0/4194304.0) + 12767.0/262144.0) - 1843.0/32768.0) + 69.0/1024.0) - 11.0/128.0) + 1.0/8.0;
@@ -546,27 +553,27 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
         c_K_2 = x < 0.13182630716008584 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*((1.0/2.0)/(x + 1) - sin((1.0/2.0)*phi)/s);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m1_root_tangent_batch: symrot_tangent_m1_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -574,26 +581,36 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 6.703903964971299e+153) || x < 7.889013259849922e-06) {
+            if (!(x < 6.703903964971299e+153)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m1__phi(s);
+                const double u0 = pow(x + 1, -1.0/4.0);
+                const double u1 = 1.0/sqrt(sqrt(x + 1) + 1);
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
+            const double u1 = u1_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -614,19 +631,18 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = (1.0/2.0)/(x + 1);
-            const double w1 = 1.0/x;
-            c_K_0_lanes[k] = w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
+            const double w0 = 1.0/x;
+            c_K_across_lanes[k] = 0.7071067811865476*u0*u1;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
             poly_K_1_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
-            c_K_2_lanes[k] = w1*(w0 - sin1/s);
+            c_K_2_lanes[k] = w0*((1.0/2.0)/(x + 1) - sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 7.889013259849922e-06 ? poly_K_1 : closed_K_1;
@@ -639,15 +655,15 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -656,10 +672,10 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
  * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = x + 1 (algebraic in x)
+ * H_inverse_across = (sqrt(x + 1) + 1)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 51 */
+ * ops: 55 */
 static inline void symrot_tangent_m1_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -669,24 +685,25 @@ static inline void symrot_tangent_m1_pdot(const double p[3], const double omega[
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = x + 1;
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(x + 1) + 1.0/2.0;
     const double c_H_inverse_2 = (1.0/2.0)*(2*sqrt(x + 1) + 1)/(sqrt(x + 1) + 1);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_tangent_m1_omega: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^511 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 1/(x + 1) (algebraic in x)
+ * H_across = 1/sqrt(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 55 */
+ * ops: 56 */
 static inline void symrot_tangent_m1_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -696,15 +713,16 @@ static inline void symrot_tangent_m1_omega(const double p[3], const double pdot[
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 1.0/(x + 1);
+    const double c_H_across = 1.0/sqrt(x + 1);
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
     const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m1_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1408,7 +1426,7 @@ static inline float symrot_tangent_m1_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = 1/sqrt(x + 1) (algebraic in x)
  * R_2 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
- * ops: 55 */
+ * ops: 51 */
 static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1426,15 +1444,16 @@ static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R
     }
     const float c_R_1 = 1.0F/sqrtf(x + 1);
     const float c_R_2 = 1.0F/(x + sqrtf(x + 1) + 1);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m1_rotation_matrix_f_batch: symrot_tangent_m1_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1487,16 +1506,17 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1505,10 +1525,10 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
  * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 1/(x + 1) (algebraic in x)
+ * H_across = 1/sqrt(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 61 */
+ * ops: 57 */
 static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1524,29 +1544,29 @@ static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 1.0F/(x + 1);
+    const float c_H_across = 1.0F/sqrtf(x + 1);
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
     const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m1_tangent_f_batch: symrot_tangent_m1_tangent_f for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(x + 1).
+ * Scalar pass: u0 = 1/sqrt(x + 1), u1 = sqrt(x + 1).
  */
 static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1556,30 +1576,34 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
-                const float u0 = sqrtf(x + 1);
+                const float u0 = 1.0F/sqrtf(x + 1);
+                const float u1 = sqrtf(x + 1);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            const float w0 = x + 1;
-            const float w1 = 1.0F/w0;
-            c_H_0_lanes[k] = w1;
-            c_H_1_lanes[k] = 1.0F/(u0 + w0);
-            c_H_2_lanes[k] = -w1/(u0 + 1);
+            const float u1 = u1_lanes[k];
+            const float w0 = u1 + 1;
+            c_H_across_lanes[k] = u0;
+            c_H_1_lanes[k] = 1.0F/(w0 + x);
+            c_H_2_lanes[k] = -1/(w0*(x + 1));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
@@ -1588,15 +1612,15 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -1605,10 +1629,10 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
  * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = x + 1 (algebraic in x)
+ * H_inverse_across = (sqrt(x + 1) + 1)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 57 */
+ * ops: 56 */
 static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1624,17 +1648,17 @@ static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float H
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = x + 1;
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(x + 1) + 1.0F/2.0F;
     const float c_H_inverse_2 = (1.0F/2.0F)*(2*sqrtf(x + 1) + 1)/(sqrtf(x + 1) + 1);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m1_tangent_inverse_f_batch: symrot_tangent_m1_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1645,7 +1669,7 @@ static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float H
  */
 static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1666,16 +1690,15 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            c_H_inverse_0_lanes[k] = x + 1;
+            c_H_inverse_across_lanes[k] = (1.0F/2.0F)*u0 + 1.0F/2.0F;
             c_H_inverse_2_lanes[k] = (1.0F/2.0F)*(2*u0 + 1)/(u0 + 1);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_2;
@@ -1683,15 +1706,15 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1719,7 +1742,7 @@ static inline float symrot_tangent_m1_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1 = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/x
- * ops: 83 */
+ * ops: 79 */
 static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1743,15 +1766,16 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
         const float phi = symrot_tangent_m1__phi_f(sqrtf(x));
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m1_root_matrix_f_batch: symrot_tangent_m1_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1824,16 +1848,17 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1842,10 +1867,10 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
  * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 1/(2*(x + 1)) (algebraic in x)
+ * K_across = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.131826, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 13 in x below x = 0.258954, else (1/(2*(x + 1)) - sin(phi/2)/s)/x
- * ops: 112 */
+ * ops: 117 */
 static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1861,7 +1886,7 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (1.0F/2.0F)/(x + 1);
+    const float c_K_across = (1.0F/2.0F)*sqrtf(2)/(powf(x + 1, 1.0F/4.0F)*sqrtf(sqrtf(x + 1) + 1));
     float c_K_1, c_K_2;
     if (x < 0.13182631F) {
         c_K_1 = x*(x*(x*(x*(x*(x*(0.038992316F + (-0.0356448F)*x) - 181215.0F/4194304.0F) + 12767.0F/262144.0F) - 1843.0F/32768.0F) + 69.0F/1024.0F) - 11.0F/128.0F) + 1.0F/8.0F;
@@ -1873,27 +1898,27 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
         c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
         c_K_2 = x < 0.2589544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F : w0*((1.0F/2.0F)/(x + 1) - sinf((1.0F/2.0F)*phi)/s);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m1_root_tangent_f_batch: symrot_tangent_m1_root_tangent_f for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1901,26 +1926,36 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F) || x < 0.0009788593F) {
+            if (!(x < 9.223372e+18F)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m1__phi_f(s);
+                const float u0 = powf(x + 1, -1.0F/4.0F);
+                const float u1 = 1.0F/sqrtf(sqrtf(x + 1) + 1);
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1941,19 +1976,18 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float w0 = (1.0F/2.0F)/(x + 1);
-            const float w1 = 1.0F/x;
-            c_K_0_lanes[k] = w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
+            const float w0 = 1.0F/x;
+            c_K_across_lanes[k] = 0.70710677F*u0*u1;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
             poly_K_1_lanes[k] = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = w1*(w0 - sin1/s);
+            c_K_2_lanes[k] = w0*((1.0F/2.0F)/(x + 1) - sin1/s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.0009788593F ? poly_K_1 : closed_K_1;
@@ -1966,15 +2000,15 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -1983,10 +2017,10 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
  * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = x + 1 (algebraic in x)
+ * H_inverse_across = (sqrt(x + 1) + 1)/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 51 */
+ * ops: 55 */
 static inline void symrot_tangent_m1_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1996,24 +2030,25 @@ static inline void symrot_tangent_m1_pdot_f(const float p[3], const float omega[
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = x + 1;
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(x + 1) + 1.0F/2.0F;
     const float c_H_inverse_2 = (1.0F/2.0F)*(2*sqrtf(x + 1) + 1)/(sqrtf(x + 1) + 1);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_tangent_m1_omega_f: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 1/(x + 1) (algebraic in x)
+ * H_across = 1/sqrt(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * ops: 55 */
+ * ops: 56 */
 static inline void symrot_tangent_m1_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2023,15 +2058,16 @@ static inline void symrot_tangent_m1_omega_f(const float p[3], const float pdot[
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 1.0F/(x + 1);
+    const float c_H_across = 1.0F/sqrtf(x + 1);
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
     const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m1_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

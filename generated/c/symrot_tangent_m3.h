@@ -79,9 +79,9 @@ static inline double symrot_tangent_m3_angle(const double p[3])
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
  * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
- * ops: 91 */
+ * ops: 87 */
 static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -104,20 +104,19 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        c_R_1 = 2*w1*cos(w0)/s;
-        c_R_2 = 2*(w1*w1)/x;
+        c_R_1 = sin(phi)/s;
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m3_rotation_matrix_batch: symrot_tangent_m3_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -157,7 +156,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -167,11 +166,19 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_R_1_lanes[k] = sin0/s;
             poly_R_1_lanes[k] = 1 + (-11.0/54.0)*x;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
+            c_R_2_lanes[k] = 2*(sin1*sin1)/x;
             poly_R_2_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -189,16 +196,17 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -207,10 +215,10 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 9/(x + 9) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 84 */
+ * ops: 98 */
 static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -226,36 +234,38 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 9/(x + 9);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
-    double c_H_1;
+    double c_H_across, c_H_1;
     if (x < 0.06877716192024325) {
+        c_H_across = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_H_across = sin(phi)/s;
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m3_tangent_batch: symrot_tangent_m3_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
+ * Scalar pass: s, phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -264,6 +274,7 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -272,6 +283,7 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
                 const double phi = symrot_tangent_m3__phi(s);
                 const double u0 = sqrt(x + 9);
                 const double u1 = pow(x + 9, -3.0/2.0);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -279,6 +291,7 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -286,10 +299,11 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -299,16 +313,29 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            c_H_0_lanes[k] = 9/(x + 9);
-            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_H_across_lanes[k] = sin0/s;
+            poly_H_across_lanes[k] = 1 + (-11.0/54.0)*x;
+            c_H_1_lanes[k] = 2*(sin1*sin1)/x;
             poly_H_1_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            const double poly_H_across = poly_H_across_lanes[k];
+            const double v_H_across = x < 1.0000000000000006e-14 ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.00021086444550021482 ? poly_H_1 : closed_H_1;
@@ -319,15 +346,15 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -336,10 +363,10 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 9)/9 (algebraic in x)
+ * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 74 */
+ * ops: 89 */
 static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -355,17 +382,17 @@ static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double H
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/9.0)*x + 1;
+    const double c_H_inverse_across = -1.0/2.0*(x - 27)*(x + 3*sqrt(x + 9) + 9)/(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108);
     const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m3_tangent_inverse_batch: symrot_tangent_m3_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -376,7 +403,7 @@ static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double H
  */
 static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -400,14 +427,14 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
             const double w0 = u0*x;
-            c_H_inverse_0_lanes[k] = (1.0/9.0)*x + 1;
+            c_H_inverse_across_lanes[k] = -1.0/2.0*(x - 27)*(3*u0 + x + 9)/(45*u0 + w0 + 12*x + 108);
             c_H_inverse_2_lanes[k] = (1.0/18.0)*(72*u0 + 2*w0 + 27*x + 243)/(27*u0 + w0 + 9*x + 81);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_2;
@@ -415,15 +442,15 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -457,7 +484,7 @@ static inline double symrot_tangent_m3_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.0687772, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/x
- * ops: 92 */
+ * ops: 88 */
 static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -483,15 +510,16 @@ static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
         c_G_1 = sin((1.0/2.0)*phi)/s;
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m3_root_matrix_batch: symrot_tangent_m3_root_matrix for n vectors p[3*k..3*k+2] into
@@ -571,16 +599,17 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -589,10 +618,10 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 9/(2*(x + 9)) (algebraic in x)
+ * K_across: Horner degree 7 in x below x = 0.0687772, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 21 in x below x = 1.93909, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*x)
- * ops: 136 */
+ * ops: 150 */
 static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -608,27 +637,29 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = (9.0/2.0)/(x + 9);
-    double c_K_1, c_K_2;
+    double c_K_across, c_K_1, c_K_2;
     if (x < 0.06877716192024325) {
+        c_K_across = x*(x*(x*(x*(x*(x*(2025115.0/4458050224128.0 + (-46876153.0/962938848411648.0)*x) - 44015.0/10319560704.0) + 17371.0/429981696.0) - 193.0/497664.0) + 79.0/20736.0) - 17.0/432.0) + 1.0/2.0;
         c_K_1 = x*(x*(x*(x*(x*(x*(7922935.0/53496602689536.0 + (-1.5920030702402974e-08)*x) - 3086575.0/2229025112064.0) + 67261.0/5159780352.0) - 8881.0/71663616.0) + 893.0/746496.0) - 41.0/3456.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/x;
-        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 1.9390924142768158 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0 : (1.0/6.0)*w0*(27/(x + 9) - 6*sin((1.0/2.0)*phi)/s);
+        const double w0 = sin((1.0/2.0)*phi)/s;
+        const double w1 = 1.0/x;
+        c_K_across = w0;
+        c_K_1 = 2*w1*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 1.9390924142768158 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0 : (1.0/6.0)*w1*(-6*w0 + 27/(x + 9));
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m3_root_tangent_batch: symrot_tangent_m3_root_tangent for n vectors p[3*k..3*k+2] into
@@ -640,7 +671,7 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
  */
 static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -648,7 +679,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 6.703903964971299e+153) || x < 0.000762210562920323) {
+            if (!(x < 6.703903964971299e+153) || x < 1.3064949572958123e-13) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -668,7 +699,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -678,7 +709,7 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = (1.0/4.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -688,19 +719,22 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = 1.0/(x + 9);
+            const double w0 = sin0/s;
             const double w1 = 1.0/x;
-            c_K_0_lanes[k] = (9.0/2.0)*w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w1;
+            c_K_across_lanes[k] = w0;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-17.0/432.0)*x;
+            c_K_1_lanes[k] = 2*(sin1*sin1)*w1;
             poly_K_1_lanes[k] = x*(x*(893.0/746496.0 + (-8881.0/71663616.0)*x) - 41.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/6.0)*w1*(27*w0 - 6*sin1/s);
+            c_K_2_lanes[k] = (1.0/6.0)*w1*(-6*w0 + 27/(x + 9));
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            const double poly_K_across = poly_K_across_lanes[k];
+            const double v_K_across = x < 1.3064949572958123e-13 ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 0.000762210562920323 ? poly_K_1 : closed_K_1;
@@ -713,15 +747,15 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -730,10 +764,10 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 9)/9 (algebraic in x)
+ * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 68 */
+ * ops: 88 */
 static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -743,24 +777,25 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/9.0)*x + 1;
+    const double c_H_inverse_across = -1.0/2.0*(x - 27)*(x + 3*sqrt(x + 9) + 9)/(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108);
     const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_tangent_m3_omega: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 9/(x + 9) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 78 */
+ * ops: 97 */
 static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -770,21 +805,24 @@ static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 9/(x + 9);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
-    double c_H_1;
+    double c_H_across, c_H_1;
     if (x < 0.06877716192024325) {
+        c_H_across = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_H_across = sin(phi)/s;
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -953,7 +991,7 @@ static inline int symrot_tangent_m3_rescale(const double p[3], double q[3])
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
  * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 6*(s**2/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 9))
@@ -986,16 +1024,15 @@ static inline void symrot_tangent_m3_rotation_derivative(const double p[3], cons
         const double w0 = 1.0/s;
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = w2*cos(w1);
-        const double w4 = (w2*w2);
-        const double w5 = (s*s);
-        const double w6 = 6*w3;
-        const double w7 = w0*((1.0/9.0)*w5 + 1);
-        const double w8 = (3.0/2.0)/(x + 9);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4/x;
-        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w8*(-6*w4 - w6*w7 + 3)/w5;
-        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w4*w7 + w6)/(s*s*s);
+        const double w3 = (w2*w2);
+        const double w4 = (s*s);
+        const double w5 = 6*w2*cos(w1);
+        const double w6 = w0*((1.0/9.0)*w4 + 1);
+        const double w7 = (3.0/2.0)/(x + 9);
+        c_R_1 = w0*sin(phi);
+        c_R_2 = 2*w3/x;
+        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w7*(-6*w3 - w5*w6 + 3)/w4;
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w7*(-12*w3*w6 + w5)/(s*s*s);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1039,7 +1076,7 @@ static inline void symrot_tangent_m3_rotation_derivative(const double p[3], cons
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
  * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 6*(s**2/9 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*s**2*(x + 9))
@@ -1072,16 +1109,15 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative(const double 
         const double w0 = 1.0/s;
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = w2*cos(w1);
-        const double w4 = (w2*w2);
-        const double w5 = (s*s);
-        const double w6 = 6*w3;
-        const double w7 = w0*((1.0/9.0)*w5 + 1);
-        const double w8 = (3.0/2.0)/(x + 9);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4/x;
-        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w8*(-6*w4 - w6*w7 + 3)/w5;
-        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w8*(-12*w4*w7 + w6)/(s*s*s);
+        const double w3 = (w2*w2);
+        const double w4 = (s*s);
+        const double w5 = 6*w2*cos(w1);
+        const double w6 = w0*((1.0/9.0)*w4 + 1);
+        const double w7 = (3.0/2.0)/(x + 9);
+        c_R_1 = w0*sin(phi);
+        c_R_2 = 2*w3/x;
+        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w7*(-6*w3 - w5*w6 + 3)/w4;
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w7*(-12*w3*w6 + w5)/(s*s*s);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1563,7 +1599,7 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
- * ops: 83 */
+ * ops: 79 */
 static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1591,15 +1627,16 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
         c_R_1 = 2*w1*cosf(w0)/s;
         c_R_2 = 2*(w1*w1)/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m3_rotation_matrix_f_batch: symrot_tangent_m3_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1671,16 +1708,17 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1689,10 +1727,10 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 9/(x + 9) (algebraic in x)
+ * H_across: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 80 */
+ * ops: 90 */
 static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1708,36 +1746,40 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 9/(x + 9);
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
-    float c_H_1;
+    float c_H_across, c_H_1;
     if (x < 0.48711845F) {
+        c_H_across = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_H_across = 2*w1*cosf(w0)/s;
+        c_H_1 = 2*(w1*w1)/x;
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m3_tangent_f_batch: symrot_tangent_m3_tangent_f for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
+ * Scalar pass: s, phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1746,6 +1788,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -1754,6 +1797,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
                 const float phi = symrot_tangent_m3__phi_f(s);
                 const float u0 = sqrtf(x + 9);
                 const float u1 = powf(x + 9, -3.0F/2.0F);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -1761,6 +1805,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -1768,6 +1813,7 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
@@ -1781,7 +1827,10 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            c_H_0_lanes[k] = 9/(x + 9);
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_H_across_lanes[k] = 2*cos0*sin0/s;
+            poly_H_across_lanes[k] = 1;
             c_H_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_H_1_lanes[k] = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
@@ -1789,8 +1838,10 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            const float poly_H_across = poly_H_across_lanes[k];
+            const float v_H_across = x < 1e-14F ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.036088683F ? poly_H_1 : closed_H_1;
@@ -1801,15 +1852,15 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -1818,10 +1869,10 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 9)/9 (algebraic in x)
+ * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 74 */
+ * ops: 89 */
 static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1837,17 +1888,17 @@ static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float H
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/9.0F)*x + 1;
+    const float c_H_inverse_across = -1.0F/2.0F*(x - 27)*(x + 3*sqrtf(x + 9) + 9)/(x*sqrtf(x + 9) + 12*x + 45*sqrtf(x + 9) + 108);
     const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m3_tangent_inverse_f_batch: symrot_tangent_m3_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1858,7 +1909,7 @@ static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float H
  */
 static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1882,14 +1933,14 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
             const float w0 = u0*x;
-            c_H_inverse_0_lanes[k] = (1.0F/9.0F)*x + 1;
+            c_H_inverse_across_lanes[k] = -1.0F/2.0F*(x - 27)*(3*u0 + x + 9)/(45*u0 + w0 + 12*x + 108);
             c_H_inverse_2_lanes[k] = (1.0F/18.0F)*(72*u0 + 2*w0 + 27*x + 243)/(27*u0 + w0 + 9*x + 81);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_2;
@@ -1897,15 +1948,15 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1938,8 +1989,8 @@ static inline float symrot_tangent_m3_tangent_det_f(const float p[3])
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.956738, else sin(phi/2)/s
- * G_2: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/x
- * ops: 104 */
+ * G_2: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/x
+ * ops: 88 */
 static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1958,23 +2009,23 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
     float c_G_1, c_G_2;
     if (x < 0.95673823F) {
         c_G_1 = x*(x*(x*(x*(x*(x*(4.5426026e-07F + (-4.8680302e-08F)*x) - 4.265201e-06F) + 4.0399394e-05F) - 193.0F/497664.0F) + 79.0F/20736.0F) - 17.0F/432.0F) + 1.0F/2.0F;
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+        c_G_2 = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        c_G_1 = sinf(w0)/s;
-        c_G_2 = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F : (1 - cosf(w0))/x;
+        c_G_1 = sinf((1.0F/2.0F)*phi)/s;
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m3_root_matrix_f_batch: symrot_tangent_m3_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2024,12 +2075,20 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = (1 - cos0)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2041,21 +2100,22 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 1.9390924F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.00996503F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -2064,10 +2124,10 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 9/(2*(x + 9)) (algebraic in x)
- * K_1: Horner degree 11 in x below x = 1.93909, else (1 - cos(phi/2))/x
+ * K_across: Horner degree 7 in x below x = 0.956738, else sin(phi/2)/s
+ * K_1: Horner degree 7 in x below x = 0.956738, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 21 in x below x = 4.19813, else (27/(x + 9) - 6*sin(phi/2)/s)/(6*x)
- * ops: 148 */
+ * ops: 150 */
 static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2083,28 +2143,29 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (9.0F/2.0F)/(x + 9);
-    float c_K_1, c_K_2;
-    if (x < 1.9390924F) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
+    float c_K_across, c_K_1, c_K_2;
+    if (x < 0.95673823F) {
+        c_K_across = x*(x*(x*(x*(x*(x*(4.5426026e-07F + (-4.8680302e-08F)*x) - 4.265201e-06F) + 4.0399394e-05F) - 193.0F/497664.0F) + 79.0F/20736.0F) - 17.0F/432.0F) + 1.0F/2.0F;
+        c_K_1 = x*(x*(x*(x*(x*(x*(1.4810165e-07F + (-1.5920032e-08F)*x) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/x;
-        const float w1 = (1.0F/2.0F)*phi;
-        c_K_1 = w0*(1 - cosf(w1));
-        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w0*(27/(x + 9) - 6*sinf(w1)/s);
+        const float w0 = sinf((1.0F/2.0F)*phi)/s;
+        const float w1 = 1.0F/x;
+        c_K_across = w0;
+        c_K_1 = 2*w1*powf(sinf((1.0F/4.0F)*phi), 2);
+        c_K_2 = x < 4.1981263F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F : (1.0F/6.0F)*w1*(-6*w0 + 27/(x + 9));
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m3_root_tangent_f_batch: symrot_tangent_m3_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2116,7 +2177,7 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
  */
 static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2124,7 +2185,7 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F) || x < 1.9390924F) {
+            if (!(x < 9.223372e+18F) || x < 1.9011963e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -2154,24 +2215,35 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = 1.0F/(x + 9);
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float w0 = sin0/s;
             const float w1 = 1.0F/x;
-            c_K_0_lanes[k] = (9.0F/2.0F)*w0;
-            c_K_1_lanes[k] = w1*(1 - cos0);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.0176964e-11F + (-2.1938631e-12F)*x) - 1.8594833e-10F) + 1.7179269e-09F) - 1.5920032e-08F) + 1.4810165e-07F) - 1.3847197e-06F) + 1.3035632e-05F) - 0.0001239262F) + 893.0F/746496.0F) - 41.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(27*w0 - 6*sin0/s);
+            c_K_across_lanes[k] = w0;
+            poly_K_across_lanes[k] = 1.0F/2.0F;
+            c_K_1_lanes[k] = 2*(sin1*sin1)*w1;
+            poly_K_1_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(-6*w0 + 27/(x + 9));
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            const float poly_K_across = poly_K_across_lanes[k];
+            const float v_K_across = x < 1.9011963e-14F ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 1.9390924F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.00996503F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -2181,15 +2253,15 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -2198,10 +2270,10 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 9)/9 (algebraic in x)
+ * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 68 */
+ * ops: 88 */
 static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2211,24 +2283,25 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/9.0F)*x + 1;
+    const float c_H_inverse_across = -1.0F/2.0F*(x - 27)*(x + 3*sqrtf(x + 9) + 9)/(x*sqrtf(x + 9) + 12*x + 45*sqrtf(x + 9) + 108);
     const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_tangent_m3_omega_f: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 9/(x + 9) (algebraic in x)
+ * H_across: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 74 */
+ * ops: 89 */
 static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2238,21 +2311,26 @@ static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 9/(x + 9);
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
-    float c_H_1;
+    float c_H_across, c_H_1;
     if (x < 0.48711845F) {
+        c_H_across = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_H_across = 2*w1*cosf(w0)/s;
+        c_H_1 = 2*(w1*w1)/x;
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

@@ -77,7 +77,7 @@ static inline double symrot_tangent_m5_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
- * ops: 91 */
+ * ops: 87 */
 static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -105,15 +105,16 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
         c_R_1 = 2*w1*cos(w0)/s;
         c_R_2 = 2*(w1*w1)/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m5_rotation_matrix_batch: symrot_tangent_m5_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -185,26 +186,27 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 25/(x + 25) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 132 */
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 146 */
 static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -220,9 +222,9 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 25/(x + 25);
-    double c_H_1, c_H_2;
+    double c_H_across, c_H_1, c_H_2;
     if (x < 0.11104807041853587) {
+        c_H_across = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
@@ -230,18 +232,21 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        c_H_1 = 2*(w1*w1)/x;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25/(x + 25) - 2*w1*cos(w0)/s)/(s*s);
+        const double w2 = 2*w1*cos(w0)/s;
+        const double w3 = 1.0/x;
+        c_H_across = w2;
+        c_H_1 = 2*(w1*w1)*w3;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w3*(-w2 + 25/(x + 25));
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m5_tangent_batch: symrot_tangent_m5_tangent for n vectors p[3*k..3*k+2] into
@@ -253,7 +258,7 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
  */
 static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -293,18 +298,22 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double w0 = 1.0/(x + 25);
-            c_H_0_lanes[k] = 25*w0;
-            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
+            const double w0 = 2*cos0*sin0/s;
+            const double w1 = 1.0/x;
+            c_H_across_lanes[k] = w0;
+            poly_H_across_lanes[k] = 1 + (-9.0/50.0)*x;
+            c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
             poly_H_1_lanes[k] = 1.0/2.0 + (-11.0/200.0)*x;
-            c_H_2_lanes[k] = (-2*cos0*sin0/s + 25*w0)/(s*s);
+            c_H_2_lanes[k] = w1*(-w0 + 25/(x + 25));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            const double poly_H_across = poly_H_across_lanes[k];
+            const double v_H_across = x < 3.327466630718667e-08 ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 3.327466630718667e-08 ? poly_H_1 : closed_H_1;
@@ -317,25 +326,25 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m5_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 25)/25 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.41316, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
- * ops: 86 */
+ * ops: 99 */
 static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -351,25 +360,27 @@ static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double H
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/25.0)*x + 1;
-    double c_H_inverse_2;
-    if (x < 3.1374537386488126) {
+    double c_H_inverse_across, c_H_inverse_2;
+    if (x < 0.4131604136062581) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((117.0/3125000000000000.0)*x - 113.0/62500000000000.0) + 7.0/125000000000.0) - 29.0/2500000000.0) - 3.0/2500000.0) - 21.0/50000.0) - 7.0/100.0) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        c_H_inverse_2 = (-1.0/2.0*s*cos(w0)/sin(w0) + (1.0/25.0)*x + 1)/x;
+        const double w1 = (1.0/2.0)*s*cos(w0)/sin(w0);
+        c_H_inverse_across = w1;
+        c_H_inverse_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0 : (-w1 + (1.0/25.0)*x + 1)/x;
     }
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m5_tangent_inverse_batch: symrot_tangent_m5_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -381,7 +392,7 @@ static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double H
  */
 static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -389,7 +400,7 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 3.1374537386488126) {
+            if (!(x <= 236.80339887498948) || x < 7.091048955981853e-14) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -421,16 +432,19 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double w0 = (1.0/25.0)*x + 1;
-            c_H_inverse_0_lanes[k] = w0;
-            c_H_inverse_2_lanes[k] = (-1.0/2.0*cos0*s/sin0 + w0)/x;
+            const double w0 = (1.0/2.0)*cos0*s/sin0;
+            c_H_inverse_across_lanes[k] = w0;
+            poly_H_inverse_across_lanes[k] = 1 + (-7.0/100.0)*x;
+            c_H_inverse_2_lanes[k] = (-w0 + (1.0/25.0)*x + 1)/x;
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const double v_H_inverse_across = x < 7.091048955981853e-14 ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
@@ -440,15 +454,15 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -477,8 +491,8 @@ static inline double symrot_tangent_m5_tangent_det(const double p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.111048, else sin(phi/2)/s
- * G_2: Horner degree 18 in x below x = 3.13745, else (1 - cos(phi/2))/x
- * ops: 124 */
+ * G_2: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/x
+ * ops: 88 */
 static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -497,23 +511,23 @@ static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
     double c_G_1, c_G_2;
     if (x < 0.11104807041853587) {
         c_G_1 = x*(x*(x*(x*(x*(x*(8357819.0/2048000000000000.0 + (-1.6919252294921874e-10)*x) - 500957.0/5120000000000.0) + 59547.0/25600000000.0) - 1747.0/32000000.0) + 1003.0/800000.0) - 11.0/400.0) + 1.0/2.0;
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        c_G_1 = sin(w0)/s;
-        c_G_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : (1 - cos(w0))/x;
+        c_G_1 = sin((1.0/2.0)*phi)/s;
+        c_G_2 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m5_root_matrix_batch: symrot_tangent_m5_root_matrix for n vectors p[3*k..3*k+2] into
@@ -563,12 +577,20 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
-            c_G_2_lanes[k] = (1 - cos0)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -580,31 +602,32 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             c_G_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 3.1374537386488126 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 4.3791113590493824e-05 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m5_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 25/(2*(x + 25)) (algebraic in x)
- * K_1: Horner degree 18 in x below x = 3.13745, else (1 - cos(phi/2))/x
+ * K_across: Horner degree 7 in x below x = 0.111048, else sin(phi/2)/s
+ * K_1: Horner degree 7 in x below x = 0.213927, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 18 in x below x = 3.13745, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
- * ops: 159 */
+ * ops: 141 */
 static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -620,27 +643,28 @@ static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9]
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = (25.0/2.0)/(x + 25);
-    double c_K_1, c_K_2;
-    if (x < 3.1374537386488126) {
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
+    double c_K_across, c_K_1, c_K_2;
+    if (x < 0.11104807041853587) {
+        c_K_across = x*(x*(x*(x*(x*(x*(8357819.0/2048000000000000.0 + (-1.6919252294921874e-10)*x) - 500957.0/5120000000000.0) + 59547.0/25600000000.0) - 1747.0/32000000.0) + 1003.0/800000.0) - 11.0/400.0) + 1.0/2.0;
+        c_K_1 = x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        c_K_1 = (1 - cos(w0))/x;
-        c_K_2 = (1.0/10.0)*(125/(x + 25) - 10*sin(w0)/s)/(s*s);
+        const double w0 = sin((1.0/2.0)*phi)/s;
+        c_K_across = w0;
+        c_K_1 = x < 0.21392718170599553 ? x*(x*(x*(x*(x*(x*(8.315707275390625e-10 + (-3.4392241806030275e-11)*x) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
+        c_K_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0 : (1.0/10.0)*(-10*w0 + 125/(x + 25))/(s*s);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m5_root_tangent_batch: symrot_tangent_m5_root_tangent for n vectors p[3*k..3*k+2] into
@@ -652,7 +676,7 @@ static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9]
  */
 static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -660,7 +684,7 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 3.1374537386488126) {
+            if (!(x <= 236.80339887498948) || x < 3.327466630718667e-08) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -690,23 +714,34 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double w0 = 1.0/(x + 25);
-            c_K_0_lanes[k] = (25.0/2.0)*w0;
-            c_K_1_lanes[k] = (1 - cos0)/x;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7908048575081606e-26)*x - 4.41690049915648e-25) + 1.0885572789479286e-23) - 2.6804551484061177e-22) + 6.593875863344967e-21) - 1.6202769427708357e-19) + 3.976328265240234e-18) - 9.74385185177362e-17) + 2.383539019911766e-15) - 5.818519848834992e-14) + 1.4168085234832764e-12) - 3.4392241806030275e-11) + 8.315707275390625e-10) - 4096643.0/204800000000000.0) + 1223143.0/2560000000000.0) - 28919.0/2560000000.0) + 841.0/3200000.0) - 19.0/3200.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/10.0)*(125*w0 - 10*sin0/s)/(s*s);
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const double w0 = sin0/s;
+            c_K_across_lanes[k] = w0;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
+            poly_K_1_lanes[k] = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/10.0)*(-10*w0 + 125/(x + 25))/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            const double poly_K_across = poly_K_across_lanes[k];
+            const double v_K_across = x < 3.327466630718667e-08 ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 3.1374537386488126 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 4.3791113590493824e-05 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
@@ -716,25 +751,25 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m5_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 25)/25 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.41316, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
- * ops: 80 */
+ * ops: 98 */
 static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -744,30 +779,33 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/25.0)*x + 1;
-    double c_H_inverse_2;
-    if (x < 3.1374537386488126) {
+    double c_H_inverse_across, c_H_inverse_2;
+    if (x < 0.4131604136062581) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((117.0/3125000000000000.0)*x - 113.0/62500000000000.0) + 7.0/125000000000.0) - 29.0/2500000000.0) - 3.0/2500000.0) - 21.0/50000.0) - 7.0/100.0) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        c_H_inverse_2 = (-1.0/2.0*s*cos(w0)/sin(w0) + (1.0/25.0)*x + 1)/x;
+        const double w1 = (1.0/2.0)*s*cos(w0)/sin(w0);
+        c_H_inverse_across = w1;
+        c_H_inverse_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0 : (-w1 + (1.0/25.0)*x + 1)/x;
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_tangent_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 25/(x + 25) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 126 */
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
+ * ops: 145 */
 static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -777,9 +815,9 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 25/(x + 25);
-    double c_H_1, c_H_2;
+    double c_H_across, c_H_1, c_H_2;
     if (x < 0.11104807041853587) {
+        c_H_across = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
@@ -787,15 +825,19 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        c_H_1 = 2*(w1*w1)/x;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25/(x + 25) - 2*w1*cos(w0)/s)/(s*s);
+        const double w2 = 2*w1*cos(w0)/s;
+        const double w3 = 1.0/x;
+        c_H_across = w2;
+        c_H_1 = 2*(w1*w1)*w3;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w3*(-w2 + 25/(x + 25));
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m5_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1125,11 +1167,11 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative(const double 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 25*(1 - 2*sin(phi/2)**2)/s - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s)/(2*s**3*(x + 25))
- * ops: 361 */
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + (50*sin(phi/2)**2 - 25)/s)/(2*s**3*(x + 25))
+ * ops: 360 */
 static inline void symrot_tangent_m5_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1159,19 +1201,17 @@ static inline void symrot_tangent_m5_tangent_derivative(const double p[3], const
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
         const double w3 = (w2*w2);
-        const double w4 = 2*w3;
-        const double w5 = (s*s);
-        const double w6 = 1.0/(x + 25);
-        const double w7 = 1.0/s;
-        const double w8 = cos(w1);
-        const double w9 = w2*w8;
-        const double w10 = 10*w9;
-        const double w11 = w6/(s*s*s);
-        const double w12 = (1.0/25.0)*x + 1;
-        c_H_1 = w0*w4;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25*w6 - 2*w7*w9)/w5;
-        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(w10 - 20*w3*w7*((1.0/25.0)*w5 + 1));
-        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w6 + 50*w0*w12*w2*w8 - 10*w12*w7*(-w10*w7 + 125*w6) - 25*w7*(1 - w4));
+        const double w4 = 1.0/(x + 25);
+        const double w5 = 1.0/s;
+        const double w6 = cos(w1);
+        const double w7 = w2*w6;
+        const double w8 = 10*w7;
+        const double w9 = w4/(s*s*s);
+        const double w10 = (1.0/25.0)*x + 1;
+        c_H_1 = 2*w0*w3;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25*w4 - 2*w5*w7);
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w9*(-20*w3*w5*((1.0/25.0)*(s*s) + 1) + w8);
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w9*(-50*s*w4 + 50*w0*w10*w2*w6 - 10*w10*w5*(125*w4 - w5*w8) + w5*(50*w3 - 25));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1217,11 +1257,11 @@ static inline void symrot_tangent_m5_tangent_derivative(const double p[3], const
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 25*(1 - 2*sin(phi/2)**2)/s - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s)/(2*s**3*(x + 25))
- * ops: 367 */
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + (50*sin(phi/2)**2 - 25)/s)/(2*s**3*(x + 25))
+ * ops: 366 */
 static inline void symrot_tangent_m5_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1251,19 +1291,17 @@ static inline void symrot_tangent_m5_tangent_transpose_derivative(const double p
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
         const double w3 = (w2*w2);
-        const double w4 = 2*w3;
-        const double w5 = (s*s);
-        const double w6 = 1.0/(x + 25);
-        const double w7 = 1.0/s;
-        const double w8 = cos(w1);
-        const double w9 = w2*w8;
-        const double w10 = 10*w9;
-        const double w11 = w6/(s*s*s);
-        const double w12 = (1.0/25.0)*x + 1;
-        c_H_1 = w0*w4;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25*w6 - 2*w7*w9)/w5;
-        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(w10 - 20*w3*w7*((1.0/25.0)*w5 + 1));
-        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w6 + 50*w0*w12*w2*w8 - 10*w12*w7*(-w10*w7 + 125*w6) - 25*w7*(1 - w4));
+        const double w4 = 1.0/(x + 25);
+        const double w5 = 1.0/s;
+        const double w6 = cos(w1);
+        const double w7 = w2*w6;
+        const double w8 = 10*w7;
+        const double w9 = w4/(s*s*s);
+        const double w10 = (1.0/25.0)*x + 1;
+        c_H_1 = 2*w0*w3;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25*w4 - 2*w5*w7);
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w9*(-20*w3*w5*((1.0/25.0)*(s*s) + 1) + w8);
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w9*(-50*s*w4 + 50*w0*w10*w2*w6 - 10*w10*w5*(125*w4 - w5*w8) + w5*(50*w3 - 25));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1392,11 +1430,11 @@ static inline void symrot_tangent_m5_tangent_inverse_derivative(const double p[3
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 25/(x + 25) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
+ * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = -25/(x + 25)**2 (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
- * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 25*(1 - 2*sin(phi/2)**2)/s - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s)/(2*s**3*(x + 25))
- * ops: 324 */
+ * H_2_x: Horner degree 21 in x below x = 3.13745, else (-50*s/(x + 25) + 50*(x/25 + 1)*sin(phi/2)*cos(phi/2)/x - 10*(x/25 + 1)*(125/(x + 25) - 10*sin(phi/2)*cos(phi/2)/s)/s + (50*sin(phi/2)**2 - 25)/s)/(2*s**3*(x + 25))
+ * ops: 323 */
 static inline void symrot_tangent_m5_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1421,19 +1459,17 @@ static inline void symrot_tangent_m5_angular_acceleration(const double p[3], con
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
         const double w3 = (w2*w2);
-        const double w4 = 2*w3;
-        const double w5 = (s*s);
-        const double w6 = 1.0/(x + 25);
-        const double w7 = 1.0/s;
-        const double w8 = cos(w1);
-        const double w9 = w2*w8;
-        const double w10 = 10*w9;
-        const double w11 = w6/(s*s*s);
-        const double w12 = (1.0/25.0)*x + 1;
-        c_H_1 = w0*w4;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25*w6 - 2*w7*w9)/w5;
-        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w11*(w10 - 20*w3*w7*((1.0/25.0)*w5 + 1));
-        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w11*(-50*s*w6 + 50*w0*w12*w2*w8 - 10*w12*w7*(-w10*w7 + 125*w6) - 25*w7*(1 - w4));
+        const double w4 = 1.0/(x + 25);
+        const double w5 = 1.0/s;
+        const double w6 = cos(w1);
+        const double w7 = w2*w6;
+        const double w8 = 10*w7;
+        const double w9 = w4/(s*s*s);
+        const double w10 = (1.0/25.0)*x + 1;
+        c_H_1 = 2*w0*w3;
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : w0*(25*w4 - 2*w5*w7);
+        c_H_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*w9*(-20*w3*w5*((1.0/25.0)*(s*s) + 1) + w8);
+        c_H_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.230213676905677e-29)*x - 9.455109736419665e-28) + 2.102251290531472e-26) - 4.647190079875676e-25) + 1.020757615045488e-23) - 2.22626420420548e-22) + 4.817203181024e-21) - 1.033126083561e-19) + 2.193530864224e-18) - 4.60416027032e-17) + 9.5371121952e-16) - 1.94535723272e-14) + 3.89671896e-13) - 7.63766676e-12) + 911159.0/6250000000000000.0) - 13461301.0/5000000000000000.0) + 1489227.0/31250000000000.0) - 39863.0/50000000000.0) + 7703.0/625000000.0) - 8457.0/50000000.0) + 237.0/125000.0) - 343.0/25000.0 : (1.0/2.0)*w9*(-50*s*w4 + 50*w0*w10*w2*w6 - 10*w10*w5*(125*w4 - w5*w8) + w5*(50*w3 - 25));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1606,8 +1642,8 @@ static inline float symrot_tangent_m5_angle_f(const float p[3])
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
- * ops: 91 */
+ * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/x
+ * ops: 87 */
 static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1631,19 +1667,19 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_R_1 = 2*w1*cosf(w0)/s;
-        c_R_2 = 2*(w1*w1)/x;
+        c_R_1 = 2*sinf(w0)*cosf(w0)/s;
+        c_R_2 = (1 - cosf(phi))/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m5_rotation_matrix_f_batch: symrot_tangent_m5_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1695,10 +1731,21 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
             poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1 - cos1)/x;
+            poly_R_2_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1710,31 +1757,32 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             c_R_1_lanes[k] = !(x < 236.8034F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 0.0081290705F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.41316044F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 236.8034F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 25/(x + 25) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
- * ops: 100 */
+ * ops: 114 */
 static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1750,29 +1798,31 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 25/(x + 25);
-    float c_H_1, c_H_2;
+    float c_H_across, c_H_1, c_H_2;
     if (x < 1.5711837F) {
+        c_H_across = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/x;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = 2*w1*cosf(w0)/s;
+        const float w3 = 1.0F/x;
+        c_H_across = w2;
+        c_H_1 = 2*(w1*w1)*w3;
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w3*(-w2 + 25/(x + 25));
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m5_tangent_f_batch: symrot_tangent_m5_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1784,7 +1834,7 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1792,7 +1842,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 0.0081290705F) {
+            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1824,19 +1874,22 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = 1.0F/(x + 25);
+            const float w0 = 2*cos0*sin0/s;
             const float w1 = 1.0F/x;
-            c_H_0_lanes[k] = 25*w0;
+            c_H_across_lanes[k] = w0;
+            poly_H_across_lanes[k] = 1;
             c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
             poly_H_1_lanes[k] = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w1*(-2*cos0*sin0/s + 25*w0);
+            c_H_2_lanes[k] = w1*(-w0 + 25/(x + 25));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            const float poly_H_across = poly_H_across_lanes[k];
+            const float v_H_across = x < 3.6909684e-14F ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x < 236.8034F) ? NAN : v_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.0081290705F ? poly_H_1 : closed_H_1;
@@ -1849,25 +1902,25 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m5_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 25)/25 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 6.51179, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
- * ops: 68 */
+ * ops: 79 */
 static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1883,25 +1936,27 @@ static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float H
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/25.0F)*x + 1;
-    float c_H_inverse_2;
+    float c_H_inverse_across, c_H_inverse_2;
     if (x < 6.5117908F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(5.6e-11F + (-1.808e-12F)*x) - 1.16e-08F) - 3.0F/2500000.0F) - 21.0F/50000.0F) - 7.0F/100.0F) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
-        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w0)/sinf(w0) + (1.0F/25.0F)*x + 1)/x;
+        const float w1 = (1.0F/2.0F)*s*cosf(w0)/sinf(w0);
+        c_H_inverse_across = w1;
+        c_H_inverse_2 = (-w1 + (1.0F/25.0F)*x + 1)/x;
     }
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m5_tangent_inverse_f_batch: symrot_tangent_m5_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1913,7 +1968,7 @@ static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float H
  */
 static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1921,7 +1976,7 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 3.1374536F) {
+            if (!(x < 236.8034F) || x < 7.0910495e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -1953,16 +2008,19 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = (1.0F/25.0F)*x + 1;
-            c_H_inverse_0_lanes[k] = w0;
-            c_H_inverse_2_lanes[k] = (-1.0F/2.0F*cos0*s/sin0 + w0)/x;
+            const float w0 = (1.0F/2.0F)*cos0*s/sin0;
+            c_H_inverse_across_lanes[k] = w0;
+            poly_H_inverse_across_lanes[k] = 1;
+            c_H_inverse_2_lanes[k] = (-w0 + (1.0F/25.0F)*x + 1)/x;
             poly_H_inverse_2_lanes[k] = x*(x*(x*(1.16e-08F + (-5.6e-11F)*x) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const float v_H_inverse_across = x < 7.0910495e-14F ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 236.8034F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 236.8034F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const float poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
@@ -1972,15 +2030,15 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -2010,7 +2068,7 @@ static inline float symrot_tangent_m5_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.57118, else sin(phi/2)/s
  * G_2: Horner degree 6 in x below x = 1.57118, else 2*sin(phi/4)**2/x
- * ops: 84 */
+ * ops: 80 */
 static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2036,15 +2094,16 @@ static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
         c_G_1 = sinf((1.0F/2.0F)*phi)/s;
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m5_root_matrix_f_batch: symrot_tangent_m5_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2124,26 +2183,27 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m5_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 25/(2*(x + 25)) (algebraic in x)
+ * K_across: Horner degree 6 in x below x = 1.57118, else sin(phi/2)/s
  * K_1: Horner degree 6 in x below x = 1.57118, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 14 in x below x = 6.51179, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
- * ops: 111 */
+ * ops: 121 */
 static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2159,26 +2219,28 @@ static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9]
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = (25.0F/2.0F)/(x + 25);
-    float c_K_1, c_K_2;
+    float c_K_across, c_K_1, c_K_2;
     if (x < 1.5711837F) {
+        c_K_across = x*(x*(x*(x*(x*((4.0809662e-09F)*x - 9.784316e-08F) + 2.3260548e-06F) - 5.459375e-05F) + 1003.0F/800000.0F) - 11.0F/400.0F) + 1.0F/2.0F;
         c_K_1 = x*(x*(x*(x*(x*((8.315707e-10F)*x - 2.000314e-08F) + 4.7779025e-07F) - 1.1296484e-05F) + 841.0F/3200000.0F) - 19.0F/3200.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
+        const float w0 = sinf((1.0F/2.0F)*phi)/s;
+        c_K_across = w0;
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
-        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*(125/(x + 25) - 10*sinf((1.0F/2.0F)*phi)/s)/(s*s);
+        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*(-10*w0 + 125/(x + 25))/(s*s);
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m5_root_tangent_f_batch: symrot_tangent_m5_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2190,7 +2252,7 @@ static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9]
  */
 static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2198,7 +2260,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 0.0081290705F) {
+            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -2218,7 +2280,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2228,7 +2290,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = (1.0F/4.0F)*phi;
             const float a1_q = rintf(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -2238,18 +2300,21 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float w0 = 1.0F/(x + 25);
-            c_K_0_lanes[k] = (25.0F/2.0F)*w0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            const float w0 = sin0/s;
+            c_K_across_lanes[k] = w0;
+            poly_K_across_lanes[k] = 1.0F/2.0F;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
             poly_K_1_lanes[k] = x*((841.0F/3200000.0F)*x - 19.0F/3200.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/10.0F)*(125*w0 - 10*sin1/s)/(s*s);
+            c_K_2_lanes[k] = (1.0F/10.0F)*(-10*w0 + 125/(x + 25))/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 236.8034F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            const float poly_K_across = poly_K_across_lanes[k];
+            const float v_K_across = x < 3.6909684e-14F ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x < 236.8034F) ? NAN : v_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.0081290705F ? poly_K_1 : closed_K_1;
@@ -2262,25 +2327,25 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m5_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 25)/25 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 6.51179, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
- * ops: 62 */
+ * ops: 78 */
 static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2290,30 +2355,33 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/25.0F)*x + 1;
-    float c_H_inverse_2;
+    float c_H_inverse_across, c_H_inverse_2;
     if (x < 6.5117908F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(5.6e-11F + (-1.808e-12F)*x) - 1.16e-08F) - 3.0F/2500000.0F) - 21.0F/50000.0F) - 7.0F/100.0F) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
-        c_H_inverse_2 = (-1.0F/2.0F*s*cosf(w0)/sinf(w0) + (1.0F/25.0F)*x + 1)/x;
+        const float w1 = (1.0F/2.0F)*s*cosf(w0)/sinf(w0);
+        c_H_inverse_across = w1;
+        c_H_inverse_2 = (-w1 + (1.0F/25.0F)*x + 1)/x;
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_tangent_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 25/(x + 25) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
- * ops: 94 */
+ * ops: 113 */
 static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2323,26 +2391,29 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 25/(x + 25);
-    float c_H_1, c_H_2;
+    float c_H_across, c_H_1, c_H_2;
     if (x < 1.5711837F) {
+        c_H_across = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/x;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        c_H_1 = 2*w0*(w2*w2);
-        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = 2*w1*cosf(w0)/s;
+        const float w3 = 1.0F/x;
+        c_H_across = w2;
+        c_H_1 = 2*(w1*w1)*w3;
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w3*(-w2 + 25/(x + 25));
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m5_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -2508,7 +2579,7 @@ static inline int symrot_tangent_m5_rescale_f(const float p[3], float q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
+ * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 8 in x below x = 1.57118, else 5*(5*cos(phi) - 5*(x/25 + 1)*sin(phi)/s)/(2*x*(x + 25))
  * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
@@ -2542,12 +2613,12 @@ static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], con
         const float w2 = sinf(w1);
         const float w3 = w2*cosf(w1);
         const float w4 = 1.0F/x;
-        const float w5 = (w2*w2);
+        const float w5 = cosf(phi);
         const float w6 = (5.0F/2.0F)/(x + 25);
         c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4*w5;
-        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*cosf(phi));
-        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*w5*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
+        c_R_2 = w4*(1 - w5);
+        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*w5);
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*(w2*w2)*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2590,7 +2661,7 @@ static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], con
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
- * R_2: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
+ * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 8 in x below x = 1.57118, else 5*(5*cos(phi) - 5*(x/25 + 1)*sin(phi)/s)/(2*x*(x + 25))
  * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
@@ -2624,12 +2695,12 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative_f(const float
         const float w2 = sinf(w1);
         const float w3 = w2*cosf(w1);
         const float w4 = 1.0F/x;
-        const float w5 = (w2*w2);
+        const float w5 = cosf(phi);
         const float w6 = (5.0F/2.0F)/(x + 25);
         c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4*w5;
-        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*cosf(phi));
-        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*w5*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
+        c_R_2 = w4*(1 - w5);
+        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*w5);
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*(w2*w2)*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];

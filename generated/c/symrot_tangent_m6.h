@@ -77,7 +77,7 @@ static inline double symrot_tangent_m6_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
  * R_2: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
- * ops: 91 */
+ * ops: 87 */
 static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -105,15 +105,16 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
         c_R_1 = 2*w1*cos(w0)/s;
         c_R_2 = 2*(w1*w1)/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m6_rotation_matrix_batch: symrot_tangent_m6_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -185,26 +186,27 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m6_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 36/(x + 36) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 74 */
+ * ops: 88 */
 static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -220,36 +222,40 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 36/(x + 36);
     const double c_H_2 = 6912/pow(x + 36, 3);
-    double c_H_1;
+    double c_H_across, c_H_1;
     if (x < 0.11094775628437428) {
+        c_H_across = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(131.0/13060694016.0 + (-19.0/52242776064.0)*x) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        c_H_across = 2*w1*cos(w0)/s;
+        c_H_1 = 2*(w1*w1)/x;
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m6_tangent_batch: symrot_tangent_m6_tangent for n vectors p[3*k..3*k+2] into
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi.
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -257,21 +263,25 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 0.002202034702797594) {
+            if (!(x < 108.0) || x < 3.327466629816501e-08) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
@@ -283,17 +293,21 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double w0 = x + 36;
-            c_H_0_lanes[k] = 36/w0;
+            const double a0_up = fabs(a0_j - 1.5) - 0.5;
+            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_H_across_lanes[k] = 2*cos0*sin0/s;
+            poly_H_across_lanes[k] = 1 + (-19.0/108.0)*x;
             c_H_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_H_1_lanes[k] = x*(x*(x*((67.0/10077696.0)*x - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
-            c_H_2_lanes[k] = 6912/(w0*w0*w0);
+            c_H_2_lanes[k] = 6912/((x + 36)*(x + 36)*(x + 36));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            const double poly_H_across = poly_H_across_lanes[k];
+            const double v_H_across = x < 3.327466629816501e-08 ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x < 108.0) ? (double)NAN : v_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.002202034702797594 ? poly_H_1 : closed_H_1;
@@ -304,25 +318,25 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m6_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 36)/36 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.411778, else (9*x - 108)/(x - 108)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 51 */
+ * ops: 65 */
 static inline void symrot_tangent_m6_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -338,17 +352,22 @@ static inline void symrot_tangent_m6_tangent_inverse(const double p[3], double H
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/36.0)*x + 1;
     const double c_H_inverse_2 = (1.0/36.0)*(x - 396)/(x - 108);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    double c_H_inverse_across;
+    if (x < 0.4117780186135704) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-1.0/21422803359744.0)*x - 1.0/198359290368.0) - 1.0/1836660096.0) - 1.0/17006112.0) - 1.0/157464.0) - 1.0/1458.0) - 2.0/27.0) + 1;
+    } else {
+        c_H_inverse_across = (9*x - 108)/(x - 108);
+    }
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m6_tangent_inverse_batch: symrot_tangent_m6_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -358,7 +377,7 @@ static inline void symrot_tangent_m6_tangent_inverse(const double p[3], double H
  */
 static inline void symrot_tangent_m6_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -373,14 +392,18 @@ static inline void symrot_tangent_m6_tangent_inverse_batch(size_t n, const doubl
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0/36.0)*x + 1;
-            c_H_inverse_2_lanes[k] = (1.0/36.0)*(x - 396)/(x - 108);
+            const double w0 = 1.0/(x - 108);
+            c_H_inverse_across_lanes[k] = w0*(9*x - 108);
+            poly_H_inverse_across_lanes[k] = 1 + (-2.0/27.0)*x;
+            c_H_inverse_2_lanes[k] = (1.0/36.0)*w0*(x - 396);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const double v_H_inverse_across = x < 1.3623247444430473e-13 ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 108.0) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 108.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_inverse_2;
@@ -388,15 +411,15 @@ static inline void symrot_tangent_m6_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -420,7 +443,7 @@ static inline double symrot_tangent_m6_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.213555, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.213555, else 2*sin(phi/4)**2/x
- * ops: 92 */
+ * ops: 88 */
 static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -446,15 +469,16 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
         c_G_1 = sin((1.0/2.0)*phi)/s;
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m6_root_matrix_batch: symrot_tangent_m6_root_matrix for n vectors p[3*k..3*k+2] into
@@ -534,26 +558,27 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 18/(x + 36) (algebraic in x)
+ * K_across: Horner degree 7 in x below x = 0.213555, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 0.213555, else 2*sin(phi/4)**2/x
  * K_2 = (sqrt(x + 36) + 24)/((x + 36)**(3/2)*(sqrt(x + 36) + 6)) (algebraic in x)
- * ops: 84 */
+ * ops: 99 */
 static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -569,36 +594,38 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = 18/(x + 36);
     const double c_K_2 = (sqrt(x + 36) + 24)/(pow(x + 36, 3.0/2.0)*(sqrt(x + 36) + 6));
-    double c_K_1;
+    double c_K_across, c_K_1;
     if (x < 0.21355546857295174) {
+        c_K_across = x*(x*(x*(x*(x*(x*(1309.0/1486016741376.0 + (-8437.0/320979616137216.0)*x) - 301.0/10319560704.0) + 1225.0/1289945088.0) - 5.0/165888.0) + 19.0/20736.0) - 11.0/432.0) + 1.0/2.0;
         c_K_1 = x*(x*(x*(x*(x*(x*(2717.0/17832200896512.0 + (-4.524722683259537e-12)*x) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
+        const double s = sqrt(x);
+        c_K_across = sin((1.0/2.0)*phi)/s;
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m6_root_tangent_batch: symrot_tangent_m6_root_tangent for n vectors p[3*k..3*k+2] into
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = sqrt(x + 36), u1 = (x + 36)**(-3/2).
+ * Scalar pass: s, phi, u0 = sqrt(x + 36), u1 = (x + 36)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -607,6 +634,7 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 108.0)) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
@@ -615,6 +643,7 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
                 const double phi = symrot_tangent_m6__phi(s);
                 const double u0 = sqrt(x + 36);
                 const double u1 = pow(x + 36, -3.0/2.0);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -622,6 +651,7 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -629,10 +659,11 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -642,16 +673,29 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            c_K_0_lanes[k] = 18/(x + 36);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
+            const double a1_a = (1.0/4.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_K_across_lanes[k] = sin0/s;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-11.0/432.0)*x;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
             poly_K_1_lanes[k] = x*((125.0/746496.0)*x - 17.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = u1*(u0 + 24)/(u0 + 6);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 108.0) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            const double poly_K_across = poly_K_across_lanes[k];
+            const double v_K_across = x < 3.327466629816501e-08 ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x < 108.0) ? (double)NAN : v_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 3.2144365899743845e-06 ? poly_K_1 : closed_K_1;
@@ -662,25 +706,25 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m6_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 36)/36 (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.411778, else (9*x - 108)/(x - 108)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 45 */
+ * ops: 64 */
 static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -690,22 +734,28 @@ static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/36.0)*x + 1;
     const double c_H_inverse_2 = (1.0/36.0)*(x - 396)/(x - 108);
+    double c_H_inverse_across;
+    if (x < 0.4117780186135704) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-1.0/21422803359744.0)*x - 1.0/198359290368.0) - 1.0/1836660096.0) - 1.0/17006112.0) - 1.0/157464.0) - 1.0/1458.0) - 2.0/27.0) + 1;
+    } else {
+        c_H_inverse_across = (9*x - 108)/(x - 108);
+    }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0/2.0*w2;
 }
 
 /* symrot_tangent_m6_omega: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 36/(x + 36) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
  * H_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 68 */
+ * ops: 87 */
 static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -715,21 +765,26 @@ static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 36/(x + 36);
     const double c_H_2 = 6912/pow(x + 36, 3);
-    double c_H_1;
+    double c_H_across, c_H_1;
     if (x < 0.11094775628437428) {
+        c_H_across = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(131.0/13060694016.0 + (-19.0/52242776064.0)*x) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        c_H_across = 2*w1*cos(w0)/s;
+        c_H_1 = 2*(w1*w1)/x;
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m6_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1486,7 +1541,7 @@ static inline float symrot_tangent_m6_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 1.55153, else sin(phi)/s
  * R_2: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
- * ops: 87 */
+ * ops: 83 */
 static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1512,15 +1567,16 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
         c_R_1 = sinf(phi)/s;
         c_R_2 = (1 - cosf(phi))/x;
     }
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m6_rotation_matrix_f_batch: symrot_tangent_m6_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1592,26 +1648,27 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m6_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 36/(x + 36) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 1.55153, else (36*x**2 - 4320*x + 46656)/(x**3 + 108*x**2 + 3888*x + 46656)
  * H_1: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 70 */
+ * ops: 84 */
 static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1627,24 +1684,26 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 36/(x + 36);
     const float c_H_2 = 6912/powf(x + 36, 3);
-    float c_H_1;
+    float c_H_across, c_H_1;
     if (x < 1.5515263F) {
+        c_H_across = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
+        const float w0 = (x*x);
+        c_H_across = (36*w0 - 4320*x + 46656)/(108*w0 + (x*x*x) + 3888*x + 46656);
         c_H_1 = (1 - cosf(phi))/x;
     }
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_tangent_m6_tangent_f_batch: symrot_tangent_m6_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1656,7 +1715,7 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1664,7 +1723,7 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 0.41177803F) {
+            if (!(x < 108.0F) || x < 3.6909684e-14F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1691,17 +1750,20 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float a0_odd = a0_j - 2*a0_h;
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = x + 36;
-            c_H_0_lanes[k] = 36/w0;
+            const float w0 = (x*x);
+            c_H_across_lanes[k] = (36*w0 - 4320*x + 46656)/(108*w0 + (x*x*x) + 3888*x + 46656);
+            poly_H_across_lanes[k] = 1;
             c_H_1_lanes[k] = (1 - cos0)/x;
             poly_H_1_lanes[k] = x*(x*(x*((67.0F/10077696.0F)*x - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = 6912/(w0*w0*w0);
+            c_H_2_lanes[k] = 6912/((x + 36)*(x + 36)*(x + 36));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 108.0F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            const float poly_H_across = poly_H_across_lanes[k];
+            const float v_H_across = x < 3.6909684e-14F ? poly_H_across : closed_H_across;
+            c_H_across_lanes[k] = !(x < 108.0F) ? NAN : v_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.41177803F ? poly_H_1 : closed_H_1;
@@ -1712,25 +1774,25 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m6_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 36)/36 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 6.19603, else (9*x - 108)/(x - 108)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 51 */
+ * ops: 62 */
 static inline void symrot_tangent_m6_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1746,17 +1808,22 @@ static inline void symrot_tangent_m6_tangent_inverse_f(const float p[3], float H
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/36.0F)*x + 1;
     const float c_H_inverse_2 = (1.0F/36.0F)*(x - 396)/(x - 108);
-    Hinv[0] = c_H_inverse_0 - c_H_inverse_2*((p[1]*p[1]) + (p[2]*p[2]));
+    float c_H_inverse_across;
+    if (x < 6.1960254F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*((-5.041357e-12F)*x - 5.444666e-10F) - 5.880239e-08F) - 1.0F/157464.0F) - 1.0F/1458.0F) - 2.0F/27.0F) + 1;
+    } else {
+        c_H_inverse_across = (9*x - 108)/(x - 108);
+    }
+    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[2]*p[2]));
+    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
     Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
     Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_0 - c_H_inverse_2*((p[0]*p[0]) + (p[1]*p[1]));
+    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
 }
 
 /* symrot_tangent_m6_tangent_inverse_f_batch: symrot_tangent_m6_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1766,7 +1833,7 @@ static inline void symrot_tangent_m6_tangent_inverse_f(const float p[3], float H
  */
 static inline void symrot_tangent_m6_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1781,14 +1848,18 @@ static inline void symrot_tangent_m6_tangent_inverse_f_batch(size_t n, const flo
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0F/36.0F)*x + 1;
-            c_H_inverse_2_lanes[k] = (1.0F/36.0F)*(x - 396)/(x - 108);
+            const float w0 = 1.0F/(x - 108);
+            c_H_inverse_across_lanes[k] = w0*(9*x - 108);
+            poly_H_inverse_across_lanes[k] = 1;
+            c_H_inverse_2_lanes[k] = (1.0F/36.0F)*w0*(x - 396);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 108.0F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const float v_H_inverse_across = x < 1.3623247e-13F ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 108.0F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 108.0F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 108.0F) ? NAN : closed_H_inverse_2;
@@ -1796,15 +1867,15 @@ static inline void symrot_tangent_m6_tangent_inverse_f_batch(size_t n, const flo
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1828,7 +1899,7 @@ static inline float symrot_tangent_m6_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 3.06078, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 3.06078, else 2*sin(phi/4)**2/x
- * ops: 92 */
+ * ops: 88 */
 static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1854,15 +1925,16 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
         c_G_1 = sinf((1.0F/2.0F)*phi)/s;
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_tangent_m6_root_matrix_f_batch: symrot_tangent_m6_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1942,26 +2014,27 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
 
 /* symrot_tangent_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_0 = 18/(x + 36) (algebraic in x)
+ * K_across: Horner degree 7 in x below x = 3.06078, else (-x*sqrt(x + 36) - 6*x + 108*sqrt(x + 36) + 648)/(x**2 + 6*x*sqrt(x + 36) + 72*x + 216*sqrt(x + 36) + 1296)
  * K_1: Horner degree 7 in x below x = 3.06078, else 2*sin(phi/4)**2/x
  * K_2 = (sqrt(x + 36) + 24)/((x + 36)**(3/2)*(sqrt(x + 36) + 6)) (algebraic in x)
- * ops: 84 */
+ * ops: 99 */
 static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1977,24 +2050,27 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 18/(x + 36);
     const float c_K_2 = (sqrtf(x + 36) + 24)/(powf(x + 36, 3.0F/2.0F)*(sqrtf(x + 36) + 6));
-    float c_K_1;
+    float c_K_across, c_K_1;
     if (x < 3.0607803F) {
+        c_K_across = x*(x*(x*(x*(x*(x*(8.8087837e-10F + (-2.6285158e-11F)*x) - 2.9167909e-08F) + 9.496528e-07F) - 5.0F/165888.0F) + 19.0F/20736.0F) - 11.0F/432.0F) + 1.0F/2.0F;
         c_K_1 = x*(x*(x*(x*(x*(x*(1.5236482e-10F + (-4.5247226e-12F)*x) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
+        const float w0 = 6*x;
+        const float w1 = sqrtf(x + 36);
+        c_K_across = (-w0 - w1*x + 108*w1 + 648)/(w0*w1 + 216*w1 + (x*x) + 72*x + 1296);
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    K[0] = c_K_0 - c_K_2*((p[1]*p[1]) + (p[2]*p[2]));
+    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
     K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[2]*p[2]));
+    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
     K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
     K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
     K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_0 - c_K_2*((p[0]*p[0]) + (p[1]*p[1]));
+    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
 }
 
 /* symrot_tangent_m6_root_tangent_f_batch: symrot_tangent_m6_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2006,7 +2082,7 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
  */
 static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2050,7 +2126,9 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            c_K_0_lanes[k] = 18/(x + 36);
+            const float w0 = 6*x;
+            c_K_across_lanes[k] = (-u0*x + 108*u0 - w0 + 648)/(u0*w0 + 216*u0 + (x*x) + 72*x + 1296);
+            poly_K_across_lanes[k] = 1.0F/2.0F;
             c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = u1*(u0 + 24)/(u0 + 6);
@@ -2058,8 +2136,10 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 108.0F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            const float poly_K_across = poly_K_across_lanes[k];
+            const float v_K_across = x < 3.6909684e-14F ? poly_K_across : closed_K_across;
+            c_K_across_lanes[k] = !(x < 108.0F) ? NAN : v_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.21355546F ? poly_K_1 : closed_K_1;
@@ -2070,25 +2150,25 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
 
 /* symrot_tangent_m6_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_0 = (x + 36)/36 (algebraic in x)
+ * H_inverse_across: Horner degree 6 in x below x = 6.19603, else (9*x - 108)/(x - 108)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 45 */
+ * ops: 61 */
 static inline void symrot_tangent_m6_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2098,22 +2178,28 @@ static inline void symrot_tangent_m6_pdot_f(const float p[3], const float omega[
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/36.0F)*x + 1;
     const float c_H_inverse_2 = (1.0F/36.0F)*(x - 396)/(x - 108);
+    float c_H_inverse_across;
+    if (x < 6.1960254F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*((-5.041357e-12F)*x - 5.444666e-10F) - 5.880239e-08F) - 1.0F/157464.0F) - 1.0F/1458.0F) - 2.0F/27.0F) + 1;
+    } else {
+        c_H_inverse_across = (9*x - 108)/(x - 108);
+    }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + c_H_inverse_2*(p[1]*w2 - p[2]*w1) - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] + c_H_inverse_2*(-p[0]*w2 + p[2]*w0) - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + c_H_inverse_2*(p[0]*w1 - p[1]*w0) - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_2*p[0]*p_dot_v + c_H_inverse_across*omega[0] - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_2*p[1]*p_dot_v + c_H_inverse_across*omega[1] - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_2*p[2]*p_dot_v + c_H_inverse_across*omega[2] - 1.0F/2.0F*w2;
 }
 
 /* symrot_tangent_m6_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0 = 36/(x + 36) (algebraic in x)
+ * H_across: Horner degree 7 in x below x = 1.55153, else (36*x**2 - 4320*x + 46656)/(x**3 + 108*x**2 + 3888*x + 46656)
  * H_1: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 64 */
+ * ops: 83 */
 static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2123,21 +2209,24 @@ static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 36/(x + 36);
     const float c_H_2 = 6912/powf(x + 36, 3);
-    float c_H_1;
+    float c_H_across, c_H_1;
     if (x < 1.5515263F) {
+        c_H_across = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
+        const float w0 = (x*x);
+        c_H_across = (36*w0 - 4320*x + 46656)/(108*w0 + (x*x*x) + 3888*x + 46656);
         c_H_1 = (1 - cosf(phi))/x;
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_tangent_m6_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

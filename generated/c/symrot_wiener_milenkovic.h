@@ -81,7 +81,7 @@ static inline double symrot_wiener_milenkovic_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * R_2 = 128/(x + 16)**2 (algebraic in x)
- * ops: 54 */
+ * ops: 50 */
 static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -99,15 +99,16 @@ static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], d
     }
     const double c_R_1 = -16*(x - 16)/pow(x + 16, 2);
     const double c_R_2 = 128/pow(x + 16, 2);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix_batch: symrot_wiener_milenkovic_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -147,16 +148,17 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -165,10 +167,10 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
  * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 16/(x + 16) (algebraic in x)
+ * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 53 */
+ * ops: 51 */
 static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -184,18 +186,18 @@ static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_0 = 16/(x + 16);
+    const double c_H_across = -16*(x - 16)/pow(x + 16, 2);
     const double c_H_1 = 128/pow(x + 16, 2);
     const double c_H_2 = 32/pow(x + 16, 2);
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_wiener_milenkovic_tangent_batch: symrot_wiener_milenkovic_tangent for n vectors p[3*k..3*k+2] into
@@ -205,7 +207,7 @@ static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[
  */
 static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -220,17 +222,16 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double w0 = x + 16;
-            const double w1 = 1.0/(w0*w0);
-            c_H_0_lanes[k] = 16/w0;
-            c_H_1_lanes[k] = 128*w1;
-            c_H_2_lanes[k] = 32*w1;
+            const double w0 = 1.0/((x + 16)*(x + 16));
+            c_H_across_lanes[k] = -16*w0*(x - 16);
+            c_H_1_lanes[k] = 128*w0;
+            c_H_2_lanes[k] = 32*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_0;
+            const double closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
@@ -239,15 +240,15 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -256,10 +257,10 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
  * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 16)/16 (algebraic in x)
+ * H_inverse_across = -(x - 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
- * ops: 50 */
+ * ops: 41 */
 static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -275,16 +276,16 @@ static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], d
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/16.0)*x + 1;
-    Hinv[0] = c_H_inverse_0 - 1.0/8.0*(p[1]*p[1]) - 1.0/8.0*(p[2]*p[2]);
+    const double c_H_inverse_across = 1 - 1.0/16.0*x;
+    Hinv[0] = c_H_inverse_across + (1.0/8.0)*(p[0]*p[0]);
     Hinv[1] = (1.0/8.0)*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = (1.0/8.0)*p[0]*p[2] - 1.0/2.0*p[1];
     Hinv[3] = (1.0/8.0)*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_0 - 1.0/8.0*(p[0]*p[0]) - 1.0/8.0*(p[2]*p[2]);
+    Hinv[4] = c_H_inverse_across + (1.0/8.0)*(p[1]*p[1]);
     Hinv[5] = (1.0/2.0)*p[0] + (1.0/8.0)*p[1]*p[2];
     Hinv[6] = (1.0/8.0)*p[0]*p[2] + (1.0/2.0)*p[1];
     Hinv[7] = -1.0/2.0*p[0] + (1.0/8.0)*p[1]*p[2];
-    Hinv[8] = c_H_inverse_0 - 1.0/8.0*(p[0]*p[0]) - 1.0/8.0*(p[1]*p[1]);
+    Hinv[8] = c_H_inverse_across + (1.0/8.0)*(p[2]*p[2]);
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse_batch: symrot_wiener_milenkovic_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -294,7 +295,7 @@ static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], d
  */
 static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -309,28 +310,28 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, cons
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0/16.0)*x + 1;
+            c_H_inverse_across_lanes[k] = 1 - 1.0/16.0*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_inverse_0;
+            const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : -1.0/2.0;
             c_H_inverse_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 1.0/8.0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -358,7 +359,7 @@ static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1 = 8/(x + 16) (algebraic in x)
  * G_2 = 2/(x + 16) (algebraic in x)
- * ops: 49 */
+ * ops: 45 */
 static inline void symrot_wiener_milenkovic_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -376,15 +377,16 @@ static inline void symrot_wiener_milenkovic_root_matrix(const double p[3], doubl
     }
     const double c_G_1 = 8/(x + 16);
     const double c_G_2 = 2/(x + 16);
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const double t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_wiener_milenkovic_root_matrix_batch: symrot_wiener_milenkovic_root_matrix for n vectors p[3*k..3*k+2] into
@@ -424,16 +426,17 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
+            const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -442,7 +445,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
  * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 8/(x + 16) (algebraic in x)
+ * K_across = 8/(x + 16) (algebraic in x)
  * K_1 = 2/(x + 16) (algebraic in x)
  * K_2 = 0 (constant)
  * ops: 19 */
@@ -461,17 +464,17 @@ static inline void symrot_wiener_milenkovic_root_tangent(const double p[3], doub
         K[8] = (double)NAN;
         return;
     }
-    const double c_K_0 = 8/(x + 16);
+    const double c_K_across = 8/(x + 16);
     const double c_K_1 = 2/(x + 16);
-    K[0] = c_K_0;
+    K[0] = c_K_across;
     K[1] = -c_K_1*p[2];
     K[2] = c_K_1*p[1];
     K[3] = c_K_1*p[2];
-    K[4] = c_K_0;
+    K[4] = c_K_across;
     K[5] = -c_K_1*p[0];
     K[6] = -c_K_1*p[1];
     K[7] = c_K_1*p[0];
-    K[8] = c_K_0;
+    K[8] = c_K_across;
 }
 
 /* symrot_wiener_milenkovic_root_tangent_batch: symrot_wiener_milenkovic_root_tangent for n vectors p[3*k..3*k+2] into
@@ -481,7 +484,7 @@ static inline void symrot_wiener_milenkovic_root_tangent(const double p[3], doub
  */
 static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -497,14 +500,14 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double w0 = 1.0/(x + 16);
-            c_K_0_lanes[k] = 8*w0;
+            c_K_across_lanes[k] = 8*w0;
             c_K_1_lanes[k] = 2*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_K_0;
+            const double closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             c_K_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_K_1;
             c_K_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 0;
@@ -512,15 +515,15 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -529,10 +532,10 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
  * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 16)/16 (algebraic in x)
+ * H_inverse_across = -(x - 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
- * ops: 44 */
+ * ops: 40 */
 static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -542,23 +545,24 @@ static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_0 = (1.0/16.0)*x + 1;
+    const double c_H_inverse_across = 1 - 1.0/16.0*x;
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + (1.0/8.0)*p[1]*w2 - 1.0/8.0*p[2]*w1 - 1.0/2.0*w0;
-    pdot[1] = c_H_inverse_0*omega[1] - 1.0/8.0*p[0]*w2 + (1.0/8.0)*p[2]*w0 - 1.0/2.0*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + (1.0/8.0)*p[0]*w1 - 1.0/8.0*p[1]*w0 - 1.0/2.0*w2;
+    const double p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_across*omega[0] + (1.0/8.0)*p[0]*p_dot_v - 1.0/2.0*w0;
+    pdot[1] = c_H_inverse_across*omega[1] + (1.0/8.0)*p[1]*p_dot_v - 1.0/2.0*w1;
+    pdot[2] = c_H_inverse_across*omega[2] + (1.0/8.0)*p[2]*p_dot_v - 1.0/2.0*w2;
 }
 
 /* symrot_wiener_milenkovic_omega: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 16/(x + 16) (algebraic in x)
+ * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 47 */
+ * ops: 50 */
 static inline void symrot_wiener_milenkovic_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -568,15 +572,16 @@ static inline void symrot_wiener_milenkovic_omega(const double p[3], const doubl
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_0 = 16/(x + 16);
+    const double c_H_across = -16*(x - 16)/pow(x + 16, 2);
     const double c_H_1 = 128/pow(x + 16, 2);
     const double c_H_2 = 32/pow(x + 16, 2);
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const double p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_wiener_milenkovic_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
@@ -1249,7 +1254,7 @@ static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * R_2 = 128/(x + 16)**2 (algebraic in x)
- * ops: 54 */
+ * ops: 50 */
 static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1267,15 +1272,16 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], 
     }
     const float c_R_1 = -16*(x - 16)/powf(x + 16, 2);
     const float c_R_2 = 128/powf(x + 16, 2);
-    R[0] = -c_R_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_R_2*x + 1;
+    R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
     R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = -c_R_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    R[4] = c_R_2*(p[1]*p[1]) + t;
     R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
     R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
     R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = -c_R_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    R[8] = c_R_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix_f_batch: symrot_wiener_milenkovic_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1315,16 +1321,17 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_0_lanes[k] - c_R_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1333,10 +1340,10 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
  * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 16/(x + 16) (algebraic in x)
+ * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 53 */
+ * ops: 51 */
 static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1352,18 +1359,18 @@ static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[
         H[8] = NAN;
         return;
     }
-    const float c_H_0 = 16/(x + 16);
+    const float c_H_across = -16*(x - 16)/powf(x + 16, 2);
     const float c_H_1 = 128/powf(x + 16, 2);
     const float c_H_2 = 32/powf(x + 16, 2);
-    H[0] = c_H_0 - c_H_2*((p[1]*p[1]) + (p[2]*p[2]));
+    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[2]*p[2]));
+    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
     H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
     H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
     H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_0 - c_H_2*((p[0]*p[0]) + (p[1]*p[1]));
+    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
 }
 
 /* symrot_wiener_milenkovic_tangent_f_batch: symrot_wiener_milenkovic_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1373,7 +1380,7 @@ static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[
  */
 static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1388,17 +1395,16 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float w0 = x + 16;
-            const float w1 = 1.0F/(w0*w0);
-            c_H_0_lanes[k] = 16/w0;
-            c_H_1_lanes[k] = 128*w1;
-            c_H_2_lanes[k] = 32*w1;
+            const float w0 = 1.0F/((x + 16)*(x + 16));
+            c_H_across_lanes[k] = -16*w0*(x - 16);
+            c_H_1_lanes[k] = 128*w0;
+            c_H_2_lanes[k] = 32*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_0 = c_H_0_lanes[k];
-            c_H_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_0;
+            const float closed_H_across = c_H_across_lanes[k];
+            c_H_across_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             c_H_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
@@ -1407,15 +1413,15 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
             out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
             out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_0_lanes[k] - c_H_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
         }
     }
 }
@@ -1424,10 +1430,10 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
  * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 16)/16 (algebraic in x)
+ * H_inverse_across = -(x - 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
- * ops: 50 */
+ * ops: 41 */
 static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1443,16 +1449,16 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], 
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/16.0F)*x + 1;
-    Hinv[0] = c_H_inverse_0 - 1.0F/8.0F*(p[1]*p[1]) - 1.0F/8.0F*(p[2]*p[2]);
+    const float c_H_inverse_across = 1 - 1.0F/16.0F*x;
+    Hinv[0] = c_H_inverse_across + (1.0F/8.0F)*(p[0]*p[0]);
     Hinv[1] = (1.0F/8.0F)*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = (1.0F/8.0F)*p[0]*p[2] - 1.0F/2.0F*p[1];
     Hinv[3] = (1.0F/8.0F)*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_0 - 1.0F/8.0F*(p[0]*p[0]) - 1.0F/8.0F*(p[2]*p[2]);
+    Hinv[4] = c_H_inverse_across + (1.0F/8.0F)*(p[1]*p[1]);
     Hinv[5] = (1.0F/2.0F)*p[0] + (1.0F/8.0F)*p[1]*p[2];
     Hinv[6] = (1.0F/8.0F)*p[0]*p[2] + (1.0F/2.0F)*p[1];
     Hinv[7] = -1.0F/2.0F*p[0] + (1.0F/8.0F)*p[1]*p[2];
-    Hinv[8] = c_H_inverse_0 - 1.0F/8.0F*(p[0]*p[0]) - 1.0F/8.0F*(p[1]*p[1]);
+    Hinv[8] = c_H_inverse_across + (1.0F/8.0F)*(p[2]*p[2]);
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse_f_batch: symrot_wiener_milenkovic_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1462,7 +1468,7 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], 
  */
 static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1477,28 +1483,28 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, co
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_H_inverse_0_lanes[k] = (1.0F/16.0F)*x + 1;
+            c_H_inverse_across_lanes[k] = 1 - 1.0F/16.0F*x;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_H_inverse_0 = c_H_inverse_0_lanes[k];
-            c_H_inverse_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_inverse_0;
+            const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
+            c_H_inverse_across_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : -1.0F/2.0F;
             c_H_inverse_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 1.0F/8.0F;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
             out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
             out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1526,7 +1532,7 @@ static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1 = 8/(x + 16) (algebraic in x)
  * G_2 = 2/(x + 16) (algebraic in x)
- * ops: 49 */
+ * ops: 45 */
 static inline void symrot_wiener_milenkovic_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1544,15 +1550,16 @@ static inline void symrot_wiener_milenkovic_root_matrix_f(const float p[3], floa
     }
     const float c_G_1 = 8/(x + 16);
     const float c_G_2 = 2/(x + 16);
-    G[0] = -c_G_2*((p[1]*p[1]) + (p[2]*p[2])) + 1;
+    const float t = -c_G_2*x + 1;
+    G[0] = c_G_2*(p[0]*p[0]) + t;
     G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
     G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = -c_G_2*((p[0]*p[0]) + (p[2]*p[2])) + 1;
+    G[4] = c_G_2*(p[1]*p[1]) + t;
     G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
     G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
     G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = -c_G_2*((p[0]*p[0]) + (p[1]*p[1])) + 1;
+    G[8] = c_G_2*(p[2]*p[2]) + t;
 }
 
 /* symrot_wiener_milenkovic_root_matrix_f_batch: symrot_wiener_milenkovic_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1592,16 +1599,17 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
+            const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
             out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
             out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_0_lanes[k] - c_G_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
         }
     }
 }
@@ -1610,7 +1618,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
  * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * K_0 = 8/(x + 16) (algebraic in x)
+ * K_across = 8/(x + 16) (algebraic in x)
  * K_1 = 2/(x + 16) (algebraic in x)
  * K_2 = 0 (constant)
  * ops: 19 */
@@ -1629,17 +1637,17 @@ static inline void symrot_wiener_milenkovic_root_tangent_f(const float p[3], flo
         K[8] = NAN;
         return;
     }
-    const float c_K_0 = 8/(x + 16);
+    const float c_K_across = 8/(x + 16);
     const float c_K_1 = 2/(x + 16);
-    K[0] = c_K_0;
+    K[0] = c_K_across;
     K[1] = -c_K_1*p[2];
     K[2] = c_K_1*p[1];
     K[3] = c_K_1*p[2];
-    K[4] = c_K_0;
+    K[4] = c_K_across;
     K[5] = -c_K_1*p[0];
     K[6] = -c_K_1*p[1];
     K[7] = c_K_1*p[0];
-    K[8] = c_K_0;
+    K[8] = c_K_across;
 }
 
 /* symrot_wiener_milenkovic_root_tangent_f_batch: symrot_wiener_milenkovic_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1649,7 +1657,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_f(const float p[3], flo
  */
 static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1665,14 +1673,14 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float w0 = 1.0F/(x + 16);
-            c_K_0_lanes[k] = 8*w0;
+            c_K_across_lanes[k] = 8*w0;
             c_K_1_lanes[k] = 2*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float closed_K_0 = c_K_0_lanes[k];
-            c_K_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_K_0;
+            const float closed_K_across = c_K_across_lanes[k];
+            c_K_across_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             c_K_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_K_1;
             c_K_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 0;
@@ -1680,15 +1688,15 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[1]*pk[1]) + (pk[2]*pk[2]));
+            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
             out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
             out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[2]*pk[2]));
+            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
             out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
             out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
             out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_0_lanes[k] - c_K_2_lanes[k]*((pk[0]*pk[0]) + (pk[1]*pk[1]));
+            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
         }
     }
 }
@@ -1697,10 +1705,10 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
  * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_0 = (x + 16)/16 (algebraic in x)
+ * H_inverse_across = -(x - 16)/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
- * ops: 44 */
+ * ops: 40 */
 static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1710,23 +1718,24 @@ static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_0 = (1.0F/16.0F)*x + 1;
+    const float c_H_inverse_across = 1 - 1.0F/16.0F*x;
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
-    pdot[0] = c_H_inverse_0*omega[0] + (1.0F/8.0F)*p[1]*w2 - 1.0F/8.0F*p[2]*w1 - 1.0F/2.0F*w0;
-    pdot[1] = c_H_inverse_0*omega[1] - 1.0F/8.0F*p[0]*w2 + (1.0F/8.0F)*p[2]*w0 - 1.0F/2.0F*w1;
-    pdot[2] = c_H_inverse_0*omega[2] + (1.0F/8.0F)*p[0]*w1 - 1.0F/8.0F*p[1]*w0 - 1.0F/2.0F*w2;
+    const float p_dot_v = omega[0]*p[0] + omega[1]*p[1] + omega[2]*p[2];
+    pdot[0] = c_H_inverse_across*omega[0] + (1.0F/8.0F)*p[0]*p_dot_v - 1.0F/2.0F*w0;
+    pdot[1] = c_H_inverse_across*omega[1] + (1.0F/8.0F)*p[1]*p_dot_v - 1.0F/2.0F*w1;
+    pdot[2] = c_H_inverse_across*omega[2] + (1.0F/8.0F)*p[2]*p_dot_v - 1.0F/2.0F*w2;
 }
 
 /* symrot_wiener_milenkovic_omega_f: omega = H pdot (eq 20).
  * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_0 = 16/(x + 16) (algebraic in x)
+ * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
  * H_1 = 128/(x + 16)**2 (algebraic in x)
  * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 47 */
+ * ops: 50 */
 static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1736,15 +1745,16 @@ static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const floa
         omega[2] = NAN;
         return;
     }
-    const float c_H_0 = 16/(x + 16);
+    const float c_H_across = -16*(x - 16)/powf(x + 16, 2);
     const float c_H_1 = 128/powf(x + 16, 2);
     const float c_H_2 = 32/powf(x + 16, 2);
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
-    omega[0] = c_H_0*pdot[0] + c_H_1*w0 + c_H_2*(p[1]*w2 - p[2]*w1);
-    omega[1] = c_H_0*pdot[1] + c_H_1*w1 + c_H_2*(-p[0]*w2 + p[2]*w0);
-    omega[2] = c_H_0*pdot[2] + c_H_1*w2 + c_H_2*(p[0]*w1 - p[1]*w0);
+    const float p_dot_v = p[0]*pdot[0] + p[1]*pdot[1] + p[2]*pdot[2];
+    omega[0] = c_H_1*w0 + c_H_2*p[0]*p_dot_v + c_H_across*pdot[0];
+    omega[1] = c_H_1*w1 + c_H_2*p[1]*p_dot_v + c_H_across*pdot[1];
+    omega[2] = c_H_1*w2 + c_H_2*p[2]*p_dot_v + c_H_across*pdot[2];
 }
 
 /* symrot_wiener_milenkovic_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).

@@ -194,6 +194,18 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return (-1/((x + 4)*(_xp.sqrt(x + 4) + 2))) + 0.0 * x
 
 
+def _H_across_64(x, phi, s, d, sin_half, cos_half):
+    return (4/(x + 4)) + 0.0 * x
+
+
+def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 1.0)
+
+
+def _K_across_64(x, phi, s, d, sin_half, cos_half):
+    return (1/_xp.sqrt(x + 4)) + 0.0 * x
+
+
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.0)
 
@@ -332,6 +344,20 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((-1/((x + 4)*(_xp.sqrt(x + 4) + 2))) + 0.0 * x, s)
 
 
+def _H_across_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    return _narrow((4/(x + 4)) + 0.0 * x, s)
+
+
+def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
+    return _xp.full_like(x, 1.0)
+
+
+def _K_across_32(x, phi, s, d, sin_half, cos_half):
+    x = _wide(x)
+    return _narrow((1/_xp.sqrt(x + 4)) + 0.0 * x, s)
+
+
 def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.0)
 
@@ -412,6 +438,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "H_across": _H_across_64,
+        "H_inverse_across": _H_inverse_across_64,
+        "K_across": _K_across_64,
         "R_0_x": _R_0_x_64,
         "R_1_x": _R_1_x_64,
         "R_2_x": _R_2_x_64,
@@ -444,6 +473,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "H_across": _H_across_32,
+        "H_inverse_across": _H_inverse_across_32,
+        "K_across": _K_across_32,
         "R_0_x": _R_0_x_32,
         "R_1_x": _R_1_x_32,
         "R_2_x": _R_2_x_32,
@@ -456,11 +488,12 @@ _COEFFICIENTS = {
         "e_0": _e_0_32,
     },
 }
+_ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
-    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
+    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
+    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
@@ -545,22 +578,30 @@ def _scalar(p, name):
     return _where(valid, _COEFFICIENTS[suffix][name](*state), math.nan)
 
 
-def _tensor(p, name):
-    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3)."""
-    p, state, valid, suffix = _prepare(_as_float(p, "p", (3,)), [name + "_0", name + "_1", name + "_2"])
+def _coefficients(p, name):
+    """p, state, valid, t, c1, c2 of T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T:
+    t = c0 - c2 |p|^2, the part across the axis, is a planned coefficient (next to 2 pi c0 and
+    c2 |p|^2 nearly cancel), computed from c0 and c2 where c0 is a constant."""
+    first = name + "_across" if name in _ACROSS else name + "_0"
+    p, state, valid, suffix = _prepare(p, [first, name + "_1", name + "_2"])
     table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](*state)
-    b = table[name + "_1"](*state)
+    t = table[first](*state)
     c = table[name + "_2"](*state)
+    if name not in _ACROSS:
+        t = t - c * state[0]
+    return p, valid, t, table[name + "_1"](*state), c
+
+
+def _tensor(p, name):
+    """T = t I + c1 (p x) + c2 p p^T for p (..., 3)."""
+    p, valid, a, b, c = _coefficients(_as_float(p, "p", (3,)), name)
     p0, p1, p2 = p[..., 0], p[..., 1], p[..., 2]
     c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
-    s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
     q01, q02, q12 = c0 * p1, c0 * p2, c1 * p2
-    # T_ii = c0 - c2 (p_j^2 + p_k^2): no cancellation against |p|^2
-    m = _xp.stack([a - c * (s1 + s2), q01 - b2, q02 + b1,
-                   q01 + b2, a - c * (s0 + s2), q12 - b0,
-                   q02 - b1, q12 + b0, a - c * (s0 + s1)], -1)
+    m = _xp.stack([a + c * (p0 * p0), q01 - b2, q02 + b1,
+                   q01 + b2, a + c * (p1 * p1), q12 - b0,
+                   q02 - b1, q12 + b0, a + c * (p2 * p2)], -1)
     m = _where(valid[..., None], m, math.nan)
     return m.reshape((*m.shape[:-1], 3, 3))
 
@@ -568,13 +609,8 @@ def _tensor(p, name):
 def _apply(p, v, name):
     p = _as_float(p, "p", (3,))
     v = _like(_as_float(v, "the second argument", (3,)), p)
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
-    table = _COEFFICIENTS[suffix]
-    x = state[0]
-    a = table[name + "_0"](*state)[..., None]
-    b = table[name + "_1"](*state)[..., None]
-    c = table[name + "_2"](*state)[..., None]
-    result = a * v + b * _cross(p, v) + c * (p * _dot(p, v)[..., None] - x[..., None] * v)
+    p, valid, t, b, c = _coefficients(p, name)
+    result = t[..., None] * v + b[..., None] * _cross(p, v) + (c * _dot(p, v))[..., None] * p
     return _where(valid[..., None], result, math.nan)
 
 

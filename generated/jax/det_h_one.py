@@ -579,6 +579,73 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
+def _H_across_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.764824235244299
+    t = _where(small, x, 0.0)
+    series = 2.4273770483331233e-15 + 0.0 * x
+    series = 3.054732998294483e-14 + t * series
+    series = 3.8844043825273724e-13 + t * series
+    series = 5.001592370976041e-12 + t * series
+    series = 6.539638581589419e-11 + t * series
+    series = 8.716860870222215e-10 + t * series
+    series = 1.1911667949082915e-08 + t * series
+    series = 1.683039183039183e-07 + t * series
+    series = 2.4930426716141e-06 + t * series
+    series = 3.968253968253968e-05 + t * series
+    series = 0.0007142857142857143 + t * series
+    series = -0.15 + t * series
+    series = 1.0 + t * series
+    phi = _where(small, 0.886071872158482, phi)
+    w0 = _xp.sin(phi)
+    closed = w0/_cbrt(6*phi - 6*w0)
+    return _where(small, series, closed)
+
+
+def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.764824235244299
+    t = _where(small, x, 0.0)
+    series = -1.847696164362506e-14 + 0.0 * x
+    series = -2.227352392712e-13 + t * series
+    series = -2.7052088947240463e-12 + t * series
+    series = -3.316097701005811e-11 + t * series
+    series = -4.112699899093853e-10 + t * series
+    series = -5.178834122911754e-09 + t * series
+    series = -6.656956359337311e-08 + t * series
+    series = -8.811723990295419e-07 + t * series
+    series = -1.2201092558235416e-05 + t * series
+    series = -0.00018253968253968255 + t * series
+    series = -0.0032142857142857142 + t * series
+    series = -0.1 + t * series
+    series = 1.0 + t * series
+    phi = _where(small, 0.886071872158482, phi)
+    sin_half = _where(small, 0.42868426614277505, sin_half)
+    w0 = _xp.sin(phi)
+    closed = (0.25)*w0*_cbrt(6*phi - 6*w0)/sin_half**2
+    return _where(small, series, closed)
+
+
+def _K_across_64(x, phi, s, d, sin_half, cos_half):
+    small = x < 0.764824235244299
+    t = _where(small, x, 0.0)
+    series = -1.2358884471431072e-15 + 0.0 * x
+    series = -1.5586041391956483e-14 + t * series
+    series = -1.9870905217627718e-13 + t * series
+    series = -2.5669594363297223e-12 + t * series
+    series = -3.370441278711113e-11 + t * series
+    series = -4.517630699305304e-10 + t * series
+    series = -6.22104590536751e-09 + t * series
+    series = -8.889107582955239e-08 + t * series
+    series = -1.340206714788188e-06 + t * series
+    series = -2.201140873015873e-05 + t * series
+    series = -0.00042410714285714285 + t * series
+    series = -0.0125 + t * series
+    series = 0.5 + t * series
+    phi = _where(small, 0.886071872158482, phi)
+    sin_half = _where(small, 0.42868426614277505, sin_half)
+    closed = sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
+    return _where(small, series, closed)
+
+
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.0)
 
@@ -1059,21 +1126,17 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222574480542
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -2.2848332772743624e-11 + 0.0 * x
-    series = -3.236771326819846e-10 + t * series
-    series = -4.75496882809808e-09 + t * series
+    series = -4.75496882809808e-09 + 0.0 * x
     series = -7.343103325246183e-08 + t * series
     series = -1.2201092558235415e-06 + t * series
     series = -2.281746031746032e-05 + t * series
     series = -0.0005357142857142857 + t * series
     series = -0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    closed = 2*sin_half**2/_cbrt(12*cos_half*sin_half - 6*phi)**2
+    phi = _where(small, 1.2281574046507382, phi)
+    closed = (1 - _xp.cos(phi))/_cbrt(6*phi - 6*_xp.sin(phi))**2
     return _where(small, series, closed)
 
 
@@ -1155,9 +1218,14 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222574480542
+    small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = -4.569666554548725e-11 + 0.0 * x
+    series = -1.1016217975387359e-16 + 0.0 * x
+    series = -1.4213047418173123e-15 + t * series
+    series = -1.8561269939266666e-14 + t * series
+    series = -2.4592808133854967e-13 + t * series
+    series = -3.3160977010058107e-12 + t * series
+    series = -4.569666554548725e-11 + t * series
     series = -6.473542653639692e-10 + t * series
     series = -9.50993765619616e-09 + t * series
     series = -1.4686206650492366e-07 + t * series
@@ -1166,9 +1234,9 @@ def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     series = -0.0010714285714285715 + t * series
     series = -0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
     closed = 4*sin_half**2/_cbrt(12*cos_half*sin_half - 6*phi)**2
     return _where(small, series, closed)
 
@@ -1321,6 +1389,56 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     w0 = _cbrt(12*cos_half*sin_half - 6*phi)
     w1 = w0**2
     closed = (sin_half/w0 + (0.125)*w1/sin_half**2)/w1
+    return _where(small, series, closed)
+
+
+def _H_across_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    t = _where(small, x, 0.0)
+    series = 1.1911667949082915e-08 + 0.0 * x
+    series = 1.683039183039183e-07 + t * series
+    series = 2.4930426716141e-06 + t * series
+    series = 3.968253968253968e-05 + t * series
+    series = 0.0007142857142857143 + t * series
+    series = -0.15 + t * series
+    series = 1.0 + t * series
+    phi = _where(small, 1.2281574046507382, phi)
+    w0 = _xp.sin(phi)
+    closed = w0/_cbrt(6*phi - 6*w0)
+    return _where(small, series, closed)
+
+
+def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    t = _where(small, x, 0.0)
+    series = -5.178834122911754e-09 + 0.0 * x
+    series = -6.656956359337311e-08 + t * series
+    series = -8.811723990295419e-07 + t * series
+    series = -1.2201092558235416e-05 + t * series
+    series = -0.00018253968253968255 + t * series
+    series = -0.0032142857142857142 + t * series
+    series = -0.1 + t * series
+    series = 1.0 + t * series
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    w0 = _xp.sin(phi)
+    closed = (0.25)*w0*_cbrt(6*phi - 6*w0)/sin_half**2
+    return _where(small, series, closed)
+
+
+def _K_across_32(x, phi, s, d, sin_half, cos_half):
+    small = x < 1.4342812011199078
+    t = _where(small, x, 0.0)
+    series = -6.22104590536751e-09 + 0.0 * x
+    series = -8.889107582955239e-08 + t * series
+    series = -1.340206714788188e-06 + t * series
+    series = -2.201140873015873e-05 + t * series
+    series = -0.00042410714285714285 + t * series
+    series = -0.0125 + t * series
+    series = 0.5 + t * series
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
     return _where(small, series, closed)
 
 
@@ -1702,6 +1820,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "H_across": _H_across_64,
+        "H_inverse_across": _H_inverse_across_64,
+        "K_across": _K_across_64,
         "R_0_x": _R_0_x_64,
         "R_1_x": _R_1_x_64,
         "R_2_x": _R_2_x_64,
@@ -1734,6 +1855,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "H_across": _H_across_32,
+        "H_inverse_across": _H_inverse_across_32,
+        "K_across": _K_across_32,
         "R_0_x": _R_0_x_32,
         "R_1_x": _R_1_x_32,
         "R_2_x": _R_2_x_32,
@@ -1746,11 +1870,12 @@ _COEFFICIENTS = {
         "e_0": _e_0_32,
     },
 }
+_ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
-    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
+    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
+    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
@@ -1835,22 +1960,30 @@ def _scalar(p, name):
     return _where(valid, _COEFFICIENTS[suffix][name](*state), math.nan)
 
 
-def _tensor(p, name):
-    """T = c0 I + c1 (p x) + c2 (p x)^2 for p (..., 3)."""
-    p, state, valid, suffix = _prepare(_as_float(p, "p", (3,)), [name + "_0", name + "_1", name + "_2"])
+def _coefficients(p, name):
+    """p, state, valid, t, c1, c2 of T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T:
+    t = c0 - c2 |p|^2, the part across the axis, is a planned coefficient (next to 2 pi c0 and
+    c2 |p|^2 nearly cancel), computed from c0 and c2 where c0 is a constant."""
+    first = name + "_across" if name in _ACROSS else name + "_0"
+    p, state, valid, suffix = _prepare(p, [first, name + "_1", name + "_2"])
     table = _COEFFICIENTS[suffix]
-    a = table[name + "_0"](*state)
-    b = table[name + "_1"](*state)
+    t = table[first](*state)
     c = table[name + "_2"](*state)
+    if name not in _ACROSS:
+        t = t - c * state[0]
+    return p, valid, t, table[name + "_1"](*state), c
+
+
+def _tensor(p, name):
+    """T = t I + c1 (p x) + c2 p p^T for p (..., 3)."""
+    p, valid, a, b, c = _coefficients(_as_float(p, "p", (3,)), name)
     p0, p1, p2 = p[..., 0], p[..., 1], p[..., 2]
     c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
-    s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
     q01, q02, q12 = c0 * p1, c0 * p2, c1 * p2
-    # T_ii = c0 - c2 (p_j^2 + p_k^2): no cancellation against |p|^2
-    m = _xp.stack([a - c * (s1 + s2), q01 - b2, q02 + b1,
-                   q01 + b2, a - c * (s0 + s2), q12 - b0,
-                   q02 - b1, q12 + b0, a - c * (s0 + s1)], -1)
+    m = _xp.stack([a + c * (p0 * p0), q01 - b2, q02 + b1,
+                   q01 + b2, a + c * (p1 * p1), q12 - b0,
+                   q02 - b1, q12 + b0, a + c * (p2 * p2)], -1)
     m = _where(valid[..., None], m, math.nan)
     return m.reshape((*m.shape[:-1], 3, 3))
 
@@ -1858,13 +1991,8 @@ def _tensor(p, name):
 def _apply(p, v, name):
     p = _as_float(p, "p", (3,))
     v = _like(_as_float(v, "the second argument", (3,)), p)
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
-    table = _COEFFICIENTS[suffix]
-    x = state[0]
-    a = table[name + "_0"](*state)[..., None]
-    b = table[name + "_1"](*state)[..., None]
-    c = table[name + "_2"](*state)[..., None]
-    result = a * v + b * _cross(p, v) + c * (p * _dot(p, v)[..., None] - x[..., None] * v)
+    p, valid, t, b, c = _coefficients(p, name)
+    result = t[..., None] * v + b[..., None] * _cross(p, v) + (c * _dot(p, v))[..., None] * p
     return _where(valid[..., None], result, math.nan)
 
 

@@ -827,6 +827,128 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
+def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = 2.4273770483331233e-15
+        series = 3.054732998294483e-14 + t * series
+        series = 3.8844043825273724e-13 + t * series
+        series = 5.001592370976041e-12 + t * series
+        series = 6.539638581589419e-11 + t * series
+        series = 8.716860870222215e-10 + t * series
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.sin(phi)
+    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
+    small = x < 0.764824235244299
+    if small.any():
+        t = x[small]
+        series = 2.4273770483331233e-15
+        series = 3.054732998294483e-14 + t * series
+        series = 3.8844043825273724e-13 + t * series
+        series = 5.001592370976041e-12 + t * series
+        series = 6.539638581589419e-11 + t * series
+        series = 8.716860870222215e-10 + t * series
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    return out
+
+
+def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = -1.847696164362506e-14
+        series = -2.227352392712e-13 + t * series
+        series = -2.7052088947240463e-12 + t * series
+        series = -3.316097701005811e-11 + t * series
+        series = -4.112699899093853e-10 + t * series
+        series = -5.178834122911754e-09 + t * series
+        series = -6.656956359337311e-08 + t * series
+        series = -8.811723990295419e-07 + t * series
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.sin(phi)
+    out = numpy.asarray((0.25)*w0*numpy.cbrt(6*phi - 6*w0)/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
+    small = x < 0.764824235244299
+    if small.any():
+        t = x[small]
+        series = -1.847696164362506e-14
+        series = -2.227352392712e-13 + t * series
+        series = -2.7052088947240463e-12 + t * series
+        series = -3.316097701005811e-11 + t * series
+        series = -4.112699899093853e-10 + t * series
+        series = -5.178834122911754e-09 + t * series
+        series = -6.656956359337311e-08 + t * series
+        series = -8.811723990295419e-07 + t * series
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    return out
+
+
+def _K_across_64(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+        t = x
+        series = -1.2358884471431072e-15
+        series = -1.5586041391956483e-14 + t * series
+        series = -1.9870905217627718e-13 + t * series
+        series = -2.5669594363297223e-12 + t * series
+        series = -3.370441278711113e-11 + t * series
+        series = -4.517630699305304e-10 + t * series
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+        return out
+    small = x < 0.764824235244299
+    if small.any():
+        t = x[small]
+        series = -1.2358884471431072e-15
+        series = -1.5586041391956483e-14 + t * series
+        series = -1.9870905217627718e-13 + t * series
+        series = -2.5669594363297223e-12 + t * series
+        series = -3.370441278711113e-11 + t * series
+        series = -4.517630699305304e-10 + t * series
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        out[small] = series
+    return out
+
+
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
@@ -1570,11 +1692,9 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = -2.2848332772743624e-11
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
+        series = -4.75496882809808e-09
         series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
@@ -1582,15 +1702,13 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
-    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+    out = numpy.asarray((1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 2.630222574480542
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = -2.2848332772743624e-11
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
+        series = -4.75496882809808e-09
         series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
@@ -1737,9 +1855,14 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
         t = x
-        series = -4.569666554548725e-11
+        series = -1.1016217975387359e-16
+        series = -1.4213047418173123e-15 + t * series
+        series = -1.8561269939266666e-14 + t * series
+        series = -2.4592808133854967e-13 + t * series
+        series = -3.3160977010058107e-12 + t * series
+        series = -4.569666554548725e-11 + t * series
         series = -6.473542653639692e-10 + t * series
         series = -9.50993765619616e-09 + t * series
         series = -1.4686206650492366e-07 + t * series
@@ -1750,12 +1873,17 @@ def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
-    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
-    small = x < 2.630222574480542
+    small = x < 4.619481091176478
     if small.any():
         t = x[small]
-        series = -4.569666554548725e-11
+        series = -1.1016217975387359e-16
+        series = -1.4213047418173123e-15 + t * series
+        series = -1.8561269939266666e-14 + t * series
+        series = -2.4592808133854967e-13 + t * series
+        series = -3.3160977010058107e-12 + t * series
+        series = -4.569666554548725e-11 + t * series
         series = -6.473542653639692e-10 + t * series
         series = -9.50993765619616e-09 + t * series
         series = -1.4686206650492366e-07 + t * series
@@ -2021,6 +2149,86 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.0001609002976190476 + t * series
         series = 0.0022098214285714286 + t * series
         series = 0.0375 + t * series
+        out[small] = series
+    return out
+
+
+def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = 1.683039183039183e-07
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.sin(phi)
+    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+        return out
+    small = x < 0.7648242161335777
+    if small.any():
+        t = x[small]
+        series = 1.683039183039183e-07
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    return out
+
+
+def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = -8.811723990295419e-07
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    w0 = numpy.sin(phi)
+    out = numpy.asarray((0.25)*w0*numpy.cbrt(6*phi - 6*w0)/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+        return out
+    small = x < 0.7648242161335777
+    if small.any():
+        t = x[small]
+        series = -8.811723990295419e-07
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
+        series = 1.0 + t * series
+        out[small] = series
+    return out
+
+
+def _K_across_32(x, phi, s, d, sin_half, cos_half, span=None):
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = -8.889107582955239e-08
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+        return out
+    small = x < 0.7648242161335777
+    if small.any():
+        t = x[small]
+        series = -8.889107582955239e-08
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
         out[small] = series
     return out
 
@@ -2563,6 +2771,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "H_across": _H_across_64,
+        "H_inverse_across": _H_inverse_across_64,
+        "K_across": _K_across_64,
         "R_0_x": _R_0_x_64,
         "R_1_x": _R_1_x_64,
         "R_2_x": _R_2_x_64,
@@ -2595,6 +2806,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "H_across": _H_across_32,
+        "H_inverse_across": _H_inverse_across_32,
+        "K_across": _K_across_32,
         "R_0_x": _R_0_x_32,
         "R_1_x": _R_1_x_32,
         "R_2_x": _R_2_x_32,
@@ -2607,15 +2821,16 @@ _COEFFICIENTS = {
         "e_0": _e_0_32,
     },
 }
+_ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
-    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
+    "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
+    "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 1.4342812090283275, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 1.4342812090283275, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 1.4342812090283275, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 1.4342812090283275, 'K_1': 1.4342812090283275, 'K_2': 2.6302227241416043, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
-    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 2.630222574480542, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 2.630222574480542, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 4.619481091176478, 'K_1': 2.630222574480542, 'K_2': 4.619481091176478, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
+    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 1.4342812090283275, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 1.4342812090283275, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 1.4342812090283275, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 1.4342812090283275, 'K_1': 1.4342812090283275, 'K_2': 2.6302227241416043, 'H_across': 0.764824235244299, 'H_inverse_across': 0.764824235244299, 'K_across': 0.764824235244299, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
+    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 1.4342812011199078, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 4.619481091176478, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 4.619481091176478, 'K_1': 2.630222574480542, 'K_2': 4.619481091176478, 'H_across': 0.7648242161335777, 'H_inverse_across': 0.7648242161335777, 'K_across': 0.7648242161335777, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
@@ -2757,24 +2972,28 @@ def _tensor(p, name):
     return out.reshape(*shape, 3, 3)
 
 
-# entry e = 3 i + j of T: the off-diagonal p_i p_j as (c p_I[e]) p_J[e] (the same product for
-# (i, j) and (j, i)), the cross term sign[e] p_K[e] with (p x)_ij = -eps_ijk p_k, and
-# T_ii = c0 - c2 (p_j^2 + p_k^2) from the squares _OTHER_1, _OTHER_2 (no cancellation against |p|^2)
+# entry e = 3 i + j of T = t I + c1 (p x) + c2 p p^T: the off-diagonal p_i p_j as (c2 p_I[e]) p_J[e]
+# (the same product for (i, j) and (j, i)), the cross term sign[e] p_K[e] with (p x)_ij = -eps_ijk p_k,
+# and T_ii = t + c2 p_i^2
 _I = numpy.array([0, 0, 0, 0, 1, 1, 0, 1, 2])
 _J = numpy.array([0, 1, 2, 1, 1, 2, 2, 2, 2])
 _K = numpy.array([0, 2, 1, 2, 0, 0, 1, 0, 0])
 _SIGN = {"64": numpy.array([0.0, -1.0, 1.0, 1.0, 0.0, -1.0, -1.0, 1.0, 0.0])}
 _SIGN["32"] = _SIGN["64"].astype(numpy.float32)
-_OTHER_1 = numpy.array([1, 0, 0])
-_OTHER_2 = numpy.array([2, 2, 1])
 _DIAGONAL = numpy.array([0, 4, 8])
 
 
 def _coefficients(p, name):
-    """p, c0, c1, c2, valid, suffix of T = c0 I + c1 (p x) + c2 (p x)^2 for the (n, 3) rows p."""
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
+    """p, t, c1, c2, valid, suffix of T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T
+    for the (n, 3) rows p: t = c0 - c2 |p|^2, the part across the axis, is a planned coefficient
+    (next to 2 pi c0 and c2 |p|^2 nearly cancel), computed from c0 and c2 where c0 is a constant."""
+    first = name + "_across" if name in _ACROSS else name + "_0"
+    p, state, valid, suffix = _prepare(p, [first, name + "_1", name + "_2"])
     table = _COEFFICIENTS[suffix]
-    return p, table[name + "_0"](*state), table[name + "_1"](*state), table[name + "_2"](*state), valid, suffix
+    t, c = table[first](*state), table[name + "_2"](*state)
+    if name not in _ACROSS:
+        t = t - c * state[0]
+    return p, t, table[name + "_1"](*state), c, valid, suffix
 
 
 def _tensor_few(p, name, out):
@@ -2789,9 +3008,9 @@ def _tensor_few(p, name, out):
         b0, b1, b2 = b_k * p0, b_k * p1, b_k * p2
         s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
         q01, q02, q12 = c0 * p1, c0 * p2, c1 * p2
-        entries += (a_k - c_k * (s1 + s2), q01 - b2, q02 + b1,
-                    q01 + b2, a_k - c_k * (s0 + s2), q12 - b0,
-                    q02 - b1, q12 + b0, a_k - c_k * (s0 + s1))
+        entries += (a_k + c_k * s0, q01 - b2, q02 + b1,
+                    q01 + b2, a_k + c_k * s1, q12 - b0,
+                    q02 - b1, q12 + b0, a_k + c_k * s2)
     out.reshape(-1)[:] = entries  # out is the contiguous (n, 9) result of _tensor
     if valid is not numpy.True_:
         out[~valid] = numpy.nan
@@ -2801,8 +3020,7 @@ def _tensor_small(p, name, out):
     p, a, b, c, valid, suffix = _coefficients(p, name)
     numpy.multiply((c[:, None] * p)[:, _I], p[:, _J], out=out)
     out += (b[:, None] * p)[:, _K] * _SIGN[suffix]
-    square = p * p
-    out[:, _DIAGONAL] = a[:, None] - c[:, None] * (square[:, _OTHER_1] + square[:, _OTHER_2])
+    out[:, _DIAGONAL] = a[:, None] + c[:, None] * (p * p)
     if valid is not numpy.True_:
         out[~valid] = numpy.nan
 
@@ -2813,9 +3031,9 @@ def _tensor_block(p, name, out):
     c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
     s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
-    numpy.subtract(a, c * (s1 + s2), out=out[:, 0])  # T_ii = c0 - c2 (p_j^2 + p_k^2)
-    numpy.subtract(a, c * (s0 + s2), out=out[:, 4])
-    numpy.subtract(a, c * (s0 + s1), out=out[:, 8])
+    numpy.add(a, c * s0, out=out[:, 0])  # T_ii = t + c2 p_i^2
+    numpy.add(a, c * s1, out=out[:, 4])
+    numpy.add(a, c * s2, out=out[:, 8])
     q = c0 * p1
     numpy.subtract(q, b2, out=out[:, 1])
     numpy.add(q, b2, out=out[:, 3])
@@ -2831,16 +3049,18 @@ def _tensor_block(p, name, out):
 
 def _apply(p, v, name):
     v = _as_float(v, "the second argument", (3,))
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
+    first = name + "_across" if name in _ACROSS else name + "_0"
+    p, state, valid, suffix = _prepare(p, [first, name + "_1", name + "_2"])
     v = v.astype(p.dtype)
     table = _COEFFICIENTS[suffix]
-    x = state[0]
-    a = table[name + "_0"](*state)[..., None]
+    c = table[name + "_2"](*state)
+    t = table[first](*state)
+    if name not in _ACROSS:
+        t = t - c * state[0]
     b = table[name + "_1"](*state)[..., None]
-    c = table[name + "_2"](*state)[..., None]
     p_cross_v = _cross(p, v)
-    p_dot_v = numpy.einsum("...i,...i->...", p, v)[..., None]
-    result = a * v + b * p_cross_v + c * (p * p_dot_v - x[..., None] * v)
+    p_dot_v = (p[..., 0] * v[..., 0] + p[..., 1] * v[..., 1]) + p[..., 2] * v[..., 2]
+    result = t[..., None] * v + b * p_cross_v + (c * p_dot_v)[..., None] * p
     return numpy.where(valid[..., None], result, numpy.nan).astype(p.dtype)
 
 

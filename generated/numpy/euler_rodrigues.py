@@ -131,6 +131,18 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
+def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
+    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
+    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+
+
+def _K_across_64(x, phi, s, d, sin_half, cos_half, span=None):
+    return numpy.full_like(x, 0.5)
+
+
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
@@ -292,6 +304,22 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
+def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
+    x = x.astype(numpy.float64)
+    d = d.astype(numpy.float64)
+    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+
+
+def _K_across_32(x, phi, s, d, sin_half, cos_half, span=None):
+    return numpy.full_like(x, 0.5)
+
+
 def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
@@ -373,6 +401,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_64,
         "K_1": _K_1_64,
         "K_2": _K_2_64,
+        "H_across": _H_across_64,
+        "H_inverse_across": _H_inverse_across_64,
+        "K_across": _K_across_64,
         "R_0_x": _R_0_x_64,
         "R_1_x": _R_1_x_64,
         "R_2_x": _R_2_x_64,
@@ -405,6 +436,9 @@ _COEFFICIENTS = {
         "K_0": _K_0_32,
         "K_1": _K_1_32,
         "K_2": _K_2_32,
+        "H_across": _H_across_32,
+        "H_inverse_across": _H_inverse_across_32,
+        "K_across": _K_across_32,
         "R_0_x": _R_0_x_32,
         "R_1_x": _R_1_x_32,
         "R_2_x": _R_2_x_32,
@@ -417,11 +451,12 @@ _COEFFICIENTS = {
         "e_0": _e_0_32,
     },
 }
+_ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
-    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
-    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
+    "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
+    "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
     "64": {},
@@ -600,24 +635,28 @@ def _tensor(p, name):
     return out.reshape(*shape, 3, 3)
 
 
-# entry e = 3 i + j of T: the off-diagonal p_i p_j as (c p_I[e]) p_J[e] (the same product for
-# (i, j) and (j, i)), the cross term sign[e] p_K[e] with (p x)_ij = -eps_ijk p_k, and
-# T_ii = c0 - c2 (p_j^2 + p_k^2) from the squares _OTHER_1, _OTHER_2 (no cancellation against |p|^2)
+# entry e = 3 i + j of T = t I + c1 (p x) + c2 p p^T: the off-diagonal p_i p_j as (c2 p_I[e]) p_J[e]
+# (the same product for (i, j) and (j, i)), the cross term sign[e] p_K[e] with (p x)_ij = -eps_ijk p_k,
+# and T_ii = t + c2 p_i^2
 _I = numpy.array([0, 0, 0, 0, 1, 1, 0, 1, 2])
 _J = numpy.array([0, 1, 2, 1, 1, 2, 2, 2, 2])
 _K = numpy.array([0, 2, 1, 2, 0, 0, 1, 0, 0])
 _SIGN = {"64": numpy.array([0.0, -1.0, 1.0, 1.0, 0.0, -1.0, -1.0, 1.0, 0.0])}
 _SIGN["32"] = _SIGN["64"].astype(numpy.float32)
-_OTHER_1 = numpy.array([1, 0, 0])
-_OTHER_2 = numpy.array([2, 2, 1])
 _DIAGONAL = numpy.array([0, 4, 8])
 
 
 def _coefficients(p, name):
-    """p, c0, c1, c2, valid, suffix of T = c0 I + c1 (p x) + c2 (p x)^2 for the (n, 3) rows p."""
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
+    """p, t, c1, c2, valid, suffix of T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T
+    for the (n, 3) rows p: t = c0 - c2 |p|^2, the part across the axis, is a planned coefficient
+    (next to 2 pi c0 and c2 |p|^2 nearly cancel), computed from c0 and c2 where c0 is a constant."""
+    first = name + "_across" if name in _ACROSS else name + "_0"
+    p, state, valid, suffix = _prepare(p, [first, name + "_1", name + "_2"])
     table = _COEFFICIENTS[suffix]
-    return p, table[name + "_0"](*state), table[name + "_1"](*state), table[name + "_2"](*state), valid, suffix
+    t, c = table[first](*state), table[name + "_2"](*state)
+    if name not in _ACROSS:
+        t = t - c * state[0]
+    return p, t, table[name + "_1"](*state), c, valid, suffix
 
 
 def _tensor_few(p, name, out):
@@ -632,9 +671,9 @@ def _tensor_few(p, name, out):
         b0, b1, b2 = b_k * p0, b_k * p1, b_k * p2
         s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
         q01, q02, q12 = c0 * p1, c0 * p2, c1 * p2
-        entries += (a_k - c_k * (s1 + s2), q01 - b2, q02 + b1,
-                    q01 + b2, a_k - c_k * (s0 + s2), q12 - b0,
-                    q02 - b1, q12 + b0, a_k - c_k * (s0 + s1))
+        entries += (a_k + c_k * s0, q01 - b2, q02 + b1,
+                    q01 + b2, a_k + c_k * s1, q12 - b0,
+                    q02 - b1, q12 + b0, a_k + c_k * s2)
     out.reshape(-1)[:] = entries  # out is the contiguous (n, 9) result of _tensor
     if valid is not numpy.True_:
         out[~valid] = numpy.nan
@@ -644,8 +683,7 @@ def _tensor_small(p, name, out):
     p, a, b, c, valid, suffix = _coefficients(p, name)
     numpy.multiply((c[:, None] * p)[:, _I], p[:, _J], out=out)
     out += (b[:, None] * p)[:, _K] * _SIGN[suffix]
-    square = p * p
-    out[:, _DIAGONAL] = a[:, None] - c[:, None] * (square[:, _OTHER_1] + square[:, _OTHER_2])
+    out[:, _DIAGONAL] = a[:, None] + c[:, None] * (p * p)
     if valid is not numpy.True_:
         out[~valid] = numpy.nan
 
@@ -656,9 +694,9 @@ def _tensor_block(p, name, out):
     c0, c1 = c * p0, c * p1
     b0, b1, b2 = b * p0, b * p1, b * p2
     s0, s1, s2 = p0 * p0, p1 * p1, p2 * p2
-    numpy.subtract(a, c * (s1 + s2), out=out[:, 0])  # T_ii = c0 - c2 (p_j^2 + p_k^2)
-    numpy.subtract(a, c * (s0 + s2), out=out[:, 4])
-    numpy.subtract(a, c * (s0 + s1), out=out[:, 8])
+    numpy.add(a, c * s0, out=out[:, 0])  # T_ii = t + c2 p_i^2
+    numpy.add(a, c * s1, out=out[:, 4])
+    numpy.add(a, c * s2, out=out[:, 8])
     q = c0 * p1
     numpy.subtract(q, b2, out=out[:, 1])
     numpy.add(q, b2, out=out[:, 3])
@@ -674,16 +712,18 @@ def _tensor_block(p, name, out):
 
 def _apply(p, v, name):
     v = _as_float(v, "the second argument", (3,))
-    p, state, valid, suffix = _prepare(p, [name + "_0", name + "_1", name + "_2"])
+    first = name + "_across" if name in _ACROSS else name + "_0"
+    p, state, valid, suffix = _prepare(p, [first, name + "_1", name + "_2"])
     v = v.astype(p.dtype)
     table = _COEFFICIENTS[suffix]
-    x = state[0]
-    a = table[name + "_0"](*state)[..., None]
+    c = table[name + "_2"](*state)
+    t = table[first](*state)
+    if name not in _ACROSS:
+        t = t - c * state[0]
     b = table[name + "_1"](*state)[..., None]
-    c = table[name + "_2"](*state)[..., None]
     p_cross_v = _cross(p, v)
-    p_dot_v = numpy.einsum("...i,...i->...", p, v)[..., None]
-    result = a * v + b * p_cross_v + c * (p * p_dot_v - x[..., None] * v)
+    p_dot_v = (p[..., 0] * v[..., 0] + p[..., 1] * v[..., 1]) + p[..., 2] * v[..., 2]
+    result = t[..., None] * v + b * p_cross_v + (c * p_dot_v)[..., None] * p
     return numpy.where(valid[..., None], result, numpy.nan).astype(p.dtype)
 
 

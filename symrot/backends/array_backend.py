@@ -230,6 +230,7 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
     return {"framework": framework, "name": plan.name, "p_text": str(plan.p), "functions": functions,
             "newton": newton, "closed_angles": closed_angles,
             "names": list(plan.precisions["float64"].coefficients),
+            "across": repr(tuple(sorted(plan.across_tensors()))),
             "e0_min": repr(plan.e0_min) if plan.e0_min is not None else None,
             "p_max": repr(plan.p_max) if finite_p_max else None, "phi_max": repr(plan.phi_max),
             "complement": str(plan.complement) if plan.complement is not None else None,

@@ -39,7 +39,15 @@ import sympy as sp
 from ..algebraic import D, S, X
 from ..parsing import PHI
 from ..plan_ir import Algebraic, Branch, Coefficient, Constant
-from .c_functions import OUTPUT_NAMES, TENSOR_OF, CFunction, P, tensor_entries
+from .c_functions import (
+    OUTPUT_NAMES,
+    TENSOR_OF,
+    CFunction,
+    P,
+    across_value,
+    tensor_coefficients,
+    tensor_entries,
+)
 from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
 from .c_sincos import TRIG, SinCosWriter
 from .c_writer import PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
@@ -107,7 +115,7 @@ class BatchWriter:
         """Body of ``symrot_NAME_F_batch(size_t n, const T *p, T *OUT)`` for matrix function F, and
         the lines of its header comment."""
         writer = self.writer
-        names = [f"{TENSOR_OF[spec.name]}_{k}" for k in range(3)]
+        names = tensor_coefficients(TENSOR_OF[spec.name], writer.plan.across_tensors())
         plan = {name: writer.precision_plan.coefficients[name] for name in names}
         lanes = Lanes()
         closed: dict[str, sp.Expr] = {}
@@ -132,6 +140,12 @@ class BatchWriter:
             notes.append("Scalar pass: " + ", ".join(scalar) + ".")
         if lanes.trig:
             notes.append(self.sincos.note())
+        candidate_body = self.candidate_pass(plan, inputs, lanes, replacements,
+                                             dict(zip(closed, reduced, strict=True)))
+        candidates: list[Statement] = [  # none when every coefficient is a constant (CGR's H^-1)
+            {"kind": "comment", "text": "every candidate value, unconditionally"},
+            {"kind": "loop", "header": f"k = 0; k < {BLOCK}; ++k", "times": 1, "body": candidate_body},
+        ] if candidate_body else []
         return [
             {"kind": "declare", "type": self.t, "names": arrays},
             {"kind": "declare", "type": "size_t", "names": ["start", "k"]},
@@ -139,10 +153,7 @@ class BatchWriter:
                 {"kind": "let", "type": "size_t", "name": "m",
                  "value": f"n - start < {BLOCK} ? n - start : {BLOCK}"},
                 *self.scalar_pass(lanes, inputs, self.polynomial_below(plan, closed, inputs)),
-                {"kind": "comment", "text": "every candidate value, unconditionally"},
-                {"kind": "loop", "header": f"k = 0; k < {BLOCK}; ++k", "times": 1,
-                 "body": self.candidate_pass(plan, inputs, lanes, replacements,
-                                             dict(zip(closed, reduced, strict=True)))},
+                *candidates,
                 {"kind": "comment", "text": "select: polynomial below the threshold, NaN outside the range"},
                 {"kind": "loop", "header": f"k = 0; k < {BLOCK}; ++k", "times": 1,
                  "body": self.select_pass(plan)},
@@ -204,12 +215,20 @@ class BatchWriter:
         return body
 
     def assembly(self, spec: CFunction, names: list[str]) -> list[Statement]:
-        """T = c0 I + c1 (p×) + c2 (p×)² for the vectors of the block, as in the single call."""
-        a, b, c = (sp.Symbol(f"c_{name}_lanes[k]", real=True) for name in names)
-        entries = [entry.xreplace(dict(zip(P, LANE, strict=True))) for entry in tensor_entries(a, b, c)]
+        """T = t I + c1 (p×) + c2 p pᵀ for the vectors of the block, as in the single call."""
+        first, b, c = (sp.Symbol(f"c_{name}_lanes[k]", real=True) for name in names)
+        tensor = TENSOR_OF[spec.name]
+        t_value = across_value(tensor, self.writer.plan.across_tensors(), first, c,
+                               sp.Symbol("x_lanes[k]", real=True))
+        across: list[Statement] = []
+        if t_value != first:
+            across.append({"kind": "let", "type": self.t, "name": "t", "value": self.c(t_value)})
+            t_value = sp.Symbol("t", real=True)
+        entries = [entry.xreplace(dict(zip(P, LANE, strict=True))) for entry in tensor_entries(t_value, b, c)]
         output = OUTPUT_NAMES[spec.name]
         return [
             {"kind": "let", "type": f"{self.t} *const", "name": "pk", "value": "p + 3 * (start + k)"},
+            *across,
             {"kind": "declare", "type": f"{self.t} *const", "names": [f"out = {output} + 9 * (start + k)"]},
             *({"kind": "set", "name": f"out[{i}]", "value": self.c(entry)}
               for i, entry in enumerate(entries)),

@@ -2,12 +2,14 @@
 
 :data:`FUNCTIONS` lists the per-vector functions of every header (each in double and, suffixed
 ``_f``, float; matrix ones also as ``_batch`` kernels); :func:`tensor_entries` and
-:func:`vector_entries` write T = c0 I + c1 (p×) + c2 (p×)² and T v entry by entry, for the single
-calls (:mod:`symrot.backends.c_writer`) and the batch kernels (:mod:`symrot.backends.c_batch`).
+:func:`applied_entries` write T = c0 I + c1 (p×) + c2 (p×)² = t I + c1 (p×) + c2 p pᵀ and T v entry by
+entry, for the single calls (:mod:`symrot.backends.c_writer`) and the batch kernels
+(:mod:`symrot.backends.c_batch`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Literal
 
@@ -52,18 +54,28 @@ FUNCTIONS: tuple[CFunction, ...] = (
 
 
 # -- outputs from coefficients ---------------------------------------------------------------------
-def tensor_entries(a: sp.Expr, b: sp.Expr, c: sp.Expr) -> list[sp.Expr]:
-    """Row-major entries of T = a I + b (p×) + c (p×)² (the form of eqs 14, 22, 26, 81, 83).
+def tensor_coefficients(tensor: str, across: Collection[str]) -> list[str]:
+    """The coefficients a tensor's outputs read: its across-axis part t = c₀ − c₂|p|² where the plan
+    has it (``T_across``, :meth:`~symrot.plan_ir.EvaluationPlan.across_tensors`), else c₀; c₁; c₂."""
+    first = f"{tensor}_across" if tensor in across else f"{tensor}_0"
+    return [first, f"{tensor}_1", f"{tensor}_2"]
 
-    (p×)² = p pᵀ − |p|² I, so T_ii = a − c (p_j² + p_k²) (no cancellation of p_i² against |p|²),
+
+def across_value(tensor: str, across: Collection[str], first: sp.Expr, c: sp.Expr, x: sp.Expr) -> sp.Expr:
+    """t = c₀ − c₂ x from the values of :func:`tensor_coefficients` (c₀ is then a constant)."""
+    return first if tensor in across else first - c * x
+
+
+def tensor_entries(t: sp.Expr, b: sp.Expr, c: sp.Expr) -> list[sp.Expr]:
+    """Row-major entries of T = a I + b (p×) + c (p×)² (the form of eqs 14, 22, 26, 81, 83), written
+    as T = t I + b (p×) + c p pᵀ with t = a − c |p|² (:func:`across_value`): T_ii = t + c p_i²,
     T_ij = c p_i p_j − b ε_ijk p_k.
     """
     entries = []
     for i in range(3):
         for j in range(3):
             if i == j:
-                others = [P[k] for k in range(3) if k != i]
-                entries.append(a - c * (others[0] ** 2 + others[1] ** 2))
+                entries.append(t + c * P[i] ** 2)
             else:
                 k = 3 - i - j
                 sign = 1 if (i, j) in ((0, 1), (1, 2), (2, 0)) else -1
@@ -71,9 +83,20 @@ def tensor_entries(a: sp.Expr, b: sp.Expr, c: sp.Expr) -> list[sp.Expr]:
     return entries
 
 
+def applied_entries(t: sp.Expr, b: sp.Expr, c: sp.Expr, v: tuple[sp.Symbol, sp.Symbol, sp.Symbol],
+                    w: tuple[sp.Symbol, sp.Symbol, sp.Symbol], dot: sp.Symbol
+                    ) -> tuple[list[sp.Expr], sp.Expr, list[sp.Expr]]:
+    """T v for T = t I + b (p×) + c p pᵀ: (w = p × v, p·v, t v + b w + (c p·v) p). Across the axis
+    only t and b act, so ω next to 2π, where c₀ ≈ c₂|p|², is not a difference of two large terms."""
+    cross_pv = [P[1] * v[2] - P[2] * v[1], P[2] * v[0] - P[0] * v[2], P[0] * v[1] - P[1] * v[0]]
+    p_dot_v = (P[0] * v[0] + P[1] * v[1]) + P[2] * v[2]
+    return cross_pv, p_dot_v, [t * v[i] + b * w[i] + (c * dot) * P[i] for i in range(3)]
+
+
 def vector_entries(a: sp.Expr, b: sp.Expr, c: sp.Expr, v: tuple[sp.Symbol, sp.Symbol, sp.Symbol],
                    w: tuple[sp.Symbol, sp.Symbol, sp.Symbol]) -> tuple[list[sp.Expr], list[sp.Expr]]:
-    """T v for T = a I + b (p×) + c (p×)²: (w = p × v, then a v + b w + c p × w)."""
+    """T v for T = a I + b (p×) + c (p×)²: (w = p × v, then a v + b w + c p × w); the derivative
+    functions' first term (:mod:`symrot.backends.c_derivatives`)."""
     cross_pv = [P[1] * v[2] - P[2] * v[1], P[2] * v[0] - P[0] * v[2], P[0] * v[1] - P[1] * v[0]]
     cross_pw = [P[1] * w[2] - P[2] * w[1], P[2] * w[0] - P[0] * w[2], P[0] * w[1] - P[1] * w[0]]
     return cross_pv, [a * v[i] + b * w[i] + c * cross_pw[i] for i in range(3)]

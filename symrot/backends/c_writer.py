@@ -22,8 +22,8 @@ and the operations (:mod:`symrot.backends.c_operations`) build on it. How a plan
   |p| itself, accurately down to the smallest subnormal: below x = 2⁻⁶⁰⁰ (2⁻¹⁰⁰ in float) the
   norm is computed on p scaled by an exact power of two;
 * tensors T = c0 I + c1 (p×) + c2 (p×)² entry by entry
-  (:func:`~symrot.backends.c_functions.tensor_entries`), vectors as c0 v + c1 p×v + c2 p×(p×v)
-  (:func:`~symrot.backends.c_functions.vector_entries`).
+  (:func:`~symrot.backends.c_functions.tensor_entries`), vectors as t v + c1 p×v + c2 (p·v) p with
+  t = c0 − c2 |p|² (:func:`~symrot.backends.c_functions.applied_entries`).
 
 ``/* ops: N */`` is the number of operations on the longest path through the function, as
 counted by ``sympy.count_ops`` (a call such as ``sin`` counts one; Newton iterations multiplied).
@@ -41,7 +41,17 @@ from ..errors import NonFiniteLiteral
 from ..newton_start import FarStart
 from ..parsing import PHI
 from ..plan_ir import Algebraic, Branch, ClosedAngle, Constant, EvaluationPlan, NewtonAngle, PrecisionPlan
-from .c_functions import OUTPUT_NAMES, TENSOR_OF, VECTOR_NAMES, CFunction, P, tensor_entries, vector_entries
+from .c_functions import (
+    OUTPUT_NAMES,
+    TENSOR_OF,
+    VECTOR_NAMES,
+    CFunction,
+    P,
+    across_value,
+    applied_entries,
+    tensor_coefficients,
+    tensor_entries,
+)
 from .c_printer import Precision, SymrotCPrinter, horner
 
 # -- statements ------------------------------------------------------------------------------------
@@ -379,14 +389,20 @@ class FunctionWriter:
                 notes += self.coefficient_notes(["det_H"])
             return self.context(spec, name, signature, statements, notes, None, None)
         tensor = TENSOR_OF[spec.name]
-        names = [f"{tensor}_{k}" for k in range(3)]
+        across = self.plan.across_tensors()
+        names = tensor_coefficients(tensor, across)
         body, values = self.coefficients(names)
-        a, b, c = (values[n] for n in names)
+        first, b, c = (values[n] for n in names)
+        t_value = across_value(tensor, across, first, c, X_SYMBOL)
+        if t_value != first:  # t = c0 - c2 x once, not in each diagonal entry
+            body.append(self.let("t", t_value))
+            t_value = sp.Symbol("t", real=True)
         if spec.kind == "matrix":
             output = OUTPUT_NAMES[spec.name]
             signature = f"void {name}(const {t} p[3], {t} {output}[9])"
             nan = [self.set(f"{output}[{i}]", self.nan) for i in range(9)] + [{"kind": "return", "value": ""}]
-            outputs = [self.set(f"{output}[{i}]", entry) for i, entry in enumerate(tensor_entries(a, b, c))]
+            outputs = [self.set(f"{output}[{i}]", entry)
+                       for i, entry in enumerate(tensor_entries(t_value, b, c))]
             batch = f"void {name}_batch(size_t n, const {t} *p, {t} *{output})"
         else:
             given, output = VECTOR_NAMES[spec.name]
@@ -394,8 +410,11 @@ class FunctionWriter:
             nan = [self.set(f"{output}[{i}]", self.nan) for i in range(3)] + [{"kind": "return", "value": ""}]
             v = tuple(sp.Symbol(f"{given}[{i}]", real=True) for i in range(3))
             w = tuple(sp.Symbol(f"w{i}", real=True) for i in range(3))
-            cross, entries = vector_entries(a, b, c, v, w)
-            outputs = [self.let(f"w{i}", cross[i]) for i in range(3)]
+            dot = sp.Symbol("p_dot_v", real=True)
+            cross, p_dot_v, entries = applied_entries(t_value, b, c, v, w, dot)
+            used = set().union(*(sp.sympify(entry).free_symbols for entry in entries))
+            outputs = [self.let(f"w{i}", cross[i]) for i in range(3) if w[i] in used]
+            outputs += [self.let("p_dot_v", p_dot_v)] if dot in used else []  # c2 = 0: no p p^T part
             outputs += [self.set(f"{output}[{i}]", entry) for i, entry in enumerate(entries)]
             batch = None
         statements.append({"kind": "if", "condition": self.out_of_range(), "then": nan, "otherwise": []})

@@ -208,6 +208,7 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
     squared, inclusive = plan.boundary(53)  # float32 x compares exactly against the double bound
     return {"name": plan.name, "p_text": str(plan.p), "functions": functions, "e0_min": e0_min,
             "names": list(plan.precisions["float64"].coefficients),
+            "across": repr(tuple(sorted(plan.across_tensors()))),
             "p_max": repr(p_max) if np.isfinite(p_max) else None, "phi_max": repr(plan.phi_max),
             "complement": str(plan.complement) if plan.complement is not None else None,
             "p_max_squared": repr(squared) if np.isfinite(squared) else "numpy.inf",
