@@ -423,7 +423,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
         for coefficient, closed in derivation.planned_expressions().items():
             tensor = across.get(coefficient)
             if tensor is not None and isinstance(coefficients[tensor + "_0"], Constant):
-                continue  # c_0 exact: T_ii = c_0 - c_2 (p_j^2 + p_k^2) loses nothing (the backends)
+                continue  # c_0 exact: the backends compute t = c_0 - c_2 x, which loses nothing
             constant = derivation.constant_value(coefficient)
             if constant is not None:
                 coefficients[coefficient] = Constant(constant)

@@ -669,7 +669,7 @@ def _scalar(p, name):
 
 
 def _coefficients(p, name):
-    """p, state, valid, t, c1, c2 of T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T:
+    """p, valid, t, c1, c2 of T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T:
     t = c0 - c2 |p|^2, the part across the axis, is a planned coefficient (next to 2 pi c0 and
     c2 |p|^2 nearly cancel), computed from c0 and c2 where c0 is a constant."""
     first = name + "_across" if name in _ACROSS else name + "_0"
