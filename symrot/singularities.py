@@ -149,6 +149,8 @@ def _symbolic_candidates(p: sp.Expr, p_prime: sp.Expr) -> tuple[tuple[sp.Expr, .
         return sp.calculus.util.singularities(p, PHI, SCAN_INTERVAL)
 
     def zeros() -> sp.Set | None:
+        if not _periodic_in_phi(p_prime):
+            return None  # solveset runs past any bound (cos(sinh φ) cosh φ: > 20 s); numeric scan only
         return sp.solveset(p_prime, PHI, SCAN_INTERVAL)
 
     found: list[sp.Expr] = []
@@ -163,6 +165,22 @@ def _symbolic_candidates(p: sp.Expr, p_prime: sp.Expr) -> tuple[tuple[sp.Expr, .
             continue
         found.extend(x for x in result if x.is_real and x.is_number)
     return tuple(found), confirmed
+
+
+_PERIODIC = (sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
+
+
+def _periodic_in_phi(expr: sp.Expr) -> bool:
+    """Whether every trigonometric function in ``expr`` has an argument linear in φ: the shape on
+    which ``solveset`` is attempted. Trigonometric functions of a transcendental argument
+    (cos(sinh φ), tan(sin φ), cos(tan(φ/2))) have zeros in infinite families that ``solveset``
+    either returns as a ConditionSet or spends minutes on; a shape, not a time, decides, so the
+    validity analysis is the same on every machine (the corpus: tests/corpus.py)."""
+    for call in expr.atoms(*_PERIODIC):
+        argument = call.args[0]
+        if not (argument.is_polynomial(PHI) and sp.degree(argument, PHI) <= 1):
+            return False
+    return True
 
 
 def _events(expr: sp.Expr, extra: tuple[float, ...] = ()) -> list[tuple[mpmath.mpf, str, bool]]:

@@ -36,7 +36,8 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
+from contextlib import AbstractContextManager, _GeneratorContextManager, contextmanager
+from types import FrameType
 from typing import Any, TypeVar
 
 from .errors import SymrotTimeout
@@ -94,9 +95,9 @@ def alarm(seconds: float, error: Callable[[], BaseException]) -> Iterator[None]:
 
     raised: list[BaseException] = []  # the latest expiry: the one a swallowing callback drops
 
-    def _on_alarm(signum: int, frame: object) -> None:
-        if getattr(_reporting_unraisable, "depth", 0):
-            return  # the repeat raises it once the report is done
+    def _on_alarm(signum: int, frame: FrameType | None) -> None:
+        if getattr(_reporting_unraisable, "depth", 0) or _cleaning_up(frame):
+            return  # the repeat raises it once the report is done; a limit being removed is over
         raised[:] = [error()]
         raise raised[0]
 
@@ -126,6 +127,22 @@ def alarm(seconds: float, error: Callable[[], BaseException]) -> Iterator[None]:
             signal.setitimer(signal.ITIMER_REAL, max(outer_remaining - elapsed, 1e-3), RETRY_SECONDS)
 
 
+def _cleaning_up(frame: FrameType | None) -> bool:
+    """Whether the interrupted code is a limit's own setup or cleanup (:func:`alarm`,
+    :func:`time_limit` or the context manager exit that runs them).
+
+    The repeated expiry must never land there: raised in the cleanup of :func:`alarm` before the
+    timer is disarmed, it skipped the rest of the cleanup and left the repeating timer and its
+    handler installed after the limit had ended, so that an unrelated later step failed with "took
+    longer than ..." (seen after a 20 s limit expired deep inside ``sympy.solveset``, whose
+    unwinding outlasted the 0.05 s repeat interval)."""
+    while frame is not None:
+        if frame.f_code in _CLEANUP_CODE:
+            return True
+        frame = frame.f_back
+    return False
+
+
 @contextmanager
 def time_limit(seconds: float, what: str = "symbolic step", marker: object = None) -> Iterator[None]:
     """Raise :class:`SymrotTimeout` (with ``.marker``) if the body runs longer than ``seconds``."""
@@ -137,6 +154,10 @@ def time_limit(seconds: float, what: str = "symbolic step", marker: object = Non
 
     with alarm(seconds, expired):
         yield
+
+
+_CLEANUP_CODE = frozenset({alarm.__wrapped__.__code__, time_limit.__wrapped__.__code__,  # type: ignore[attr-defined]
+                           _GeneratorContextManager.__exit__.__code__})
 
 
 def bounded(seconds: float, fallback: T, func: Callable[..., T], *args: Any) -> T:

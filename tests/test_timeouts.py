@@ -149,3 +149,26 @@ def test_a_slow_machine_gets_the_same_simplified_form(monkeypatch: pytest.Monkey
     assert simplest.__wrapped__(expr) == fast
     with time_fallbacks():  # what the nominal bound alone would have printed
         assert simplest.__wrapped__(expr) != fast
+
+
+def test_no_timer_outlives_its_limit_when_the_cleanup_is_slow(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The repeated expiry once landed in the cleanup of an expired limit (the unwinding of a deep
+    sympy.solveset outlasted the 0.05 s repeat), skipped the disarming, and a later, unrelated step
+    failed with "took longer than 20 s". Here the disarming itself takes 0.3 s (6 repeats)."""
+    import signal
+
+    setitimer = signal.setitimer
+
+    def slow_setitimer(which: int, seconds: float, interval: float = 0.0) -> tuple[float, float]:
+        if seconds == 0:  # the disarming in the cleanup: repeats fire meanwhile
+            spin(0.3)
+        return setitimer(which, seconds, interval)
+
+    monkeypatch.setattr(signal, "setitimer", slow_setitimer)
+    handler = signal.getsignal(signal.SIGALRM)
+    with pytest.raises(SymrotTimeout), time_limit(0.05):
+        spin(2)
+    monkeypatch.undo()
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+    assert signal.getsignal(signal.SIGALRM) == handler
+    assert spin(0.3) == "finished"
