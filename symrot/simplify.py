@@ -10,9 +10,10 @@
 2. A time-bounded ``trigsimp`` of the candidates, which contracts 2cos²θ − 1 into cos 2θ.
 
 The shortest candidate (by operation count, then by printed length) wins. Which inputs a step
-is tried on is decided by size (``BASE_ANGLE_OPS``, ``TRIGSIMP_OPS`` operations), so that the
-result does not depend on the machine's speed; every step also has a time bound as a safety net
-(:mod:`symrot.timeouts`) and falls back to the unsimplified input, which is always correct.
+is tried on is decided by size (``BASE_ANGLE_OPS``, ``TRIGSIMP_OPS`` operations, the largest
+multiple ``BASE_ANGLE_MULTIPLE`` of the base angle), so that the result does not depend on the
+machine's speed; every step also has a time bound as a safety net (:mod:`symrot.timeouts`), whose
+expiry is an error (deterministic mode), never a silent change of the result.
 """
 
 from __future__ import annotations
@@ -29,6 +30,10 @@ _TRIG = (sp.sin, sp.cos, sp.tan)
 BASE_ANGLE_OPS = 150
 """Largest input (operation count) of the base-angle reduction; the derivations of the named
 parameterizations reach 47 (≤ 0.05 s)."""
+BASE_ANGLE_MULTIPLE = 24
+"""Largest n with sin(nθ) or cos(nθ) expanded by the base-angle reduction: its time grows steeply
+with n (0.11 s at n = 12, 0.72 s at 40, 4.2 s at 100, past 5 s at 800 for the higher-order Cayley
+family, cayley_m800); the named parameterizations reach 12 (sine_m12, tangent_m12)."""
 TRIGSIMP_OPS = 40
 """Largest trigonometric sum factor (operation count) given to ``trigsimp``; the named
 parameterizations reach 24 (≤ 0.1 s)."""
@@ -71,6 +76,16 @@ def _trig_multiples(expr: sp.Expr) -> list[sp.Rational] | None:
     return multiples
 
 
+def expands_beyond_the_cap(expr: sp.Expr, angle: sp.Expr) -> bool:
+    """Whether some sin/cos/tan(k·``angle``) of ``expr`` has |k| > BASE_ANGLE_MULTIPLE: expanding
+    it as a polynomial in the sine and cosine of ``angle`` is not attempted (a size, not a time)."""
+    for atom in expr.atoms(*_TRIG):
+        k = atom.args[0] / angle
+        if k.is_Rational and abs(k) > BASE_ANGLE_MULTIPLE:
+            return True
+    return False
+
+
 def base_angle_reduction(expr: sp.Expr) -> sp.Expr | None:
     """Reduce a rational function of φ and trig(kφ) modulo sin² + cos² = 1 (see module doc)."""
     opaque: dict[sp.Expr, sp.Symbol] = {}
@@ -89,6 +104,8 @@ def base_angle_reduction(expr: sp.Expr) -> sp.Expr | None:
         reduced = sp.cancel(sp.together(hidden))
         return reduced.xreplace({v: k for k, v in opaque.items()})
     denominator = reduce(lcm, (k.q for k in multiples), 1)
+    if max(abs(k) * denominator for k in multiples) > BASE_ANGLE_MULTIPLE:
+        return None
     theta = sp.Dummy("theta")
     s, c = sp.Dummy("s"), sp.Dummy("c")
 
