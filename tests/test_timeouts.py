@@ -130,7 +130,7 @@ def test_a_slow_machine_gets_the_same_simplified_form(monkeypatch: pytest.Monkey
     """The CI failure this prevents: a 0.5 s trigsimp that takes 0.28 s on an idle machine ran past
     0.5 s in a test process busy with JAX's garbage collection, fell back to the unsimplified form
     and changed a generated module (float64 pdot of sin(phi)/2 + sinh(phi)/2 went from 2e5 to 5e6
-    ulp). A machine 1.2 s slower per trigsimp than this one must get the same form."""
+    ulp). A machine on which every trigsimp takes 0.6 s longer must get the same form."""
     import sympy as sp
 
     from symrot.parsing import PHI
