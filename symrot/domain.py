@@ -8,9 +8,10 @@ x > 1.3·10¹⁵⁴, i.e. |p| ≳ 10⁷⁷, and gave 1.6·10⁻¹⁵⁹·I inste
 
 :func:`domain_limit` therefore evaluates every printed coefficient (algebraic forms, the closed side
 of branches, the closed angle) in the target precision with the ideal-libm model of
-:mod:`symrot.evaluation`, at x = 2^k for k = :data:`FIRST_POWER` … top, against mpmath at a
-precision that resolves φ next to φ_max, and returns the largest 2^k below which all of them are
-finite and within :data:`WRONG_ULP` of the output they feed (:func:`_weight_and_scale`).
+:mod:`symrot.evaluation`, at x = 2^k and 1.3·2^k (:data:`OFF_POWER`) for k = :data:`FIRST_POWER` …
+top, against mpmath at a precision that resolves φ next to φ_max, and returns the largest 2^k
+below which all of them are finite and within :data:`WRONG_ULP` of the output they feed
+(:func:`_weight_and_scale`).
 Backends print that bound as the edge of the domain. A form that is merely less accurate (a few
 ulp) does not move the bound: the error model chose it; this sweep catches overflow, underflow and
 cancellation that make a result wrong, not imprecise.
@@ -35,6 +36,11 @@ TOP_POWER = {"float64": 600, "float32": 100}
 """x < 2^TOP_POWER: the cut-off of unbounded ranges (x itself must stay finite)."""
 FIRST_POWER = 32
 """The sweep starts at x = 2^32: below it the plan's own error model has measured every form."""
+OFF_POWER = 1.3
+"""The second point of each octave, x = 2^k·1.3 (not √2, whose square is 2): at x = 2^k itself
+16/(x + 16), its square and a power-of-two multiple are often exact, which hides the rounding of a
+form that underflows (the tangent's H₂ = (16/(x + 16))²/8 of Wiener–Milenkovic is subnormal from
+x = 2^514 in float64)."""
 WRONG_ULP = 64.0
 """A relative error beyond this many ulp is a wrong result, not an imprecise one."""
 
@@ -50,7 +56,6 @@ def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mappin
     top = TOP_POWER[label]
     if math.isfinite(p_max) and p_max * p_max < 2.0**FIRST_POWER:
         return 2.0**top
-    epsilon = float(np.finfo(dtype).eps)
     models = {name: model_function(expression, [X, PHI, S, D])
               for name, (_, expression) in coefficients.items()}
     exact = {name: sp.lambdify(PHI, expression, modules=[mpmath_namespace(), "mpmath"])
@@ -58,31 +63,41 @@ def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mappin
     angle_of = _angle_function(p, inverse, phi_max)
     complement = p_max * p_max if math.isfinite(p_max) else math.inf
     for k in range(FIRST_POWER, top + 1):
-        x = 2.0**k
-        if x >= complement:
-            break
-        digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
-        with mpmath.workdps(digits):
-            s_exact = mpmath.sqrt(mpmath.mpf(x))
-            try:
-                phi = angle_of(s_exact)
-                values = {name: function(phi) for name, function in exact.items()}
-            except (ZeroDivisionError, ValueError, OverflowError):
-                # φ is indistinguishable from the pole at this precision (p ~ e^(1/(φ_max − φ)),
-                # e.g. atanh): nothing beyond can be verified, so the domain ends here
-                return 2.0 ** (k - 1) if k > FIRST_POWER else 2.0**FIRST_POWER
-            arguments = (dtype(x), dtype(float(phi)), dtype(float(s_exact)),
-                         dtype(complement - x if math.isfinite(complement) else 0.0))
-            for name, model in models.items():
-                reference = values[name]
-                if not mpmath.isfinite(reference):
-                    continue
-                value = float(model(*arguments))
-                weight, scale = _weight_and_scale(name, values, s_exact)
-                allowed = WRONG_ULP * epsilon * max(scale, float(np.finfo(dtype).tiny))
-                if not math.isfinite(value) or float(abs(mpmath.mpf(value) - reference) * weight) > allowed:
-                    return 2.0 ** (k - 1) if k > FIRST_POWER else 2.0**FIRST_POWER
+        for x, edge in ((2.0**k, 2.0 ** (k - 1)), (2.0**k * OFF_POWER, 2.0**k)):
+            if x >= complement:
+                return 2.0**top
+            if not _right_at(x, k, models, exact, angle_of, complement, dtype):
+                return edge if edge >= 2.0**FIRST_POWER else 2.0**FIRST_POWER
     return 2.0**top
+
+
+def _right_at(x: float, k: int, models: Mapping[str, Callable[..., Any]],
+              exact: Mapping[str, Callable[..., Any]], angle_of: Callable[[mpmath.mpf], mpmath.mpf],
+              complement: float, dtype: type) -> bool:
+    """Whether every printed form is finite and within :data:`WRONG_ULP` at x (2^k ≤ x < 2^(k+1))."""
+    epsilon = float(np.finfo(dtype).eps)
+    digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
+    with mpmath.workdps(digits):
+        s_exact = mpmath.sqrt(mpmath.mpf(x))
+        try:
+            phi = angle_of(s_exact)
+            values = {name: function(phi) for name, function in exact.items()}
+        except (ZeroDivisionError, ValueError, OverflowError):
+            # φ is indistinguishable from the pole at this precision (p ~ e^(1/(φ_max − φ)),
+            # e.g. atanh): nothing beyond can be verified, so the domain ends here
+            return False
+        arguments = (dtype(x), dtype(float(phi)), dtype(float(s_exact)),
+                     dtype(complement - x if math.isfinite(complement) else 0.0))
+        for name, model in models.items():
+            reference = values[name]
+            if not mpmath.isfinite(reference):
+                continue
+            value = float(model(*arguments))
+            weight, scale = _weight_and_scale(name, values, s_exact)
+            allowed = WRONG_ULP * epsilon * max(scale, float(np.finfo(dtype).tiny))
+            if not math.isfinite(value) or float(abs(mpmath.mpf(value) - reference) * weight) > allowed:
+                return False
+    return True
 
 
 def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf) -> tuple[mpmath.mpf, float]:

@@ -143,6 +143,13 @@ class ModelPrinter(PythonCodePrinter):
             return f"(1.0/({self._print(base)}))"
         return f"_m.pow({self._print(base)}, {self._print(exponent)})"
 
+    def _print_BoundedPower(self, expr: Any) -> str:
+        """(base)**n as the backends print it: one pow of the bounded base (ideal libm)."""
+        base, exponent = expr.args
+        if exponent == 1:
+            return f"({self._print(base)})"
+        return f"_m.pow({self._print(base)}, {self._print(exponent)})"
+
     def _print_Rational(self, expr: sp.Rational) -> str:
         return repr(float(expr))
 

@@ -50,6 +50,7 @@ from .algebraic import (
     closed_with_complement,
     fold_complement,
     reduction_size,
+    with_bounded_powers,
     with_complement,
     with_inverse,
 )
@@ -471,6 +472,9 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
         elif inverse is not None:
             coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
                             if isinstance(c, Branch) else c for n, c in coefficients.items()}
+        if not math.isfinite(p_max):  # x unbounded: (k x + a)^n overflows before the value does
+            coefficients = {n: Algebraic(with_bounded_powers(c.expression)) if isinstance(c, Algebraic) else c
+                            for n, c in coefficients.items()}
         slopes = {n: c for n, c in coefficients.items() if n in derivation.slopes}
         kinematic = {n: c for n, c in coefficients.items() if n not in derivation.slopes}
         limit = _domain_limit(derivation, kinematic, angle, inverse, phi_max, p_max, dtype)

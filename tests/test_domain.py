@@ -13,6 +13,7 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import pytest
+import sympy as sp
 
 from symrot.api import derive
 from symrot.core import tensor_definitions
@@ -48,7 +49,6 @@ def test_numpy_module_is_right_below_x_limit_and_nan_beyond(name: str) -> None:
     axis = np.array([0.6, 0.8, 0.0])
     for label, dtype in (("float64", np.float64), ("float32", np.float32)):
         limit = plan.precisions[label].x_limit
-        assert limit < (2.0**600 if dtype is np.float64 else 2.0**100)  # the forms do overflow earlier
         eps = float(np.finfo(dtype).eps)
         inside = axis * math.sqrt(limit) * 0.5
         outside = axis * math.sqrt(limit) * 1.01
@@ -61,8 +61,34 @@ def test_numpy_module_is_right_below_x_limit_and_nan_beyond(name: str) -> None:
 
 
 def test_the_reported_wiener_milenkovic_tangent_is_nan_not_wrong() -> None:
+    """x = 10^160 = 2^531.5: H₂ = (16/(x + 16))²/8 ≈ 3·10⁻³¹⁹ is subnormal there (18 bits), so the
+    tangent would be off by ~10⁻⁵ relative; the domain (2^518 in float64) ends before."""
     module = load(ROOT / "generated" / "numpy" / "wiener_milenkovic.py", "domain_wm_report")
     assert np.all(np.isnan(module.tangent(np.array([6e79, 8e79, 0.0]))))
+
+
+@pytest.mark.parametrize("name", UNBOUNDED)
+def test_float32_reaches_the_last_representable_angle(name: str) -> None:
+    """Every float32 angle below φ_max is inside the float32 domain and meets the 4-ulp target.
+
+    Wiener–Milenkovic's float32 module was NaN from φ = 2π − 7.6·10⁻⁶ (x = 2^42): det H =
+    4096/(x + 16)³ overflowed in its denominator (symrot.algebraic.bounded_powers)."""
+    module = load(ROOT / "generated" / "numpy" / f"{name}.py", f"domain32_{name}")
+    m = 4 if name == "wiener_milenkovic" else 2
+    phi_max = m * math.pi / 2  # p = m tan(φ/m) → ∞
+    eps = float(np.finfo(np.float32).eps)
+    axis = np.array([0.6, 0.8, 0.0])
+    for phi in (float(np.nextafter(np.float32(phi_max), np.float32(0))), phi_max - 1e-6):
+        p = (axis * m * math.tan(phi / m)).astype(np.float32)
+        for function, tensor in FUNCTIONS.items():
+            got = getattr(module, function)(p).astype(np.float64)
+            exact = _reference(name, tensor, p.astype(np.float64))
+            assert np.all(np.isfinite(got)), (function, phi)
+            assert np.max(np.abs(got - exact)) <= 4 * eps * np.max(np.abs(exact)), (function, phi)
+        with mpmath.workdps(60):
+            s = mpmath.norm(mpmath.matrix([mpmath.mpf(float(c)) for c in p]))
+            exact_det = float((m * m / (s * s + m * m)) ** (m // 2 + 1))  # cos^(m+2)(φ/m)
+        assert abs(float(module.tangent_det(p)) - exact_det) <= 4 * eps * exact_det + 2.0**-149, phi
 
 
 def test_c_header_prints_the_same_limit() -> None:
@@ -71,3 +97,35 @@ def test_c_header_prints_the_same_limit() -> None:
     for label in ("float64", "float32"):
         power = math.frexp(plan.precisions[label].x_limit)[1] - 1
         assert f"|p|^2 < 2^{power}" in header
+
+
+def test_bounded_powers_keep_the_value_and_do_not_overflow_first() -> None:
+    """symrot.algebraic.bounded_powers: the same rational function, evaluated without overflow in
+    float32 where the expanded denominator (x + a)^n overflows, and printed as a power of the ratio."""
+    from symrot.algebraic import X, bounded_powers
+    from symrot.backends.c_printer import SymrotCPrinter
+    from symrot.evaluation import model_function
+    from symrot.functions import BoundedPower
+
+    forms = [4096 / (X + 16) ** 3, 128 / (X + 16) ** 2, -16 * (X - 16) / (X + 16) ** 2,
+             32 * (X - 16) / (X + 16) ** 3 - 16 / (X + 16) ** 2, 3 * (X + 1) / (2 * X + 9) ** 4]
+    eps, tiny = float(np.finfo(np.float32).eps), float(np.finfo(np.float32).tiny)
+    for form in forms:
+        rewritten = bounded_powers(form)
+        assert rewritten.has(BoundedPower), form
+        assert sp.simplify(rewritten.doit() - form) == 0, form
+        for power in rewritten.atoms(BoundedPower):
+            base = power.args[0]
+            assert all(0 < float(base.subs(X, v)) <= 1 for v in (0, 1, 1e3, 1e30)), form
+        plain, bounded = (model_function(f, [X]) for f in (form, rewritten))
+        for k in range(20, 100):  # the first x at which the expanded form goes wrong in float32
+            x = sp.Integer(2) ** k * sp.Rational(13, 10)
+            exact = float(form.subs(X, sp.Float(x, 60)))
+            if abs(float(plain(np.float32(x))) - exact) > 1e-3 * abs(exact):
+                break
+        assert abs(exact) >= tiny, (form, k)  # it goes wrong while the value is a normal number
+        assert abs(float(bounded(np.float32(x))) - exact) <= 8 * eps * abs(exact), (form, k)
+    cube = "((16/(x + 16))*(16/(x + 16))*(16/(x + 16)))"  # the compiler computes the ratio once
+    assert SymrotCPrinter("float").doprint(bounded_powers(forms[0])) == cube
+    assert bounded_powers(16 / (X + 16)) == 16 / (X + 16)  # nothing to bound
+    assert bounded_powers(1 / (X - 16) ** 2) == 1 / (X - 16) ** 2  # a pole in the range: no ratio in (0, 1]

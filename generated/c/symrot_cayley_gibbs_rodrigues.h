@@ -10,7 +10,7 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * Never a silently wrong value: NaN in every output instead.
  *
  * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
@@ -51,7 +51,7 @@ static inline double symrot_cayley_gibbs_rodrigues__phi(double s)
 }
 
 /* symrot_cayley_gibbs_rodrigues_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * phi = 2*atan(s/2) (closed inverse of p(phi))
@@ -59,7 +59,7 @@ static inline double symrot_cayley_gibbs_rodrigues__phi(double s)
 static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         return (double)NAN;
     }
     double s;
@@ -75,7 +75,7 @@ static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -85,7 +85,7 @@ static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         R[0] = (double)NAN;
         R[1] = (double)NAN;
         R[2] = (double)NAN;
@@ -140,11 +140,11 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
+            c_R_0_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -164,7 +164,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_across = 4/(x + 4) (algebraic in x)
@@ -174,7 +174,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
 static inline void symrot_cayley_gibbs_rodrigues_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         H[0] = (double)NAN;
         H[1] = (double)NAN;
         H[2] = (double)NAN;
@@ -229,10 +229,10 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_across = c_H_across_lanes[k];
-            c_H_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_across;
+            c_H_across_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_1;
-            c_H_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 0;
+            c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_H_1;
+            c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -251,7 +251,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = 1 (constant)
@@ -261,7 +261,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         Hinv[0] = (double)NAN;
         Hinv[1] = (double)NAN;
         Hinv[2] = (double)NAN;
@@ -306,9 +306,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n,
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_H_inverse_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
-            c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
-            c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1.0/4.0;
+            c_H_inverse_across_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : 1;
+            c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : -1.0/2.0;
+            c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : 1.0/4.0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -327,23 +327,23 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n,
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * det_H = 16/(x + 4)**2 (algebraic in x)
+ * det_H = (4/(x + 4))**2 (algebraic in x)
  * ops: 9 */
 static inline double symrot_cayley_gibbs_rodrigues_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         return (double)NAN;
     }
-    const double c_det_H = 16/pow(x + 4, 2);
+    const double c_det_H = ((4/(x + 4))*(4/(x + 4)));
     return c_det_H;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
@@ -353,7 +353,7 @@ static inline double symrot_cayley_gibbs_rodrigues_tangent_det(const double p[3]
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         G[0] = (double)NAN;
         G[1] = (double)NAN;
         G[2] = (double)NAN;
@@ -395,7 +395,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 6.703903964971299e+153)) {
+            if (!(x < 4.149515568880993e+180)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -421,11 +421,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
+            c_G_0_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -445,7 +445,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_across = 1/sqrt(x + 4) (algebraic in x)
@@ -455,7 +455,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         K[0] = (double)NAN;
         K[1] = (double)NAN;
         K[2] = (double)NAN;
@@ -497,7 +497,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 6.703903964971299e+153)) {
+            if (!(x < 4.149515568880993e+180)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -526,11 +526,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_across = c_K_across_lanes[k];
-            c_K_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_across;
+            c_K_across_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_1;
+            c_K_1_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
-            c_K_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_K_2;
+            c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_K_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -549,7 +549,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
 }
 
 /* symrot_cayley_gibbs_rodrigues_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = 1 (constant)
@@ -559,7 +559,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
 static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         pdot[0] = (double)NAN;
         pdot[1] = (double)NAN;
         pdot[2] = (double)NAN;
@@ -575,7 +575,7 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const d
 }
 
 /* symrot_cayley_gibbs_rodrigues_omega: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_across = 4/(x + 4) (algebraic in x)
@@ -585,7 +585,7 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot(const double p[3], const d
 static inline void symrot_cayley_gibbs_rodrigues_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         omega[0] = (double)NAN;
         omega[1] = (double)NAN;
         omega[2] = (double)NAN;
@@ -602,7 +602,7 @@ static inline void symrot_cayley_gibbs_rodrigues_omega(const double p[3], const 
 }
 
 /* symrot_cayley_gibbs_rodrigues_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * e_0 = 2/sqrt(x + 4) (algebraic in x)
@@ -611,7 +611,7 @@ static inline void symrot_cayley_gibbs_rodrigues_omega(const double p[3], const 
 static inline void symrot_cayley_gibbs_rodrigues_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         e[0] = (double)NAN;
         e[1] = (double)NAN;
         e[2] = (double)NAN;
@@ -662,7 +662,7 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion(double e0, doub
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 6.703903964971299e+153)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 4.149515568880993e+180)) {
         p[0] = (double)NAN;
         p[1] = (double)NAN;
         p[2] = (double)NAN;
@@ -756,19 +756,19 @@ static inline int symrot_cayley_gibbs_rodrigues_rescale(const double p[3], doubl
 
 /* symrot_cayley_gibbs_rodrigues_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = -4/(x + 4)**2 (algebraic in x)
- * R_2_x = -2/(x + 4)**2 (algebraic in x)
- * ops: 138 */
+ * R_1_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * R_2_x = -(4/(x + 4))**2/8 (algebraic in x)
+ * ops: 140 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -782,8 +782,8 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative(const doubl
     }
     const double c_R_1 = 4/(x + 4);
     const double c_R_2 = 2/(x + 4);
-    const double c_R_1_x = -4/pow(x + 4, 2);
-    const double c_R_2_x = -2/pow(x + 4, 2);
+    const double c_R_1_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
+    const double c_R_2_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -823,19 +823,19 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative(const doubl
 
 /* symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = -4/(x + 4)**2 (algebraic in x)
- * R_2_x = -2/(x + 4)**2 (algebraic in x)
- * ops: 139 */
+ * R_1_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * R_2_x = -(4/(x + 4))**2/8 (algebraic in x)
+ * ops: 141 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -849,8 +849,8 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative(c
     }
     const double c_R_1 = 4/(x + 4);
     const double c_R_2 = 2/(x + 4);
-    const double c_R_1_x = -4/pow(x + 4, 2);
-    const double c_R_2_x = -2/pow(x + 4, 2);
+    const double c_R_1_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
+    const double c_R_2_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -888,19 +888,19 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative(c
 
 /* symrot_cayley_gibbs_rodrigues_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
- * H_0_x = -4/(x + 4)**2 (algebraic in x)
- * H_1_x = -2/(x + 4)**2 (algebraic in x)
+ * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 74 */
+ * ops: 76 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -913,8 +913,8 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative(const double
         return;
     }
     const double c_H_1 = 2/(x + 4);
-    const double c_H_0_x = -4/pow(x + 4, 2);
-    const double c_H_1_x = -2/pow(x + 4, 2);
+    const double c_H_0_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
+    const double c_H_1_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
     const double dw0 = 2*p[0];
     const double dw1 = a[1]*p[2];
     const double dw2 = c_H_1_x*(a[2]*p[1] - dw1);
@@ -943,19 +943,19 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative(const double
 
 /* symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
- * H_0_x = -4/(x + 4)**2 (algebraic in x)
- * H_1_x = -2/(x + 4)**2 (algebraic in x)
+ * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 80 */
+ * ops: 82 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -968,8 +968,8 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(co
         return;
     }
     const double c_H_1 = 2/(x + 4);
-    const double c_H_0_x = -4/pow(x + 4, 2);
-    const double c_H_1_x = -2/pow(x + 4, 2);
+    const double c_H_0_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
+    const double c_H_1_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
     const double dw0 = 2*p[0];
     const double dw1 = c_H_1_x*(-a[1]*p[2] + a[2]*p[1]);
     const double dw2 = a[2]*c_H_1;
@@ -995,7 +995,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(co
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
@@ -1007,7 +1007,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(co
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -1041,20 +1041,20 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative(cons
 
 /* symrot_cayley_gibbs_rodrigues_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^511 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
- * H_0_x = -4/(x + 4)**2 (algebraic in x)
- * H_1_x = -2/(x + 4)**2 (algebraic in x)
+ * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 67 */
+ * ops: 69 */
 static inline void symrot_cayley_gibbs_rodrigues_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 6.703903964971299e+153)) {
+    if (!(x < 4.149515568880993e+180)) {
         alpha[0] = (double)NAN;
         alpha[1] = (double)NAN;
         alpha[2] = (double)NAN;
@@ -1062,8 +1062,8 @@ static inline void symrot_cayley_gibbs_rodrigues_angular_acceleration(const doub
     }
     const double c_H_0 = 4/(x + 4);
     const double c_H_1 = 2/(x + 4);
-    const double c_H_0_x = -4/pow(x + 4, 2);
-    const double c_H_1_x = -2/pow(x + 4, 2);
+    const double c_H_0_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
+    const double c_H_1_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
     const double w2 = p[0]*pddot[1] - p[1]*pddot[0];
@@ -1206,7 +1206,7 @@ static inline float symrot_cayley_gibbs_rodrigues__phi_f(float s)
 }
 
 /* symrot_cayley_gibbs_rodrigues_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * phi = 2*atan(s/2) (closed inverse of p(phi))
@@ -1214,7 +1214,7 @@ static inline float symrot_cayley_gibbs_rodrigues__phi_f(float s)
 static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         return NAN;
     }
     float s;
@@ -1230,7 +1230,7 @@ static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -1240,7 +1240,7 @@ static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -1295,11 +1295,11 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 3.8685626e+25F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1319,7 +1319,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_across = 4/(x + 4) (algebraic in x)
@@ -1329,7 +1329,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
 static inline void symrot_cayley_gibbs_rodrigues_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -1384,10 +1384,10 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_across = c_H_across_lanes[k];
-            c_H_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_across;
+            c_H_across_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_1;
-            c_H_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : 0;
+            c_H_1_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_H_1;
+            c_H_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1406,7 +1406,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = 1 (constant)
@@ -1416,7 +1416,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -1461,9 +1461,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_H_inverse_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
-            c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
-            c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1.0F/4.0F;
+            c_H_inverse_across_lanes[k] = !(x < 3.8685626e+25F) ? NAN : 1;
+            c_H_inverse_1_lanes[k] = !(x < 3.8685626e+25F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : 1.0F/4.0F;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1482,23 +1482,23 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t 
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * det_H = 16/(x + 4)**2 (algebraic in x)
+ * det_H = (4/(x + 4))**2 (algebraic in x)
  * ops: 9 */
 static inline float symrot_cayley_gibbs_rodrigues_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         return NAN;
     }
-    const float c_det_H = 16/powf(x + 4, 2);
+    const float c_det_H = ((4/(x + 4))*(4/(x + 4)));
     return c_det_H;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
@@ -1508,7 +1508,7 @@ static inline float symrot_cayley_gibbs_rodrigues_tangent_det_f(const float p[3]
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -1550,7 +1550,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F)) {
+            if (!(x < 3.8685626e+25F)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -1576,11 +1576,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 3.8685626e+25F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1600,7 +1600,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_across = 1/sqrt(x + 4) (algebraic in x)
@@ -1610,7 +1610,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -1652,7 +1652,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F)) {
+            if (!(x < 3.8685626e+25F)) {
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
@@ -1681,11 +1681,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_K_across = c_K_across_lanes[k];
-            c_K_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_across;
+            c_K_across_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_1;
+            c_K_1_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
-            c_K_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_K_2;
+            c_K_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_K_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1704,7 +1704,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
 }
 
 /* symrot_cayley_gibbs_rodrigues_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = 1 (constant)
@@ -1714,7 +1714,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
 static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -1730,7 +1730,7 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const 
 }
 
 /* symrot_cayley_gibbs_rodrigues_omega_f: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_across = 4/(x + 4) (algebraic in x)
@@ -1740,7 +1740,7 @@ static inline void symrot_cayley_gibbs_rodrigues_pdot_f(const float p[3], const 
 static inline void symrot_cayley_gibbs_rodrigues_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
@@ -1757,7 +1757,7 @@ static inline void symrot_cayley_gibbs_rodrigues_omega_f(const float p[3], const
 }
 
 /* symrot_cayley_gibbs_rodrigues_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * e_0 = 2/sqrt(x + 4) (algebraic in x)
@@ -1766,7 +1766,7 @@ static inline void symrot_cayley_gibbs_rodrigues_omega_f(const float p[3], const
 static inline void symrot_cayley_gibbs_rodrigues_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;
@@ -1817,7 +1817,7 @@ static inline int symrot_cayley_gibbs_rodrigues__from_quaternion_f(float e0, flo
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 9.223372e+18F)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 3.8685626e+25F)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;
@@ -1911,19 +1911,19 @@ static inline int symrot_cayley_gibbs_rodrigues_rescale_f(const float p[3], floa
 
 /* symrot_cayley_gibbs_rodrigues_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = -4/(x + 4)**2 (algebraic in x)
- * R_2_x = -2/(x + 4)**2 (algebraic in x)
- * ops: 138 */
+ * R_1_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * R_2_x = -(4/(x + 4))**2/8 (algebraic in x)
+ * ops: 140 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -1937,8 +1937,8 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative_f(const flo
     }
     const float c_R_1 = 4/(x + 4);
     const float c_R_2 = 2/(x + 4);
-    const float c_R_1_x = -4/powf(x + 4, 2);
-    const float c_R_2_x = -2/powf(x + 4, 2);
+    const float c_R_1_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
+    const float c_R_2_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -1978,19 +1978,19 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative_f(const flo
 
 /* symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_1 = 4/(x + 4) (algebraic in x)
  * R_2 = 2/(x + 4) (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = -4/(x + 4)**2 (algebraic in x)
- * R_2_x = -2/(x + 4)**2 (algebraic in x)
- * ops: 139 */
+ * R_1_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * R_2_x = -(4/(x + 4))**2/8 (algebraic in x)
+ * ops: 141 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -2004,8 +2004,8 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f
     }
     const float c_R_1 = 4/(x + 4);
     const float c_R_2 = 2/(x + 4);
-    const float c_R_1_x = -4/powf(x + 4, 2);
-    const float c_R_2_x = -2/powf(x + 4, 2);
+    const float c_R_1_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
+    const float c_R_2_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -2043,19 +2043,19 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f
 
 /* symrot_cayley_gibbs_rodrigues_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
- * H_0_x = -4/(x + 4)**2 (algebraic in x)
- * H_1_x = -2/(x + 4)**2 (algebraic in x)
+ * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 74 */
+ * ops: 76 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -2068,8 +2068,8 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative_f(const floa
         return;
     }
     const float c_H_1 = 2/(x + 4);
-    const float c_H_0_x = -4/powf(x + 4, 2);
-    const float c_H_1_x = -2/powf(x + 4, 2);
+    const float c_H_0_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
+    const float c_H_1_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
     const float dw0 = 2*p[0];
     const float dw1 = a[1]*p[2];
     const float dw2 = c_H_1_x*(a[2]*p[1] - dw1);
@@ -2098,19 +2098,19 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative_f(const floa
 
 /* symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
- * H_0_x = -4/(x + 4)**2 (algebraic in x)
- * H_1_x = -2/(x + 4)**2 (algebraic in x)
+ * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 80 */
+ * ops: 82 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -2123,8 +2123,8 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(
         return;
     }
     const float c_H_1 = 2/(x + 4);
-    const float c_H_0_x = -4/powf(x + 4, 2);
-    const float c_H_1_x = -2/powf(x + 4, 2);
+    const float c_H_0_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
+    const float c_H_1_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
     const float dw0 = 2*p[0];
     const float dw1 = c_H_1_x*(-a[1]*p[2] + a[2]*p[1]);
     const float dw2 = a[2]*c_H_1;
@@ -2150,7 +2150,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
@@ -2162,7 +2162,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -2196,20 +2196,20 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative_f(co
 
 /* symrot_cayley_gibbs_rodrigues_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^63 (|phi| < 3.1415926535897931), the largest power
+ * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 4/(x + 4) (algebraic in x)
  * H_1 = 2/(x + 4) (algebraic in x)
  * H_2 = 0 (constant)
- * H_0_x = -4/(x + 4)**2 (algebraic in x)
- * H_1_x = -2/(x + 4)**2 (algebraic in x)
+ * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
+ * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 67 */
+ * ops: 69 */
 static inline void symrot_cayley_gibbs_rodrigues_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 9.223372e+18F)) {
+    if (!(x < 3.8685626e+25F)) {
         alpha[0] = NAN;
         alpha[1] = NAN;
         alpha[2] = NAN;
@@ -2217,8 +2217,8 @@ static inline void symrot_cayley_gibbs_rodrigues_angular_acceleration_f(const fl
     }
     const float c_H_0 = 4/(x + 4);
     const float c_H_1 = 2/(x + 4);
-    const float c_H_0_x = -4/powf(x + 4, 2);
-    const float c_H_1_x = -2/powf(x + 4, 2);
+    const float c_H_0_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
+    const float c_H_1_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];
     const float w2 = p[0]*pddot[1] - p[1]*pddot[0];

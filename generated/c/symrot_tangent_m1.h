@@ -1023,7 +1023,7 @@ static inline void symrot_tangent_m1_rotation_transpose_derivative(const double 
  * non-finite p, every output is NaN.
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * H_0_x = -1/(x + 1)**2 (algebraic in x)
+ * H_0_x = -(1/(x + 1))**2 (algebraic in x)
  * H_1_x = (-1 - 1/(2*sqrt(x + 1)))/(x + sqrt(x + 1) + 1)**2 (algebraic in x)
  * H_2_x = 1/((x + 1)**2*(sqrt(x + 1) + 1)) + 1/(2*(x + 1)**(3/2)*(sqrt(x + 1) + 1)**2) (algebraic in x)
  * ops: 192 */
@@ -1044,7 +1044,7 @@ static inline void symrot_tangent_m1_tangent_derivative(const double p[3], const
     }
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
     const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
-    const double c_H_0_x = -1/pow(x + 1, 2);
+    const double c_H_0_x = -((1.0/(x + 1))*(1.0/(x + 1)));
     const double c_H_1_x = (-1 - (1.0/2.0)/sqrt(x + 1))/pow(x + sqrt(x + 1) + 1, 2);
     const double c_H_2_x = 1/(pow(x + 1, 2)*(sqrt(x + 1) + 1)) + (1.0/2.0)/(pow(x + 1, 3.0/2.0)*pow(sqrt(x + 1) + 1, 2));
     const double dw0 = a[0]*p[0];
@@ -1094,7 +1094,7 @@ static inline void symrot_tangent_m1_tangent_derivative(const double p[3], const
  * non-finite p, every output is NaN.
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * H_0_x = -1/(x + 1)**2 (algebraic in x)
+ * H_0_x = -(1/(x + 1))**2 (algebraic in x)
  * H_1_x = (-1 - 1/(2*sqrt(x + 1)))/(x + sqrt(x + 1) + 1)**2 (algebraic in x)
  * H_2_x = 1/((x + 1)**2*(sqrt(x + 1) + 1)) + 1/(2*(x + 1)**(3/2)*(sqrt(x + 1) + 1)**2) (algebraic in x)
  * ops: 198 */
@@ -1115,7 +1115,7 @@ static inline void symrot_tangent_m1_tangent_transpose_derivative(const double p
     }
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
     const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
-    const double c_H_0_x = -1/pow(x + 1, 2);
+    const double c_H_0_x = -((1.0/(x + 1))*(1.0/(x + 1)));
     const double c_H_1_x = (-1 - (1.0/2.0)/sqrt(x + 1))/pow(x + sqrt(x + 1) + 1, 2);
     const double c_H_2_x = 1/(pow(x + 1, 2)*(sqrt(x + 1) + 1)) + (1.0/2.0)/(pow(x + 1, 3.0/2.0)*pow(sqrt(x + 1) + 1, 2));
     const double dw0 = a[0]*p[0];
@@ -1231,7 +1231,7 @@ static inline void symrot_tangent_m1_tangent_inverse_derivative(const double p[3
  * H_0 = 1/(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * H_0_x = -1/(x + 1)**2 (algebraic in x)
+ * H_0_x = -(1/(x + 1))**2 (algebraic in x)
  * H_1_x = (-1 - 1/(2*sqrt(x + 1)))/(x + sqrt(x + 1) + 1)**2 (algebraic in x)
  * H_2_x = 1/((x + 1)**2*(sqrt(x + 1) + 1)) + 1/(2*(x + 1)**(3/2)*(sqrt(x + 1) + 1)**2) (algebraic in x)
  * ops: 155 */
@@ -1247,7 +1247,7 @@ static inline void symrot_tangent_m1_angular_acceleration(const double p[3], con
     const double c_H_0 = 1.0/(x + 1);
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
     const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
-    const double c_H_0_x = -1/pow(x + 1, 2);
+    const double c_H_0_x = -((1.0/(x + 1))*(1.0/(x + 1)));
     const double c_H_1_x = (-1 - (1.0/2.0)/sqrt(x + 1))/pow(x + sqrt(x + 1) + 1, 2);
     const double c_H_2_x = 1/(pow(x + 1, 2)*(sqrt(x + 1) + 1)) + (1.0/2.0)/(pow(x + 1, 3.0/2.0)*pow(sqrt(x + 1) + 1, 2));
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
@@ -2368,7 +2368,7 @@ static inline void symrot_tangent_m1_rotation_transpose_derivative_f(const float
  * non-finite p, every output is NaN.
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * H_0_x = -1/(x + 1)**2 (algebraic in x)
+ * H_0_x = -(1/(x + 1))**2 (algebraic in x)
  * H_1_x = (-1 - 1/(2*sqrt(x + 1)))/(x + sqrt(x + 1) + 1)**2 (algebraic in x)
  * H_2_x = 1/((x + 1)**2*(sqrt(x + 1) + 1)) + 1/(2*(x + 1)**(3/2)*(sqrt(x + 1) + 1)**2) (algebraic in x)
  * ops: 192 */
@@ -2389,7 +2389,7 @@ static inline void symrot_tangent_m1_tangent_derivative_f(const float p[3], cons
     }
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
     const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
-    const float c_H_0_x = -1/powf(x + 1, 2);
+    const float c_H_0_x = -((1.0F/(x + 1))*(1.0F/(x + 1)));
     const float c_H_1_x = (-1 - (1.0F/2.0F)/sqrtf(x + 1))/powf(x + sqrtf(x + 1) + 1, 2);
     const float c_H_2_x = 1/(powf(x + 1, 2)*(sqrtf(x + 1) + 1)) + (1.0F/2.0F)/(powf(x + 1, 3.0F/2.0F)*powf(sqrtf(x + 1) + 1, 2));
     const float dw0 = a[0]*p[0];
@@ -2439,7 +2439,7 @@ static inline void symrot_tangent_m1_tangent_derivative_f(const float p[3], cons
  * non-finite p, every output is NaN.
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * H_0_x = -1/(x + 1)**2 (algebraic in x)
+ * H_0_x = -(1/(x + 1))**2 (algebraic in x)
  * H_1_x = (-1 - 1/(2*sqrt(x + 1)))/(x + sqrt(x + 1) + 1)**2 (algebraic in x)
  * H_2_x = 1/((x + 1)**2*(sqrt(x + 1) + 1)) + 1/(2*(x + 1)**(3/2)*(sqrt(x + 1) + 1)**2) (algebraic in x)
  * ops: 198 */
@@ -2460,7 +2460,7 @@ static inline void symrot_tangent_m1_tangent_transpose_derivative_f(const float 
     }
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
     const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
-    const float c_H_0_x = -1/powf(x + 1, 2);
+    const float c_H_0_x = -((1.0F/(x + 1))*(1.0F/(x + 1)));
     const float c_H_1_x = (-1 - (1.0F/2.0F)/sqrtf(x + 1))/powf(x + sqrtf(x + 1) + 1, 2);
     const float c_H_2_x = 1/(powf(x + 1, 2)*(sqrtf(x + 1) + 1)) + (1.0F/2.0F)/(powf(x + 1, 3.0F/2.0F)*powf(sqrtf(x + 1) + 1, 2));
     const float dw0 = a[0]*p[0];
@@ -2576,7 +2576,7 @@ static inline void symrot_tangent_m1_tangent_inverse_derivative_f(const float p[
  * H_0 = 1/(x + 1) (algebraic in x)
  * H_1 = 1/(x + sqrt(x + 1) + 1) (algebraic in x)
  * H_2 = -1/((x + 1)*(sqrt(x + 1) + 1)) (algebraic in x)
- * H_0_x = -1/(x + 1)**2 (algebraic in x)
+ * H_0_x = -(1/(x + 1))**2 (algebraic in x)
  * H_1_x = (-1 - 1/(2*sqrt(x + 1)))/(x + sqrt(x + 1) + 1)**2 (algebraic in x)
  * H_2_x = 1/((x + 1)**2*(sqrt(x + 1) + 1)) + 1/(2*(x + 1)**(3/2)*(sqrt(x + 1) + 1)**2) (algebraic in x)
  * ops: 155 */
@@ -2592,7 +2592,7 @@ static inline void symrot_tangent_m1_angular_acceleration_f(const float p[3], co
     const float c_H_0 = 1.0F/(x + 1);
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
     const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
-    const float c_H_0_x = -1/powf(x + 1, 2);
+    const float c_H_0_x = -((1.0F/(x + 1))*(1.0F/(x + 1)));
     const float c_H_1_x = (-1 - (1.0F/2.0F)/sqrtf(x + 1))/powf(x + sqrtf(x + 1) + 1, 2);
     const float c_H_2_x = 1/(powf(x + 1, 2)*(sqrtf(x + 1) + 1)) + (1.0F/2.0F)/(powf(x + 1, 3.0F/2.0F)*powf(sqrtf(x + 1) + 1, 2));
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];

@@ -1161,10 +1161,10 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative(const double 
  * non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_0_x = -(9/(x + 9))**2/9 (algebraic in x)
  * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 277 */
+ * ops: 278 */
 static inline void symrot_tangent_m3_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1181,7 +1181,7 @@ static inline void symrot_tangent_m3_tangent_derivative(const double p[3], const
         return;
     }
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
-    const double c_H_0_x = -9/pow(x + 9, 2);
+    const double c_H_0_x = -1.0/9.0*((9/(x + 9))*(9/(x + 9)));
     const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1, c_H_1_x;
     if (x < 0.06877716192024325) {
@@ -1243,10 +1243,10 @@ static inline void symrot_tangent_m3_tangent_derivative(const double p[3], const
  * non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_0_x = -(9/(x + 9))**2/9 (algebraic in x)
  * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 283 */
+ * ops: 284 */
 static inline void symrot_tangent_m3_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1263,7 +1263,7 @@ static inline void symrot_tangent_m3_tangent_transpose_derivative(const double p
         return;
     }
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
-    const double c_H_0_x = -9/pow(x + 9, 2);
+    const double c_H_0_x = -1.0/9.0*((9/(x + 9))*(9/(x + 9)));
     const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1, c_H_1_x;
     if (x < 0.06877716192024325) {
@@ -1393,10 +1393,10 @@ static inline void symrot_tangent_m3_tangent_inverse_derivative(const double p[3
  * H_0 = 9/(x + 9) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_0_x = -(9/(x + 9))**2/9 (algebraic in x)
  * H_1_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 240 */
+ * ops: 241 */
 static inline void symrot_tangent_m3_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1408,7 +1408,7 @@ static inline void symrot_tangent_m3_angular_acceleration(const double p[3], con
     }
     const double c_H_0 = 9/(x + 9);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
-    const double c_H_0_x = -9/pow(x + 9, 2);
+    const double c_H_0_x = -1.0/9.0*((9/(x + 9))*(9/(x + 9)));
     const double c_H_2_x = (1.0/2.0)/(pow(x + 9, 2)*(sqrt(x + 9) + 3)) - 1.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 2)*pow(sqrt(x + 9) + 3, 2)) - 3.0/2.0*(sqrt(x + 9) + 12)/(pow(x + 9, 5.0/2.0)*(sqrt(x + 9) + 3));
     double c_H_1, c_H_1_x;
     if (x < 0.06877716192024325) {
@@ -2667,10 +2667,10 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative_f(const float
  * non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_0_x = -(9/(x + 9))**2/9 (algebraic in x)
  * H_1_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 245 */
+ * ops: 246 */
 static inline void symrot_tangent_m3_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2687,7 +2687,7 @@ static inline void symrot_tangent_m3_tangent_derivative_f(const float p[3], cons
         return;
     }
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
-    const float c_H_0_x = -9/powf(x + 9, 2);
+    const float c_H_0_x = -1.0F/9.0F*((9/(x + 9))*(9/(x + 9)));
     const float c_H_2_x = (1.0F/2.0F)/(powf(x + 9, 2)*(sqrtf(x + 9) + 3)) - 1.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 2)*powf(sqrtf(x + 9) + 3, 2)) - 3.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 5.0F/2.0F)*(sqrtf(x + 9) + 3));
     float c_H_1, c_H_1_x;
     if (x < 0.48711845F) {
@@ -2746,10 +2746,10 @@ static inline void symrot_tangent_m3_tangent_derivative_f(const float p[3], cons
  * non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_0_x = -(9/(x + 9))**2/9 (algebraic in x)
  * H_1_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 251 */
+ * ops: 252 */
 static inline void symrot_tangent_m3_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2766,7 +2766,7 @@ static inline void symrot_tangent_m3_tangent_transpose_derivative_f(const float 
         return;
     }
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
-    const float c_H_0_x = -9/powf(x + 9, 2);
+    const float c_H_0_x = -1.0F/9.0F*((9/(x + 9))*(9/(x + 9)));
     const float c_H_2_x = (1.0F/2.0F)/(powf(x + 9, 2)*(sqrtf(x + 9) + 3)) - 1.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 2)*powf(sqrtf(x + 9) + 3, 2)) - 3.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 5.0F/2.0F)*(sqrtf(x + 9) + 3));
     float c_H_1, c_H_1_x;
     if (x < 0.48711845F) {
@@ -2893,10 +2893,10 @@ static inline void symrot_tangent_m3_tangent_inverse_derivative_f(const float p[
  * H_0 = 9/(x + 9) (algebraic in x)
  * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * H_0_x = -9/(x + 9)**2 (algebraic in x)
+ * H_0_x = -(9/(x + 9))**2/9 (algebraic in x)
  * H_1_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
  * H_2_x = 1/(2*(x + 9)**2*(sqrt(x + 9) + 3)) - (sqrt(x + 9) + 12)/(2*(x + 9)**2*(sqrt(x + 9) + 3)**2) - 3*(sqrt(x + 9) + 12)/(2*(x + 9)**(5/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 208 */
+ * ops: 209 */
 static inline void symrot_tangent_m3_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2908,7 +2908,7 @@ static inline void symrot_tangent_m3_angular_acceleration_f(const float p[3], co
     }
     const float c_H_0 = 9/(x + 9);
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
-    const float c_H_0_x = -9/powf(x + 9, 2);
+    const float c_H_0_x = -1.0F/9.0F*((9/(x + 9))*(9/(x + 9)));
     const float c_H_2_x = (1.0F/2.0F)/(powf(x + 9, 2)*(sqrtf(x + 9) + 3)) - 1.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 2)*powf(sqrtf(x + 9) + 3, 2)) - 3.0F/2.0F*(sqrtf(x + 9) + 12)/(powf(x + 9, 5.0F/2.0F)*(sqrtf(x + 9) + 3));
     float c_H_1, c_H_1_x;
     if (x < 0.48711845F) {

@@ -10,7 +10,7 @@
  * p = p(phi) u (eq 11) as p[3]; matrices are 3x3, row-major (M[3*i + j] = M_ij). Each exists in
  * double and, suffixed _f, in float computed with float functions and the float32 plan.
  *
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * Never a silently wrong value: NaN in every output instead.
  *
  * Rotations of any size: to_quaternion, from_quaternion, from_rotation_matrix, compose
@@ -51,7 +51,7 @@ static inline double symrot_wiener_milenkovic__phi(double s)
 }
 
 /* symrot_wiener_milenkovic_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * phi = 4*atan(s/4) (closed inverse of p(phi))
@@ -59,7 +59,7 @@ static inline double symrot_wiener_milenkovic__phi(double s)
 static inline double symrot_wiener_milenkovic_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         return (double)NAN;
     }
     double s;
@@ -75,17 +75,17 @@ static inline double symrot_wiener_milenkovic_angle(const double p[3])
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * R_2 = 128/(x + 16)**2 (algebraic in x)
- * ops: 50 */
+ * R_1 = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * R_2 = (16/(x + 16))**2/2 (algebraic in x)
+ * ops: 53 */
 static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         R[0] = (double)NAN;
         R[1] = (double)NAN;
         R[2] = (double)NAN;
@@ -97,8 +97,8 @@ static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], d
         R[8] = (double)NAN;
         return;
     }
-    const double c_R_1 = -16*(x - 16)/pow(x + 16, 2);
-    const double c_R_2 = 128/pow(x + 16, 2);
+    const double c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
+    const double c_R_2 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
     const double t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -133,18 +133,19 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double w0 = 1.0/((x + 16)*(x + 16));
-            c_R_1_lanes[k] = -16*w0*(x - 16);
-            c_R_2_lanes[k] = 128*w0;
+            const double w0 = 1.0/(x + 16);
+            const double w1 = 16*w0;
+            c_R_1_lanes[k] = -w0*(x - 16)*(w1);
+            c_R_2_lanes[k] = (1.0/2.0)*((w1)*(w1));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 1;
+            c_R_0_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -164,17 +165,17 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
 }
 
 /* symrot_wiener_milenkovic_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 51 */
+ * H_across = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * ops: 55 */
 static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         H[0] = (double)NAN;
         H[1] = (double)NAN;
         H[2] = (double)NAN;
@@ -186,9 +187,9 @@ static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[
         H[8] = (double)NAN;
         return;
     }
-    const double c_H_across = -16*(x - 16)/pow(x + 16, 2);
-    const double c_H_1 = 128/pow(x + 16, 2);
-    const double c_H_2 = 32/pow(x + 16, 2);
+    const double c_H_across = -(x - 16)*(16/(x + 16))/(x + 16);
+    const double c_H_1 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_2 = (1.0/8.0)*((16/(x + 16))*(16/(x + 16)));
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -222,20 +223,22 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double w0 = 1.0/((x + 16)*(x + 16));
-            c_H_across_lanes[k] = -16*w0*(x - 16);
-            c_H_1_lanes[k] = 128*w0;
-            c_H_2_lanes[k] = 32*w0;
+            const double w0 = 1.0/(x + 16);
+            const double w1 = 16*w0;
+            const double w2 = ((w1)*(w1));
+            c_H_across_lanes[k] = -w0*(x - 16)*(w1);
+            c_H_1_lanes[k] = (1.0/2.0)*w2;
+            c_H_2_lanes[k] = (1.0/8.0)*w2;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_across = c_H_across_lanes[k];
-            c_H_across_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_across;
+            c_H_across_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_1;
+            c_H_1_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -254,7 +257,7 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = -(x - 16)/16 (algebraic in x)
@@ -264,7 +267,7 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
 static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         Hinv[0] = (double)NAN;
         Hinv[1] = (double)NAN;
         Hinv[2] = (double)NAN;
@@ -316,9 +319,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, cons
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            c_H_inverse_across_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_H_inverse_across;
-            c_H_inverse_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : -1.0/2.0;
-            c_H_inverse_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 1.0/8.0;
+            c_H_inverse_across_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_H_inverse_across;
+            c_H_inverse_1_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : -1.0/2.0;
+            c_H_inverse_2_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : 1.0/8.0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -337,23 +340,23 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_batch(size_t n, cons
 }
 
 /* symrot_wiener_milenkovic_tangent_det: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * det_H = 4096/(x + 16)**3 (algebraic in x)
+ * det_H = (16/(x + 16))**3 (algebraic in x)
  * ops: 9 */
 static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         return (double)NAN;
     }
-    const double c_det_H = 4096/pow(x + 16, 3);
+    const double c_det_H = ((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     return c_det_H;
 }
 
 /* symrot_wiener_milenkovic_root_matrix: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
@@ -363,7 +366,7 @@ static inline double symrot_wiener_milenkovic_tangent_det(const double p[3])
 static inline void symrot_wiener_milenkovic_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         G[0] = (double)NAN;
         G[1] = (double)NAN;
         G[2] = (double)NAN;
@@ -418,11 +421,11 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 1;
+            c_G_0_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -442,7 +445,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
 }
 
 /* symrot_wiener_milenkovic_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_across = 8/(x + 16) (algebraic in x)
@@ -452,7 +455,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
 static inline void symrot_wiener_milenkovic_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         K[0] = (double)NAN;
         K[1] = (double)NAN;
         K[2] = (double)NAN;
@@ -507,10 +510,10 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_across = c_K_across_lanes[k];
-            c_K_across_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_K_across;
+            c_K_across_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : closed_K_1;
-            c_K_2_lanes[k] = !(x < 4.4794894843556084e+102) ? (double)NAN : 0;
+            c_K_1_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : closed_K_1;
+            c_K_2_lanes[k] = !(x < 8.580997075163262e+155) ? (double)NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
@@ -529,7 +532,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
 }
 
 /* symrot_wiener_milenkovic_pdot: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = -(x - 16)/16 (algebraic in x)
@@ -539,7 +542,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_batch(size_t n, const d
 static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         pdot[0] = (double)NAN;
         pdot[1] = (double)NAN;
         pdot[2] = (double)NAN;
@@ -556,25 +559,25 @@ static inline void symrot_wiener_milenkovic_pdot(const double p[3], const double
 }
 
 /* symrot_wiener_milenkovic_omega: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 50 */
+ * H_across = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * ops: 54 */
 static inline void symrot_wiener_milenkovic_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         omega[0] = (double)NAN;
         omega[1] = (double)NAN;
         omega[2] = (double)NAN;
         return;
     }
-    const double c_H_across = -16*(x - 16)/pow(x + 16, 2);
-    const double c_H_1 = 128/pow(x + 16, 2);
-    const double c_H_2 = 32/pow(x + 16, 2);
+    const double c_H_across = -(x - 16)*(16/(x + 16))/(x + 16);
+    const double c_H_1 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_2 = (1.0/8.0)*((16/(x + 16))*(16/(x + 16)));
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double w2 = p[0]*pdot[1] - p[1]*pdot[0];
@@ -585,7 +588,7 @@ static inline void symrot_wiener_milenkovic_omega(const double p[3], const doubl
 }
 
 /* symrot_wiener_milenkovic_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * e_0 = -(x - 16)/(x + 16) (algebraic in x)
@@ -594,7 +597,7 @@ static inline void symrot_wiener_milenkovic_omega(const double p[3], const doubl
 static inline void symrot_wiener_milenkovic_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         e[0] = (double)NAN;
         e[1] = (double)NAN;
         e[2] = (double)NAN;
@@ -639,7 +642,7 @@ static inline int symrot_wiener_milenkovic__from_quaternion(double e0, double e1
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 4.4794894843556084e+102)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 8.580997075163262e+155)) {
         p[0] = (double)NAN;
         p[1] = (double)NAN;
         p[2] = (double)NAN;
@@ -733,19 +736,19 @@ static inline int symrot_wiener_milenkovic_rescale(const double p[3], double q[3
 
 /* symrot_wiener_milenkovic_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * R_2 = 128/(x + 16)**2 (algebraic in x)
+ * R_1 = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * R_2 = (16/(x + 16))**2/2 (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = 32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2 (algebraic in x)
- * R_2_x = -256/(x + 16)**3 (algebraic in x)
- * ops: 148 */
+ * R_1_x = (x - 16)*(16/(x + 16))**2/(8*(x + 16)) - (16/(x + 16))**2/16 (algebraic in x)
+ * R_2_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * ops: 156 */
 static inline void symrot_wiener_milenkovic_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -757,10 +760,10 @@ static inline void symrot_wiener_milenkovic_rotation_derivative(const double p[3
         D[8] = (double)NAN;
         return;
     }
-    const double c_R_1 = -16*(x - 16)/pow(x + 16, 2);
-    const double c_R_2 = 128/pow(x + 16, 2);
-    const double c_R_1_x = 32*(x - 16)/pow(x + 16, 3) - 16/pow(x + 16, 2);
-    const double c_R_2_x = -256/pow(x + 16, 3);
+    const double c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
+    const double c_R_2 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_R_1_x = (1.0/8.0)*(x - 16)*((16/(x + 16))*(16/(x + 16)))/(x + 16) - 1.0/16.0*((16/(x + 16))*(16/(x + 16)));
+    const double c_R_2_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -800,19 +803,19 @@ static inline void symrot_wiener_milenkovic_rotation_derivative(const double p[3
 
 /* symrot_wiener_milenkovic_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * R_2 = 128/(x + 16)**2 (algebraic in x)
+ * R_1 = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * R_2 = (16/(x + 16))**2/2 (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = 32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2 (algebraic in x)
- * R_2_x = -256/(x + 16)**3 (algebraic in x)
- * ops: 149 */
+ * R_1_x = (x - 16)*(16/(x + 16))**2/(8*(x + 16)) - (16/(x + 16))**2/16 (algebraic in x)
+ * R_2_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * ops: 157 */
 static inline void symrot_wiener_milenkovic_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -824,10 +827,10 @@ static inline void symrot_wiener_milenkovic_rotation_transpose_derivative(const 
         D[8] = (double)NAN;
         return;
     }
-    const double c_R_1 = -16*(x - 16)/pow(x + 16, 2);
-    const double c_R_2 = 128/pow(x + 16, 2);
-    const double c_R_1_x = 32*(x - 16)/pow(x + 16, 3) - 16/pow(x + 16, 2);
-    const double c_R_2_x = -256/pow(x + 16, 3);
+    const double c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
+    const double c_R_2 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_R_1_x = (1.0/8.0)*(x - 16)*((16/(x + 16))*(16/(x + 16)))/(x + 16) - 1.0/16.0*((16/(x + 16))*(16/(x + 16)));
+    const double c_R_2_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -865,19 +868,19 @@ static inline void symrot_wiener_milenkovic_rotation_transpose_derivative(const 
 
 /* symrot_wiener_milenkovic_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * H_0_x = -16/(x + 16)**2 (algebraic in x)
- * H_1_x = -256/(x + 16)**3 (algebraic in x)
- * H_2_x = -64/(x + 16)**3 (algebraic in x)
- * ops: 158 */
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * H_0_x = -(16/(x + 16))**2/16 (algebraic in x)
+ * H_1_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * H_2_x = -(16/(x + 16))**3/64 (algebraic in x)
+ * ops: 163 */
 static inline void symrot_wiener_milenkovic_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -889,11 +892,11 @@ static inline void symrot_wiener_milenkovic_tangent_derivative(const double p[3]
         D[8] = (double)NAN;
         return;
     }
-    const double c_H_1 = 128/pow(x + 16, 2);
-    const double c_H_2 = 32/pow(x + 16, 2);
-    const double c_H_0_x = -16/pow(x + 16, 2);
-    const double c_H_1_x = -256/pow(x + 16, 3);
-    const double c_H_2_x = -64/pow(x + 16, 3);
+    const double c_H_1 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_2 = (1.0/8.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_0_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_1_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
+    const double c_H_2_x = -1.0/64.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
     const double dw2 = a[1]*p[1];
@@ -936,19 +939,19 @@ static inline void symrot_wiener_milenkovic_tangent_derivative(const double p[3]
 
 /* symrot_wiener_milenkovic_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * H_0_x = -16/(x + 16)**2 (algebraic in x)
- * H_1_x = -256/(x + 16)**3 (algebraic in x)
- * H_2_x = -64/(x + 16)**3 (algebraic in x)
- * ops: 164 */
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * H_0_x = -(16/(x + 16))**2/16 (algebraic in x)
+ * H_1_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * H_2_x = -(16/(x + 16))**3/64 (algebraic in x)
+ * ops: 169 */
 static inline void symrot_wiener_milenkovic_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -960,11 +963,11 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative(const d
         D[8] = (double)NAN;
         return;
     }
-    const double c_H_1 = 128/pow(x + 16, 2);
-    const double c_H_2 = 32/pow(x + 16, 2);
-    const double c_H_0_x = -16/pow(x + 16, 2);
-    const double c_H_1_x = -256/pow(x + 16, 3);
-    const double c_H_2_x = -64/pow(x + 16, 3);
+    const double c_H_1 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_2 = (1.0/8.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_0_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_1_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
+    const double c_H_2_x = -1.0/64.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
     const double dw2 = a[1]*p[1];
@@ -1009,7 +1012,7 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative(const d
 
 /* symrot_wiener_milenkovic_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
@@ -1021,7 +1024,7 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative(const d
 static inline void symrot_wiener_milenkovic_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         D[0] = (double)NAN;
         D[1] = (double)NAN;
         D[2] = (double)NAN;
@@ -1053,31 +1056,31 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_derivative(const dou
 
 /* symrot_wiener_milenkovic_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^341 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^518 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * H_0_x = -16/(x + 16)**2 (algebraic in x)
- * H_1_x = -256/(x + 16)**3 (algebraic in x)
- * H_2_x = -64/(x + 16)**3 (algebraic in x)
- * ops: 121 */
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * H_0_x = -(16/(x + 16))**2/16 (algebraic in x)
+ * H_1_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * H_2_x = -(16/(x + 16))**3/64 (algebraic in x)
+ * ops: 126 */
 static inline void symrot_wiener_milenkovic_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.4794894843556084e+102)) {
+    if (!(x < 8.580997075163262e+155)) {
         alpha[0] = (double)NAN;
         alpha[1] = (double)NAN;
         alpha[2] = (double)NAN;
         return;
     }
     const double c_H_0 = 16/(x + 16);
-    const double c_H_1 = 128/pow(x + 16, 2);
-    const double c_H_2 = 32/pow(x + 16, 2);
-    const double c_H_0_x = -16/pow(x + 16, 2);
-    const double c_H_1_x = -256/pow(x + 16, 3);
-    const double c_H_2_x = -64/pow(x + 16, 3);
+    const double c_H_1 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_2 = (1.0/8.0)*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_0_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16)));
+    const double c_H_1_x = -1.0/16.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
+    const double c_H_2_x = -1.0/64.0*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
     const double w2 = p[0]*pddot[1] - p[1]*pddot[0];
@@ -1224,7 +1227,7 @@ static inline float symrot_wiener_milenkovic__phi_f(float s)
 }
 
 /* symrot_wiener_milenkovic_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * phi = 4*atan(s/4) (closed inverse of p(phi))
@@ -1232,7 +1235,7 @@ static inline float symrot_wiener_milenkovic__phi_f(float s)
 static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         return NAN;
     }
     float s;
@@ -1248,17 +1251,17 @@ static inline float symrot_wiener_milenkovic_angle_f(const float p[3])
 }
 
 /* symrot_wiener_milenkovic_rotation_matrix_f: rotation tensor R (eq 14).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * R_2 = 128/(x + 16)**2 (algebraic in x)
- * ops: 50 */
+ * R_1 = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * R_2 = (16/(x + 16))**2/2 (algebraic in x)
+ * ops: 53 */
 static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         R[0] = NAN;
         R[1] = NAN;
         R[2] = NAN;
@@ -1270,8 +1273,8 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], 
         R[8] = NAN;
         return;
     }
-    const float c_R_1 = -16*(x - 16)/powf(x + 16, 2);
-    const float c_R_2 = 128/powf(x + 16, 2);
+    const float c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
+    const float c_R_2 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
     const float t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
     R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
@@ -1306,18 +1309,19 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float w0 = 1.0F/((x + 16)*(x + 16));
-            c_R_1_lanes[k] = -16*w0*(x - 16);
-            c_R_2_lanes[k] = 128*w0;
+            const float w0 = 1.0F/(x + 16);
+            const float w1 = 16*w0;
+            c_R_1_lanes[k] = -w0*(x - 16)*(w1);
+            c_R_2_lanes[k] = (1.0F/2.0F)*((w1)*(w1));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_R_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 1;
+            c_R_0_lanes[k] = !(x < 5.902958e+20F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            c_R_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_R_1;
+            c_R_1_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
-            c_R_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_R_2;
+            c_R_2_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_R_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1337,17 +1341,17 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
 }
 
 /* symrot_wiener_milenkovic_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 51 */
+ * H_across = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * ops: 55 */
 static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         H[0] = NAN;
         H[1] = NAN;
         H[2] = NAN;
@@ -1359,9 +1363,9 @@ static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[
         H[8] = NAN;
         return;
     }
-    const float c_H_across = -16*(x - 16)/powf(x + 16, 2);
-    const float c_H_1 = 128/powf(x + 16, 2);
-    const float c_H_2 = 32/powf(x + 16, 2);
+    const float c_H_across = -(x - 16)*(16/(x + 16))/(x + 16);
+    const float c_H_1 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_2 = (1.0F/8.0F)*((16/(x + 16))*(16/(x + 16)));
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
     H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
@@ -1395,20 +1399,22 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float w0 = 1.0F/((x + 16)*(x + 16));
-            c_H_across_lanes[k] = -16*w0*(x - 16);
-            c_H_1_lanes[k] = 128*w0;
-            c_H_2_lanes[k] = 32*w0;
+            const float w0 = 1.0F/(x + 16);
+            const float w1 = 16*w0;
+            const float w2 = ((w1)*(w1));
+            c_H_across_lanes[k] = -w0*(x - 16)*(w1);
+            c_H_1_lanes[k] = (1.0F/2.0F)*w2;
+            c_H_2_lanes[k] = (1.0F/8.0F)*w2;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_across = c_H_across_lanes[k];
-            c_H_across_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_across;
+            c_H_across_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
-            c_H_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_1;
+            c_H_1_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
-            c_H_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_2;
+            c_H_2_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_H_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1427,7 +1433,7 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
 }
 
 /* symrot_wiener_milenkovic_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = -(x - 16)/16 (algebraic in x)
@@ -1437,7 +1443,7 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
 static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         Hinv[0] = NAN;
         Hinv[1] = NAN;
         Hinv[2] = NAN;
@@ -1489,9 +1495,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, co
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            c_H_inverse_across_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_H_inverse_across;
-            c_H_inverse_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : -1.0F/2.0F;
-            c_H_inverse_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 1.0F/8.0F;
+            c_H_inverse_across_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_H_inverse_across;
+            c_H_inverse_1_lanes[k] = !(x < 5.902958e+20F) ? NAN : -1.0F/2.0F;
+            c_H_inverse_2_lanes[k] = !(x < 5.902958e+20F) ? NAN : 1.0F/8.0F;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1510,23 +1516,23 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f_batch(size_t n, co
 }
 
 /* symrot_wiener_milenkovic_tangent_det_f: det H = mu nu^2 (eq 24).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * det_H = 4096/(x + 16)**3 (algebraic in x)
+ * det_H = (16/(x + 16))**3 (algebraic in x)
  * ops: 9 */
 static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         return NAN;
     }
-    const float c_det_H = 4096/powf(x + 16, 3);
+    const float c_det_H = ((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     return c_det_H;
 }
 
 /* symrot_wiener_milenkovic_root_matrix_f: square root G of R, G G = R (eq 81).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * G_0 = 1 (constant)
@@ -1536,7 +1542,7 @@ static inline float symrot_wiener_milenkovic_tangent_det_f(const float p[3])
 static inline void symrot_wiener_milenkovic_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         G[0] = NAN;
         G[1] = NAN;
         G[2] = NAN;
@@ -1591,11 +1597,11 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            c_G_0_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 1;
+            c_G_0_lanes[k] = !(x < 5.902958e+20F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
-            c_G_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_G_1;
+            c_G_1_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
-            c_G_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_G_2;
+            c_G_2_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_G_2;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1615,7 +1621,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
 }
 
 /* symrot_wiener_milenkovic_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * K_across = 8/(x + 16) (algebraic in x)
@@ -1625,7 +1631,7 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
 static inline void symrot_wiener_milenkovic_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         K[0] = NAN;
         K[1] = NAN;
         K[2] = NAN;
@@ -1680,10 +1686,10 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_K_across = c_K_across_lanes[k];
-            c_K_across_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_K_across;
+            c_K_across_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
-            c_K_1_lanes[k] = !(x < 4.3980465e+12F) ? NAN : closed_K_1;
-            c_K_2_lanes[k] = !(x < 4.3980465e+12F) ? NAN : 0;
+            c_K_1_lanes[k] = !(x < 5.902958e+20F) ? NAN : closed_K_1;
+            c_K_2_lanes[k] = !(x < 5.902958e+20F) ? NAN : 0;
         }
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
@@ -1702,7 +1708,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
 }
 
 /* symrot_wiener_milenkovic_pdot_f: pdot = H^-1 omega (eq 25).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_across = -(x - 16)/16 (algebraic in x)
@@ -1712,7 +1718,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
 static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         pdot[0] = NAN;
         pdot[1] = NAN;
         pdot[2] = NAN;
@@ -1729,25 +1735,25 @@ static inline void symrot_wiener_milenkovic_pdot_f(const float p[3], const float
 }
 
 /* symrot_wiener_milenkovic_omega_f: omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * ops: 50 */
+ * H_across = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * ops: 54 */
 static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         omega[0] = NAN;
         omega[1] = NAN;
         omega[2] = NAN;
         return;
     }
-    const float c_H_across = -16*(x - 16)/powf(x + 16, 2);
-    const float c_H_1 = 128/powf(x + 16, 2);
-    const float c_H_2 = 32/powf(x + 16, 2);
+    const float c_H_across = -(x - 16)*(16/(x + 16))/(x + 16);
+    const float c_H_1 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_2 = (1.0F/8.0F)*((16/(x + 16))*(16/(x + 16)));
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float w2 = p[0]*pdot[1] - p[1]*pdot[0];
@@ -1758,7 +1764,7 @@ static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const floa
 }
 
 /* symrot_wiener_milenkovic_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * e_0 = -(x - 16)/(x + 16) (algebraic in x)
@@ -1767,7 +1773,7 @@ static inline void symrot_wiener_milenkovic_omega_f(const float p[3], const floa
 static inline void symrot_wiener_milenkovic_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         e[0] = NAN;
         e[1] = NAN;
         e[2] = NAN;
@@ -1812,7 +1818,7 @@ static inline int symrot_wiener_milenkovic__from_quaternion_f(float e0, float e1
     p[0] = e1*f*sigma;
     p[1] = e2*f*sigma;
     p[2] = e3*f*sigma;
-    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 4.3980465e+12F)) {
+    if (!((p[0] * p[0]) + (p[1] * p[1]) + (p[2] * p[2]) < 5.902958e+20F)) {
         p[0] = NAN;
         p[1] = NAN;
         p[2] = NAN;
@@ -1906,19 +1912,19 @@ static inline int symrot_wiener_milenkovic_rescale_f(const float p[3], float q[3
 
 /* symrot_wiener_milenkovic_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * R_2 = 128/(x + 16)**2 (algebraic in x)
+ * R_1 = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * R_2 = (16/(x + 16))**2/2 (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = 32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2 (algebraic in x)
- * R_2_x = -256/(x + 16)**3 (algebraic in x)
- * ops: 148 */
+ * R_1_x = (x - 16)*(16/(x + 16))**2/(8*(x + 16)) - (16/(x + 16))**2/16 (algebraic in x)
+ * R_2_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * ops: 156 */
 static inline void symrot_wiener_milenkovic_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -1930,10 +1936,10 @@ static inline void symrot_wiener_milenkovic_rotation_derivative_f(const float p[
         D[8] = NAN;
         return;
     }
-    const float c_R_1 = -16*(x - 16)/powf(x + 16, 2);
-    const float c_R_2 = 128/powf(x + 16, 2);
-    const float c_R_1_x = 32*(x - 16)/powf(x + 16, 3) - 16/powf(x + 16, 2);
-    const float c_R_2_x = -256/powf(x + 16, 3);
+    const float c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
+    const float c_R_2 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_R_1_x = (1.0F/8.0F)*(x - 16)*((16/(x + 16))*(16/(x + 16)))/(x + 16) - 1.0F/16.0F*((16/(x + 16))*(16/(x + 16)));
+    const float c_R_2_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -1973,19 +1979,19 @@ static inline void symrot_wiener_milenkovic_rotation_derivative_f(const float p[
 
 /* symrot_wiener_milenkovic_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1 = -16*(x - 16)/(x + 16)**2 (algebraic in x)
- * R_2 = 128/(x + 16)**2 (algebraic in x)
+ * R_1 = -(x - 16)*(16/(x + 16))/(x + 16) (algebraic in x)
+ * R_2 = (16/(x + 16))**2/2 (algebraic in x)
  * R_0_x = 0 (constant)
- * R_1_x = 32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2 (algebraic in x)
- * R_2_x = -256/(x + 16)**3 (algebraic in x)
- * ops: 149 */
+ * R_1_x = (x - 16)*(16/(x + 16))**2/(8*(x + 16)) - (16/(x + 16))**2/16 (algebraic in x)
+ * R_2_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * ops: 157 */
 static inline void symrot_wiener_milenkovic_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -1997,10 +2003,10 @@ static inline void symrot_wiener_milenkovic_rotation_transpose_derivative_f(cons
         D[8] = NAN;
         return;
     }
-    const float c_R_1 = -16*(x - 16)/powf(x + 16, 2);
-    const float c_R_2 = 128/powf(x + 16, 2);
-    const float c_R_1_x = 32*(x - 16)/powf(x + 16, 3) - 16/powf(x + 16, 2);
-    const float c_R_2_x = -256/powf(x + 16, 3);
+    const float c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
+    const float c_R_2 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_R_1_x = (1.0F/8.0F)*(x - 16)*((16/(x + 16))*(16/(x + 16)))/(x + 16) - 1.0F/16.0F*((16/(x + 16))*(16/(x + 16)));
+    const float c_R_2_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -2038,19 +2044,19 @@ static inline void symrot_wiener_milenkovic_rotation_transpose_derivative_f(cons
 
 /* symrot_wiener_milenkovic_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * H_0_x = -16/(x + 16)**2 (algebraic in x)
- * H_1_x = -256/(x + 16)**3 (algebraic in x)
- * H_2_x = -64/(x + 16)**3 (algebraic in x)
- * ops: 158 */
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * H_0_x = -(16/(x + 16))**2/16 (algebraic in x)
+ * H_1_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * H_2_x = -(16/(x + 16))**3/64 (algebraic in x)
+ * ops: 163 */
 static inline void symrot_wiener_milenkovic_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -2062,11 +2068,11 @@ static inline void symrot_wiener_milenkovic_tangent_derivative_f(const float p[3
         D[8] = NAN;
         return;
     }
-    const float c_H_1 = 128/powf(x + 16, 2);
-    const float c_H_2 = 32/powf(x + 16, 2);
-    const float c_H_0_x = -16/powf(x + 16, 2);
-    const float c_H_1_x = -256/powf(x + 16, 3);
-    const float c_H_2_x = -64/powf(x + 16, 3);
+    const float c_H_1 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_2 = (1.0F/8.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_0_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_1_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
+    const float c_H_2_x = -1.0F/64.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
     const float dw2 = a[1]*p[1];
@@ -2109,19 +2115,19 @@ static inline void symrot_wiener_milenkovic_tangent_derivative_f(const float p[3
 
 /* symrot_wiener_milenkovic_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * H_0_x = -16/(x + 16)**2 (algebraic in x)
- * H_1_x = -256/(x + 16)**3 (algebraic in x)
- * H_2_x = -64/(x + 16)**3 (algebraic in x)
- * ops: 164 */
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * H_0_x = -(16/(x + 16))**2/16 (algebraic in x)
+ * H_1_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * H_2_x = -(16/(x + 16))**3/64 (algebraic in x)
+ * ops: 169 */
 static inline void symrot_wiener_milenkovic_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -2133,11 +2139,11 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative_f(const
         D[8] = NAN;
         return;
     }
-    const float c_H_1 = 128/powf(x + 16, 2);
-    const float c_H_2 = 32/powf(x + 16, 2);
-    const float c_H_0_x = -16/powf(x + 16, 2);
-    const float c_H_1_x = -256/powf(x + 16, 3);
-    const float c_H_2_x = -64/powf(x + 16, 3);
+    const float c_H_1 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_2 = (1.0F/8.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_0_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_1_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
+    const float c_H_2_x = -1.0F/64.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
     const float dw2 = a[1]*p[1];
@@ -2182,7 +2188,7 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative_f(const
 
 /* symrot_wiener_milenkovic_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
@@ -2194,7 +2200,7 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative_f(const
 static inline void symrot_wiener_milenkovic_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         D[0] = NAN;
         D[1] = NAN;
         D[2] = NAN;
@@ -2226,31 +2232,31 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_derivative_f(const f
 
 /* symrot_wiener_milenkovic_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
- * Valid for every p with |p|^2 < 2^42 (|phi| < 6.2831853071795862), the largest power
+ * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_0 = 16/(x + 16) (algebraic in x)
- * H_1 = 128/(x + 16)**2 (algebraic in x)
- * H_2 = 32/(x + 16)**2 (algebraic in x)
- * H_0_x = -16/(x + 16)**2 (algebraic in x)
- * H_1_x = -256/(x + 16)**3 (algebraic in x)
- * H_2_x = -64/(x + 16)**3 (algebraic in x)
- * ops: 121 */
+ * H_1 = (16/(x + 16))**2/2 (algebraic in x)
+ * H_2 = (16/(x + 16))**2/8 (algebraic in x)
+ * H_0_x = -(16/(x + 16))**2/16 (algebraic in x)
+ * H_1_x = -(16/(x + 16))**3/16 (algebraic in x)
+ * H_2_x = -(16/(x + 16))**3/64 (algebraic in x)
+ * ops: 126 */
 static inline void symrot_wiener_milenkovic_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
-    if (!(x < 4.3980465e+12F)) {
+    if (!(x < 5.902958e+20F)) {
         alpha[0] = NAN;
         alpha[1] = NAN;
         alpha[2] = NAN;
         return;
     }
     const float c_H_0 = 16/(x + 16);
-    const float c_H_1 = 128/powf(x + 16, 2);
-    const float c_H_2 = 32/powf(x + 16, 2);
-    const float c_H_0_x = -16/powf(x + 16, 2);
-    const float c_H_1_x = -256/powf(x + 16, 3);
-    const float c_H_2_x = -64/powf(x + 16, 3);
+    const float c_H_1 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_2 = (1.0F/8.0F)*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_0_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16)));
+    const float c_H_1_x = -1.0F/16.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
+    const float c_H_2_x = -1.0F/64.0F*((16/(x + 16))*(16/(x + 16))*(16/(x + 16)));
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];
     const float w2 = p[0]*pddot[1] - p[1]*pddot[0];

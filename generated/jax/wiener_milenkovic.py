@@ -4,7 +4,7 @@
 Vectorial parameterization (Bauchau & Trainelli 2003): p = p(phi) u, x = |p|^2.  Every function
 takes p of shape (..., 3) (a JAX array); float32 input is computed in float32 with the
 float32 plan, float64 input in float64, other input is converted to float64 (float32 unless jax_enable_x64 is set).
-Validity: every p with |p|^2 < 2^341 (2^42 in float32); outside it every output is NaN.
+Validity: every p with |p|^2 < 2^518 (2^69 in float32); outside it every output is NaN.
 
 Branch-free and traceable: every branch of the plan is evaluated on all lanes and selected with
 where, each side on safe arguments, so values and derivatives of every order are finite inside the
@@ -131,7 +131,7 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    return (4096/(x + 16)**3) + 0.0 * x
+    return ((16/(x + 16))**3) + 0.0 * x
 
 
 def _R_0_64(x, phi, s, d, sin_half, cos_half):
@@ -139,11 +139,11 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    return (-16*(x - 16)/(x + 16)**2) + 0.0 * x
+    return (-(x - 16)*(16/(x + 16))/(x + 16)) + 0.0 * x
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
-    return (128/(x + 16)**2) + 0.0 * x
+    return ((0.5)*(16/(x + 16))**2) + 0.0 * x
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half):
@@ -151,11 +151,11 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    return (128/(x + 16)**2) + 0.0 * x
+    return ((0.5)*(16/(x + 16))**2) + 0.0 * x
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
-    return (32/(x + 16)**2) + 0.0 * x
+    return ((0.125)*(16/(x + 16))**2) + 0.0 * x
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
@@ -195,7 +195,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half):
-    return (-16*(x - 16)/(x + 16)**2) + 0.0 * x
+    return (-(x - 16)*(16/(x + 16))/(x + 16)) + 0.0 * x
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
@@ -211,23 +211,23 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return (32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2) + 0.0 * x
+    return ((0.125)*(x - 16)*(16/(x + 16))**2/(x + 16) - 0.0625*(16/(x + 16))**2) + 0.0 * x
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-256/(x + 16)**3) + 0.0 * x
+    return (-0.0625*(16/(x + 16))**3) + 0.0 * x
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-16/(x + 16)**2) + 0.0 * x
+    return (-0.0625*(16/(x + 16))**2) + 0.0 * x
 
 
 def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-256/(x + 16)**3) + 0.0 * x
+    return (-0.0625*(16/(x + 16))**3) + 0.0 * x
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-64/(x + 16)**3) + 0.0 * x
+    return (-0.015625*(16/(x + 16))**3) + 0.0 * x
 
 
 def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
@@ -272,7 +272,7 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((4096/(x + 16)**3) + 0.0 * x, s)
+    return _narrow(((16/(x + 16))**3) + 0.0 * x, s)
 
 
 def _R_0_32(x, phi, s, d, sin_half, cos_half):
@@ -281,12 +281,12 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half):
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-16*(x - 16)/(x + 16)**2) + 0.0 * x, s)
+    return _narrow((-(x - 16)*(16/(x + 16))/(x + 16)) + 0.0 * x, s)
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((128/(x + 16)**2) + 0.0 * x, s)
+    return _narrow(((0.5)*(16/(x + 16))**2) + 0.0 * x, s)
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half):
@@ -296,12 +296,12 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half):
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((128/(x + 16)**2) + 0.0 * x, s)
+    return _narrow(((0.5)*(16/(x + 16))**2) + 0.0 * x, s)
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((32/(x + 16)**2) + 0.0 * x, s)
+    return _narrow(((0.125)*(16/(x + 16))**2) + 0.0 * x, s)
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
@@ -347,7 +347,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
 
 def _H_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-16*(x - 16)/(x + 16)**2) + 0.0 * x, s)
+    return _narrow((-(x - 16)*(16/(x + 16))/(x + 16)) + 0.0 * x, s)
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
@@ -366,27 +366,27 @@ def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2) + 0.0 * x, s)
+    return _narrow(((0.125)*(x - 16)*(16/(x + 16))**2/(x + 16) - 0.0625*(16/(x + 16))**2) + 0.0 * x, s)
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-256/(x + 16)**3) + 0.0 * x, s)
+    return _narrow((-0.0625*(16/(x + 16))**3) + 0.0 * x, s)
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-16/(x + 16)**2) + 0.0 * x, s)
+    return _narrow((-0.0625*(16/(x + 16))**2) + 0.0 * x, s)
 
 
 def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-256/(x + 16)**3) + 0.0 * x, s)
+    return _narrow((-0.0625*(16/(x + 16))**3) + 0.0 * x, s)
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-64/(x + 16)**3) + 0.0 * x, s)
+    return _narrow((-0.015625*(16/(x + 16))**3) + 0.0 * x, s)
 
 
 def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
@@ -500,7 +500,7 @@ _USES_PHI = {
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
-_X_LIMIT = {"64": 4.4794894843556084e+102, "32": 4398046511104.0}
+_X_LIMIT = {"64": 8.580997075163262e+155, "32": 5.902958103587057e+20}
 E0_MIN = -math.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": 2.0 ** -11}
 

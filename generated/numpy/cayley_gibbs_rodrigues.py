@@ -3,7 +3,7 @@
 
 Vectorial parameterization (Bauchau & Trainelli 2003): p = p(phi) u, x = |p|^2.  Every function
 takes p of shape (..., 3); float32 input is computed in float32 with the float32 plan, any other
-input in float64.  Validity: every p with |p|^2 < 2^511 (2^63 in float32), the largest
+input in float64.  Validity: every p with |p|^2 < 2^600 (2^85 in float32), the largest
 power of two up to which every printed form was checked; outside it every output is NaN.
 
 angle(p) -> phi; rotation_matrix(p) -> R (eq 16); tangent(p) -> H, omega = H pdot (eq 20);
@@ -53,7 +53,7 @@ def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(16/(x + 4)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray((4/(x + 4))**2).astype(numpy.float64, copy=False)
 
 
 def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -133,19 +133,19 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-4/(x + 4)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.25*(4/(x + 4))**2).astype(numpy.float64, copy=False)
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-2/(x + 4)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.125*(4/(x + 4))**2).astype(numpy.float64, copy=False)
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-4/(x + 4)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.25*(4/(x + 4))**2).astype(numpy.float64, copy=False)
 
 
 def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-2/(x + 4)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.125*(4/(x + 4))**2).astype(numpy.float64, copy=False)
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -198,7 +198,7 @@ def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(16/(x + 4)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray((4/(x + 4))**2).astype(numpy.float32, copy=False)
 
 
 def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -291,22 +291,22 @@ def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-4/(x + 4)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.25*(4/(x + 4))**2).astype(numpy.float32, copy=False)
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-2/(x + 4)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.125*(4/(x + 4))**2).astype(numpy.float32, copy=False)
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-4/(x + 4)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.25*(4/(x + 4))**2).astype(numpy.float32, copy=False)
 
 
 def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-2/(x + 4)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.125*(4/(x + 4))**2).astype(numpy.float32, copy=False)
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -427,9 +427,9 @@ _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (few
 _FEW = {"d": 16, "f": 6}  # up to this many vectors (by dtype character): entries as scalar arithmetic
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
-_X_LIMIT = {"64": 6.703903964971299e+153, "32": numpy.float32(9.223372036854776e+18)}
+_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(3.8685626227668134e+25)}
 _FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
-_DERIVATIVE_X_LIMIT = {"64": 6.703903964971299e+153, "32": numpy.float32(9.223372036854776e+18)}
+_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(3.8685626227668134e+25)}
 E0_MIN = 0.0
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 

@@ -3,7 +3,7 @@
 
 Vectorial parameterization (Bauchau & Trainelli 2003): p = p(phi) u, x = |p|^2.  Every function
 takes p of shape (..., 3); float32 input is computed in float32 with the float32 plan, any other
-input in float64.  Validity: every p with |p|^2 < 2^341 (2^42 in float32), the largest
+input in float64.  Validity: every p with |p|^2 < 2^518 (2^69 in float32), the largest
 power of two up to which every printed form was checked; outside it every output is NaN.
 
 angle(p) -> phi; rotation_matrix(p) -> R (eq 16); tangent(p) -> H, omega = H pdot (eq 20);
@@ -53,7 +53,7 @@ def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(4096/(x + 16)**3).astype(numpy.float64, copy=False)
+    return numpy.asarray((16/(x + 16))**3).astype(numpy.float64, copy=False)
 
 
 def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -61,11 +61,11 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-16*(x - 16)/(x + 16)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray(-(x - 16)*(16/(x + 16))/(x + 16)).astype(numpy.float64, copy=False)
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(128/(x + 16)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -73,11 +73,11 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(128/(x + 16)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(32/(x + 16)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray((0.125)*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -117,7 +117,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-16*(x - 16)/(x + 16)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray(-(x - 16)*(16/(x + 16))/(x + 16)).astype(numpy.float64, copy=False)
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -133,23 +133,23 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray((0.125)*(x - 16)*(16/(x + 16))**2/(x + 16) - 0.0625*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-256/(x + 16)**3).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.0625*(16/(x + 16))**3).astype(numpy.float64, copy=False)
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-16/(x + 16)**2).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.0625*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
 def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-256/(x + 16)**3).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.0625*(16/(x + 16))**3).astype(numpy.float64, copy=False)
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-64/(x + 16)**3).astype(numpy.float64, copy=False)
+    return numpy.asarray(-0.015625*(16/(x + 16))**3).astype(numpy.float64, copy=False)
 
 
 def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -199,7 +199,7 @@ def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(4096/(x + 16)**3).astype(numpy.float32, copy=False)
+    return numpy.asarray((16/(x + 16))**3).astype(numpy.float32, copy=False)
 
 
 def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -208,12 +208,12 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-16*(x - 16)/(x + 16)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray(-(x - 16)*(16/(x + 16))/(x + 16)).astype(numpy.float32, copy=False)
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(128/(x + 16)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -223,12 +223,12 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(128/(x + 16)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(32/(x + 16)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray((0.125)*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -274,7 +274,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-16*(x - 16)/(x + 16)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray(-(x - 16)*(16/(x + 16))/(x + 16)).astype(numpy.float32, copy=False)
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -293,27 +293,27 @@ def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(32*(x - 16)/(x + 16)**3 - 16/(x + 16)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray((0.125)*(x - 16)*(16/(x + 16))**2/(x + 16) - 0.0625*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-256/(x + 16)**3).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.0625*(16/(x + 16))**3).astype(numpy.float32, copy=False)
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-16/(x + 16)**2).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.0625*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
 def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-256/(x + 16)**3).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.0625*(16/(x + 16))**3).astype(numpy.float32, copy=False)
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     x = x.astype(numpy.float64)
-    return numpy.asarray(-64/(x + 16)**3).astype(numpy.float32, copy=False)
+    return numpy.asarray(-0.015625*(16/(x + 16))**3).astype(numpy.float32, copy=False)
 
 
 def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -430,9 +430,9 @@ _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (few
 _FEW = {"d": 16, "f": 6}  # up to this many vectors (by dtype character): entries as scalar arithmetic
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
-_X_LIMIT = {"64": 4.4794894843556084e+102, "32": numpy.float32(4398046511104.0)}
+_X_LIMIT = {"64": 8.580997075163262e+155, "32": numpy.float32(5.902958103587057e+20)}
 _FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
-_DERIVATIVE_X_LIMIT = {"64": 4.4794894843556084e+102, "32": numpy.float32(4398046511104.0)}
+_DERIVATIVE_X_LIMIT = {"64": 8.580997075163262e+155, "32": numpy.float32(5.902958103587057e+20)}
 E0_MIN = -numpy.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 

@@ -4,7 +4,7 @@
 Vectorial parameterization (Bauchau & Trainelli 2003): p = p(phi) u, x = |p|^2.  Every function
 takes p of shape (..., 3) (a torch tensor, on any device); float32 input is computed in float32 with the
 float32 plan, float64 input in float64, other input is converted to float64.
-Validity: every p with |p|^2 < 2^511 (2^63 in float32); outside it every output is NaN.
+Validity: every p with |p|^2 < 2^600 (2^85 in float32); outside it every output is NaN.
 
 Branch-free and traceable: every branch of the plan is evaluated on all lanes and selected with
 where, each side on safe arguments, so values and derivatives of every order are finite inside the
@@ -135,7 +135,7 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    return (16/(x + 4)**2) + 0.0 * x
+    return ((4/(x + 4))**2) + 0.0 * x
 
 
 def _R_0_64(x, phi, s, d, sin_half, cos_half):
@@ -215,19 +215,19 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-4/(x + 4)**2) + 0.0 * x
+    return (-0.25*(4/(x + 4))**2) + 0.0 * x
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-2/(x + 4)**2) + 0.0 * x
+    return (-0.125*(4/(x + 4))**2) + 0.0 * x
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-4/(x + 4)**2) + 0.0 * x
+    return (-0.25*(4/(x + 4))**2) + 0.0 * x
 
 
 def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-2/(x + 4)**2) + 0.0 * x
+    return (-0.125*(4/(x + 4))**2) + 0.0 * x
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -275,7 +275,7 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((16/(x + 4)**2) + 0.0 * x, s)
+    return _narrow(((4/(x + 4))**2) + 0.0 * x, s)
 
 
 def _R_0_32(x, phi, s, d, sin_half, cos_half):
@@ -368,22 +368,22 @@ def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-4/(x + 4)**2) + 0.0 * x, s)
+    return _narrow((-0.25*(4/(x + 4))**2) + 0.0 * x, s)
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-2/(x + 4)**2) + 0.0 * x, s)
+    return _narrow((-0.125*(4/(x + 4))**2) + 0.0 * x, s)
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-4/(x + 4)**2) + 0.0 * x, s)
+    return _narrow((-0.25*(4/(x + 4))**2) + 0.0 * x, s)
 
 
 def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-2/(x + 4)**2) + 0.0 * x, s)
+    return _narrow((-0.125*(4/(x + 4))**2) + 0.0 * x, s)
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -501,7 +501,7 @@ _USES_PHI = {
 }
 _TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
 _HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
-_X_LIMIT = {"64": 6.703903964971299e+153, "32": 9.223372036854776e+18}
+_X_LIMIT = {"64": 4.149515568880993e+180, "32": 3.8685626227668134e+25}
 E0_MIN = 0.0
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": 2.0 ** -11}
 

@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from ..algebraic import D, S, X
+from ..functions import BoundedPower
 from ..parsing import PHI
 from ..plan_ir import Algebraic, Branch, Coefficient, Constant
 from .c_functions import (
@@ -100,7 +101,8 @@ class BatchWriter:
             return sp.Float(expr.evalf(40), 40)
         if isinstance(expr, TRIG) and self.sincos.applies(expr.args[0]):
             return expr
-        if expr.is_Add or expr.is_Mul or (expr.is_Pow and expr.exp.is_Integer):
+        arithmetic = expr.is_Add or expr.is_Mul or isinstance(expr, BoundedPower)
+        if arithmetic or (expr.is_Pow and expr.exp.is_Integer):
             return expr.func(*(self.split(arg, lanes) for arg in expr.args))
         if expr not in lanes.atoms:
             lanes.atoms[expr] = sp.Symbol(f"u{len(lanes.atoms)}", real=True)

@@ -133,6 +133,15 @@ class SymrotCPrinter(C99CodePrinter):
             return f"{self._print_Float(sp.Float(1))}/sqrt{suffix}({self._print(base)})"
         return str(super()._print_Pow(expr))
 
+    def _print_BoundedPower(self, expr: sp.Expr) -> str:
+        """(b)**n of :class:`symrot.functions.BoundedPower`: the base once, or a product of its
+        copies (which the compiler computes once) up to :data:`MAX_EXPANDED_POWER`."""
+        base, exponent = expr.args
+        text = f"({self._print(base)})"
+        if int(exponent) <= MAX_EXPANDED_POWER:
+            return "(" + "*".join([text] * int(exponent)) + ")" if exponent > 1 else text
+        return f"pow{self._get_func_suffix(real)}({self._print(base)}, {self._print(exponent)})"
+
 
 def horner(coefficients: tuple[sp.Expr, ...], variable: sp.Symbol) -> sp.Expr:
     """Σ coefficients[j] variable^j in Horner order, unevaluated so that it prints as nested."""

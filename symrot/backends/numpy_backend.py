@@ -61,6 +61,12 @@ class SymrotNumPyPrinter(NumPyPrinter):
     def _print_Half(self, expr: sp.Rational) -> str:
         return "0.5"
 
+    def _print_BoundedPower(self, expr: Any) -> str:
+        """(b)**n of :class:`symrot.functions.BoundedPower`, never bⁿ's expansion."""
+        base, exponent = expr.args
+        text = f"({self._print(base)})"
+        return text if exponent == 1 else f"{text}**{self._print(exponent)}"
+
 
 def _printer() -> SymrotNumPyPrinter:
     return SymrotNumPyPrinter({"fully_qualified_modules": True, "inline": True})
