@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from functools import lru_cache
 from typing import Any
 
 import mpmath
@@ -72,7 +73,7 @@ def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mappin
 
 
 def _right_at(x: float, k: int, models: Mapping[str, Callable[..., Any]],
-              exact: Mapping[str, Callable[..., Any]], angle_of: Callable[[mpmath.mpf], mpmath.mpf],
+              exact: Mapping[str, Callable[..., Any]], angle_of: Callable[[float, int], mpmath.mpf],
               complement: float, dtype: type) -> bool:
     """Whether every printed form is finite and within :data:`WRONG_ULP` at x (2^k ≤ x < 2^(k+1))."""
     epsilon = float(np.finfo(dtype).eps)
@@ -80,7 +81,7 @@ def _right_at(x: float, k: int, models: Mapping[str, Callable[..., Any]],
     with mpmath.workdps(digits):
         s_exact = mpmath.sqrt(mpmath.mpf(x))
         try:
-            phi = angle_of(s_exact)
+            phi = angle_of(x, digits)
             values = {name: function(phi) for name, function in exact.items()}
         except (ZeroDivisionError, ValueError, OverflowError):
             # φ is indistinguishable from the pole at this precision (p ~ e^(1/(φ_max − φ)),
@@ -104,12 +105,13 @@ def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf
     """How an error in coefficient ``name`` shows in the output, and the output's scale.
 
     A tensor coefficient c_k multiplies (p×)^k, of norm s^k: its error counts as |δc_k| s^k against
-    the tensor's size max_j |c_j| s^j (so R₁ = sin φ/s next to a pole is judged on sin φ, and an
+    the tensor's size max_j |c_j| s^j (the across-axis part t = c₀ − c₂ s² multiplies I, as the plan
+    measures it: ``T_across`` as c_0) (so R₁ = sin φ/s next to a pole is judged on sin φ, and an
     H₂ that underflows to 0 while H₀ does too is caught). e₀ and ν s/2 are quaternion components
     (scale 1); every other scalar, and the angle, keeps its own relative accuracy."""
     tensor, _, power = name.rpartition("_")
-    if tensor and power.isdigit() and f"{tensor}_0" in values:
-        weight = s ** int(power)
+    if tensor and (power.isdigit() or power == "across") and f"{tensor}_0" in values:
+        weight = s ** int(power) if power.isdigit() else mpmath.mpf(1)
         scale = max(abs(values.get(f"{tensor}_{j}", mpmath.mpf(0))) * s**j for j in range(3))
         return weight, float(scale)
     if name == "e_0":
@@ -119,20 +121,27 @@ def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf
     return mpmath.mpf(1), float(abs(values[name]))
 
 
+@lru_cache(maxsize=16)
 def _angle_function(p: sp.Expr, inverse: sp.Expr | None,
-                    phi_max: float) -> Callable[[mpmath.mpf], mpmath.mpf]:
-    """φ(s) at the current mpmath precision: the closed inverse, or bisection on p(φ) = s."""
-    if inverse is not None:
-        closed = sp.lambdify(S, inverse, modules=[mpmath_namespace(), "mpmath"])
-        return closed
+                    phi_max: float) -> Callable[[float, int], mpmath.mpf]:
+    """φ(√x) at ``digits`` digits: the closed inverse, or bisection on p(φ) = s. Memoized per
+    (x, digits): a plan sweeps the same points four times (kinematic forms and slopes, two
+    precisions), and the bisection was half of the sweep's time."""
+    exact_inverse = (sp.lambdify(S, inverse, modules=[mpmath_namespace(), "mpmath"])
+                     if inverse is not None else None)
     p_of = sp.lambdify(PHI, p, modules=[mpmath_namespace(), "mpmath"])
 
-    def bisect(s: mpmath.mpf) -> mpmath.mpf:
-        low, high = mpmath.mpf(0), mpmath.mpf(phi_max)
-        for _ in range(int(mpmath.mp.prec) + 8):
-            middle = (low + high) / 2
-            value = p_of(middle)
-            low, high = (middle, high) if (mpmath.isfinite(value) and value < s) else (low, middle)
-        return (low + high) / 2
+    @lru_cache(maxsize=4096)
+    def angle(x: float, digits: int) -> mpmath.mpf:
+        with mpmath.workdps(digits):
+            s = mpmath.sqrt(mpmath.mpf(x))
+            if exact_inverse is not None:
+                return exact_inverse(s)
+            low, high = mpmath.mpf(0), mpmath.mpf(phi_max)
+            for _ in range(int(mpmath.mp.prec) + 8):
+                middle = (low + high) / 2
+                value = p_of(middle)
+                low, high = (middle, high) if (mpmath.isfinite(value) and value < s) else (low, middle)
+            return (low + high) / 2
 
-    return bisect
+    return angle

@@ -83,6 +83,7 @@ from .plan_ir import (
     PrecisionPlan,
     QuaternionScale,
 )
+from .pole import pole_factor, with_pole_factor
 from .quaternion_plan import (
     QUATERNION_SCALAR,
     e0_min,
@@ -109,6 +110,9 @@ CLOSED_TOLERANCE_ULP = 1.5
 ANGLE_TOLERANCE_ULP = 2.0
 """A closed inverse φ(s) is printed only when its measured error (beyond the conditioning of φ(s),
 see :func:`closed_angle_error`) stays within this; otherwise the Newton angle is used."""
+UNREAD_SCALARS = frozenset({"p_prime", "epsilon", "mu"})
+"""Planned and printed beside the others (eqs 15, 16, 21), but no emitted function reads them (the
+tangent's determinant is det H, the quaternion reads e₀ and ν): they do not bound the domain."""
 NEWTON_ITERATIONS = 6
 START_TERMS = 8
 
@@ -150,6 +154,22 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
         if value.is_real and abs(value - probe / kappa) < sp.Rational(1, 10**6):
             return sp.simplify(candidate) if len(str(candidate)) < 80 else candidate
     return None
+
+
+RATIONALIZED_OPS = 40
+"""Largest closed inverse (``count_ops``) whose radicals :func:`angle_forms` moves: a size cap."""
+
+
+def angle_forms(inverse: sp.Expr) -> tuple[sp.Expr, ...]:
+    """The closed inverse φ(s) as solved and with its square roots moved into the denominator
+    (``radsimp`` of 1/φ): for p = φ/(1 − φ²/10), (√(10s² + 25) − 5)/s cancels for small s and was
+    never printed (the Newton angle was 416 float32 ulp off next to the pole), while
+    10s/(√(10s² + 25) + 5) is accurate everywhere. The plan prints the first that measures within
+    :data:`ANGLE_TOLERANCE_ULP`."""
+    radicals = [a for a in inverse.atoms(sp.Pow) if a.exp.is_Rational and not a.exp.is_Integer]
+    if not radicals or sp.count_ops(inverse) > RATIONALIZED_OPS:
+        return (inverse,)
+    return tuple(dict.fromkeys((inverse, 1 / sp.radsimp(1 / inverse))))
 
 
 def _solvable_shape(p: sp.Expr) -> bool:
@@ -227,6 +247,9 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     forms += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
     plain = tuple(dict.fromkeys([closed, *forms]))
     forms += [with_length(form, argument) for form in forms]
+    pole = pole_factor(argument, phi_max) if argument != PHI else None
+    if pole is not None:  # p → ∞ at φ_max: its vanishing factor through s (symrot.pole)
+        forms += [with_pole_factor(form, pole) for form in forms]
     if inverse is not None and argument != PHI:
         forms += [with_inverse(form, inverse) for form in forms]
         forms = [closed_with_base_angle(form, inverse) for form in forms]
@@ -261,10 +284,29 @@ class TensorPart(NamedTuple):
     power: int
 
 
-def tensor_part(derivation: Derivation, coefficient: str) -> TensorPart | None:
+QUATERNION_PART = TensorPart(sp.Integer(2), 1)
+"""How ν enters the quaternion's vector part (ν/2) p (eq 75), of unit scale: its error counts as
+|δν| s/2 against 1, as :func:`symrot.domain.domain_limit` counts it (relative to max(|ν|, ν(0)) a
+form in φ that loses every digit of ν → 0 next to a pole passed, and the sweep then ended the
+domain at |p|² = 2³²)."""
+
+OWN_SCALE = TensorPart(sp.Integer(0), 0)
+"""Where p → ∞ at φ_max, det H (``tangent_det``) and the slopes dc/dx are measured relative to
+themselves, as the domain sweep counts them: s then resolves the distance to the edge, and every
+coefficient of s is well conditioned up to it (det H = μν² ~ 1/x² next to a pole, where a form in
+φ̂ loses every digit). With p finite at the edge (ν → 0 at 2π, a fold) det H(s) is ill conditioned
+there, and they keep the floor max(|c|, |c(0)|)."""
+
+
+def tensor_part(derivation: Derivation, coefficient: str, unbounded: bool = False) -> TensorPart | None:
     """The :class:`TensorPart` of a coefficient of R, H, H⁻¹, G or K (or of its across-axis part),
-    None for the scalars and slopes. The norm is the largest eigenvalue modulus, max(|a|, |a − c|,
+    :data:`QUATERNION_PART` for ν, :data:`OWN_SCALE` for det H where p is ``unbounded``, None for
+    the other scalars and the slopes. The norm is the largest eigenvalue modulus, max(|a|, |a − c|,
     |b|) of the u-basis a I + b U + c U² (axial a, across the axis (a − c) ± i b; eqs 17, 23, 27)."""
+    if coefficient == "nu":
+        return QUATERNION_PART
+    if coefficient == "det_H":
+        return OWN_SCALE if unbounded else None
     for tensor in derivation.tensors.values():
         names = (*tensor.coefficient_names(), tensor.across_name)
         if coefficient in names:
@@ -410,6 +452,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     inverse = closed_inverse(p, derivation.kappa)
     x_of_phi = p ** 2
     p_max = float(limits.p_max_float)
+    unbounded = not math.isfinite(p_max)  # p → ∞ at φ_max
     complement = fold_complement(inverse, p_max)
     # the algebraic search of one plan is capped by the size of what it simplifies (a few seconds
     # for every named parameterization; expressions whose forms never simplify would otherwise
@@ -432,7 +475,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             if coefficient in derivation.slopes:  # after every parent: its parent's plan is known
                 try:
                     coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max,
-                                                            dtype, inverse, complement)
+                                                            dtype, inverse, complement, unbounded)
                 except UnplannableCoefficient:  # e.g. 1e-8*phi in float32: dc/dx ~ 1/kappa^4 overflows
                     coefficients[coefficient] = Constant(sp.Integer(0))  # never used: see slope_limit
                     slopes_unrepresentable = True
@@ -457,13 +500,16 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             simplest_form = derivation.simplified_form(coefficient)
             extra = difference_forms(coefficients, tensor, complement) if tensor is not None else ()
             coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
-                                                    inverse, complement, tensor_part(derivation, coefficient),
+                                                    inverse, complement,
+                                                    tensor_part(derivation, coefficient, unbounded),
                                                     extra)
         coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
                                                              dtype)
         scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
-        angle = (ClosedAngle(inverse) if inverse is not None and complement is None
-                 and closed_angle_error(inverse, p, phi_max, dtype) <= ANGLE_TOLERANCE_ULP
+        closed_angle = None if inverse is None or complement is not None else next(
+            (form for form in angle_forms(inverse)
+             if closed_angle_error(form, p, phi_max, dtype) <= ANGLE_TOLERANCE_ULP), None)
+        angle = (ClosedAngle(closed_angle) if closed_angle is not None
                  else _newton_angle(derivation, phi_max, p_max, dtype))
         if complement is not None:
             assert inverse is not None
@@ -472,11 +518,12 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
         elif inverse is not None:
             coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
                             if isinstance(c, Branch) else c for n, c in coefficients.items()}
-        if not math.isfinite(p_max):  # x unbounded: (k x + a)^n overflows before the value does
+        if unbounded:  # x unbounded: (k x + a)^n overflows before the value does
             coefficients = {n: Algebraic(with_bounded_powers(c.expression)) if isinstance(c, Algebraic) else c
                             for n, c in coefficients.items()}
         slopes = {n: c for n, c in coefficients.items() if n in derivation.slopes}
-        kinematic = {n: c for n, c in coefficients.items() if n not in derivation.slopes}
+        kinematic = {n: c for n, c in coefficients.items()
+                     if n not in derivation.slopes and n not in UNREAD_SCALARS}
         limit = _domain_limit(derivation, kinematic, angle, inverse, phi_max, p_max, dtype)
         slope_limit = min(limit, _domain_limit(derivation, slopes, angle, inverse, phi_max, p_max, dtype))
         if slopes_unrepresentable:  # the derivative functions are NaN everywhere in this format
@@ -513,7 +560,8 @@ def _algebraic_value(coefficient: Coefficient) -> sp.Expr | None:
 
 
 def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coefficient], phi_max: float,
-                dtype: type, inverse: sp.Expr | None, complement: sp.Rational | None) -> Coefficient:
+                dtype: type, inverse: sp.Expr | None, complement: sp.Rational | None,
+                unbounded: bool) -> Coefficient:
     """A slope dc/dx (:mod:`symrot.derivatives`): the derivative in x of its parent's algebraic form when
     the parent has one (d(D)/dx = −1), else a Branch of its closed form and exact series. Never a search
     of its own under the algebraic time budget, so that the plan is the same on a loaded machine."""
@@ -522,7 +570,7 @@ def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coeff
         return Algebraic(sp.diff(parent.expression, X) - sp.diff(parent.expression, D))
     series = derivation.series_in_x(name, MAX_TERMS)
     return plan_branch(derivation.simplified_form(name), series, derivation.p ** 2, phi_max, dtype,
-                       derivation.p, inverse, complement)
+                       derivation.p, inverse, complement, OWN_SCALE if unbounded else None)
 
 
 def _check_scale(derivation: Derivation) -> None:

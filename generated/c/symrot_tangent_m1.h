@@ -524,7 +524,7 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
  * non-finite p, every output is NaN.
  * K_across = sqrt(2)/(2*(x + 1)**(1/4)*sqrt(sqrt(x + 1) + 1)) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.00598683, else 2*sin(phi/4)**2/x
- * K_2: Horner degree 18 in x below x = 0.131826, else (1/(2*(x + 1)) - sin(phi/2)/s)/x
+ * K_2: Horner degree 18 in x below x = 0.131826, else (x + 1)*((1/sqrt(x + 1))**2/2 - sqrt(x + 1)*sin(phi/2)*(1/sqrt(x + 1))/s)*(1/sqrt(x + 1))**2/s**2
  * ops: 133 */
 static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9])
 {
@@ -549,9 +549,12 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
     } else {
         const double phi = symrot_tangent_m1__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/x;
-        c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
-        c_K_2 = x < 0.13182630716008584 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*((1.0/2.0)/(x + 1) - sin((1.0/2.0)*phi)/s);
+        const double w0 = x + 1;
+        const double w1 = sqrt(w0);
+        const double w2 = (1.0/w1);
+        const double w3 = (w2*w2);
+        c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
+        c_K_2 = x < 0.13182630716008584 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*w3*((1.0/2.0)*w3 - w1*w2*sin((1.0/2.0)*phi)/s)/(s*s);
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -568,12 +571,12 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1).
+ * Scalar pass: s, phi, u0 = (x + 1)**(-1/4), u1 = 1/sqrt(sqrt(x + 1) + 1), u2 = 1/sqrt(x + 1), u3 = sqrt(x + 1).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], u2_lanes[SYMROT_BATCH_BLOCK], u3_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -586,15 +589,21 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
+                u2_lanes[k] = 0;
+                u3_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m1__phi(s);
                 const double u0 = pow(x + 1, -1.0/4.0);
                 const double u1 = 1.0/sqrt(sqrt(x + 1) + 1);
+                const double u2 = 1.0/sqrt(x + 1);
+                const double u3 = sqrt(x + 1);
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                u2_lanes[k] = u2;
+                u3_lanes[k] = u3;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -603,6 +612,8 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
+            u2_lanes[k] = 0;
+            u3_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -611,6 +622,8 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
+            const double u2 = u2_lanes[k];
+            const double u3 = u3_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -631,11 +644,12 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = 1.0/x;
+            const double w0 = (u2);
+            const double w1 = (w0*w0);
             c_K_across_lanes[k] = 0.7071067811865476*u0*u1;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
-            c_K_2_lanes[k] = w0*((1.0/2.0)/(x + 1) - sin1/s);
+            c_K_2_lanes[k] = w1*((1.0/2.0)*w1 - sin1*u3*w0/s)*(x + 1)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */

@@ -1,0 +1,176 @@
+"""The vanishing factor of a pole written through s = |p|: candidate forms next to a pole edge.
+
+When the validity range ends by p → ∞ (Section 3.4) at a simple zero of a factor f of p's
+denominator, p = N(φ)/(D(φ)·f(φ)), every coefficient that contains f (or a sum that is a multiple of
+f) loses digits next to φ_max when it is evaluated from the rounded angle φ̂: f(φ̂) has the absolute
+error f′·δφ ≈ ε·φ_max but the size of f → 0, so its relative error grows as 1/(φ_max − φ). For
+p = φ/(1 − φ²/10), p′ = (10φ² + 100)/(φ² − 10)² is 10⁶ ulp off at φ_max − 10⁻⁶, and the domain
+sweep (:mod:`symrot.domain`) ended the range at |p|² = 2³² (NaN from φ_max − 4·10⁻⁴).
+
+The backends have s = |p| as rounded input, so f = N/(D·s) is available to a few ulp wherever N and
+D are away from zero: :func:`with_pole_factor` writes f, and every sum in a form that is a
+polynomial multiple of f, through it, as one bounded factor (:class:`symrot.functions.BoundedPower`:
+SymPy would merge (φ/s)³ with the form's other powers of s into φ³/s⁵, which overflows float32 next
+to the pole while the value does not). The plan measures those forms beside the others
+(:func:`symrot.plan.plan_branch`) and takes them where they are more accurate.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import NamedTuple
+
+import mpmath
+import sympy as sp
+
+from .algebraic import S
+from .functions import BoundedPower, mpmath_namespace
+from .parsing import PHI
+from .timeouts import bounded
+
+ZERO_DIGITS = 50
+"""Precision at which a factor is tested for a zero at φ_max."""
+ROOT_DISTANCE = 1e-9
+"""A factor's root found from the float φ_max must lie this close to it (relative)."""
+MAX_DIVISIONS = 4
+"""Largest multiplicity of f divided out of one sum ((φ² − 10)² = φ⁴ − 20φ² + 100 needs 2)."""
+MAX_MULTIPLE = 4
+"""Largest multiple n of the factor's angle whose sin(naφ), cos(naφ) are expanded."""
+DIVISION_OPS = 120
+"""Largest sum (``count_ops``) that is tried for division by f: a size cap, not a time."""
+
+_QUOTIENTS = {
+    sp.tan: lambda a: sp.sin(a) / sp.cos(a),
+    sp.cot: lambda a: sp.cos(a) / sp.sin(a),
+    sp.sec: lambda a: 1 / sp.cos(a),
+    sp.csc: lambda a: 1 / sp.sin(a),
+    sp.tanh: lambda a: sp.sinh(a) / sp.cosh(a),
+    sp.coth: lambda a: sp.cosh(a) / sp.sinh(a),
+    sp.sech: lambda a: 1 / sp.cosh(a),
+    sp.csch: lambda a: 1 / sp.sinh(a),
+}
+
+
+class PoleFactor(NamedTuple):
+    """p = N/(D·f) with f(φ_max) = 0 (simple): ``factor`` f and ``through_s`` = N/(D·s)."""
+
+    factor: sp.Expr
+    through_s: sp.Expr
+    phi_max: mpmath.mpf
+
+
+def as_quotients(expr: sp.Expr) -> sp.Expr:
+    """tan, cot, sec, csc and their hyperbolic kin written as quotients of sin, cos (sinh, cosh)."""
+    return expr.replace(lambda z: type(z) in _QUOTIENTS, lambda z: _QUOTIENTS[type(z)](z.args[0]))
+
+
+@lru_cache(maxsize=64)
+def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """The :class:`PoleFactor` of p at ``phi_max`` when p → ∞ there through one simple zero of a
+    factor of its denominator (written as a quotient, :func:`as_quotients`), else None."""
+    if not mpmath.isfinite(phi_max) or phi_max <= 0:
+        return None
+    quotient = bounded(2.0, None, lambda: sp.together(as_quotients(p)))
+    if quotient is None:
+        return None
+    numerator, denominator = sp.fraction(quotient)
+    if not denominator.has(PHI):
+        return None
+    factored = bounded(2.0, None, sp.factor_list, denominator)
+    if factored is None:
+        return None
+    constant, factors = factored
+    with mpmath.workdps(ZERO_DIGITS):
+        roots = {f: (_root_near(f, phi_max), m) for f, m in factors if f.has(PHI)}
+        vanishing = [(f, root, m) for f, (root, m) in roots.items() if root is not None]
+        if len(vanishing) != 1 or vanishing[0][2] != 1:
+            return None
+        factor, root, _ = vanishing[0]
+        rest = constant * sp.Mul(*(f**m for f, m in factors if f != factor))
+        if _value(numerator / rest, root) in (None, 0):
+            return None  # 0/0 at φ_max: not a pole of this factor
+    return PoleFactor(factor, numerator / (rest * S), root)
+
+
+def _value(expr: sp.Expr, phi: mpmath.mpf) -> mpmath.mpf | None:
+    """expr at φ (current mpmath precision), None where it cannot be evaluated (or has s in it)."""
+    if expr.free_symbols - {PHI}:
+        return None
+    try:
+        value = sp.lambdify(PHI, expr, modules=[mpmath_namespace(), "mpmath"])(phi)
+    except (ZeroDivisionError, ValueError, OverflowError, TypeError):
+        return None
+    return value if mpmath.isfinite(value) else None
+
+
+def _root_near(factor: sp.Expr, phi_max: float) -> mpmath.mpf | None:
+    """The zero of ``factor`` next to the float ``phi_max`` (Newton at the current precision), or None."""
+    function = sp.lambdify(PHI, factor, modules=[mpmath_namespace(), "mpmath"])
+    try:
+        root = mpmath.findroot(function, mpmath.mpf(phi_max))
+    except (ValueError, ZeroDivisionError, OverflowError, TypeError):
+        return None
+    if abs(root - phi_max) > ROOT_DISTANCE * phi_max:
+        return None
+    return root
+
+
+def with_pole_factor(form: sp.Expr, pole: PoleFactor) -> sp.Expr:
+    """``form`` with the pole's factor f, and every sum that is f^k times a polynomial quotient,
+    written through s (f = N/(D·s)); a form with neither is returned as it is. For f = cos(aφ) (or
+    sin(aφ)), the multiples sin(naφ), cos(naφ) (n ≤ :data:`MAX_MULTIPLE`) that vanish with it are
+    first expanded into powers of f: for p = φ/cos(φ/4), sin(φ/2) = 2 sin(φ/4) cos(φ/4) next to
+    the pole at 2π, where sin(φ/2) from φ̂ has lost as many digits as f."""
+    quotients = _expanded_multiples(as_quotients(form), pole)
+    rewritten = _rewrite(quotients, pole)
+    return form if rewritten == quotients else rewritten
+
+
+def _expanded_multiples(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
+    if not isinstance(pole.factor, (sp.sin, sp.cos)):
+        return expr
+    base = pole.factor.args[0]
+    angle = sp.Dummy("angle")
+
+    def multiple(call: sp.Expr) -> int | None:
+        ratio = sp.simplify(call.args[0] / base)
+        if ratio.is_Integer and 2 <= ratio <= MAX_MULTIPLE:
+            with mpmath.workdps(ZERO_DIGITS):
+                value = _value(call, pole.phi_max)
+            if value is not None and abs(value) < mpmath.mpf(10) ** (10 - ZERO_DIGITS):
+                return int(ratio)
+        return None
+
+    return expr.replace(lambda z: isinstance(z, (sp.sin, sp.cos)) and multiple(z) is not None,
+                        lambda z: sp.expand_trig(type(z)(multiple(z) * angle)).subs(angle, base))
+
+
+def _rewrite(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
+    if expr == pole.factor:
+        return BoundedPower(pole.through_s, 1)
+    if not expr.args or not expr.has(PHI):
+        return expr
+    rebuilt = expr.func(*(_rewrite(arg, pole) for arg in expr.args))
+    if expr.is_Add and rebuilt == expr:
+        return _divided(expr, pole)
+    return rebuilt
+
+
+def _divided(total: sp.Expr, pole: PoleFactor) -> sp.Expr:
+    """A sum that vanishes at φ_max as quotient · (N/(D·s))^k when it is f^k times a polynomial."""
+    if sp.count_ops(total) > DIVISION_OPS:
+        return total
+    with mpmath.workdps(ZERO_DIGITS):
+        value = _value(total, pole.phi_max)
+    if value is None or abs(value) > mpmath.mpf(10) ** (10 - ZERO_DIGITS):
+        return total
+    quotient, power = total, 0
+    while power < MAX_DIVISIONS:
+        try:
+            divided, remainder = sp.div(quotient, pole.factor)
+        except (sp.PolynomialError, sp.GeneratorsNeeded, sp.CoercionFailed):
+            break
+        if remainder != 0 or divided == 0:
+            break
+        quotient, power = divided, power + 1
+    return total if power == 0 else quotient * BoundedPower(pole.through_s, power)

@@ -1,0 +1,104 @@
+"""symrot.pole: the vanishing factor of a pole edge written through s = |p| (issue 16).
+
+Next to a pole of p, forms evaluated from the rounded angle φ̂ lose digits in every factor that
+vanishes there; the rewrite must (1) keep the value exactly, (2) be accurate in floating point where
+the form in φ is not, and (3) reach the emitted code, whose domain then extends to the edge.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+from symrot.algebraic import D, S, X
+from symrot.evaluation import model_function
+from symrot.functions import mpmath_namespace
+from symrot.parsing import PHI
+from symrot.pole import pole_factor, with_pole_factor
+
+POLES = {  # p: φ_max (the pole)
+    "phi/(1 - phi**2/10)": "sqrt(10)",
+    "phi/cos(phi/4)": "2*pi",
+    "tan(phi)/2 + tanh(phi)/2": "pi/2",
+    "tan(phi/3) + 8*tan(3*phi/4)/9": "2*pi/3",
+    "4*tan(phi/4)": "2*pi",
+}
+
+
+def _p(text: str) -> sp.Expr:
+    return sp.sympify(text, locals={"phi": PHI})
+
+
+@pytest.mark.parametrize("text", list(POLES))
+def test_the_factor_vanishes_at_the_pole_and_its_s_form_is_p_s_identity(text: str) -> None:
+    p, phi_max = _p(text), sp.sympify(POLES[text])
+    pole = pole_factor(p, float(phi_max))
+    assert pole is not None
+    assert abs(sp.N(pole.factor.subs(PHI, phi_max), 40)) < 1e-35
+    with mpmath.workdps(50):
+        assert abs(pole.phi_max - mpmath.mpf(sp.N(phi_max, 50))) < mpmath.mpf(10) ** -40
+    # f = N/(D s) holds where s = p
+    assert sp.simplify(pole.through_s.subs(S, p) - pole.factor) == 0
+
+
+@pytest.mark.parametrize("text, phi_max", [("sin(phi)", "pi"), ("phi + phi**3/6", "2*pi"),
+                                           ("phi/(1 - phi**2/10)**2", "sqrt(10)"),
+                                           ("2*asin(phi/2)", "2")])
+def test_no_factor_without_a_simple_pole(text: str, phi_max: str) -> None:
+    """No pole (sin, a polynomial), a double pole, a bounded p whose p′ → ∞: nothing to rewrite."""
+    assert pole_factor(_p(text), float(sp.sympify(phi_max))) is None
+
+
+def _relative_error(form: sp.Expr, p: sp.Expr, theta: mpmath.mpf) -> float:
+    """Error of ``form`` evaluated in float64 from the backends' inputs (φ̂ = θ rounded, s = p(θ)
+    rounded) against the exact value at θ, in ulp of the value."""
+    p_of = sp.lambdify(PHI, p, "mpmath")
+    exact = sp.lambdify(PHI, form.subs(S, p), modules=[mpmath_namespace(), "mpmath"])(theta)
+    s = float(p_of(theta))
+    model = model_function(form, [X, PHI, S, D])
+    value = float(model(np.float64(s * s), np.float64(float(theta)), np.float64(s), np.float64(0)))
+    return float(abs(value - exact) / abs(exact)) / float(np.finfo(float).eps)
+
+
+def test_rewritten_forms_keep_the_value_and_their_digits_next_to_the_pole() -> None:
+    """p = φ/(1 − φ²/10): p′, det H and ν as derived contain (φ² − 10)^k;
+    written through s they are within a few ulp at φ_max − 10⁻⁹ where the forms in φ are not."""
+    p = _p("phi/(1 - phi**2/10)")
+    pole = pole_factor(p, math.sqrt(10))
+    assert pole is not None
+    forms = [(10 * PHI**2 + 100) / (PHI**4 - 20 * PHI**2 + 100),
+             (PHI**2 - 10)**4 * sp.sin(PHI / 2)**2 / (250 * PHI**2 * (PHI**2 + 10)),
+             2 * (1 - PHI**2 / 10) * sp.sin(PHI / 2) / PHI]
+    with mpmath.workdps(60):
+        theta = mpmath.sqrt(10) - mpmath.mpf("1e-9") * mpmath.mpf("1.37")
+        for form in forms:
+            rewritten = with_pole_factor(form, pole)
+            assert rewritten.has(S) and sp.simplify(rewritten.subs(S, p).doit() - form) == 0, form
+            assert _relative_error(rewritten, p, theta) <= 4, rewritten
+            assert _relative_error(form, p, theta) > 1e4, form  # the reason for the rewrite
+
+
+def test_a_form_without_the_factor_is_returned_unchanged() -> None:
+    pole = pole_factor(_p("phi/cos(phi/4)"), 2 * math.pi)
+    assert pole is not None
+    form = sp.cos(PHI / 2) ** 2 / PHI  # cos(phi/2) = -1 at the pole: nothing vanishes
+    assert with_pole_factor(form, pole) is form
+
+
+def test_multiples_of_the_factor_angle_that_vanish_with_it_are_expanded() -> None:
+    """p = φ/cos(φ/4): the pole coincides with the end of ν at 2π, where sin(φ/2) from φ̂ loses
+    digits as fast as cos(φ/4); written as 2 sin(φ/4)·φ/s it does not."""
+    p = _p("phi/cos(phi/4)")
+    pole = pole_factor(p, 2 * math.pi)
+    assert pole is not None
+    form = 2 * sp.sin(PHI / 2) / p  # ν (eq 15)
+    rewritten = with_pole_factor(form, pole)
+    assert not rewritten.has(sp.sin(PHI / 2)) and sp.simplify(rewritten.subs(S, p).doit() - form) == 0
+    with mpmath.workdps(60):
+        theta = 2 * mpmath.pi - mpmath.mpf("1.37e-7")
+        assert _relative_error(rewritten, p, theta) <= 4
+        assert _relative_error(form, p, theta) > 1e4
