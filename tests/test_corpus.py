@@ -40,11 +40,11 @@ from accuracy_corpus import Measurement, emit, verdict  # noqa: E402
 CATEGORIES = {"polynomial", "rational", "hyperbolic", "inverse hyperbolic", "inverse trigonometric",
               "trig x polynomial", "trig + hyperbolic", "composition"}
 HYPOTHESIS_EXAMPLES = 2
-EMIT_LIMIT = 30.0
-"""Seconds an emit may take in these tests (issue 16 asks ≤ 10 s; the machine may be shared)."""
 SAFETY_LIMIT = 600.0
 """Seconds the hypothesis sample's emits may take: a bound on a hang, never the verdict (its
-slowest function takes ~19 s CPU; issue 16's 10 s target is measured by bench/accuracy_hypothesis.py)."""
+slowest function takes ~19 s CPU; issue 16's 10 s target is measured by bench/accuracy_hypothesis.py
+and bench/accuracy_corpus.py). The corpus sample had a 30 s limit: `phi*cos(phi/4)` and
+`sin(phi)/2 + sinh(phi)/2` take 15-20 s alone and ran past it beside the rest of the suite."""
 POINTS = 4
 """Log-spaced angles of the sweep in the tests (bench/accuracy_corpus.py runs 8 or more)."""
 
@@ -196,11 +196,13 @@ SAMPLE: dict[str, str | None] = {
     # root_matrix 6 ulp (float64) and 8.7 ulp (float32), float32 omega 61 ulp at 6.27-6.28 before
     # the across-axis part t = c0 - c2 |p|^2 was planned and forms in x found inside sums
     "sin(phi)/2 + sinh(phi)/2": None,
+    # a pole at 2*pi: NaN in every output from |p|^2 = 2^32 before symrot/pole.py (126 NaN/Inf)
+    "phi/cos(phi/4)": None,
 }
 
 
 def measure(function: GeneratingFunction, name: str,
-            limit: float = EMIT_LIMIT) -> dict[str, list[dict[str, Any]]]:
+            limit: float = SAFETY_LIMIT) -> dict[str, list[dict[str, Any]]]:
     """{precision: tallies} of the emitted NumPy module over the sweep with POINTS angles."""
     with time_limit(limit, "emit"):
         plan, _source, _seconds = emit(function.expression, name)
