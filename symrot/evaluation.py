@@ -78,10 +78,15 @@ def _elementwise(name: str) -> Callable[..., Any]:
         if dtype not in (np.float32, np.float64):
             dtype = np.dtype(np.float64)
         single = dtype == np.float32
-        arrays = np.broadcast_arrays(*(np.asarray(a) for a in arguments))
-        lanes = zip(*(a.ravel().tolist() for a in arrays), strict=True)  # Python floats, exact
-        values = [_cached(name, tuple(lane), single) for lane in lanes]
-        out = np.array(values, dtype=dtype).reshape(arrays[0].shape)
+        arrays = [np.asarray(a) for a in arguments]
+        shape = max((a.shape for a in arrays), key=len)
+        if any(a.shape not in ((), shape) for a in arrays):
+            arrays = list(np.broadcast_arrays(*arrays))
+        size = math.prod(shape)
+        columns = [a.ravel().tolist() if a.shape else [a.item()] * size  # Python floats, exact
+                   for a in arrays]
+        values = [_cached(name, lane, single) for lane in zip(*columns, strict=True)]
+        out = np.array(values, dtype=dtype).reshape(shape)
         return out if out.ndim else out[()]
 
     apply.__name__ = name

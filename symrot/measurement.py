@@ -152,7 +152,8 @@ def reference_values(forms: tuple[sp.Expr, ...], argument: sp.Expr, phi_max: flo
     equivalent form of a coefficient."""
     inputs = measured_inputs(argument, phi_max, dtype, complement)
     with mpmath.workdps(REFERENCE_DIGITS):
-        functions = [sp.lambdify(PHI, form, modules=[mpmath_namespace(), "mpmath"]) for form in forms]
+        functions = [sp.lambdify(PHI, form, modules=[mpmath_namespace(), "mpmath"], cse=True)
+                     for form in forms]
         values = []
         for thetas in inputs.exact:
             row = []

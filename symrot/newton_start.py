@@ -11,10 +11,11 @@ converges only linearly. So beyond a switch s₀ the start is a polynomial in a 
 * ``linear`` (p_max finite, no fold): v = s/p_max;
 * ``ratio`` (p unbounded): v = s/(s + c), c = p(φ_max/2).
 
-φ(v) is interpolated at Chebyshev nodes (values from a 30-digit bisection) by a polynomial in
-y = 2v − 1, stored as Chebyshev coefficients and evaluated by Clenshaw's recurrence (its monomial
-form has alternating coefficients up to ~10⁹ for degree 40, which lose every digit in float32:
-sinh's float32 angle at φ = 1 came out as 1.15); the degree is the smallest whose start is within
+φ(v) is interpolated at Chebyshev nodes (values from the 30-digit root of
+:mod:`symrot.angle_solve`) by a polynomial in y = 2v − 1, stored as Chebyshev coefficients and
+evaluated by Clenshaw's recurrence (its monomial form has alternating coefficients up to ~10⁹ for
+degree 40, which lose every digit in float32: sinh's float32 angle at φ = 1 came out as 1.15); the
+degree is the smallest whose start is within
 ``START_TOLERANCE`` (relative to φ_max) at the midpoints. s₀ is where the reverted series' own
 relative error reaches ``SERIES_TOLERANCE``. Plan-time numerics only (mpmath, and NumPy arithmetic
 that is the same on every CPU); no SymPy call that can hang.
@@ -25,12 +26,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import mpmath
 import numpy as np
 import sympy as sp
 
+from .angle_solve import angle_of_length
 from .evaluation import log_grid
 from .functions import mpmath_namespace
 from .parsing import PHI
@@ -58,7 +60,7 @@ class FarStart:
     """Worst relative start error (of φ_max) at the check points."""
 
 
-def _p_function(p: sp.Expr) -> object:
+def _p_function(p: sp.Expr) -> Callable[[Any], Any]:
     return sp.lambdify(PHI, p, modules=[mpmath_namespace(), "mpmath"])
 
 
@@ -67,7 +69,7 @@ def fold_order(p: sp.Expr, phi_max: float) -> int:
     f = _p_function(p)
     with mpmath.workdps(DIGITS):
         at = mpmath.mpf(phi_max)
-        scale = max(abs(f(at)), 1)  # type: ignore[operator]
+        scale = max(abs(f(at)), 1)
         for k in range(1, 5):
             if abs(mpmath.diff(f, at, k)) > FOLD_DERIVATIVE * scale:
                 return k
@@ -92,17 +94,9 @@ def _s_of_v(kind: str, scale: float, order: int, v: mpmath.mpf) -> mpmath.mpf:
     return scale * v / (1 - v)
 
 
-def _phi_of_s(f: object, s: mpmath.mpf, phi_max: mpmath.mpf) -> mpmath.mpf:
-    low, high = mpmath.mpf(0), phi_max
-    for _ in range(110):
-        middle = (low + high) / 2
-        low, high = (middle, high) if f(middle) < s else (low, middle)  # type: ignore[operator]
-    return (low + high) / 2
-
-
 def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, ...]) -> FarStart:
     """The far-field start for p(φ) on 0 ≤ φ < φ_max (|p| < p_max)."""
-    f = _p_function(p)
+    f, f_slope = _p_function(p), _p_function(sp.diff(p, PHI))
     if math.isfinite(p_max):
         order = fold_order(p, phi_max)
         kind: Literal["fold", "linear", "ratio"] = "fold" if order > 1 else "linear"
@@ -110,14 +104,14 @@ def far_start(p: sp.Expr, p_max: float, phi_max: float, series: tuple[sp.Expr, .
     else:
         kind, order = "ratio", 1
         with mpmath.workdps(DIGITS):
-            scale = float(f(mpmath.mpf(phi_max) / 2))  # type: ignore[operator]
+            scale = float(f(mpmath.mpf(phi_max) / 2))
     with mpmath.workdps(DIGITS):
         top = mpmath.mpf(phi_max)
 
         def phi_at_v(v: float | mpmath.mpf) -> float:
             if v >= 1:
                 return phi_max
-            return float(_phi_of_s(f, _s_of_v(kind, scale, order, mpmath.mpf(v)), top))
+            return float(angle_of_length(f, f_slope, _s_of_v(kind, scale, order, mpmath.mpf(v)), top))
 
         checks = np.linspace(0.0, 1.0, 97)[1:-1]
         check_values = np.array([phi_at_v(v) for v in checks])
@@ -165,12 +159,12 @@ def clenshaw(chebyshev: Sequence[float] | np.ndarray, y: np.ndarray) -> np.ndarr
     return chebyshev[0] + y * current - following
 
 
-def _series_switch(f: object, series: tuple[sp.Expr, ...], phi_max: float) -> float:
+def _series_switch(f: Callable[[Any], Any], series: tuple[sp.Expr, ...], phi_max: float) -> float:
     """Largest s on a log grid below which the reverted series is within SERIES_TOLERANCE."""
     coefficients = [mpmath.mpf(sp.N(c, DIGITS)) for c in series]
     switch = 0.0
     for angle in log_grid(1e-6, phi_max * 0.99, 80):
-        s = f(mpmath.mpf(angle))  # type: ignore[operator]
+        s = f(mpmath.mpf(angle))
         estimate = s * mpmath.polyval(coefficients[::-1], s * s)
         if abs(estimate - angle) > SERIES_TOLERANCE * angle:
             break
@@ -202,11 +196,11 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
     sizes, exact, tolerance = [], [], []
     with mpmath.workdps(DIGITS):
         for angle in angles:
-            s = dtype(float(f(mpmath.mpf(float(angle)))))  # type: ignore[operator]
+            s = dtype(float(f(mpmath.mpf(float(angle)))))
             if not (np.isfinite(s) and s > 0):
                 continue
-            theta = _phi_of_s(f, mpmath.mpf(float(s)), mpmath.mpf(phi_max))
-            rate = abs(f_slope(theta))  # type: ignore[operator]
+            theta = angle_of_length(f, f_slope, mpmath.mpf(float(s)), mpmath.mpf(phi_max))
+            rate = abs(f_slope(theta))
             # 2 ε of the angle, plus what one ε of s moves it (large next to a fold, p′ → 0)
             spread = float(s) / float(rate) if rate > 0 else math.inf
             sizes.append(s)

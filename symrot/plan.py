@@ -322,7 +322,7 @@ def tensor_floors(part: TensorPart, argument: sp.Expr, phi_max: float, dtype: ty
     """‖T‖/|p|^k at the exact angles of :func:`measured_inputs` (30 digits, NaN where it cannot be
     evaluated): the size of the error of c_k that the tensor can absorb."""
     inputs = measured_inputs(argument, phi_max, dtype, complement)
-    norm = sp.lambdify(PHI, part.norm, modules=[mpmath_namespace(), "mpmath"])
+    norm = sp.lambdify(PHI, part.norm, modules=[mpmath_namespace(), "mpmath"], cse=True)
     p_of = sp.lambdify(PHI, argument, modules=[mpmath_namespace(), "mpmath"])
     values = []
     with mpmath.workdps(30):
@@ -368,11 +368,15 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     # c(0): G_2 ~ 2/x next to 2 pi (G_2 x is of order 1, c(0) = 1/8 would hide any relative error of
     # G_2 itself); H_across ~ mu next to 2 pi for phi + phi^3/6 (~ 0.05, with c(0) = 1)
     closed_error = np.zeros(len(angles))
+    # one evaluation over every grid angle's points (the model is elementwise), split per angle
+    joined = [np.concatenate(columns) for columns in (inputs.angles, inputs.lengths, inputs.squares,
+                                                      inputs.complements)]
+    printed_all = np.broadcast_to(np.asarray(model_closed(*joined), dtype=np.float64), joined[0].shape)
+    ends = np.cumsum([len(a) for a in inputs.angles])
     for k in range(len(angles)):
         if not len(inputs.angles[k]):
             continue
-        printed = model_closed(inputs.angles[k], inputs.lengths[k], inputs.squares[k], inputs.complements[k])
-        values = np.broadcast_to(np.asarray(printed, dtype=np.float64), inputs.angles[k].shape)
+        values = printed_all[ends[k] - len(inputs.angles[k]):ends[k]]
         exact = reference[k]
         with np.errstate(all="ignore"):
             floor = scale0 if floors is None else np.fmin(scale0, floors[k])
