@@ -98,7 +98,11 @@ def test_product_rule_property(a: object, b: object, k: int) -> None:
 def test_reciprocal_trigonometric_functions_match_sympy(expr: sp.Expr) -> None:
     ours = coefficient_list(taylor_series(expr, 9), 0, 9)
     reference = sp.series(expr, PHI, 0, 9).removeO()
-    assert all(sp.simplify(ours[k] - reference.coeff(PHI, k)) == 0 for k in range(9))
+    # equal at 60 digits: simplify(ours - reference) == 0 took 143 s on the cot(1), csc(1) terms
+    # of cot(φ + 1)
+    for k in range(9):
+        exact = reference.coeff(PHI, k)
+        assert abs(sp.N(ours[k] - exact, 60)) <= sp.Float(10, 60) ** -50 * (1 + abs(sp.N(exact, 60))), k
 
 
 def test_cot_has_a_pole_not_a_missing_rule() -> None:
