@@ -108,6 +108,11 @@ CORPUS: tuple[Entry, ...] = (
     Entry("sinh(sin(phi))", "composition", "fold", True, "pi/2"),
     Entry("sin(sinh(phi))", "composition", "fold", True, "asinh(pi/2)"),
     Entry("asinh(tan(phi))", "composition", "pole", True, "pi/2"),
+    # sums of tangents of several frequencies (no closed inverse; p′ is rational in the sine and
+    # cosine of the base angle φ/12, where solveset and the base-angle expansion were slowest;
+    # appended last, so that the numbers of docs/accuracy_corpus.md stay those of the entries)
+    Entry("tan(phi/3) + 8*tan(3*phi/4)/9", "trig + trig", "pole", False, "2*pi/3"),
+    Entry("tan(phi/2) + sin(phi)/2", "trig + trig", "pole", False, "pi"),
 )
 
 

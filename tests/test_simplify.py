@@ -12,3 +12,31 @@ def test_numbers_beyond_the_str_digit_limit_are_ranked_and_simplified() -> None:
     big = sp.Integer(10) ** 5000
     assert complexity(big * PHI)[2] > 5000
     assert simplest(big * sp.sin(PHI) ** 2 / (1 - sp.cos(PHI) ** 2)) == big
+
+
+def test_the_remainder_modulo_the_circle_is_sympys() -> None:
+    """The ring-arithmetic remainder (symrot.simplify._reduced_modulo) is sp.reduced's, also with
+    coefficients outside QQ (√3), which take sp.reduced itself."""
+    from symrot.simplify import _reduced_modulo
+
+    s, c, o = sp.symbols("s c o")
+    relation = s**2 + c**2 - 1
+    for polynomial in ((s + 2 * c) ** 7 * (c - s) ** 5 + o * s**3, sp.sqrt(3) * (s + c) ** 4 - o):
+        for gens in ([s, c, o], [c, s, o]):
+            expected = sp.reduced(sp.expand(polynomial), [relation], *gens, order="lex")[1]
+            assert sp.expand(_reduced_modulo(polynomial, relation, gens) - expected) == 0
+
+
+def test_tangents_of_two_frequencies_reduce_and_keep_their_value() -> None:
+    """A coefficient of tan(φ/3) + 8 tan(3φ/4)/9 (base angle φ/12, multiples up to 9): the
+    reduction expanded its Expr tree for 4.5 s and `derive` stopped at the 5 s safety bound."""
+    from symrot.simplify import base_angle_reduction
+
+    t = sp.tan(PHI / 3) + 8 * sp.tan(3 * PHI / 4) / 9
+    slope = sp.tan(PHI / 3) ** 2 / 3 + 2 * sp.tan(3 * PHI / 4) ** 2 / 3 + 1
+    expr = 4 * sp.sin(PHI / 2) ** 2 / (t**2 * slope)
+    reduced = base_angle_reduction(expr)
+    assert reduced is not None
+    for phi in (sp.Rational(3, 10), sp.Rational(11, 10), 2):
+        before, after = (sp.N(e.subs(PHI, phi), 50) for e in (expr, reduced))
+        assert abs(before - after) <= sp.Float(10, 50) ** -40 * abs(before)

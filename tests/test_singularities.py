@@ -110,3 +110,21 @@ def test_the_edge_of_the_real_domain_is_a_singularity(text: str, edge: sp.Expr, 
     assert p_events and p_events[0].phi == edge and p_events[0].limit == limit
     assert (result.p_max_float == float("inf")) == (limit == "oo")
     assert time.monotonic() - started < 20
+
+
+def test_solveset_is_tried_on_one_frequency_or_on_sines_and_cosines_only() -> None:
+    """A shape decides (symrot.singularities._one_frequency_or_polynomial): solveset took 7–400 s
+    on p′ of sums of tangents of several frequencies; their edges are then located numerically."""
+    from symrot.singularities import _one_frequency_or_polynomial
+
+    shapes = {"tan(phi/4)**2 + 1": True, "sin(phi) + sin(2*phi)/4": True, "cos(phi/3) + cos(phi/2)": True,
+              "tan(phi/2)**2/2 + cos(phi)/2 + 1/2": False, "tan(phi/3)**2 + tan(3*phi/4)**2": False}
+    for text, expected in shapes.items():
+        assert _one_frequency_or_polynomial(parse_expression(text)) is expected, text
+
+
+@pytest.mark.parametrize(("text", "edge"), [("tan(phi/3) + 8*tan(3*phi/4)/9", 2 * sp.pi / 3),
+                                            ("tan(phi/2) + sin(phi)/2", sp.pi)])
+def test_sums_of_tangents_have_their_pole_as_the_edge(text: str, edge: sp.Expr) -> None:
+    found = validity(derive_expression(parse_expression(text)))
+    assert abs(found.phi_max_float - float(edge)) < 1e-12
