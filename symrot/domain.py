@@ -110,13 +110,13 @@ def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf
     measures it: ``T_across`` as c_0) (so R₁ = sin φ/s next to a pole is judged on sin φ, and an
     H₂ that underflows to 0 while H₀ does too is caught). e₀ and ν s/2 are quaternion components
     (scale 1); every other scalar, and the angle, keeps its own relative accuracy."""
+    if name == "e_0":  # before the tensors: "e_0" reads as coefficient 0 of a tensor "e"
+        return mpmath.mpf(1), 1.0
     tensor, _, power = name.rpartition("_")
     if tensor and (power.isdigit() or power == "across") and f"{tensor}_0" in values:
         weight = s ** int(power) if power.isdigit() else mpmath.mpf(1)
         scale = max(abs(values.get(f"{tensor}_{j}", mpmath.mpf(0))) * s**j for j in range(3))
         return weight, float(scale)
-    if name == "e_0":
-        return mpmath.mpf(1), 1.0
     if name == "nu":
         return s / 2, 1.0
     return mpmath.mpf(1), float(abs(values[name]))

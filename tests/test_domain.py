@@ -129,3 +129,17 @@ def test_bounded_powers_keep_the_value_and_do_not_overflow_first() -> None:
     assert SymrotCPrinter("float").doprint(bounded_powers(forms[0])) == cube
     assert bounded_powers(16 / (X + 16)) == 16 / (X + 16)  # nothing to bound
     assert bounded_powers(1 / (X - 16) ** 2) == 1 / (X - 16) ** 2  # a pole in the range: no ratio in (0, 1]
+
+
+def test_a_pole_at_pi_keeps_the_domain_open_past_the_measured_range() -> None:
+    """p = tan(φ/2) + sin(φ)/2 has its pole at φ = π, where e₀ = cos(φ/2) → 0. The sweep counted
+    e₀ relative to itself ("e_0" read as coefficient 0 of a tensor "e") instead of against the
+    unit quaternion, and ended the domain at x = 2^32, |p| = 65536 (φ = π − 3·10⁻⁵): every output
+    was NaN next to the pole. Measured: 2^107 in float64 (φ̂ rounds to π beyond), 2^63 in float32."""
+    from symrot.domain import _weight_and_scale
+
+    values = {"e_0": mpmath.mpf("1e-5"), "R_0": mpmath.mpf(1), "R_1": mpmath.mpf(0), "R_2": mpmath.mpf(0)}
+    assert _weight_and_scale("e_0", values, mpmath.mpf(10) ** 5) == (1, 1.0)
+    plan = evaluation_plan(derive("tan(phi/2) + sin(phi)/2").derivation, "pole_at_pi")
+    assert plan.precisions["float64"].x_limit >= 2.0**100
+    assert plan.precisions["float32"].x_limit >= 2.0**60
