@@ -15,8 +15,8 @@ converges only linearly. So beyond a switch s₀ the start is a polynomial in a 
 :mod:`symrot.angle_solve`) by a polynomial in y = 2v − 1, stored as Chebyshev coefficients and
 evaluated by Clenshaw's recurrence (its monomial form has alternating coefficients up to ~10⁹ for
 degree 40, which lose every digit in float32: sinh's float32 angle at φ = 1 came out as 1.15); the
-degree is the smallest whose start is within
-``START_TOLERANCE`` (relative to φ_max) at the midpoints. s₀ is where the reverted series' own
+degree is the smallest whose start is within ``START_TOLERANCE`` (relative to φ_max) at the
+midpoints. s₀ is where the reverted series' own
 relative error reaches ``SERIES_TOLERANCE``. Plan-time numerics only (mpmath, and NumPy arithmetic
 that is the same on every CPU); no SymPy call that can hang.
 """

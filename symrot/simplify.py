@@ -76,21 +76,6 @@ def _trig_multiples(expr: sp.Expr) -> list[sp.Rational] | None:
     return multiples
 
 
-def expanded_degree(expr: sp.Expr, base: sp.Expr) -> int:
-    """An upper bound on the degree in (sin θ, cos θ), θ = ``base``, of the numerator and denominator
-    of ``expr`` over a common denominator: trig(nθ) has degree |n|; a product or a sum (together)
-    adds its factors' degrees; an integer power multiplies. It sizes the base-angle reduction before
-    the reduction runs (its cost grows with this degree, not with the input's operation count)."""
-    if isinstance(expr, _TRIG):
-        k = expr.args[0] / base
-        return int(abs(k)) if k.is_Rational else 0
-    if isinstance(expr, sp.Pow) and expr.exp.is_Integer:
-        return abs(int(expr.exp)) * expanded_degree(expr.base, base)
-    if isinstance(expr, (sp.Add, sp.Mul)):
-        return sum(expanded_degree(argument, base) for argument in expr.args)
-    return 0
-
-
 def expands_beyond_the_cap(expr: sp.Expr, angle: sp.Expr) -> bool:
     """Whether some sin/cos/tan(k·``angle``) of ``expr`` has |k| > BASE_ANGLE_MULTIPLE: expanding
     it as a polynomial in the sine and cosine of ``angle`` is not attempted (a size, not a time)."""
