@@ -44,6 +44,15 @@ REDUCTION_OPS = 300
 family's H⁻¹ coefficients expand to 200–300 operations and simplify in under a second; the raw
 H⁻¹₂ of 5 tan(φ/5) expands to 478 and takes 3–14 s (and failed its accuracy check anyway)."""
 
+REDUCTION_MULTIPLE = 12
+"""Largest multiple n of the half base angle η (φ = 2cη for φ = c·F(s/k)) with sin/cos/tan(nη)
+expanded for :func:`reduce_to_x`: the tangent family up to m = 6 reaches 12 (sin φ of 6 tan(φ/6)).
+The operation count of the expansion does not predict the simplification's time: for tan(φ/20),
+4 sin²(φ/2)/((tan²(φ/20) + 1)/20·tan²(φ/20)) expands to 289 operations (n = 20) and simplified in
+34 s, past the 6 s nominal bound and, on a loaded machine, its 60 s safety bound, while the
+283-operation H⁻¹ coefficient of 5 tan(φ/5) (n = 10) takes 0.9 s. Beyond the cap the coefficient
+is planned as a measured branch instead."""
+
 
 def base_angle(inverse: sp.Expr) -> tuple[sp.Expr, sp.Expr] | None:
     """(c, F(arg)) with φ(s) = c·F(arg), c rational, F an inverse trigonometric function."""
@@ -79,7 +88,8 @@ def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     if base is None and not inverse.has(*INVERSE_FUNCTIONS):
         return None
     eta = sp.Symbol("eta", positive=True)
-    if base is not None and expands_beyond_the_cap(closed.subs(PHI, 2 * base[0] * eta), eta):
+    if base is not None and expands_beyond_the_cap(closed.subs(PHI, 2 * base[0] * eta), eta,
+                                                   REDUCTION_MULTIPLE):
         return None  # sin(800 η) for cayley_m800: the expansion alone ran past 20 s
 
     def expand() -> sp.Expr:

@@ -76,12 +76,12 @@ def _trig_multiples(expr: sp.Expr) -> list[sp.Rational] | None:
     return multiples
 
 
-def expands_beyond_the_cap(expr: sp.Expr, angle: sp.Expr) -> bool:
-    """Whether some sin/cos/tan(k·``angle``) of ``expr`` has |k| > BASE_ANGLE_MULTIPLE: expanding
-    it as a polynomial in the sine and cosine of ``angle`` is not attempted (a size, not a time)."""
+def expands_beyond_the_cap(expr: sp.Expr, angle: sp.Expr, cap: int = BASE_ANGLE_MULTIPLE) -> bool:
+    """Whether some sin/cos/tan(k·``angle``) of ``expr`` has |k| > ``cap``: expanding it as a
+    polynomial in the sine and cosine of ``angle`` is not attempted (a size, not a time)."""
     for atom in expr.atoms(*_TRIG):
         k = atom.args[0] / angle
-        if k.is_Rational and abs(k) > BASE_ANGLE_MULTIPLE:
+        if k.is_Rational and abs(k) > cap:
             return True
     return False
 

@@ -141,3 +141,19 @@ def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
                          closed_inverse(derivation.p, derivation.kappa), None, tensor_part(derivation, "G_2"))
     assert branch.closed.has(X)
     assert branch.edge_ulp <= 1.5
+
+
+def test_the_reduction_to_x_is_sized_by_the_largest_multiple_angle() -> None:
+    """symrot.algebraic.REDUCTION_MULTIPLE: for tan(φ/20) the coefficient 4 sin²(φ/2)/(…) expands
+    sin(20η) (η = atan(s)/2) and simplified in 34 s, past its nominal bound; it is not attempted.
+    The tangent family up to m = 6 (sin φ = sin(12η) for 6 tan(φ/6)) still is."""
+    from symrot.algebraic import REDUCTION_MULTIPLE, expanded_in_s
+    from symrot.parsing import PHI
+
+    assert REDUCTION_MULTIPLE >= 12
+    tangent = sp.tan(PHI / 20)
+    beyond = 4 * sp.sin(PHI / 2) ** 2 / ((tangent**2 / 20 + sp.Rational(1, 20)) * tangent**2)
+    s = sp.Symbol("s", nonnegative=True)
+    assert expanded_in_s(beyond, 20 * sp.atan(s)) is None
+    within = sp.sin(PHI) / (6 * sp.tan(PHI / 6))
+    assert expanded_in_s(within, 6 * sp.atan(s / 6)) is not None
