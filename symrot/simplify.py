@@ -34,6 +34,14 @@ BASE_ANGLE_MULTIPLE = 24
 """Largest n with sin(nθ) or cos(nθ) expanded by the base-angle reduction: its time grows steeply
 with n (0.11 s at n = 12, 0.72 s at 40, 4.2 s at 100, past 5 s at 800 for the higher-order Cayley
 family, cayley_m800); the named parameterizations reach 12 (sine_m12, tangent_m12)."""
+REDUCTION_TERMS = 40
+REDUCTION_DEGREE = 40
+"""Largest reduced numerator or denominator (terms, total degree in the sine and cosine of the
+base angle and the opaque symbols) that the base-angle reduction cancels and factors. The named
+parameterizations reach 11 terms; the factoring is what grows: for tan(2φ)cosh(φ/3)/4 +
+3 sin(2φ/3)/(4(φ² + 1)) polynomials of 44–490 terms (φ and cosh(φ/3) as further generators) ran
+past the 5 s safety bound, and for tan(φ/3) + 8 tan(3φ/4)/9 one of 30 terms and degree 64 took
+over 0.5 s, while 19 terms of degree 36 took 0.48 s."""
 TRIGSIMP_OPS = 40
 """Largest trigonometric sum factor (operation count) given to ``trigsimp``; the named
 parameterizations reach 24 (≤ 0.1 s)."""
@@ -128,6 +136,8 @@ def base_angle_reduction(expr: sp.Expr) -> sp.Expr | None:
         gens = [*order, *others]
         gens = list(dict.fromkeys(gens))
         num_r, den_r = (_reduced_modulo(part, relation, gens) for part in (numerator, denom))
+        if any(_beyond_the_factoring_cap(part, gens) for part in (num_r, den_r)):
+            return None
         candidate = sp.factor(sp.cancel(num_r / den_r))
         if best is None or complexity(candidate) < complexity(best):
             best = candidate
@@ -137,16 +147,36 @@ def base_angle_reduction(expr: sp.Expr) -> sp.Expr | None:
     return result
 
 
+def _beyond_the_factoring_cap(polynomial: sp.Expr, gens: list[sp.Expr]) -> bool:
+    """Whether a reduced numerator or denominator has more than ``REDUCTION_TERMS`` terms or total
+    degree above ``REDUCTION_DEGREE``: cancelling and factoring it is not attempted (a size, not a
+    time; see the constants)."""
+    poly = sp.Poly(polynomial, *gens)
+    return len(poly.terms()) > REDUCTION_TERMS or poly.total_degree() > REDUCTION_DEGREE
+
+
 def _reduced_modulo(polynomial: sp.Expr, relation: sp.Expr, gens: list[sp.Expr]) -> sp.Expr:
-    """The remainder of ``polynomial`` modulo ``relation`` in lex order of ``gens`` (unique: one
-    polynomial is a Gröbner basis). Expanded by ring arithmetic over QQ (``sp.expand`` of the
-    Expr tree took 4.5 of 6 s for tan(φ/3) + 8 tan(3φ/4)/9, whose multiples reach 9θ); with other
-    coefficients (√3, π) through ``sp.reduced``, whose remainder is the same polynomial."""
+    """The remainder of ``polynomial`` modulo ``relation`` = g₀² + g₁² − 1 in lex order of ``gens``
+    (unique: one polynomial is a Gröbner basis): every g₀^e becomes g₀^(e mod 2)·(1 − g₁²)^(e div 2).
+    Expanded and substituted by ring arithmetic over QQ (``sp.expand`` of the Expr tree took 4.5 of
+    6 s for tan(φ/3) + 8 tan(3φ/4)/9, the generic multivariate division 4.6 s for
+    tan(2φ) cosh(φ/3)/4 + 3 sin(2φ/3)/(4(φ² + 1))); with other coefficients (√3, π) through
+    ``sp.reduced``, whose remainder is the same polynomial."""
     try:
-        ring, *_ = sp.polys.rings.ring(gens, sp.QQ, sp.polys.orderings.lex)
-        remainder = ring.from_expr(polynomial).rem([ring.from_expr(relation)])
+        ring, lead, other, *_ = sp.polys.rings.ring(gens, sp.QQ, sp.polys.orderings.lex)
+        element = ring.from_expr(polynomial)
     except (ValueError, sp.polys.polyerrors.PolynomialError, sp.polys.polyerrors.CoercionFailed):
         return sp.reduced(sp.expand(polynomial), [relation], *gens, order="lex")[1]
+    assert ring.from_expr(relation) == lead**2 + other**2 - 1
+    complement = 1 - other**2
+    powers = [ring.one]
+    remainder = ring.zero
+    for monomial, coefficient in element.terms():
+        half, parity = divmod(monomial[0], 2)
+        while len(powers) <= half:
+            powers.append(powers[-1] * complement)
+        rest = ring({(parity, *monomial[1:]): coefficient})
+        remainder += rest * powers[half]
     return remainder.as_expr()
 
 

@@ -27,16 +27,28 @@ def test_the_remainder_modulo_the_circle_is_sympys() -> None:
             assert sp.expand(_reduced_modulo(polynomial, relation, gens) - expected) == 0
 
 
-def test_tangents_of_two_frequencies_reduce_and_keep_their_value() -> None:
-    """A coefficient of tan(φ/3) + 8 tan(3φ/4)/9 (base angle φ/12, multiples up to 9): the
-    reduction expanded its Expr tree for 4.5 s and `derive` stopped at the 5 s safety bound."""
+def test_tangents_of_two_frequencies_reduce_or_stop_at_the_size_cap() -> None:
+    """Coefficients of tan(φ/3) + 8 tan(3φ/4)/9 (base angle φ/12, multiples up to 9): the
+    reduction expanded its Expr tree for 4.5 s and `derive` stopped at the 5 s safety bound. A small
+    one reduces and keeps its value; the largest is beyond REDUCTION_DEGREE and is not factored."""
     from symrot.simplify import base_angle_reduction
 
     t = sp.tan(PHI / 3) + 8 * sp.tan(3 * PHI / 4) / 9
     slope = sp.tan(PHI / 3) ** 2 / 3 + 2 * sp.tan(3 * PHI / 4) ** 2 / 3 + 1
-    expr = 4 * sp.sin(PHI / 2) ** 2 / (t**2 * slope)
-    reduced = base_angle_reduction(expr)
+    small = 2 * sp.sin(PHI / 2) / t
+    reduced = base_angle_reduction(small)
     assert reduced is not None
     for phi in (sp.Rational(3, 10), sp.Rational(11, 10), 2):
-        before, after = (sp.N(e.subs(PHI, phi), 50) for e in (expr, reduced))
+        before, after = (sp.N(e.subs(PHI, phi), 50) for e in (small, reduced))
         assert abs(before - after) <= sp.Float(10, 50) ** -40 * abs(before)
+    assert base_angle_reduction(4 * sp.sin(PHI / 2) ** 2 / (t**2 * slope)) is None
+
+
+def test_a_large_reduction_is_refused_by_size_not_time() -> None:
+    """tan(2φ)cosh(φ/3)/4 + 3 sin(2φ/3)/(4(φ² + 1)) (hypothesis row 4): its coefficients reduce to
+    polynomials of up to 490 terms in sin, cos, φ and cosh(φ/3), whose division and factoring ran
+    past the 5 s safety bound; it derives now."""
+    from symrot.api import derive
+
+    derivation = derive("tan(2*phi)*cosh(phi/3)/4 + 3*sin(2*phi/3)/(4*(phi**2 + 1))").derivation
+    assert derivation.p.has(sp.cosh)
