@@ -11,7 +11,8 @@
 
 The shortest candidate (by operation count, then by printed length) wins. Which inputs a step
 is tried on is decided by size (``BASE_ANGLE_OPS``, ``TRIGSIMP_OPS`` operations, the largest
-multiple ``BASE_ANGLE_MULTIPLE`` of the base angle), so that the result does not depend on the
+multiple ``BASE_ANGLE_MULTIPLE`` of the base angle, the terms and degree ``REDUCTION_TERMS``,
+``REDUCTION_DEGREE`` of the reduced polynomials), so that the result does not depend on the
 machine's speed; every step also has a time bound as a safety net (:mod:`symrot.timeouts`), whose
 expiry is an error (deterministic mode), never a silent change of the result.
 """
