@@ -45,10 +45,10 @@ def test_tangents_of_two_frequencies_reduce_or_stop_at_the_size_cap() -> None:
 
 
 def test_a_large_reduction_is_refused_by_size_not_time() -> None:
-    """tan(2φ)cosh(φ/3)/4 + 3 sin(2φ/3)/(4(φ² + 1)) (hypothesis row 4): its coefficients reduce to
-    polynomials of up to 490 terms in sin, cos, φ and cosh(φ/3), whose division and factoring ran
-    past the 5 s safety bound; it derives now."""
-    from symrot.api import derive
+    """tan(2φ)cosh(φ/3)/4 + 3 sin(2φ/3)/(4(φ² + 1)) (hypothesis row 4): the reduction of its
+    coefficient 4 sin²(φ/2)/(p² p′) ran past the 5 s safety bound (polynomials of up to 490 terms
+    in sin, cos, φ and cosh(φ/3)); it is now refused by the term and degree caps."""
+    from symrot.simplify import base_angle_reduction
 
-    derivation = derive("tan(2*phi)*cosh(phi/3)/4 + 3*sin(2*phi/3)/(4*(phi**2 + 1))").derivation
-    assert derivation.p.has(sp.cosh)
+    p = sp.tan(2 * PHI) * sp.cosh(PHI / 3) / 4 + 3 * sp.sin(2 * PHI / 3) / (4 * (PHI**2 + 1))
+    assert base_angle_reduction(4 * sp.sin(PHI / 2) ** 2 / (p**2 * sp.diff(p, PHI))) is None
