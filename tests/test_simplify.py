@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 import sympy as sp
 
 from symrot.parsing import PHI
@@ -52,3 +53,28 @@ def test_a_large_reduction_is_refused_by_size_not_time() -> None:
 
     p = sp.tan(2 * PHI) * sp.cosh(PHI / 3) / 4 + 3 * sp.sin(2 * PHI / 3) / (4 * (PHI**2 + 1))
     assert base_angle_reduction(4 * sp.sin(PHI / 2) ** 2 / (p**2 * sp.diff(p, PHI))) is None
+
+
+def test_trigsimp_sees_hyperbolic_functions_as_symbols(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A sum factor of hypothesis row 4 with cosh(φ/3) and sinh(φ/3) beside circular functions:
+    trigsimp rewrote the hyperbolic functions through imaginary arguments (3.7 s under load, the
+    safety bound met in CI); it now gets them as opaque symbols and returns the same contraction,
+    tan² + 1 = 1/cos², with the hyperbolic functions restored."""
+    from symrot import simplify
+
+    factor = (6 * (sp.tan(2 * PHI) ** 2 + 1) * sp.cosh(PHI / 3) + sp.tan(2 * PHI) * sp.sinh(PHI / 3)
+              + 6 * sp.cos(2 * PHI / 3) / (PHI**2 + 1))
+    seen: list[sp.Expr] = []
+    trigsimp = sp.trigsimp
+
+    def recording_trigsimp(expr: sp.Expr) -> sp.Expr:
+        seen.append(expr)
+        return trigsimp(expr)
+
+    monkeypatch.setattr(sp, "trigsimp", recording_trigsimp)
+    simplify._trigsimp.cache_clear()
+    contracted = simplify._trigsimp(factor)
+    simplify._trigsimp.cache_clear()
+    assert len(seen) == 1 and not seen[0].has(sp.cosh, sp.sinh)
+    assert contracted == (6 * sp.cosh(PHI / 3) / sp.cos(2 * PHI) ** 2 + sp.tan(2 * PHI) * sp.sinh(PHI / 3)
+                          + 6 * sp.cos(2 * PHI / 3) / (PHI**2 + 1))
