@@ -177,14 +177,17 @@ MAX_ITERATIONS = 64
 
 def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], far: FarStart,
                         angles: np.ndarray, phi_max: float, dtype: type,
-                        printed: tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]
-                        ) -> int:
+                        printed: tuple[Callable[[np.ndarray], np.ndarray],
+                                       Callable[[np.ndarray], np.ndarray]],
+                        reciprocal: bool = False, bracket_top: float | None = None) -> int:
     """Steps the printed safeguarded Newton iteration needs, counted by running it.
 
     At every angle θ of ``angles`` the input s = p(θ) is rounded to ``dtype``; the start (reverted
     series below ``far.switch``, the Chebyshev far start above) and the bracketed Newton steps are
     evaluated as the backends do, with ``printed`` = (p(φ)/φ, p′(φ)) as the plan's branches print
-    them (evaluated with the ideal libm of :mod:`symrot.evaluation`).
+    them (evaluated with the ideal libm of :mod:`symrot.evaluation`), and with the steps of Newton
+    on 1/p if ``reciprocal`` (:class:`symrot.plan_ir.NewtonAngle`), in the bracket [0, ``bracket_top``]
+    (default ``phi_max``).
     The result is one more than the first step count after which every lane is within 2 ε of the
     exact angle of its rounded s, plus what one ε of s moves that angle (next to a fold Newton
     converges only to there), or ``MAX_ITERATIONS`` if no count is. Near a pole of p where φ(s)
@@ -217,16 +220,21 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
             series = (dtype(c) + s_values * s_values * series).astype(dtype)
         y = 2.0 * v_of_s(far.kind, far.scale, far.order, s_values) - 1.0
         far_value: np.ndarray = np.asarray(clenshaw(np.asarray(far.chebyshev), y), dtype=dtype)
-        phi = np.clip(np.where(s_values < far.switch, s_values * series, far_value), 0.0, phi_max)
+        top = phi_max if bracket_top is None else bracket_top
+        phi = np.clip(np.where(s_values < far.switch, s_values * series, far_value), 0.0, top)
         phi = phi.astype(dtype)
-        low, high = np.zeros_like(s_values), np.full_like(s_values, phi_max)
+        low, high = np.zeros_like(s_values), np.full_like(s_values, top)
         for step_count in range(1, MAX_ITERATIONS + 1):
-            residual = phi * np.asarray(ratio_model(phi), dtype=dtype) - s_values
+            value: np.ndarray = (phi * np.asarray(ratio_model(phi), dtype=dtype)).astype(dtype)
+            residual = (value - s_values).astype(dtype)
             high = np.where(residual > 0, phi, high)
             low = np.where(residual <= 0, phi, low)
             derivative: np.ndarray = np.asarray(slope_model(phi), dtype=dtype)
             safe = derivative > 0
-            step = phi - residual / np.where(safe, derivative, 1.0)
+            change = (residual / np.where(safe, derivative, 1.0)).astype(dtype)
+            if reciprocal:
+                change = (change * (value / np.where(s_values > 0, s_values, 1.0))).astype(dtype)
+            step = phi - change
             inside = safe & (step >= low) & (step <= high)
             phi = np.where(inside, step, 0.5 * (low + high)).astype(dtype)
             if np.all(np.abs(phi.astype(np.float64) - theta) <= limit):

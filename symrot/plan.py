@@ -514,7 +514,8 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             (form for form in angle_forms(inverse)
              if closed_angle_error(form, p, phi_max, dtype) <= ANGLE_TOLERANCE_ULP), None)
         angle = (ClosedAngle(closed_angle) if closed_angle is not None
-                 else _newton_angle(derivation, phi_max, p_max, dtype))
+                 else _newton_angle(derivation, phi_max, p_max, dtype,
+                                    _bracket_top(limits.phi_max, phi_max, dtype)))
         if complement is not None:
             assert inverse is not None
             coefficients = {n: _use_complement(c, inverse, complement) for n, c in coefficients.items()}
@@ -661,7 +662,23 @@ def _scale_forms(p: sp.Expr) -> tuple[sp.Expr | None, sp.Expr]:
     return None, (sp.simplify(scale_expression(p)) if not p.has(RealCbrt) else scale_expression(p))
 
 
-def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: type) -> NewtonAngle:
+def _bracket_top(exact: sp.Expr, phi_max: float, dtype: type) -> float:
+    """The largest ``dtype`` value not above φ_max (``phi_max`` if φ_max is not finite): the top of
+    the Newton bracket and of the clipped start. Rounded to nearest it can lie past a pole or a
+    fold, where p is negative or decreasing: float32(3π/4) is beyond the pole of tan(2φ/3), and
+    the iteration stayed there, 2·10⁻⁶ off, for 64 steps."""
+    if not exact.is_finite:
+        return float(dtype(phi_max))
+    with mpmath.workdps(40):
+        edge = mpmath.mpf(sp.N(exact, 40))
+        top = dtype(float(edge))
+        while mpmath.mpf(float(top)) > edge:
+            top = np.nextafter(top, dtype(0))
+    return float(top)
+
+
+def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: type,
+                  bracket_top: float) -> NewtonAngle:
     order = 2 * MAX_TERMS
     p = derivation.p
     ratio_series = coefficient_list(taylor_series(p / PHI, order), 0, order)[0::2]
@@ -674,10 +691,11 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
     far = _far_start(p, p_max, phi_max, start)
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
+    reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
     iterations = max(newton_iterations(far.measured, float(np.finfo(dtype).eps)),
                      measured_iterations(p, derivation.scalars["p_prime"], start, far, grid, phi_max, dtype,
-                                         printed))
-    return NewtonAngle(start, ratio, slope, iterations, phi_max, far)
+                                         printed, reciprocal, bracket_top))
+    return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal)
 
 
 def _branch_model(branch: Branch, dtype: type) -> Callable[[np.ndarray], np.ndarray]:

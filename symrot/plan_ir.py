@@ -32,12 +32,13 @@ for the sine family, ``D`` = p_max² − x):
 ``ClosedAngle(expression)``
     φ = expression(S), S = |p| = √x, the closed-form inverse of p(φ) (e.g. 4 atan(S/4); for the
     sine family k asin(S/k) becomes k atan2(S, √D), accurate up to the fold).
-``NewtonAngle(start, ratio, slope, iterations, phi_max, far)``
-    φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s, started from the odd reverted series
-    φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from the fold-aware interpolant ``far``
-    (:mod:`symrot.newton_start`) above it, where ``ratio`` = g (Branch in t = φ² for p(φ)/φ,
-    Taylor-safe) and ``slope`` (Branch in t = φ² for p′(φ)).  Safeguard: keep a bracket
-    [lo, hi] ⊂ [0, phi_max], shrink it by the sign of r and bisect when a step leaves it.
+``NewtonAngle(start, ratio, slope, iterations, phi_max, far, reciprocal)``
+    φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s (on 1/(φ·g(φ²)) − 1/s if ``reciprocal``),
+    started from the odd reverted series φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from
+    the fold-aware interpolant ``far`` (:mod:`symrot.newton_start`) above it, where ``ratio`` = g
+    (Branch in t = φ² for p(φ)/φ, Taylor-safe) and ``slope`` (Branch in t = φ² for p′(φ)).
+    Safeguard: keep a bracket [lo, hi] ⊂ [0, phi_max] (``phi_max`` rounded down in the precision),
+    shrink it by the sign of r and bisect when a step leaves it.
 ``QuaternionScale(algebraic, branch)``
     σ = p(φ)/sin(φ/2) of from_quaternion (:mod:`symrot.quaternion_plan`): algebraic in e₀, or a
     ``Branch`` in t = φ².
@@ -100,6 +101,11 @@ class NewtonAngle:
     phi_max: float
     far: FarStart
     """The start for s ≥ far.switch (see :mod:`symrot.newton_start`)."""
+    reciprocal: bool = False
+    """Steps of Newton on 1/p(φ) = 1/s instead of p(φ) = s: the step (s − p)/p′ times p/s. Used when
+    p is unbounded (a pole at φ_max), where 1/p is nearly linear: the direct step from a start just
+    below the pole moves by less than half an ulp (row 96 of docs/accuracy_hypothesis.md stayed
+    10⁻⁶ off for 64 steps)."""
 
 
 Coefficient = Constant | Algebraic | Branch

@@ -131,6 +131,17 @@ def test_forms_near_an_edge_where_p_prime_grows_use_s_not_phi() -> None:
             assert abs(axial - slope) <= 4 * eps * abs(slope), (expression, gap, axial, slope)
 
 
+def _rounded_size_and_its_angle(p_of: object, top: mpmath.mpf, gap: str, dtype: type) -> tuple[object, float]:
+    """s = p(top − gap) rounded to ``dtype``, and the exact angle of that s (by bisection in [0, top])."""
+    with mpmath.workdps(40):
+        size = dtype(float(p_of(top - mpmath.mpf(gap))))  # type: ignore[operator]
+        low, high = mpmath.mpf(0), top
+        for _ in range(140):
+            middle = (low + high) / 2
+            low, high = (middle, high) if p_of(middle) < float(size) else (low, middle)  # type: ignore[operator]
+        return size, float((low + high) / 2)
+
+
 def test_newton_steps_are_counted_by_running_the_printed_iteration() -> None:
     """2 cos(2φ) atanh(3φ/2)/3 has no closed inverse and a pole at φ = 2/3 where φ(s) flattens:
     the far start is poor in relative terms there and the bracketed Newton falls back on bisection.
@@ -146,12 +157,45 @@ def test_newton_steps_are_counted_by_running_the_printed_iteration() -> None:
     top = mpmath.mpf(2) / 3
     for dtype in (np.float64, np.float32):
         for gap in ("1e-2", "1e-3", "1e-4", "1e-5", "1e-6"):
-            with mpmath.workdps(40):
-                size = dtype(float(p_of(top - mpmath.mpf(gap))))
-                low, high = mpmath.mpf(0), top
-                for _ in range(140):  # bisection: the exact angle of the rounded size
-                    middle = (low + high) / 2
-                    low, high = (middle, high) if p_of(middle) < float(size) else (low, middle)
-                exact = float((low + high) / 2)
+            size, exact = _rounded_size_and_its_angle(p_of, top, gap, dtype)
             got = float(namespace["angle"](np.array([size, 0, 0], dtype=dtype)))  # type: ignore[operator]
+            assert abs(got - exact) <= 4 * float(np.finfo(dtype).eps) * exact, (dtype, gap, got, exact)
+
+
+def test_newton_next_to_a_pole_steps_on_the_reciprocal_below_the_pole() -> None:
+    """Hypothesis row 96, 3 tan(2φ/3)/(2(3φ²/4 + 1)): no closed inverse, a pole at 3π/4. From a start
+    at the top of the bracket, a Newton step on p moved φ by less than half an ulp, and the angle
+    stayed 10⁻⁶ off for 64 steps (3·10⁹ ulp in R at φ_max − 10⁻⁶); float32(3π/4) lies beyond the
+    pole, where p < 0, and the float32 iteration stayed there. Steps on 1/p, in a bracket rounded
+    down, converge in a few steps. Runs the printed NumPy iteration (ratio, slope and angle)."""
+    import math
+    import textwrap
+
+    from symrot.backends.numpy_backend import _angle_lines, _branch_lines
+    from symrot.plan import _bracket_top, _newton_angle
+    from symrot.singularities import validity
+
+    expression = "3*tan(2*phi/3)/(2*(3*phi**2/4 + 1))"
+    derivation = derive(expression).derivation
+    limits = validity(derivation)
+    p_of = sp.lambdify(PHI, sp.sympify(expression), "mpmath")
+    with mpmath.workdps(40):
+        pole = 3 * mpmath.pi / 4
+    for dtype in (np.float64, np.float32):
+        phi_max = float(limits.phi_max_float)
+        top = _bracket_top(limits.phi_max, phi_max, dtype)
+        angle = _newton_angle(derivation, phi_max, math.inf, dtype, top)
+        assert angle.reciprocal and angle.iterations <= 12 and angle.phi_max < pole
+        functions = [("_ratio", "t, phi", _branch_lines(angle.ratio, "t", "phi")),
+                     ("_slope", "t, phi", _branch_lines(angle.slope, "t", "phi")),
+                     ("_angle", "s", _angle_lines(angle))]
+        source = "\n".join(f"def {name}({args}):\n" + textwrap.indent("\n".join(body), "    ")
+                           for name, args, body in functions)
+        namespace: dict[str, object] = {"numpy": np}
+        exec(compile(source.replace("_ratio(phi * phi)", "_ratio(phi * phi, phi)"), "<angle>", "exec"),
+             namespace)
+        for gap in ("1e-1", "1e-3", "1e-5", "1e-6", "3e-7"):
+            size, exact = _rounded_size_and_its_angle(p_of, pole, gap, dtype)
+            with np.errstate(all="ignore"):  # the modules' functions are wrapped so; p overflows at the top
+                got = float(namespace["_angle"](np.array([size], dtype=dtype))[0])  # type: ignore[operator]
             assert abs(got - exact) <= 4 * float(np.finfo(dtype).eps) * exact, (dtype, gap, got, exact)

@@ -65,7 +65,7 @@ static inline double symrot_det_h_one__phi(double s)
     }
     for (k = 0; k < 6; ++k) {
         const double t = (phi*phi);
-        double ratio, slope, residual, step;
+        double ratio, slope, value, residual, step;
         if (t < 0.7851233626304374) {
             ratio = t*(t*(t*(t*(t*(t*((-5.032990449379227e-15)*t - 41.0/254270016000000.0) + 19.0/1816214400000.0) + 1.0/349272000.0)) + 1.0/8400.0) - 1.0/60.0) + 1;
         } else {
@@ -76,7 +76,8 @@ static inline double symrot_det_h_one__phi(double s)
         } else {
             slope = 2*(1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
         }
-        residual = phi*ratio - s;
+        value = phi*ratio;
+        residual = value - s;
         if (residual > 0) {
             high = phi;
         } else {
@@ -1727,7 +1728,7 @@ static inline int symrot_det_h_one_rescale_jacobian(const double p[3], double J[
 }
 
 /* symrot_det_h_one__phi_f: internal: phi from s = |p| (eq 11).
- * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
+ * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831850051879883]
  * ops: 379 */
 static inline float symrot_det_h_one__phi_f(float s)
 {
@@ -1742,14 +1743,14 @@ static inline float symrot_det_h_one__phi_f(float s)
         b2 = b1;
         b1 = b0;
     }
-    float phi = s < 0.69862944F ? s*(s2*(s2*(s2*(s2*(s2*(s2*((8.716861e-10F)*s2 + 1.1911668e-08F) + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) + 1.0F/60.0F) + 1) : b1*y - b2 + 3.4262488F, low = 0, high = 6.2831855F;
+    float phi = s < 0.69862944F ? s*(s2*(s2*(s2*(s2*(s2*(s2*((8.716861e-10F)*s2 + 1.1911668e-08F) + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) + 1.0F/60.0F) + 1) : b1*y - b2 + 3.4262488F, low = 0, high = 6.283185F;
     int k;
-    if (phi > 6.2831855F) {
+    if (phi > 6.283185F) {
         phi = high;
     }
     for (k = 0; k < 6; ++k) {
         const float t = (phi*phi);
-        float ratio, slope, residual, step;
+        float ratio, slope, value, residual, step;
         if (t < 5.567348F) {
             ratio = t*(t*(t*(t*((1.046132e-11F)*t + 2.8630982e-09F)) + 1.0F/8400.0F) - 1.0F/60.0F) + 1;
         } else {
@@ -1763,7 +1764,8 @@ static inline float symrot_det_h_one__phi_f(float s)
             const float slope_w1 = sinf(slope_w0);
             slope = 4*(slope_w1*slope_w1)/powf(cbrtf(6*phi - 12*slope_w1*cosf(slope_w0)), 2);
         }
-        residual = phi*ratio - s;
+        value = phi*ratio;
+        residual = value - s;
         if (residual > 0) {
             high = phi;
         } else {
@@ -1781,7 +1783,7 @@ static inline float symrot_det_h_one__phi_f(float s)
 
 /* symrot_det_h_one_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
+ * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831850051879883]
  * ops: 397 */
 static inline float symrot_det_h_one_angle_f(const float p[3])
 {

@@ -986,7 +986,8 @@ def _newton_64(s):
     low = 0.0 * s
     high = low + 6.283185307179586
     for _ in range(6):
-        residual = phi * _ratio_64(phi * phi, phi) - s
+        value = phi * _ratio_64(phi * phi, phi)
+        residual = value - s
         high = _where(residual > 0, phi, high)
         low = _where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
@@ -1759,11 +1760,12 @@ def _newton_32(s):
     b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
     far = 3.4262488119907286 + y * b1 - b2
     phi = _where(s < 0.6986294588918609, s * start, far)
-    phi = _xp.clip(phi, 0.0, 6.283185307179586)
+    phi = _xp.clip(phi, 0.0, 6.283185005187988)
     low = 0.0 * s
-    high = low + 6.283185307179586
+    high = low + 6.283185005187988
     for _ in range(6):
-        residual = phi * _ratio_32(phi * phi, phi) - s
+        value = phi * _ratio_32(phi * phi, phi)
+        residual = value - s
         high = _where(residual > 0, phi, high)
         low = _where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)

@@ -1476,7 +1476,8 @@ def _angle_64(s, d):
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
     for _ in range(6):
-        residual = phi * _ratio_64(phi * phi, phi) - s
+        value = phi * _ratio_64(phi * phi, phi)
+        residual = value - s
         high = numpy.where(residual > 0, phi, high)
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
@@ -2713,11 +2714,12 @@ def _angle_32(s, d):
     b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
     far = 3.4262488119907286 + y * b1 - b2
     phi = numpy.where(s < 0.6986294588918609, s * start, far)
-    phi = numpy.clip(phi, 0.0, 6.283185307179586).astype(s.dtype)
+    phi = numpy.clip(phi, 0.0, 6.283185005187988).astype(s.dtype)
     low = numpy.zeros_like(s)
-    high = numpy.full_like(s, 6.283185307179586)
+    high = numpy.full_like(s, 6.283185005187988)
     for _ in range(6):
-        residual = phi * _ratio_32(phi * phi, phi) - s
+        value = phi * _ratio_32(phi * phi, phi)
+        residual = value - s
         high = numpy.where(residual > 0, phi, high)
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)

@@ -231,13 +231,15 @@ class FunctionWriter:
         start = S_SYMBOL * horner(angle.start, s2)
         body: list[Statement] = [
             self.let("t", PHI_SYMBOL**2),
-            {"kind": "declare", "type": self.ctype, "names": ["ratio", "slope", "residual", "step"]},
+            {"kind": "declare", "type": self.ctype, "names": ["ratio", "slope", "value", "residual", "step"]},
             self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
             self.branch_value(angle.slope, T_SYMBOL, "slope"),
-            self.set("residual", PHI_SYMBOL * sp.Symbol("ratio") - S_SYMBOL),
+            self.set("value", PHI_SYMBOL * sp.Symbol("ratio")),
+            self.set("residual", "value - s", ops=1),
             {"kind": "if", "condition": "residual > 0", "then": [self.set("high", "phi")],
              "otherwise": [self.set("low", "phi")]},
-            self.set("step", PHI_SYMBOL - sp.Symbol("residual") / sp.Symbol("slope")),
+            self.set("step", "phi - residual / slope * (value / s_or_one)", ops=4) if angle.reciprocal
+            else self.set("step", PHI_SYMBOL - sp.Symbol("residual") / sp.Symbol("slope")),
             {"kind": "if", "condition": "slope > 0 && step >= low && step <= high",
              "then": [self.set("phi", "step")],
              "otherwise": [self.set("phi", (sp.Symbol("low") + sp.Symbol("high")) / 2)]},
@@ -269,6 +271,8 @@ class FunctionWriter:
                        "low = 0", f"high = {phi_max}"],
              "ops": 1 + max(sp.count_ops(start), sp.count_ops(far_value))},
             {"kind": "declare", "type": "int", "names": ["k"]},
+            *([{"kind": "let", "type": self.ctype, "name": "s_or_one", "value": "s > 0 ? s : 1", "ops": 1}]
+              if angle.reciprocal else []),
             {"kind": "if", "condition": f"phi > {phi_max}", "then": [self.set("phi", "high")],
              "otherwise": []},
             {"kind": "loop", "header": f"k = 0; k < {angle.iterations}; ++k", "body": body,
