@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, NamedTuple
 
 import mpmath
 import numpy as np
@@ -175,11 +175,19 @@ def _series_switch(f: Callable[[Any], Any], series: tuple[sp.Expr, ...], phi_max
 MAX_ITERATIONS = 64
 
 
+class NewtonCount(NamedTuple):
+    """What :func:`measured_iterations` found: the steps to print, and the smallest s = |p| whose
+    angle those steps do not reach (∞ when every checked angle is reached)."""
+
+    steps: int
+    unconverged: float
+
+
 def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], far: FarStart,
                         angles: np.ndarray, phi_max: float, dtype: type,
                         printed: tuple[Callable[[np.ndarray], np.ndarray],
                                        Callable[[np.ndarray], np.ndarray]],
-                        reciprocal: bool = False, bracket_top: float | None = None) -> int:
+                        reciprocal: bool = False, bracket_top: float | None = None) -> NewtonCount:
     """Steps the printed safeguarded Newton iteration needs, counted by running it.
 
     At every angle θ of ``angles`` the input s = p(θ) is rounded to ``dtype``; the start (reverted
@@ -188,9 +196,11 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
     them (evaluated with the ideal libm of :mod:`symrot.evaluation`), and with the steps of Newton
     on 1/p if ``reciprocal`` (:class:`symrot.plan_ir.NewtonAngle`), in the bracket [0, ``bracket_top``]
     (default ``phi_max``).
-    The result is one more than the first step count after which every lane is within 2 ε of the
+    The steps are one more than the first step count after which every lane is within 2 ε of the
     exact angle of its rounded s, plus what one ε of s moves that angle (next to a fold Newton
-    converges only to there), or ``MAX_ITERATIONS`` if no count is. Near a pole of p where φ(s)
+    converges only to there), or ``MAX_ITERATIONS`` if no count is; then ``unconverged`` is the
+    smallest s whose lane is still outside after ``MAX_ITERATIONS`` steps (the plan ends the
+    range below it), and ∞ otherwise. Near a pole of p where φ(s)
     flattens (2 cos(2φ) atanh(3φ/2)/3 at φ = 2/3) the far start is poor in relative terms and Newton
     falls back on bisection: nine steps left the angle 10⁻³ off there."""
     epsilon = float(np.finfo(dtype).eps)
@@ -210,7 +220,7 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
             exact.append(float(theta))
             tolerance.append(2 * epsilon * (float(theta) + spread))
     if not sizes:
-        return 0
+        return NewtonCount(0, math.inf)
     s_values: np.ndarray = np.asarray(sizes, dtype=dtype)
     theta, limit = np.asarray(exact), np.asarray(tolerance)
     coefficients = [float(c) for c in start]
@@ -237,6 +247,7 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
             step = phi - change
             inside = safe & (step >= low) & (step <= high)
             phi = np.where(inside, step, 0.5 * (low + high)).astype(dtype)
-            if np.all(np.abs(phi.astype(np.float64) - theta) <= limit):
-                return min(step_count + 1, MAX_ITERATIONS)
-    return MAX_ITERATIONS
+            converged = np.abs(phi.astype(np.float64) - theta) <= limit
+            if np.all(converged):
+                return NewtonCount(min(step_count + 1, MAX_ITERATIONS), math.inf)
+    return NewtonCount(MAX_ITERATIONS, float(np.min(s_values[~converged])))

@@ -530,6 +530,8 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
         kinematic = {n: c for n, c in coefficients.items()
                      if n not in derivation.slopes and n not in UNREAD_SCALARS}
         limit = _domain_limit(derivation, kinematic, angle, inverse, phi_max, p_max, dtype)
+        if isinstance(angle, NewtonAngle):  # the angle's steps do not reach beyond this size
+            limit = min(limit, angle.converges_below ** 2)
         slope_limit = min(limit, _domain_limit(derivation, slopes, angle, inverse, phi_max, p_max, dtype))
         if slopes_unrepresentable:  # the derivative functions are NaN everywhere in this format
             slope_limit = 0.0
@@ -692,10 +694,10 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
     reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
-    iterations = max(newton_iterations(far.measured, float(np.finfo(dtype).eps)),
-                     measured_iterations(p, derivation.scalars["p_prime"], start, far, grid, phi_max, dtype,
-                                         printed, reciprocal, bracket_top))
-    return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal)
+    count = measured_iterations(p, derivation.scalars["p_prime"], start, far, grid, phi_max, dtype, printed,
+                                reciprocal, bracket_top)
+    iterations = max(newton_iterations(far.measured, float(np.finfo(dtype).eps)), count.steps)
+    return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal, count.unconverged)
 
 
 def _branch_model(branch: Branch, dtype: type) -> Callable[[np.ndarray], np.ndarray]:

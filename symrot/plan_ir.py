@@ -46,6 +46,7 @@ for the sine family, ``D`` = p_max² − x):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import mpmath
@@ -106,6 +107,9 @@ class NewtonAngle:
     p is unbounded (a pole at φ_max), where 1/p is nearly linear: the direct step from a start just
     below the pole moves by less than half an ulp (row 96 of docs/accuracy_hypothesis.md stayed
     10⁻⁶ off for 64 steps)."""
+    converges_below: float = math.inf
+    """The smallest s = |p| of the plan's checks whose angle ``iterations`` steps do not reach
+    (:func:`symrot.newton_start.measured_iterations`); the precision's range ends below it."""
 
 
 Coefficient = Constant | Algebraic | Branch
