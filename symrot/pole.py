@@ -7,8 +7,11 @@ error f′·δφ ≈ ε·φ_max but the size of f → 0, so its relative error g
 p = φ/(1 − φ²/10), p′ = (10φ² + 100)/(φ² − 10)² is 10⁶ ulp off at φ_max − 10⁻⁶, and the domain
 sweep (:mod:`symrot.domain`) ended the range at |p|² = 2³² (NaN from φ_max − 4·10⁻⁴).
 
+When p → ∞ like a logarithm, p = A + B·atanh(u) with u(φ_max) = 1, the factor 1 − u² of p′ and
+of the coefficients built from it vanishes the same way (:func:`_logarithmic_pole`).
+
 The backends have s = |p| as rounded input, so f = N/(D·s) is available to a few ulp wherever N and
-D are away from zero: :func:`with_pole_factor` writes f, and every sum in a form that is a
+D are away from zero (for the logarithm, f = (1 + u)² exp(−2 (s − A)/B)): :func:`with_pole_factor` writes f, and every sum in a form that is a
 polynomial multiple of f, through it, as one bounded factor (:class:`symrot.functions.BoundedPower`:
 SymPy would merge (φ/s)³ with the form's other powers of s into φ³/s⁵, which overflows float32 next
 to the pole while the value does not). The plan measures those forms beside the others
@@ -75,7 +78,7 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         return None
     numerator, denominator = sp.fraction(quotient)
     if not denominator.has(PHI):
-        return None
+        return _logarithmic_pole(p, phi_max)
     factored = bounded(2.0, None, sp.factor_list, denominator)
     if factored is None:
         return None
@@ -83,6 +86,8 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     with mpmath.workdps(ZERO_DIGITS):
         roots = {f: (_root_near(f, phi_max), m) for f, m in factors if f.has(PHI)}
         vanishing = [(f, root, m) for f, (root, m) in roots.items() if root is not None]
+        if not vanishing:
+            return _logarithmic_pole(p, phi_max)
         if len(vanishing) != 1 or vanishing[0][2] != 1:
             return None
         factor, root, _ = vanishing[0]
@@ -90,6 +95,32 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         if _value(numerator / rest, root) in (None, 0):
             return None  # 0/0 at φ_max: not a pole of this factor
     return PoleFactor(factor, numerator / (rest * S), root)
+
+
+def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """p = A + B·atanh(u) with u(φ_max) = 1 (p → ∞ like a logarithm): f = 1 − u², the factor that
+    vanishes in p′ = A′ + B′ atanh(u) + B u′/(1 − u²) and in the coefficients built from it, written
+    through s as f = (1 + u)² exp(−2 (s − A)/B) (from 1 − u = (1 + u) e^(−2 atanh u)). Its relative
+    error is twice the absolute error of (s − A)/B, a few ε wherever B is not small; f from the
+    rounded φ loses ε φ_max/(φ_max − φ) (10⁵ ulp of det H for atanh(φ/2) terms at 2 − 10⁻⁶)."""
+    calls = [call for call in p.atoms(sp.atanh) if call.has(PHI)]
+    if len(calls) != 1:
+        return None
+    call = calls[0]
+    level = sp.Dummy("L")
+    linear = p.xreplace({call: level})
+    if linear.has(call) or not linear.is_polynomial(level) or sp.degree(linear, level) != 1:
+        return None
+    weight, rest = sp.diff(linear, level), linear.subs(level, 0)
+    inner = call.args[0]
+    factor = 1 - inner**2
+    with mpmath.workdps(ZERO_DIGITS):
+        root = _root_near(1 - inner, phi_max)
+        weight_at_root = None if root is None else _value(weight, root)
+        if root is None or weight_at_root in (None, 0) or _value(rest, root) is None:
+            return None
+    through_s = (1 + inner) ** 2 * sp.exp(-2 * (S - rest) / weight)
+    return PoleFactor(factor, through_s, root)
 
 
 def _value(expr: sp.Expr, phi: mpmath.mpf) -> mpmath.mpf | None:

@@ -102,3 +102,36 @@ def test_multiples_of_the_factor_angle_that_vanish_with_it_are_expanded() -> Non
         theta = 2 * mpmath.pi - mpmath.mpf("1.37e-7")
         assert _relative_error(rewritten, p, theta) <= 4
         assert _relative_error(form, p, theta) > 1e4
+
+
+LOGARITHMIC_POLES = {  # p = A + B atanh(u), u(φ_max) = 1: φ_max
+    "2*cos(2*phi)*atanh(3*phi/2)/3": "2/3",
+    "3*phi*cos(phi/2)/11 + 6*sinh(phi)/(11*(3*phi**2/2 + 1)) + 8*atanh(3*phi/4)/(33*(phi**2/4 + 1))": "4/3",
+}
+
+
+@pytest.mark.parametrize("text", list(LOGARITHMIC_POLES))
+def test_a_logarithmic_pole_writes_one_minus_u_squared_through_s(text: str) -> None:
+    """Hypothesis rows 31 and 15: p → ∞ like atanh(u). f = 1 − u² (the factor of p′) is
+    (1 + u)² exp(−2 (s − A)/B). Its condition number with respect to s is 2s/B (≈ 2 ln(1/(φ_max − φ))),
+    and p′ written through it stays within 4 (1 + s/B) ulp at φ_max − 1.37·10⁻⁹ (14 and 25 ulp),
+    where p′ in φ has lost more than 10⁴ ulp (row 15: 1.5·10⁵ ulp of det H at φ_max − 10⁻⁶)."""
+    p, phi_max = _p(text), sp.sympify(LOGARITHMIC_POLES[text])
+    pole = pole_factor(p, float(phi_max))
+    assert pole is not None and abs(sp.N(pole.factor.subs(PHI, phi_max), 40)) < 1e-35
+    identity = sp.lambdify(PHI, pole.through_s.subs(S, p) - pole.factor,
+                           modules=[mpmath_namespace(), "mpmath"])
+    with mpmath.workdps(50):
+        for angle in ("0.1", "0.4", "0.6"):
+            assert abs(identity(mpmath.mpf(angle))) < mpmath.mpf(10) ** -40
+    slope = sp.diff(p, PHI)
+    rewritten = with_pole_factor(slope, pole)
+    assert rewritten.has(S)
+    (call,) = p.atoms(sp.atanh)
+    weight = sp.lambdify(PHI, sp.diff(p.xreplace({call: S}), S), "mpmath")
+    p_of = sp.lambdify(PHI, p, "mpmath")
+    with mpmath.workdps(60):
+        theta = mpmath.mpf(sp.N(phi_max, 60)) - mpmath.mpf("1e-9") * mpmath.mpf("1.37")
+        condition = float(p_of(theta) / weight(theta))
+        assert _relative_error(rewritten, p, theta) <= 4 * (1 + condition), rewritten
+        assert _relative_error(slope, p, theta) > 1e4
