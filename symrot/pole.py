@@ -11,11 +11,12 @@ When p → ∞ like a logarithm, p = A + B·atanh(u) with u(φ_max) = 1, the fac
 of the coefficients built from it vanishes the same way (:func:`_logarithmic_pole`).
 
 The backends have s = |p| as rounded input, so f = N/(D·s) is available to a few ulp wherever N and
-D are away from zero (for the logarithm, f = (1 + u)² exp(−2 (s − A)/B)): :func:`with_pole_factor` writes f, and every sum in a form that is a
-polynomial multiple of f, through it, as one bounded factor (:class:`symrot.functions.BoundedPower`:
-SymPy would merge (φ/s)³ with the form's other powers of s into φ³/s⁵, which overflows float32 next
-to the pole while the value does not). The plan measures those forms beside the others
-(:func:`symrot.plan.plan_branch`) and takes them where they are more accurate.
+D are away from zero (for the logarithm, f = (1 + u)² exp(−2 (s − A)/B)): :func:`with_pole_factor`
+writes f, and every sum in a form that is a polynomial multiple of f, through it, as one bounded
+factor (:class:`symrot.functions.BoundedPower`: SymPy would merge (φ/s)³ with the form's other
+powers of s into φ³/s⁵, which overflows float32 next to the pole while the value does not). The plan
+measures those forms beside the others (:func:`symrot.plan.plan_branch`) and takes them where they
+are more accurate.
 """
 
 from __future__ import annotations

@@ -201,14 +201,14 @@ def _trigsimp(base: sp.Expr) -> sp.Expr:
     """``sp.trigsimp`` of a sum that has circular functions, with its hyperbolic functions as opaque
     symbols, remembered.
 
-    Hidden: ``trigsimp`` rewrites hyperbolic functions as circular ones of imaginary arguments and
-    back, and no identity joins cosh(aφ) to a circular function of a real multiple of φ. For
-    tan(2φ)cosh(φ/3)/4 + 3 sin(2φ/3)/(4(φ² + 1)) one sum factor of 32 operations took 1.5 s with
-    them (3.7 s under load, the 5 s safety bound of a whole derivation met once in CI) and 0.45 s
-    without, with the same result. Remembered: the derived coefficients share their sum factors
-    (p′, p and their powers in every denominator); for tan(φ/3) + 8 tan(3φ/4)/9, 127 calls had 27
-    distinct arguments, and the repeats were 5.9 of the 8.5 s spent in ``trigsimp``. An
-    interrupted call (the time bound's exception) is not remembered."""
+    Hidden: ``trigsimp`` rewrites hyperbolic functions as circular ones of imaginary arguments and back,
+    and no identity joins cosh(aφ) to a circular function of a real multiple of φ. For
+    tan(2φ)cosh(φ/3)/4 + 3 sin(2φ/3)/(4(φ² + 1)) one sum factor of 32 operations took 1.5–3.7 s with
+    them and 0.9–1.3 s without, with the same result (all measured beside a CI run; the 5 s safety
+    bound of a whole derivation was met once in CI). Remembered: the derived coefficients share
+    their sum factors (p′, p and their powers in every denominator); for tan(φ/3) + 8 tan(3φ/4)/9,
+    127 calls had 27 distinct arguments, and the repeats were 5.9 of the 8.5 s spent in
+    ``trigsimp``. An interrupted call (the time bound's exception) is not remembered."""
     hyperbolic = sorted(base.atoms(HyperbolicFunction), key=sp.default_sort_key)
     opaque = {function: sp.Dummy("h") for function in hyperbolic}
     contracted: sp.Expr = sp.trigsimp(base.xreplace(opaque))
