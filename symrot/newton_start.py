@@ -187,7 +187,7 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
                         angles: np.ndarray, phi_max: float, dtype: type,
                         printed: tuple[Callable[[np.ndarray], np.ndarray],
                                        Callable[[np.ndarray], np.ndarray]],
-                        reciprocal: bool = False, bracket_top: float | None = None) -> NewtonCount:
+                        reciprocal: bool, bracket_top: float) -> NewtonCount:
     """Steps the printed safeguarded Newton iteration needs, counted by running it.
 
     At every angle θ of ``angles`` the input s = p(θ) is rounded to ``dtype``; the start (reverted
@@ -195,7 +195,7 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
     evaluated as the backends do, with ``printed`` = (p(φ)/φ, p′(φ)) as the plan's branches print
     them (evaluated with the ideal libm of :mod:`symrot.evaluation`), and with the steps of Newton
     on 1/p if ``reciprocal`` (:class:`symrot.plan_ir.NewtonAngle`), in the bracket [0, ``bracket_top``]
-    (default ``phi_max``).
+    (the largest value of ``dtype`` not above the exact φ_max).
     The steps are one more than the first step count after which every lane is within 2 ε of the
     exact angle of its rounded s, plus what one ε of s moves that angle (next to a fold Newton
     converges only to there), or ``MAX_ITERATIONS`` if no count is; then ``unconverged`` is the
@@ -230,10 +230,9 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
             series = (dtype(c) + s_values * s_values * series).astype(dtype)
         y = 2.0 * v_of_s(far.kind, far.scale, far.order, s_values) - 1.0
         far_value: np.ndarray = np.asarray(clenshaw(np.asarray(far.chebyshev), y), dtype=dtype)
-        top = phi_max if bracket_top is None else bracket_top
-        phi = np.clip(np.where(s_values < far.switch, s_values * series, far_value), 0.0, top)
+        phi = np.clip(np.where(s_values < far.switch, s_values * series, far_value), 0.0, bracket_top)
         phi = phi.astype(dtype)
-        low, high = np.zeros_like(s_values), np.full_like(s_values, top)
+        low, high = np.zeros_like(s_values), np.full_like(s_values, bracket_top)
         for step_count in range(1, MAX_ITERATIONS + 1):
             value: np.ndarray = (phi * np.asarray(ratio_model(phi), dtype=dtype)).astype(dtype)
             residual = (value - s_values).astype(dtype)

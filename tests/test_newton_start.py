@@ -25,7 +25,7 @@ def _sinh_models(wrong_above: float) -> tuple:
 def test_every_angle_reached_counts_steps_and_no_limit() -> None:
     angles = np.geomspace(1e-3, 3.0, 40)
     count = measured_iterations(sp.sinh(PHI), sp.cosh(PHI), [sp.Integer(1)], SERIES_ONLY, angles, 6.0,
-                                np.float64, _sinh_models(math.inf))
+                                np.float64, _sinh_models(math.inf), False, 6.0)
     assert count.steps < MAX_ITERATIONS and count.unconverged == math.inf
 
 
@@ -34,7 +34,7 @@ def test_angles_the_steps_do_not_reach_end_the_range_at_the_smallest_size() -> N
     would be): those lanes converge to the wrong angle, whatever the count of steps."""
     angles = np.geomspace(1e-3, 3.0, 40)
     count = measured_iterations(sp.sinh(PHI), sp.cosh(PHI), [sp.Integer(1)], SERIES_ONLY, angles, 6.0,
-                                np.float64, _sinh_models(1.0))
+                                np.float64, _sinh_models(1.0), False, 6.0)
     first_wrong = float(np.sinh(angles[angles > 1.0][0]))
     assert count.steps == MAX_ITERATIONS
     assert math.isclose(count.unconverged, first_wrong, rel_tol=1e-12)
