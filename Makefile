@@ -47,8 +47,8 @@ lint: ## ruff over the package, tests and benchmarks
 typecheck: ## mypy over the package
 	$(PYTHON) -m mypy
 
-pytest: ## The test suite only, on TEST_JOBS processes (pytest-xdist; default: one per CPU)
-	$(PYTHON) -m pytest -n $(TEST_JOBS) --dist worksteal $(PYTEST_ARGS)
+pytest: ## The test suite only, on TEST_JOBS processes (pytest-xdist; default: one per CPU), with the 25 slowest tests listed
+	$(PYTHON) -m pytest -n $(TEST_JOBS) --dist worksteal --durations=25 $(PYTEST_ARGS)
 
 generate: ## Rewrite generated/ for the named parameterizations (deterministic)
 	$(PYTHON) -m symrot.generate generated
