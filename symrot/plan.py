@@ -143,7 +143,8 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
     if p.has(RealCbrt) or not _solvable_shape(p):
         return None
     try:
-        solutions: list[sp.Expr] = bounded(10, [], sp.solve, sp.Eq(p, S), PHI)
+        solutions: list[sp.Expr] = bounded(10, [], _hyperbolic_solutions, p)
+        solutions += bounded(10, [], sp.solve, sp.Eq(p, S), PHI)
     except Exception:
         return None  # no closed inverse: the plan uses the Newton angle
     for candidate in solutions:
@@ -154,6 +155,19 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
         if value.is_real and abs(value - probe / kappa) < sp.Rational(1, 10**6):
             return sp.simplify(candidate) if len(str(candidate)) < 80 else candidate
     return None
+
+
+def _hyperbolic_solutions(p: sp.Expr) -> list[sp.Expr]:
+    """The real solutions φ(s) of p(φ) = s that ``solveset`` writes with asinh/atanh, for p with
+    sinh, cosh or tanh in it: ``solve`` writes them through exp, as log(s + √(s² + 1)) for sinh φ,
+    which cancels for small s (every digit lost at s = 10⁻⁸) and made the plan take the Newton angle
+    and coefficients in φ where 2 asinh(3s/2)/3 and 1/√(1 + 9s²/4) are exact (issue 16)."""
+    if not p.has(sp.sinh, sp.cosh, sp.tanh):
+        return []
+    found = sp.solveset(sp.Eq(p, S), PHI, sp.S.Reals)
+    finite = [found] if isinstance(found, sp.FiniteSet) else [
+        part for part in getattr(found, "args", ()) if isinstance(part, sp.FiniteSet)]
+    return [solution for part in finite for solution in part.args]
 
 
 RATIONALIZED_OPS = 40
@@ -269,9 +283,12 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     if not branches:
         raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: every form divides "
                                      "by zero on the grid")
-    # equally accurate forms: the shortest polynomial, then a form in φ alone (a form in s and x is
-    # taken where it is measurably more accurate), then the fewest sin/cos arguments
-    return min(branches, key=lambda b: (max(_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
+    # the smallest worst error class, then the smaller other class (sinh φ: H₂ through √(1 + x) is
+    # 3.5 ulp at the edge where the form in φ̂ is 7, both 11 inside: the edge decides); equally
+    # accurate forms: the shortest polynomial, then a form in φ alone (a form in s and x is taken
+    # where it is measurably more accurate), then the fewest sin/cos arguments
+    return min(branches, key=lambda b: (*sorted((_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
+                                                reverse=True),
                                         len(b.smallest_switch[1]), b.closed.has(S, X),
                                         trig_arguments(b.closed), b.edge_ulp, b.measured_ulp))
 

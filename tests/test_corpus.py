@@ -188,9 +188,9 @@ SAMPLE: dict[str, str | None] = {
     # one per category where the emit is fast (the whole corpus: bench/accuracy_corpus.py)
     "phi - phi**3/50": None,
     "phi + phi**5/120": None,  # float32 root_matrix 9.2 ulp at 6.28 before G_k was measured as c_k |p|^k
-    # 55 ulp at 6.28 before t = c0 - c2 |p|^2 was planned; what remains is H_2 in phi (sinh^3 carries
-    # the float32 angle's rounding, 6.5 ulp of H_2 x ~ mu) and t = sin(phi)/sinh(phi) (cot(phi) ~ 10)
-    "sinh(phi)": "float32 omega 15.9 ulp at phi = 6.18",
+    # float32 omega 55 ulp at 6.28 before t = c0 - c2 |p|^2 was planned, 15.9 at 6.18 before the
+    # angle was asinh(s) (sp.solve's log form cancels) and H_2 through sqrt(1 + x) (6.5 ulp in phi)
+    "sinh(phi)": None,
     "atan(phi)": None,
     "phi*cos(phi/4)": None,
     # root_matrix 6 ulp (float64) and 8.7 ulp (float32), float32 omega 61 ulp at 6.27-6.28 before

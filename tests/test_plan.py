@@ -157,3 +157,19 @@ def test_the_reduction_to_x_is_sized_by_the_largest_multiple_angle() -> None:
     assert expanded_in_s(beyond, 20 * sp.atan(s)) is None
     within = sp.sin(PHI) / (6 * sp.tan(PHI / 6))
     assert expanded_in_s(within, 6 * sp.atan(s / 6)) is not None
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("sinh(phi)", "asinh(s)"), ("2*sinh(3*phi/2)/3", "2*asinh(3*s/2)/3"), ("tanh(phi)", "atanh(s)")])
+def test_hyperbolic_inverses_are_inverse_hyperbolic_functions(text: str, expected: str) -> None:
+    """sp.solve writes φ(s) for sinh φ = s as log(s + √(s² + 1)), which loses every digit for small s:
+    the plan took the Newton angle, and cosh(φ) = √(1 + x) was never found for H₀ = 1/p′."""
+    from symrot.parsing import PHI
+    from symrot.plan import ANGLE_TOLERANCE_ULP, S, closed_angle_error, closed_inverse
+
+    p = sp.sympify(text, locals={"phi": PHI})
+    inverse = closed_inverse(p, sp.Integer(1))
+    assert inverse is not None and sp.simplify(inverse - sp.sympify(expected, locals={"s": S})) == 0
+    assert not inverse.has(sp.log)
+    for dtype in (np.float64, np.float32):
+        assert closed_angle_error(inverse, p, 2 * np.pi, dtype) <= ANGLE_TOLERANCE_ULP

@@ -9,7 +9,7 @@ import sympy as sp
 
 from symrot.api import derive
 from symrot.parsing import PHI
-from symrot.plan import NewtonAngle, closed_angle_error, closed_inverse, evaluation_plan
+from symrot.plan import ClosedAngle, S, closed_angle_error, closed_inverse, evaluation_plan
 
 
 def test_a_solver_that_raises_means_no_closed_inverse() -> None:
@@ -38,8 +38,9 @@ def test_user_function_angle_keeps_relative_accuracy_down_to_1e_300() -> None:
     with mpmath.workdps(50):
         exact = [float(mpmath.asinh(mpmath.mpf(float(m)))) for m in magnitudes]
     assert np.all(np.abs(got - exact) <= 2 * np.finfo(float).eps * np.abs(exact))
-    # SymPy's inverse of sinh cancels for small s: the measured plan takes the Newton angle
-    assert all(isinstance(p.angle, NewtonAngle) for p in plan.precisions.values())
+    # sp.solve's inverse of sinh, log(s + √(s² + 1)), cancels for small s; solveset's asinh(s) does not
+    assert all(isinstance(p.angle, ClosedAngle) and p.angle.expression == sp.asinh(S)
+               for p in plan.precisions.values())
 
 
 def test_a_poor_far_start_gets_the_newton_steps_it_needs() -> None:

@@ -1807,8 +1807,8 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
- * ops: 433 */
+ * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * ops: 473 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1827,13 +1827,14 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
     float c_R_1, c_R_2;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
-        const float w1 = cbrtf(6*phi - 6*w0);
-        c_R_1 = w0/w1;
-        c_R_2 = (1 - cosf(phi))/(w1*w1);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        c_R_1 = w0/cbrtf(6*phi - 6*w0);
+        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*(w2*w2)/powf(cbrtf(6*phi - 12*w2*cosf(w1)), 2);
     }
     const float t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -1851,12 +1852,12 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1867,24 +1868,29 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
                 const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
+            const float u1 = u1_lanes[k];
             const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1895,12 +1901,20 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_R_1_lanes[k] = sin0/u0;
             poly_R_1_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-            c_R_2_lanes[k] = (1 - cos0)/(u0*u0);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin1*sin1)/(u1*u1);
+            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1912,7 +1926,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             c_R_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 1.4342812F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 4.619481F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2775,11 +2789,11 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 611 */
+ * ops: 654 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2798,24 +2812,25 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
         const float w1 = phi - w0;
-        const float w2 = cbrtf(6*w1);
-        const float w3 = (1.0F/2.0F)*phi;
-        const float w4 = sinf(w3);
-        const float w5 = (w4*w4);
-        const float w6 = (1.0F/8.0F)/w5;
-        const float w7 = w4*cosf(w3);
-        const float w8 = 2*w7;
-        c_R_1 = w0/w2;
-        c_R_2 = (1 - cosf(phi))/(w2*w2);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w6*(-2.0F/3.0F*w0*w5/w1 - 2*w5 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w6*(-8.0F/3.0F*(w4*w4*w4*w4)/(phi - w8) + w8)/cbrtf(6*phi - 12*w7);
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = w3*cosf(w2);
+        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w6 = (w3*w3);
+        const float w7 = 2*w6;
+        const float w8 = (1.0F/8.0F)/w6;
+        const float w9 = 2*w4;
+        c_R_1 = w0/cbrtf(6*w1);
+        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2858,11 +2873,11 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 612 */
+ * ops: 655 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2881,24 +2896,25 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
         const float w1 = phi - w0;
-        const float w2 = cbrtf(6*w1);
-        const float w3 = (1.0F/2.0F)*phi;
-        const float w4 = sinf(w3);
-        const float w5 = (w4*w4);
-        const float w6 = (1.0F/8.0F)/w5;
-        const float w7 = w4*cosf(w3);
-        const float w8 = 2*w7;
-        c_R_1 = w0/w2;
-        c_R_2 = (1 - cosf(phi))/(w2*w2);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w6*(-2.0F/3.0F*w0*w5/w1 - 2*w5 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w6*(-8.0F/3.0F*(w4*w4*w4*w4)/(phi - w8) + w8)/cbrtf(6*phi - 12*w7);
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = w3*cosf(w2);
+        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w6 = (w3*w3);
+        const float w7 = 2*w6;
+        const float w8 = (1.0F/8.0F)/w6;
+        const float w9 = 2*w4;
+        c_R_1 = w0/cbrtf(6*w1);
+        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];

@@ -334,7 +334,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
 
 /* symrot_sine_m5_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*sin(phi)/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
  * ops: 114 */
@@ -361,11 +361,11 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
+        const double w1 = cos(w0)/sin(w0);
         const double w2 = (1.0/5.0)*phi;
         const double w3 = sin(w2);
-        c_H_inverse_across = (1.0/4.0)*s*sin(phi)/(w1*w1);
-        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(cos(w2) - 5.0/2.0*w3*cos(w0)/w1)/(w3*w3);
+        c_H_inverse_across = (1.0/2.0)*s*w1;
+        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(-5.0/2.0*w1*w3 + cos(w2))/(w3*w3);
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -395,7 +395,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844) || x < 0.000596571734285774) {
+            if (!(x < 22.612712429686844) || x < 0.002201880264785416) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -427,7 +427,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = phi;
+            const double a1_a = (1.0/5.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -437,21 +437,12 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a2_a = (1.0/5.0)*phi;
-            const double a2_q = rint(a2_a*0.6366197723675814);
-            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
-            const double a2_z = a2_r*a2_r;
-            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
-            const double a2_h = rint(0.5*a2_j - 0.25);
-            const double a2_odd = a2_j - 2*a2_h;
-            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const double a2_up = fabs(a2_j - 1.5) - 0.5;
-            const double cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
-            c_H_inverse_across_lanes[k] = (1.0/4.0)*s*sin1/(sin0*sin0);
-            poly_H_inverse_across_lanes[k] = x*(x*((-181.0/2500000.0)*x - 101.0/50000.0) - 9.0/100.0) + 1;
-            c_H_inverse_2_lanes[k] = (1.0/25.0)*(-5.0/2.0*cos0*sin2/sin0 + cos2)/(sin2*sin2);
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const double w0 = cos0/sin0;
+            c_H_inverse_across_lanes[k] = (1.0/2.0)*s*w0;
+            poly_H_inverse_across_lanes[k] = x*(x*(x*((-7229.0/2500000000.0)*x - 181.0/2500000.0) - 101.0/50000.0) - 9.0/100.0) + 1;
+            c_H_inverse_2_lanes[k] = (1.0/25.0)*(cos1 - 5.0/2.0*sin1*w0)/(sin1*sin1);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -459,7 +450,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
             const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const double v_H_inverse_across = x < 0.000596571734285774 ? poly_H_inverse_across : closed_H_inverse_across;
+            const double v_H_inverse_across = x < 0.002201880264785416 ? poly_H_inverse_across : closed_H_inverse_across;
             c_H_inverse_across_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
@@ -786,7 +777,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
 
 /* symrot_sine_m5_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*sin(phi)/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
  * ops: 113 */
@@ -807,11 +798,11 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
+        const double w1 = cos(w0)/sin(w0);
         const double w2 = (1.0/5.0)*phi;
         const double w3 = sin(w2);
-        c_H_inverse_across = (1.0/4.0)*s*sin(phi)/(w1*w1);
-        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(cos(w2) - 5.0/2.0*w3*cos(w0)/w1)/(w3*w3);
+        c_H_inverse_across = (1.0/2.0)*s*w1;
+        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(-5.0/2.0*w1*w3 + cos(w2))/(w3*w3);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -1169,8 +1160,8 @@ static inline void symrot_sine_m5_rotation_transpose_derivative(const double p[3
  * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 348 */
+ * H_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(5/cos(phi/5) - sin(phi)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 - 5*cos(phi)/sin(phi/5) + sin(phi)*cos(phi/5)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
+ * ops: 347 */
 static inline void symrot_sine_m5_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1199,20 +1190,19 @@ static inline void symrot_sine_m5_tangent_derivative(const double p[3], const do
         const double w0 = 1.0/x;
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = 2*(w2*w2);
-        const double w4 = (1.0/5.0)*phi;
-        const double w5 = cos(w4);
-        const double w6 = 1.0/w5;
-        const double w7 = cos(w1);
-        const double w8 = 2*w2*w7;
-        const double w9 = sin(w4);
-        const double w10 = 1.0/w9;
-        const double w11 = 2*w10*w5;
-        const double w12 = w6/(w9*w9*w9);
-        c_H_1 = w0*w3;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w6 - w8/s);
-        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(-5*w10*(1 - w3) - w11*(-w10*w8 + 5*w6) + 2*w2*w5*w7/(w9*w9) + 5*w9/(w5*w5));
+        const double w3 = (1.0/5.0)*phi;
+        const double w4 = cos(w3);
+        const double w5 = 1.0/w4;
+        const double w6 = sin(phi);
+        const double w7 = cos(phi);
+        const double w8 = sin(w3);
+        const double w9 = 1.0/w8;
+        const double w10 = 2*w4*w9;
+        const double w11 = w5/(w8*w8*w8);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w5 - 2*w2*cos(w1)/s);
+        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w11*(-w10*(1 - w7) + 5*w6);
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w11*(-w10*(5*w5 - w6*w9) + w4*w6/(w8*w8) - 5*w7*w9 + 5*w8/(w4*w4));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1261,8 +1251,8 @@ static inline void symrot_sine_m5_tangent_derivative(const double p[3], const do
  * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 354 */
+ * H_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(5/cos(phi/5) - sin(phi)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 - 5*cos(phi)/sin(phi/5) + sin(phi)*cos(phi/5)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
+ * ops: 353 */
 static inline void symrot_sine_m5_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1291,20 +1281,19 @@ static inline void symrot_sine_m5_tangent_transpose_derivative(const double p[3]
         const double w0 = 1.0/x;
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = 2*(w2*w2);
-        const double w4 = (1.0/5.0)*phi;
-        const double w5 = cos(w4);
-        const double w6 = 1.0/w5;
-        const double w7 = cos(w1);
-        const double w8 = 2*w2*w7;
-        const double w9 = sin(w4);
-        const double w10 = 1.0/w9;
-        const double w11 = 2*w10*w5;
-        const double w12 = w6/(w9*w9*w9);
-        c_H_1 = w0*w3;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w6 - w8/s);
-        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(-5*w10*(1 - w3) - w11*(-w10*w8 + 5*w6) + 2*w2*w5*w7/(w9*w9) + 5*w9/(w5*w5));
+        const double w3 = (1.0/5.0)*phi;
+        const double w4 = cos(w3);
+        const double w5 = 1.0/w4;
+        const double w6 = sin(phi);
+        const double w7 = cos(phi);
+        const double w8 = sin(w3);
+        const double w9 = 1.0/w8;
+        const double w10 = 2*w4*w9;
+        const double w11 = w5/(w8*w8*w8);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w5 - 2*w2*cos(w1)/s);
+        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w11*(-w10*(1 - w7) + 5*w6);
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w11*(-w10*(5*w5 - w6*w9) + w4*w6/(w8*w8) - 5*w7*w9 + 5*w8/(w4*w4));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1436,8 +1425,8 @@ static inline void symrot_sine_m5_tangent_inverse_derivative(const double p[3], 
  * H_2: Horner degree 15 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * H_0_x = 5/(2*(25 - x)**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 21 in x below x = 5.16615, else (-2*(1 - cos(phi))*cos(phi/5)/sin(phi/5) + 5*sin(phi))/(1250*sin(phi/5)**3*cos(phi/5))
- * H_2_x: Horner degree 21 in x below x = 5.16615, else (-5*(1 - 2*sin(phi/2)**2)/sin(phi/5) - 2*(5/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 + 2*sin(phi/2)*cos(phi/5)*cos(phi/2)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
- * ops: 313 */
+ * H_2_x: Horner degree 21 in x below x = 5.16615, else (-2*(5/cos(phi/5) - sin(phi)/sin(phi/5))*cos(phi/5)/sin(phi/5) + 5*sin(phi/5)/cos(phi/5)**2 - 5*cos(phi)/sin(phi/5) + sin(phi)*cos(phi/5)/sin(phi/5)**2)/(6250*sin(phi/5)**3*cos(phi/5))
+ * ops: 312 */
 static inline void symrot_sine_m5_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1461,20 +1450,19 @@ static inline void symrot_sine_m5_angular_acceleration(const double p[3], const 
         const double w0 = 1.0/x;
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = 2*(w2*w2);
-        const double w4 = (1.0/5.0)*phi;
-        const double w5 = cos(w4);
-        const double w6 = 1.0/w5;
-        const double w7 = cos(w1);
-        const double w8 = 2*w2*w7;
-        const double w9 = sin(w4);
-        const double w10 = 1.0/w9;
-        const double w11 = 2*w10*w5;
-        const double w12 = w6/(w9*w9*w9);
-        c_H_1 = w0*w3;
-        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w6 - w8/s);
-        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w12*(-w11*(1 - cos(phi)) + 5*sin(phi));
-        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w12*(-5*w10*(1 - w3) - w11*(-w10*w8 + 5*w6) + 2*w2*w5*w7/(w9*w9) + 5*w9/(w5*w5));
+        const double w3 = (1.0/5.0)*phi;
+        const double w4 = cos(w3);
+        const double w5 = 1.0/w4;
+        const double w6 = sin(phi);
+        const double w7 = cos(phi);
+        const double w8 = sin(w3);
+        const double w9 = 1.0/w8;
+        const double w10 = 2*w4*w9;
+        const double w11 = w5/(w8*w8*w8);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(w5 - 2*w2*cos(w1)/s);
+        c_H_1_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.62907292648e-33)*x + 6.795930267e-32) + 1.76043978e-30) + 4.5712752954e-29) + 1.190250828e-27) + 3.10881363e-26) + 8.149176e-25) + 2.14512375e-23) + 5.67456736e-22) + 1.5099604e-20) + 4.046544e-19) + 1.09395e-17) + 2.99e-16) + 8.28828e-15) + 1463.0/6250000000000000.0) + 6783.0/1000000000000000.0) + 51.0/250000000000.0) + 13.0/2000000000.0) + 143.0/625000000.0) + 99.0/10000000.0) + 21.0/25000.0) - 7.0/200.0 : (1.0/1250.0)*w11*(-w10*(1 - w7) + 5*w6);
+        c_H_2_x = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.811354760072e-32)*x + 4.418607823812e-31) + 1.07651574888e-29) + 2.61908404758e-28) + 6.362147484e-27) + 1.542773001e-25) + 3.733769952e-24) + 9.01620585e-23) + 2.17164528e-21) + 5.215158e-20) + 1.248072e-18) + 2.9745716e-17) + 7.05432e-16) + 1.662804e-14) + 2431.0/6250000000000000.0) + 9009.0/1000000000000000.0) + 1287.0/6250000000000.0) + 231.0/50000000000.0) + 63.0/625000000.0) + 21.0/10000000.0) + 1.0/25000.0) - 113.0/25000.0 : (1.0/6250.0)*w11*(-w10*(5*w5 - w6*w9) + w4*w6/(w8*w8) - 5*w7*w9 + 5*w8/(w4*w4));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1906,7 +1894,7 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_across: Horner degree 6 in x below x = 1.47828, else 5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
+ * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-s*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/x
  * ops: 93 */
 static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv[9])
 {
@@ -1929,12 +1917,12 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = (5.0F/2.0F)*w1*cosf(w2)/sinf(w2);
-        c_H_inverse_across = w3;
-        c_H_inverse_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F : (1.0F/25.0F)*(-w3 + cosf(w0))/(w1*w1);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = cosf(w1)/sinf(w1);
+        c_H_inverse_across = (5.0F/2.0F)*w2*sinf(w0);
+        c_H_inverse_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F : (-1.0F/2.0F*s*w2 + cosf(w0))/x;
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -1951,12 +1939,12 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi.
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1965,20 +1953,24 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 22.612713F) || x < 1.1864381e-05F) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/5.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
@@ -2004,10 +1996,10 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float w0 = (5.0F/2.0F)*cos1*sin0/sin1;
-            c_H_inverse_across_lanes[k] = w0;
+            const float w0 = cos1/sin1;
+            c_H_inverse_across_lanes[k] = (5.0F/2.0F)*sin0*w0;
             poly_H_inverse_across_lanes[k] = 1 + (-9.0F/100.0F)*x;
-            c_H_inverse_2_lanes[k] = (1.0F/25.0F)*(cos0 - w0)/(sin0*sin0);
+            c_H_inverse_2_lanes[k] = (cos0 - 1.0F/2.0F*s*w0)/x;
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2344,7 +2336,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_across: Horner degree 6 in x below x = 1.47828, else 5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
+ * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-s*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/x
  * ops: 92 */
 static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
@@ -2361,12 +2353,12 @@ static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3],
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = (5.0F/2.0F)*w1*cosf(w2)/sinf(w2);
-        c_H_inverse_across = w3;
-        c_H_inverse_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F : (1.0F/25.0F)*(-w3 + cosf(w0))/(w1*w1);
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = cosf(w1)/sinf(w1);
+        c_H_inverse_across = (5.0F/2.0F)*w2*sinf(w0);
+        c_H_inverse_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F : (-1.0F/2.0F*s*w2 + cosf(w0))/x;
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -2899,7 +2891,7 @@ static inline void symrot_sine_m5_tangent_transpose_derivative_f(const float p[3
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
+ * H_inverse_2: Horner degree 11 in x below x = 5.16615, else (-s*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/x
  * H_inverse_0_x = -1/(10*sqrt(25 - x)) (algebraic in x)
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 13 in x below x = 5.16615, else (-25*(1 - 2*sin(phi/2)**2)*sin(phi/5)/(2*sin(phi/2)**2) - 2*(-5*sin(phi/5)*cos(phi/2)/sin(phi/2) + 2*cos(phi/5))*cos(phi/5)/sin(phi/5) - 2*sin(phi/5) + 25*sin(phi/5)*cos(phi/2)**2/sin(phi/2)**2 - 5*cos(phi/5)*cos(phi/2)/sin(phi/2))/(2500*sin(phi/5)**3*cos(phi/5))
@@ -2926,18 +2918,19 @@ static inline void symrot_sine_m5_tangent_inverse_derivative_f(const float p[3],
         c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.239837e-20F)*x + 8.925276e-19F) + 1.8688804e-17F) + 3.8891862e-16F) + 8.034982e-15F) + 1.6457122e-13F) + 3.335498e-12F) + 6.6726666e-11F) + 1.3127636e-09F) + 2.525944e-08F) + 4.71072e-07F) + 8.3748e-06F) + 171.0F/1250000.0F) + 91.0F/50000.0F;
     } else {
         const float phi = symrot_sine_m5__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = (1.0F/5.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        const float w3 = (1.0F/2.0F)*phi;
-        const float w4 = sinf(w3);
-        const float w5 = cosf(w3);
-        const float w6 = w5/w4;
-        const float w7 = w1*w6;
-        const float w8 = (w4*w4);
+        const float w1 = cosf(w0);
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = cosf(w2);
+        const float w5 = w4/w3;
+        const float w6 = sinf(w0);
+        const float w7 = 5*w5;
+        const float w8 = (w3*w3);
         const float w9 = 1.0F/w8;
-        c_H_inverse_2 = (1.0F/25.0F)*(w2 - 5.0F/2.0F*w7)/(w1*w1);
-        c_H_inverse_2_x = (1.0F/2500.0F)*(25*w1*(w5*w5)*w9 - 25.0F/2.0F*w1*w9*(1 - 2*w8) - 2*w1 - 5*w2*w6 - 2*w2*(2*w2 - 5*w7)/w1)/((w1*w1*w1)*w2);
+        c_H_inverse_2 = (-1.0F/2.0F*s*w5 + w1)/x;
+        c_H_inverse_2_x = (1.0F/2500.0F)*(-w1*w7 - 2*w1*(2*w1 - w6*w7)/w6 + 25*(w4*w4)*w6*w9 - 25.0F/2.0F*w6*w9*(1 - 2*w8) - 2*w6)/(w1*(w6*w6*w6));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_inverse_0_x;

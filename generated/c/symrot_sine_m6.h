@@ -536,8 +536,8 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_across = -(x - 27)/54 (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.407121, else 2*sin(phi/4)**2/x
- * K_2: Horner degree 7 in x below x = 0.407121, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(6*x*(1 - 2*sin(phi/12)**2))
- * ops: 88 */
+ * K_2: Horner degree 18 in x below x = 5.28621, else (4*sin(phi/12)**2 + 2*sin(phi/4)**2)/(216*(1 - 2*sin(phi/12)**2)*sin(phi/6)**2)
+ * ops: 121 */
 static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -557,14 +557,13 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
     double c_K_1, c_K_2;
     if (x < 0.4071212524285563) {
         c_K_1 = x*(x*(x*(x*(x*(x*((-1.820598476104429e-14)*x - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
-        c_K_2 = x*(x*(x*(x*(x*(x*((3.4805559101996437e-14)*x + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7314656570180201e-31)*x + 6.401743294055816e-30) + 2.370474088313239e-28) + 8.792303891198196e-27) + 3.2673335750517166e-25) + 1.2168000900192599e-23) + 4.542720336071904e-22) + 1.7007944938253208e-20) + 6.389071489848162e-19) + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
     } else {
         const double phi = symrot_sine_m6__phi(sqrt(x));
-        const double w0 = 1.0/x;
-        const double w1 = 2*pow(sin((1.0/4.0)*phi), 2);
-        const double w2 = pow(sin((1.0/12.0)*phi), 2);
-        c_K_1 = w0*w1;
-        c_K_2 = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
+        const double w0 = 2*pow(sin((1.0/4.0)*phi), 2);
+        const double w1 = pow(sin((1.0/12.0)*phi), 2);
+        c_K_1 = w0/x;
+        c_K_2 = x < 5.286206912907945 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7314656570180201e-31)*x + 6.401743294055816e-30) + 2.370474088313239e-28) + 8.792303891198196e-27) + 3.2673335750517166e-25) + 1.2168000900192599e-23) + 4.542720336071904e-22) + 1.7007944938253208e-20) + 6.389071489848162e-19) + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0 : (1.0/216.0)*(w0 + 4*w1)/((1 - 2*w1)*pow(sin((1.0/6.0)*phi), 2));
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -594,7 +593,7 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 27.0) || x < 3.4444713740739134e-10) {
+            if (!(x < 27.0) || x < 0.05760039934430118) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
@@ -630,14 +629,23 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = 1.0/x;
-            const double w1 = 2*(sin0*sin0);
-            const double w2 = (sin1*sin1);
+            const double a2_a = (1.0/6.0)*phi;
+            const double a2_q = rint(a2_a*0.6366197723675814);
+            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
+            const double a2_z = a2_r*a2_r;
+            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
+            const double a2_h = rint(0.5*a2_j - 0.25);
+            const double a2_odd = a2_j - 2*a2_h;
+            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const double w0 = 2*(sin0*sin0);
+            const double w1 = (sin1*sin1);
             c_K_across_lanes[k] = 1.0/2.0 - 1.0/54.0*x;
-            c_K_1_lanes[k] = w0*w1;
+            c_K_1_lanes[k] = w0/x;
             poly_K_1_lanes[k] = x*(x*(x*(x*((-91.0/2229025112064.0)*x - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/6.0)*w0*(w1 + 4*w2)/(1 - 2*w2);
-            poly_K_2_lanes[k] = (1.0/6912.0)*x + 11.0/432.0;
+            c_K_2_lanes[k] = (1.0/216.0)*(w0 + 4*w1)/((sin2*sin2)*(1 - 2*w1));
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7314656570180201e-31)*x + 6.401743294055816e-30) + 2.370474088313239e-28) + 8.792303891198196e-27) + 3.2673335750517166e-25) + 1.2168000900192599e-23) + 4.542720336071904e-22) + 1.7007944938253208e-20) + 6.389071489848162e-19) + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -650,7 +658,7 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             c_K_1_lanes[k] = !(x < 27.0) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 3.4444713740739134e-10 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 5.286206912907945 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 27.0) ? (double)NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {

@@ -1127,17 +1127,26 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
+    small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = -4.75496882809808e-09 + 0.0 * x
+    series = -5.5081089876936793e-17 + 0.0 * x
+    series = -7.106523709086561e-16 + t * series
+    series = -9.280634969633333e-15 + t * series
+    series = -1.2296404066927484e-13 + t * series
+    series = -1.6580488505029053e-12 + t * series
+    series = -2.2848332772743624e-11 + t * series
+    series = -3.236771326819846e-10 + t * series
+    series = -4.75496882809808e-09 + t * series
     series = -7.343103325246183e-08 + t * series
     series = -1.2201092558235415e-06 + t * series
     series = -2.281746031746032e-05 + t * series
     series = -0.0005357142857142857 + t * series
     series = -0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    closed = (1 - _xp.cos(phi))/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    phi = _where(small, 2.3595228756885396, phi)
+    sin_half = _where(small, 0.9245151118510668, sin_half)
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = 2*sin_half**2/_cbrt(12*cos_half*sin_half - 6*phi)**2
     return _where(small, series, closed)
 
 

@@ -1693,9 +1693,16 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
         t = x
-        series = -4.75496882809808e-09
+        series = -5.5081089876936793e-17
+        series = -7.106523709086561e-16 + t * series
+        series = -9.280634969633333e-15 + t * series
+        series = -1.2296404066927484e-13 + t * series
+        series = -1.6580488505029053e-12 + t * series
+        series = -2.2848332772743624e-11 + t * series
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
         series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
@@ -1703,13 +1710,20 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+    out = numpy.asarray(2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
+    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
-    small = x < 1.4342812011199078
+    small = x < 4.619481091176478
     if small.any():
         t = x[small]
-        series = -4.75496882809808e-09
+        series = -5.5081089876936793e-17
+        series = -7.106523709086561e-16 + t * series
+        series = -9.280634969633333e-15 + t * series
+        series = -1.2296404066927484e-13 + t * series
+        series = -1.6580488505029053e-12 + t * series
+        series = -2.2848332772743624e-11 + t * series
+        series = -3.236771326819846e-10 + t * series
+        series = -4.75496882809808e-09 + t * series
         series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
@@ -2832,7 +2846,7 @@ _USES_PHI = {
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
     "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 1.4342812090283275, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 1.4342812090283275, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 1.4342812090283275, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 1.4342812090283275, 'K_1': 1.4342812090283275, 'K_2': 2.6302227241416043, 'H_across': 0.764824235244299, 'H_inverse_across': 0.764824235244299, 'K_across': 0.764824235244299, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
-    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 1.4342812011199078, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 4.619481091176478, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 4.619481091176478, 'K_1': 2.630222574480542, 'K_2': 4.619481091176478, 'H_across': 0.7648242161335777, 'H_inverse_across': 0.7648242161335777, 'K_across': 0.7648242161335777, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
+    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 4.619481091176478, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 4.619481091176478, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 4.619481091176478, 'K_1': 2.630222574480542, 'K_2': 4.619481091176478, 'H_across': 0.7648242161335777, 'H_inverse_across': 0.7648242161335777, 'K_across': 0.7648242161335777, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
