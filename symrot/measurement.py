@@ -140,7 +140,36 @@ def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         # p = sinh(φ) cosh(φ): 1/p² is the factors sinh⁻² cosh⁻² of a larger product, no subtree
         # that xreplace could match; subs matches such sub-products (an exact substitution still)
         written = written.subs([(argument**2, X), (argument, S)])
+        written = _with_product_length(written, argument)
     return written
+
+
+def _with_product_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
+    """``expr`` with every power p^k (k ≠ 0 an integer) of a product p = c·∏ f_i^(e_i) of two or
+    more factors in φ that a product of ``expr`` holds, written as (s/c)^k, (x/c²)^(k/2) for even k.
+    ``subs`` misses p⁻¹ in 3 sin(φ)/(4 cosh(3φ/4) asin(3φ/4)) for p = 4 cosh(3φ/4) asin(3φ/4)/3
+    (the constant differs): R₁ then recomputed asin(3φ̂/4) next to its edge at φ = 4/3, where
+    the rounding of φ̂ costs 500 ulp (73 ulp of R at 4/3 − 10⁻⁵)."""
+    constant, rest = argument.as_independent(PHI, as_Add=False)
+    factors = rest.as_powers_dict()
+    if len(factors) < 2 or constant == 0:
+        return expr
+
+    def holds_a_power(term: sp.Expr) -> bool:
+        return isinstance(term, sp.Mul) and all(base in term.as_powers_dict() for base in factors)
+
+    def factor_out(term: sp.Expr) -> sp.Expr:
+        powers = term.as_powers_dict()
+        ratios = [powers[base] / exponent for base, exponent in factors.items()]
+        if not all(r.is_Rational and r * ratios[0] > 0 for r in ratios):
+            return term
+        k = int(min(ratios, key=abs))  # the largest whole power of p in the product
+        if k == 0:
+            return term
+        length = (X / constant**2) ** (k // 2) if k % 2 == 0 else (S / constant) ** k
+        return term * rest ** -k * length
+
+    return expr.replace(holds_a_power, factor_out)
 
 
 @lru_cache(maxsize=8)

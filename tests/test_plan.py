@@ -125,6 +125,18 @@ def test_forms_in_s_and_x_are_found_inside_products_and_sums() -> None:
     total = sp.sin(PHI) / 2 + sp.sinh(PHI) / 2
     assert with_length(8 * sp.sin(PHI / 4) ** 2 / (sp.sin(PHI) + sp.sinh(PHI)) ** 2, total) == \
         2 * sp.sin(PHI / 4) ** 2 / X
+    # a constant factor in p that the product does not share (hypothesis rows 42-43: R_1 recomputed
+    # asin(3 phi/4) from the rounded angle, 73 ulp of R at 4/3 - 1e-5), and powers left over
+    scaled = sp.Rational(4, 3) * sp.cosh(3 * PHI / 4) * sp.asin(3 * PHI / 4)
+    forms = [3 * sp.sin(PHI) / (4 * sp.cosh(3 * PHI / 4) * sp.asin(3 * PHI / 4)),
+             9 * sp.sin(PHI / 2) ** 2 / (8 * sp.cosh(3 * PHI / 4) ** 2 * sp.asin(3 * PHI / 4) ** 2),
+             sp.cosh(3 * PHI / 4) ** 3 * sp.asin(3 * PHI / 4) * sp.sin(PHI)]
+    written = [with_length(form, scaled) for form in forms]
+    assert written[:2] == [sp.sin(PHI) / S, 2 * sp.sin(PHI / 2) ** 2 / X]
+    assert written[2] == 3 * S * sp.sin(PHI) * sp.cosh(3 * PHI / 4) ** 2 / 4
+    for form, rewritten in zip(forms, written, strict=True):  # the same function of phi
+        back = rewritten.xreplace({X: scaled**2, S: scaled})
+        assert all(abs(sp.N((back - form).subs(PHI, angle), 30)) < 1e-25 for angle in (0.3, 1.1, 1.3))
 
 
 def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
