@@ -8,7 +8,8 @@ p = φ/(1 − φ²/10), p′ = (10φ² + 100)/(φ² − 10)² is 10⁶ ulp off a
 sweep (:mod:`symrot.domain`) ended the range at |p|² = 2³² (NaN from φ_max − 4·10⁻⁴).
 
 When p → ∞ like a logarithm, p = A + B·atanh(u) with u(φ_max) = 1, the factor 1 − u² of p′ and
-of the coefficients built from it vanishes the same way (:func:`_logarithmic_pole`).
+of the coefficients built from it vanishes the same way (:func:`_logarithmic_pole`); so it does
+where p = A + B·asin(u) stays finite and p′ → ∞ at u = ±1 (:func:`_arcsine_edge`).
 
 The backends have s = |p| as rounded input, so f = N/(D·s) is available to a few ulp wherever N and
 D are away from zero (for the logarithm, f = (1 + u)² exp(−2 (s − A)/B)): :func:`with_pole_factor`
@@ -79,7 +80,7 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         return None
     numerator, denominator = sp.fraction(quotient)
     if not denominator.has(PHI):
-        return _logarithmic_pole(p, phi_max)
+        return _logarithmic_pole(p, phi_max) or _arcsine_edge(p, phi_max)
     factored = bounded(2.0, None, sp.factor_list, denominator)
     if factored is None:
         return None
@@ -88,7 +89,7 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         roots = {f: (_root_near(f, phi_max), m) for f, m in factors if f.has(PHI)}
         vanishing = [(f, root, m) for f, (root, m) in roots.items() if root is not None]
         if not vanishing:
-            return _logarithmic_pole(p, phi_max)
+            return _logarithmic_pole(p, phi_max) or _arcsine_edge(p, phi_max)
         if len(vanishing) != 1 or vanishing[0][2] != 1:
             return None
         factor, root, _ = vanishing[0]
@@ -122,6 +123,30 @@ def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
             return None
     through_s = (1 + inner) ** 2 * sp.exp(-2 * (S - rest) / weight)
     return PoleFactor(factor, through_s, root)
+
+
+def _arcsine_edge(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """p = A + B·asin(u) (or acos(u)) with u(φ_max)² = 1: p stays finite, but p′ = A′ + B′ asin(u)
+    + B u′/√(1 − u²) → ∞, and f = 1 − u², in p′ and the coefficients built from it, loses digits
+    from the rounded φ̂ as a pole's factor does (hypothesis row 42, 4 cosh(3φ/4) asin(3φ/4)/3:
+    H 54 ulp off at 4/3 − 10⁻⁶). Through s, asin(u) = (s − A)/B, so f = cos²((s − A)/B)
+    (sin² for acos), whose error is that of (s − A)/B, next to π/2 (0): as conditioned as μ."""
+    calls = [call for call in p.atoms(sp.asin, sp.acos) if call.has(PHI)]
+    if len(calls) != 1:
+        return None
+    call = calls[0]
+    level = sp.Dummy("L")
+    linear = p.xreplace({call: level})
+    if not linear.is_polynomial(level) or sp.degree(linear, level) != 1:
+        return None
+    weight, rest = sp.diff(linear, level), linear.subs(level, 0)
+    factor = sp.expand(1 - call.args[0] ** 2)
+    with mpmath.workdps(ZERO_DIGITS):
+        root = _root_near(factor, phi_max)
+        if root is None or _value(weight, root) in (None, 0) or _value(rest, root) is None:
+            return None
+    angle = (S - rest) / weight
+    return PoleFactor(factor, (sp.cos(angle) if isinstance(call, sp.asin) else sp.sin(angle)) ** 2, root)
 
 
 def _value(expr: sp.Expr, phi: mpmath.mpf) -> mpmath.mpf | None:

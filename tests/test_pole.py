@@ -47,9 +47,9 @@ def test_the_factor_vanishes_at_the_pole_and_its_s_form_is_p_s_identity(text: st
 
 @pytest.mark.parametrize("text, phi_max", [("sin(phi)", "pi"), ("phi + phi**3/6", "2*pi"),
                                            ("phi/(1 - phi**2/10)**2", "sqrt(10)"),
-                                           ("2*asin(phi/2)", "2")])
+                                           ("sin(phi)*cosh(phi/3)", "pi/2")])
 def test_no_factor_without_a_simple_pole(text: str, phi_max: str) -> None:
-    """No pole (sin, a polynomial), a double pole, a bounded p whose p′ → ∞: nothing to rewrite."""
+    """No pole (sin, a polynomial, a fold), a double pole: nothing to rewrite."""
     assert pole_factor(_p(text), float(sp.sympify(phi_max))) is None
 
 
@@ -135,3 +135,44 @@ def test_a_logarithmic_pole_writes_one_minus_u_squared_through_s(text: str) -> N
         condition = float(p_of(theta) / weight(theta))
         assert _relative_error(rewritten, p, theta) <= 4 * (1 + condition), rewritten
         assert _relative_error(slope, p, theta) > 1e4
+
+
+ARCSINE_EDGES = {  # p = A + B asin(u) (acos), u(φ_max)² = 1, p′ → ∞: φ_max
+    "4*cosh(3*phi/4)*asin(3*phi/4)/3": "4/3",
+    "3*cosh(phi/3)*asin(phi/3)": "3",
+    "2*asin(phi/2)": "2",
+    "phi/10 + 2*acos(1 - phi/2)": "4",
+}
+
+
+@pytest.mark.parametrize("text", list(ARCSINE_EDGES))
+def test_an_arcsine_edge_writes_one_minus_u_squared_through_s(text: str) -> None:
+    """Hypothesis rows 42-44: p stays finite and p′ → ∞ through 1/√(1 − u²). f = 1 − u² is
+    cos²((s − A)/B) (sin² for acos); its condition number with respect to s is 2 s tan(y)/B
+    (y = (s − A)/B, cot y for acos), and p′ written through it stays within 4 (1 + that) ulp at
+    φ_max − 1.37·10⁻⁹ (it stays below 1 + that: 2.7·10³ to 3.3·10⁴ ulp where the condition number is
+    7·10⁴ to 1.8·10⁵), where p′ in φ̂ loses 10³ times more (54 ulp of H at 4/3 − 10⁻⁶)."""
+    p, phi_max = _p(text), sp.sympify(ARCSINE_EDGES[text])
+    pole = pole_factor(p, float(phi_max))
+    assert pole is not None and abs(sp.N(pole.factor.subs(PHI, phi_max), 40)) < 1e-35
+    identity = sp.lambdify(PHI, pole.through_s.subs(S, p) - pole.factor,
+                           modules=[mpmath_namespace(), "mpmath"])
+    with mpmath.workdps(50):
+        for fraction in ("0.1", "0.5", "0.9"):
+            assert abs(identity(mpmath.mpf(fraction) * mpmath.mpf(sp.N(phi_max, 50)))) < mpmath.mpf(10) ** -40
+    slope = sp.diff(p, PHI)
+    rewritten = with_pole_factor(slope, pole)
+    assert rewritten.has(S)
+    (call,) = p.atoms(sp.asin, sp.acos)
+    linear = p.xreplace({call: S})
+    weight = sp.lambdify(PHI, sp.diff(linear, S), "mpmath")
+    rest = sp.lambdify(PHI, linear.subs(S, 0), "mpmath")
+    p_of = sp.lambdify(PHI, p, "mpmath")
+    with mpmath.workdps(60):
+        theta = mpmath.mpf(sp.N(phi_max, 60)) - mpmath.mpf("1e-9") * mpmath.mpf("1.37")
+        y = (p_of(theta) - rest(theta)) / weight(theta)
+        slant = mpmath.tan(y) if isinstance(call, sp.asin) else mpmath.cot(y)
+        condition = float(abs(2 * p_of(theta) * slant / weight(theta)))
+        assert _relative_error(rewritten, p, theta) <= 4 * (1 + condition), rewritten
+        # in φ̂: 800-2100 times the condition number (5.6·10⁷ to 1.9·10⁸ ulp)
+        assert _relative_error(slope, p, theta) > 100 * (1 + condition)
