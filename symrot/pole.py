@@ -22,6 +22,7 @@ are more accurate.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 from typing import NamedTuple
 
@@ -99,39 +100,22 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     return PoleFactor(factor, numerator / (rest * S), root)
 
 
-def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
-    """p = A + B·atanh(u) with u(φ_max) = 1 (p → ∞ like a logarithm): f = 1 − u², the factor that
-    vanishes in p′ = A′ + B′ atanh(u) + B u′/(1 − u²) and in the coefficients built from it, written
-    through s as f = (1 + u)² exp(−2 (s − A)/B) (from 1 − u = (1 + u) e^(−2 atanh u)). Its relative
-    error is twice the absolute error of (s − A)/B, a few ε wherever B is not small; f from the
-    rounded φ loses ε φ_max/(φ_max − φ) (10⁵ ulp of det H for atanh(φ/2) terms at 2 − 10⁻⁶)."""
-    calls = [call for call in p.atoms(sp.atanh) if call.has(PHI)]
-    if len(calls) != 1:
-        return None
-    call = calls[0]
-    level = sp.Dummy("L")
-    linear = p.xreplace({call: level})
-    if not linear.is_polynomial(level) or sp.degree(linear, level) != 1:
-        return None
-    weight, rest = sp.diff(linear, level), linear.subs(level, 0)
-    inner = call.args[0]
-    factor = 1 - inner**2
-    with mpmath.workdps(ZERO_DIGITS):
-        root = _root_near(1 - inner, phi_max)
-        weight_at_root = None if root is None else _value(weight, root)
-        if root is None or weight_at_root in (None, 0) or _value(rest, root) is None:
-            return None
-    through_s = (1 + inner) ** 2 * sp.exp(-2 * (S - rest) / weight)
-    return PoleFactor(factor, through_s, root)
+class _LinearCall(NamedTuple):
+    """p = rest + weight·call for the one ``call`` of an inverse function, its edge where the
+    ``factor`` 1 − u² of p′ vanishes (u the call's argument), and that edge's angle."""
+
+    call: sp.Expr
+    weight: sp.Expr
+    rest: sp.Expr
+    factor: sp.Expr
+    root: mpmath.mpf
 
 
-def _arcsine_edge(p: sp.Expr, phi_max: float) -> PoleFactor | None:
-    """p = A + B·asin(u) (or acos(u)) with u(φ_max)² = 1: p stays finite, but p′ = A′ + B′ asin(u)
-    + B u′/√(1 − u²) → ∞, and f = 1 − u², in p′ and the coefficients built from it, loses digits
-    from the rounded φ̂ as a pole's factor does (hypothesis row 42, 4 cosh(3φ/4) asin(3φ/4)/3:
-    H 54 ulp off at 4/3 − 10⁻⁶). Through s, asin(u) = (s − A)/B, so f = cos²((s − A)/B)
-    (sin² for acos), whose error is that of (s − A)/B, next to π/2 (0): as conditioned as μ."""
-    calls = [call for call in p.atoms(sp.asin, sp.acos) if call.has(PHI)]
+def _linear_call(p: sp.Expr, functions: tuple[type[sp.Function], ...],
+                 vanishing: Callable[[sp.Expr], sp.Expr] | None, phi_max: float) -> _LinearCall | None:
+    """p linear in its one call of ``functions`` with 1 − u² (or ``vanishing``(u), a factor of it)
+    zero at ``phi_max`` and the weight and rest finite there (the weight nonzero), else None."""
+    calls = [call for call in p.atoms(*functions) if call.has(PHI)]
     if len(calls) != 1:
         return None
     call = calls[0]
@@ -142,11 +126,38 @@ def _arcsine_edge(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     weight, rest = sp.diff(linear, level), linear.subs(level, 0)
     factor = sp.expand(1 - call.args[0] ** 2)
     with mpmath.workdps(ZERO_DIGITS):
-        root = _root_near(factor, phi_max)
+        root = _root_near(factor if vanishing is None else vanishing(call.args[0]), phi_max)
         if root is None or _value(weight, root) in (None, 0) or _value(rest, root) is None:
             return None
-    angle = (S - rest) / weight
-    return PoleFactor(factor, (sp.cos(angle) if isinstance(call, sp.asin) else sp.sin(angle)) ** 2, root)
+    return _LinearCall(call, weight, rest, factor, root)
+
+
+def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """p = A + B·atanh(u) with u(φ_max) = 1 (p → ∞ like a logarithm): f = 1 − u², the factor that
+    vanishes in p′ = A′ + B′ atanh(u) + B u′/(1 − u²) and in the coefficients built from it, written
+    through s as f = (1 + u)² exp(−2 (s − A)/B) (from 1 − u = (1 + u) e^(−2 atanh u)). Its relative
+    error is twice the absolute error of (s − A)/B, a few ε wherever B is not small; f from the
+    rounded φ loses ε φ_max/(φ_max − φ) (10⁵ ulp of det H for atanh(φ/2) terms at 2 − 10⁻⁶)."""
+    found = _linear_call(p, (sp.atanh,), lambda u: 1 - u, phi_max)
+    if found is None:
+        return None
+    inner = found.call.args[0]
+    through_s = (1 + inner) ** 2 * sp.exp(-2 * (S - found.rest) / found.weight)
+    return PoleFactor(1 - inner**2, through_s, found.root)
+
+
+def _arcsine_edge(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """p = A + B·asin(u) (or acos(u)) with u(φ_max)² = 1: p stays finite, but p′ = A′ + B′ asin(u)
+    + B u′/√(1 − u²) → ∞, and f = 1 − u², in p′ and the coefficients built from it, loses digits
+    from the rounded φ̂ as a pole's factor does (hypothesis row 42, 4 cosh(3φ/4) asin(3φ/4)/3:
+    H 54 ulp off at 4/3 − 10⁻⁶). Through s, asin(u) = (s − A)/B, so f = cos²((s − A)/B)
+    (sin² for acos), whose error is that of (s − A)/B, next to π/2 (0): as conditioned as μ."""
+    found = _linear_call(p, (sp.asin, sp.acos), None, phi_max)
+    if found is None:
+        return None
+    angle = (S - found.rest) / found.weight
+    through_s = (sp.cos(angle) if isinstance(found.call, sp.asin) else sp.sin(angle)) ** 2
+    return PoleFactor(found.factor, through_s, found.root)
 
 
 def _value(expr: sp.Expr, phi: mpmath.mpf) -> mpmath.mpf | None:
