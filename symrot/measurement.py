@@ -28,6 +28,8 @@ EDGE_POINTS = 12
 JITTER = 0.0137
 JITTER_SAMPLES = 6
 REFERENCE_DIGITS = 60
+EQUAL_SUM_OPS = 80
+"""Largest sum (``count_ops``) compared with p by :func:`_with_equal_sums`: a size cap for ``cancel``."""
 OFF_GRID = mpmath.mpf("0.37")
 """Where between two neighbouring angles of the format the measured inputs lie: an angle that the
 format holds exactly would hide the rounding of φ̂ (θ of its rounded x is within 10⁻¹² of it
@@ -141,7 +143,35 @@ def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         # that xreplace could match; subs matches such sub-products (an exact substitution still)
         written = written.subs([(argument**2, X), (argument, S)])
         written = _with_product_length(written, argument)
+    if argument.is_Add and written.has(*argument.atoms(sp.Function)):
+        written = _with_equal_sums(written, argument)
     return written
+
+
+def _with_equal_sums(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
+    """``expr`` with every sum that is a constant multiple c·p of the sum p, written otherwise (the
+    simplified coefficients of φ cosh(3φ/2)/2 + 2 atan(φ/4)/(φ²/2 + 1) hold
+    φ cosh(3φ/2)/2 + 4 atan(φ/4)/(φ² + 2)), as c·s, and s² as x: G₂ = 2 sin²(φ/4)/p² recomputed
+    p from φ̂, 7 ulp next to 2π (hypothesis row 22). A sum qualifies when it has p's function calls
+    and (sum − c·p) cancels to 0 for c its ratio to p at one angle."""
+    calls = argument.atoms(sp.Function)
+
+    def is_multiple(node: sp.Expr) -> bool:
+        return (isinstance(node, sp.Add) and node.atoms(sp.Function) == calls
+                and sp.count_ops(node) <= EQUAL_SUM_OPS and _ratio(node, argument) is not None)
+
+    written = expr.replace(is_multiple, lambda node: _ratio(node, argument) * S)
+    return written.xreplace({S**2: X, S**-2: 1 / X}) if written != expr else expr
+
+
+@lru_cache(maxsize=4096)
+def _ratio(node: sp.Expr, argument: sp.Expr) -> sp.Rational | None:
+    """The rational c with node = c·argument identically, or None (the ratio is read at φ = 1/7,
+    inside every range, and proved by ``cancel``)."""
+    value = sp.nsimplify(sp.N((node / argument).subs(PHI, sp.Rational(1, 7)), 30), rational=True)
+    if not value.is_Rational or value == 0 or sp.cancel(sp.together(node - value * argument)) != 0:
+        return None
+    return value
 
 
 def _with_product_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:

@@ -137,6 +137,14 @@ def test_forms_in_s_and_x_are_found_inside_products_and_sums() -> None:
     for form, rewritten in zip(forms, written, strict=True):  # the same function of phi
         back = rewritten.xreplace({X: scaled**2, S: scaled})
         assert all(abs(sp.N((back - form).subs(PHI, angle), 30)) < 1e-25 for angle in (0.3, 1.1, 1.3))
+    # a sum written otherwise by simplification (hypothesis row 22: G_2 recomputed p from the
+    # rounded angle, 7 ulp next to 2 pi); a sum that is not a multiple of p stays
+    total = PHI * sp.cosh(3 * PHI / 2) / 2 + 2 * sp.atan(PHI / 4) / (PHI**2 / 2 + 1)
+    other = PHI * sp.cosh(3 * PHI / 2) + 8 * sp.atan(PHI / 4) / (PHI**2 + 2)  # 2 p
+    assert with_length(2 * sp.sin(PHI / 4) ** 2 / other**2, total) == sp.sin(PHI / 4) ** 2 / (2 * X)
+    assert with_length(sp.sin(PHI / 2) * other, total) == 2 * S * sp.sin(PHI / 2)
+    unrelated = PHI * sp.cosh(3 * PHI / 2) + sp.atan(PHI / 4)
+    assert with_length(1 / unrelated, total) == 1 / unrelated
 
 
 def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
