@@ -63,20 +63,35 @@ def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mappin
     exact = _reference_function(tuple(references.items()))
     angle_of = _angle_function(p, inverse, phi_max)
     complement = p_max * p_max if math.isfinite(p_max) else math.inf
+    floors = _floors(exact, references, math.isfinite(p_max))
     for k in range(FIRST_POWER, top + 1):
         for x, edge in ((2.0**k, 2.0 ** (k - 1)), (2.0**k * OFF_POWER, 2.0**k)):
             if x >= complement:
                 return 2.0**top
-            if not _right_at(x, k, models, exact, angle_of, complement, dtype):
+            if not _right_at(x, k, models, exact, angle_of, complement, dtype, floors):
                 return edge if edge >= 2.0**FIRST_POWER else 2.0**FIRST_POWER
     return 2.0**top
+
+
+def _floors(exact: Callable[[mpmath.mpf], dict[str, mpmath.mpf]], references: Mapping[str, sp.Expr],
+            bounded: bool) -> dict[str, float]:
+    """Scales below which a scalar is judged absolutely: det H at p = 0 for det H when p is bounded.
+    Then det H = μν² → 0 with ν at 2π, where it is ill conditioned in s (its form from φ̂ was 91 ulp
+    off at φ = 6.24 for √(φ²/2 + 1) sinh(2φ)/2, an imprecise result, not a wrong one, and the range
+    ended there, every output NaN up to 2π); the plan measures it against the same floor
+    (:data:`symrot.plan.OWN_SCALE`). Next to a pole (p unbounded) it keeps its relative accuracy."""
+    if not bounded or "det_H" not in references:
+        return {}
+    with mpmath.workdps(40):
+        return {"det_H": float(abs(exact(mpmath.mpf(10) ** -12)["det_H"]))}
 
 
 def _right_at(x: float, k: int, models: Mapping[str, Callable[..., Any]],
               exact: Callable[[mpmath.mpf], dict[str, mpmath.mpf]],
               angle_of: Callable[[float, int], mpmath.mpf],
-              complement: float, dtype: type) -> bool:
-    """Whether every printed form is finite and within :data:`WRONG_ULP` at x (2^k ≤ x < 2^(k+1))."""
+              complement: float, dtype: type, floors: Mapping[str, float]) -> bool:
+    """Whether every printed form is finite and within :data:`WRONG_ULP` at x (2^k ≤ x < 2^(k+1))
+    of its scale (:func:`_weight_and_scale`, at least ``floors``)."""
     epsilon = float(np.finfo(dtype).eps)
     digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
     with mpmath.workdps(digits):
@@ -96,6 +111,7 @@ def _right_at(x: float, k: int, models: Mapping[str, Callable[..., Any]],
                 continue
             value = float(model(*arguments))
             weight, scale = _weight_and_scale(name, values, s_exact)
+            scale = max(scale, floors.get(name, 0.0))
             allowed = WRONG_ULP * epsilon * max(scale, float(np.finfo(dtype).tiny))
             if not math.isfinite(value) or float(abs(mpmath.mpf(value) - reference) * weight) > allowed:
                 return False

@@ -143,3 +143,22 @@ def test_a_pole_at_pi_keeps_the_domain_open_past_the_measured_range() -> None:
     plan = evaluation_plan(derive("tan(phi/2) + sin(phi)/2").derivation, "pole_at_pi")
     assert plan.precisions["float64"].x_limit >= 2.0**100
     assert plan.precisions["float32"].x_limit >= 2.0**60
+
+
+def test_an_ill_conditioned_det_h_of_a_bounded_p_does_not_end_the_range() -> None:
+    """√(φ²/2 + 1) sinh(2φ)/2 (hypothesis row 53) reaches |p|² = 1.07·10¹¹ at 2π, where det H = μν²
+    → 0 with ν: from the rounded angle its form in φ is 91 ulp off itself at φ = 6.24, which the sweep
+    took for a wrong result and ended the range at 2³⁶ (every output NaN from φ = 6.06). Judged as
+    the plan measures it, against det H(0) when p is bounded, it is right up to the edge (relative
+    to itself, as next to a pole, the limit is 2³⁶ < p_max², measured)."""
+    from symrot.domain import _floors, domain_limit
+    from symrot.singularities import validity
+
+    derivation = derive("sqrt(phi**2/2 + 1)*sinh(2*phi)/2").derivation
+    limits = validity(derivation)
+    phi_max, p_max = float(limits.phi_max_float), float(limits.p_max_float)
+    det_h = derivation.scalars["det_H"]
+    printed = {"det_H": ("closed", det_h)}  # the form in φ the plan prints (or measures) for det H
+    limit = domain_limit(printed, {"det_H": det_h}, derivation.p, None, phi_max, p_max, np.float64)
+    assert limit > p_max**2
+    assert _floors(lambda phi: {"det_H": mpmath.mpf(1)}, {"det_H": det_h}, bounded=False) == {}
