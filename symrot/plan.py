@@ -142,11 +142,12 @@ def closed_inverse(p: sp.Expr, kappa: sp.Expr) -> sp.Expr | None:
         return S
     if p.has(RealCbrt) or not _solvable_shape(p):
         return None
-    try:
-        solutions: list[sp.Expr] = bounded(10, [], _hyperbolic_solutions, p)
-        solutions += bounded(10, [], sp.solve, sp.Eq(p, S), PHI)
-    except Exception:
-        return None  # no closed inverse: the plan uses the Newton angle
+    solutions: list[sp.Expr] = []
+    for solver in (_hyperbolic_solutions, lambda q: sp.solve(sp.Eq(q, S), PHI)):
+        try:  # one solver failing (NotImplementedError, its time bound) leaves the other's solutions
+            solutions += bounded(10, [], solver, p)
+        except Exception:
+            continue
     for candidate in solutions:
         if candidate.has(sp.I) or candidate.free_symbols != {S}:
             continue

@@ -32,7 +32,7 @@ for the sine family, ``D`` = p_max² − x):
 ``ClosedAngle(expression)``
     φ = expression(S), S = |p| = √x, the closed-form inverse of p(φ) (e.g. 4 atan(S/4); for the
     sine family k asin(S/k) becomes k atan2(S, √D), accurate up to the fold).
-``NewtonAngle(start, ratio, slope, iterations, phi_max, far, reciprocal)``
+``NewtonAngle(start, ratio, slope, iterations, phi_max, far, reciprocal, converges_below)``
     φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s (on 1/(φ·g(φ²)) − 1/s if ``reciprocal``),
     started from the odd reverted series φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from
     the fold-aware interpolant ``far`` (:mod:`symrot.newton_start`) above it, where ``ratio`` = g
@@ -46,7 +46,6 @@ for the sine family, ``D`` = p_max² − x):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import mpmath
@@ -102,12 +101,12 @@ class NewtonAngle:
     phi_max: float
     far: FarStart
     """The start for s ≥ far.switch (see :mod:`symrot.newton_start`)."""
-    reciprocal: bool = False
+    reciprocal: bool
     """Steps of Newton on 1/p(φ) = 1/s instead of p(φ) = s: the step (s − p)/p′ times p/s. Used when
     p is unbounded (a pole at φ_max), where 1/p is nearly linear: the direct step from a start just
     below the pole moves by less than half an ulp (row 96 of docs/accuracy_hypothesis.md stayed
     10⁻⁶ off for 64 steps)."""
-    converges_below: float = math.inf
+    converges_below: float
     """The smallest s = |p| of the plan's checks whose angle ``iterations`` steps do not reach
     (:func:`symrot.newton_start.measured_iterations`); the precision's range ends below it."""
 
