@@ -104,6 +104,23 @@ def test_multiples_of_the_factor_angle_that_vanish_with_it_are_expanded() -> Non
         assert _relative_error(form, p, theta) > 1e4
 
 
+def _slope_through_s(p: sp.Expr, phi_max: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
+    """(p′, p′ with the edge's factor written through s), after checking that the factor vanishes at
+    φ_max and that its form through s equals it where s = p (at 0.1, 0.5 and 0.9 φ_max)."""
+    pole = pole_factor(p, float(phi_max))
+    assert pole is not None and abs(sp.N(pole.factor.subs(PHI, phi_max), 40)) < 1e-35
+    identity = sp.lambdify(PHI, pole.through_s.subs(S, p) - pole.factor,
+                           modules=[mpmath_namespace(), "mpmath"])
+    with mpmath.workdps(50):
+        for fraction in ("0.1", "0.5", "0.9"):
+            angle = mpmath.mpf(fraction) * mpmath.mpf(sp.N(phi_max, 50))
+            assert abs(identity(angle)) < mpmath.mpf(10) ** -40
+    slope = sp.diff(p, PHI)
+    rewritten = with_pole_factor(slope, pole)
+    assert rewritten.has(S)
+    return slope, rewritten
+
+
 LOGARITHMIC_POLES = {  # p = A + B atanh(u), u(φ_max) = 1: φ_max
     "2*cos(2*phi)*atanh(3*phi/2)/3": "2/3",
     "3*phi*cos(phi/2)/11 + 6*sinh(phi)/(11*(3*phi**2/2 + 1)) + 8*atanh(3*phi/4)/(33*(phi**2/4 + 1))": "4/3",
@@ -117,16 +134,7 @@ def test_a_logarithmic_pole_writes_one_minus_u_squared_through_s(text: str) -> N
     and p′ written through it stays within 4 (1 + s/B) ulp at φ_max − 1.37·10⁻⁹ (14 and 25 ulp),
     where p′ in φ has lost more than 10⁴ ulp (row 15: 1.5·10⁵ ulp of det H at φ_max − 10⁻⁶)."""
     p, phi_max = _p(text), sp.sympify(LOGARITHMIC_POLES[text])
-    pole = pole_factor(p, float(phi_max))
-    assert pole is not None and abs(sp.N(pole.factor.subs(PHI, phi_max), 40)) < 1e-35
-    identity = sp.lambdify(PHI, pole.through_s.subs(S, p) - pole.factor,
-                           modules=[mpmath_namespace(), "mpmath"])
-    with mpmath.workdps(50):
-        for angle in ("0.1", "0.4", "0.6"):
-            assert abs(identity(mpmath.mpf(angle))) < mpmath.mpf(10) ** -40
-    slope = sp.diff(p, PHI)
-    rewritten = with_pole_factor(slope, pole)
-    assert rewritten.has(S)
+    slope, rewritten = _slope_through_s(p, phi_max)
     (call,) = p.atoms(sp.atanh)
     weight = sp.lambdify(PHI, sp.diff(p.xreplace({call: S}), S), "mpmath")
     p_of = sp.lambdify(PHI, p, "mpmath")
@@ -153,16 +161,7 @@ def test_an_arcsine_edge_writes_one_minus_u_squared_through_s(text: str) -> None
     φ_max − 1.37·10⁻⁹ (it stays below 1 + that: 2.7·10³ to 3.3·10⁴ ulp where the condition number is
     7·10⁴ to 1.8·10⁵), where p′ in φ̂ loses 10³ times more (54 ulp of H at 4/3 − 10⁻⁶)."""
     p, phi_max = _p(text), sp.sympify(ARCSINE_EDGES[text])
-    pole = pole_factor(p, float(phi_max))
-    assert pole is not None and abs(sp.N(pole.factor.subs(PHI, phi_max), 40)) < 1e-35
-    identity = sp.lambdify(PHI, pole.through_s.subs(S, p) - pole.factor,
-                           modules=[mpmath_namespace(), "mpmath"])
-    with mpmath.workdps(50):
-        for fraction in ("0.1", "0.5", "0.9"):
-            assert abs(identity(mpmath.mpf(fraction) * mpmath.mpf(sp.N(phi_max, 50)))) < mpmath.mpf(10) ** -40
-    slope = sp.diff(p, PHI)
-    rewritten = with_pole_factor(slope, pole)
-    assert rewritten.has(S)
+    slope, rewritten = _slope_through_s(p, phi_max)
     (call,) = p.atoms(sp.asin, sp.acos)
     linear = p.xreplace({call: S})
     weight = sp.lambdify(PHI, sp.diff(linear, S), "mpmath")
