@@ -41,8 +41,9 @@ from ..plan import (
     S,
     evaluation_plan,
 )
+from ..plan_ir import ANGLE_CORRECTION_GROWTH
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
-from .numpy_backend import SUFFIX, print_expression, uses_phi
+from .numpy_backend import SUFFIX, angle_low_helpers, print_expression, uses_phi
 from .templating import render
 
 FRAMEWORKS = ("jax", "torch")
@@ -163,6 +164,19 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
     ]
 
 
+def angle_low_lines(angle: NewtonAngle, suffix: str) -> list[str]:
+    """λ ≈ φ* − φ, one more Newton correction of the iterate φ where p grows fast enough for it to
+    help (0 elsewhere); see ``EvaluationPlan.angle_correction``."""
+    return [
+        f"value = phi * _ratio_{suffix}(phi * phi, phi)",
+        f"slope = _slope_{suffix}(phi * phi, phi)",
+        f"useful = phi * slope > {ANGLE_CORRECTION_GROWTH!r} * s",
+        "low = (s - value) / _where(useful, slope, 1.0)"
+        + (" * (value / _where(s > 0, s, 1.0))" if angle.reciprocal else ""),
+        "return _where(useful, low, 0.0)",
+    ]
+
+
 def _far_variable(far: FarStart) -> str:
     if far.kind == "fold":
         inner = f"_xp.clip(1.0 - s / {far.scale!r}, 0.0, None)"
@@ -220,6 +234,9 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
                                   "body": branch_lines(branch, "t", None)})
             functions.append({"name": f"_newton_{suffix}", "args": "s",
                               "body": newton_lines(angle, suffix)})
+            if label in plan.angle_correction().values():
+                functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi",
+                                  "body": angle_low_lines(angle, suffix)})
             newton.append(suffix)
         else:
             assert isinstance(angle, ClosedAngle)
@@ -231,6 +248,7 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
     finite_p_max = math.isfinite(plan.p_max)
     return {"framework": framework, "name": plan.name, "p_text": str(plan.p), "functions": functions,
             "newton": newton, "closed_angles": closed_angles,
+            "angle_low": angle_low_helpers(plan),
             "names": list(plan.precisions["float64"].coefficients),
             "across": repr(tuple(sorted(plan.across_tensors()))),
             "e0_min": repr(plan.e0_min) if plan.e0_min is not None else None,

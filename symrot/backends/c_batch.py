@@ -51,7 +51,7 @@ from .c_functions import (
 )
 from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
 from .c_sincos import TRIG, SinCosWriter
-from .c_writer import PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
+from .c_writer import HALF_LOW, PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
 
 BLOCK = "SYMROT_BATCH_BLOCK"
 DEFAULT_BLOCK = 32
@@ -125,12 +125,13 @@ class BatchWriter:
             if isinstance(coefficient, Algebraic):
                 closed[name] = self.vectorize(coefficient.expression.subs(X, X_SYMBOL), lanes)
             elif isinstance(coefficient, Branch):
-                closed[name] = self.vectorize(coefficient.closed.subs({PHI: PHI_SYMBOL, X: X_SYMBOL}), lanes)
+                form = coefficient.closed.subs({PHI: PHI_SYMBOL, X: X_SYMBOL})
+                closed[name] = self.vectorize(writer.half_angle_corrected(form), lanes)
         replacements, reduced = sp.cse(list(closed.values()), symbols=sp.numbered_symbols("w"))
         used: set[sp.Basic] = set().union(*(e.free_symbols for e in closed.values()))
         if lanes.trig:
             used.add(PHI_SYMBOL)
-        inputs = [symbol for symbol in (S, D, PHI_SYMBOL, *lanes.atoms.values()) if symbol in used]
+        inputs = [symbol for symbol in (S, D, PHI_SYMBOL, HALF_LOW, *lanes.atoms.values()) if symbol in used]
         branches = [name for name in names if isinstance(plan[name], Branch)]
         arrays = [f"{name}_lanes[{BLOCK}]" for name in ["x", *(str(s) for s in inputs)]]
         arrays += [f"c_{name}_lanes[{BLOCK}]" for name in names]
@@ -252,7 +253,7 @@ class BatchWriter:
         (and at or above ``below``, where a closed form is used)."""
         writer = self.writer
         needs = set(inputs) | set().union(*(atom.free_symbols for atom in lanes.atoms))
-        if lanes.trig:
+        if lanes.trig or HALF_LOW in needs:
             needs.add(PHI_SYMBOL)
         if PHI_SYMBOL in needs:
             needs.add(S)
@@ -266,6 +267,9 @@ class BatchWriter:
             inside.append({"kind": "let", "type": self.t, "name": "s", "value": f"sqrt{self.f}(x)"})
         if PHI_SYMBOL in needs:
             inside.append({"kind": "let", "type": self.t, "name": "phi", "value": writer.angle_call("s")})
+        if HALF_LOW in needs:
+            inside.append({"kind": "let", "type": self.t, "name": "half_low",
+                           "value": writer.half_low_call("s", "phi")})
         inside += [writer.let(str(symbol), atom) for atom, symbol in lanes.atoms.items()]
         inside += [{"kind": "set", "name": f"{symbol}_lanes[k]", "value": str(symbol)} for symbol in inputs]
         zero = [{"kind": "set", "name": f"{symbol}_lanes[k]", "value": "0"} for symbol in inputs]

@@ -40,7 +40,16 @@ from ..algebraic import S, X
 from ..errors import NonFiniteLiteral
 from ..newton_start import FarStart
 from ..parsing import PHI
-from ..plan_ir import Algebraic, Branch, ClosedAngle, Constant, EvaluationPlan, NewtonAngle, PrecisionPlan
+from ..plan_ir import (
+    ANGLE_CORRECTION_GROWTH,
+    Algebraic,
+    Branch,
+    ClosedAngle,
+    Constant,
+    EvaluationPlan,
+    NewtonAngle,
+    PrecisionPlan,
+)
 from .c_functions import (
     OUTPUT_NAMES,
     TENSOR_OF,
@@ -67,6 +76,8 @@ X_SYMBOL = sp.Symbol("x", real=True)
 S_SYMBOL = sp.Symbol("s", real=True)
 PHI_SYMBOL = sp.Symbol("phi", real=True)
 T_SYMBOL = sp.Symbol("t", real=True)
+HALF_LOW = sp.Symbol("half_low", real=True)
+"""λ/2, half the part of the Newton angle below φ's last bit (``EvaluationPlan.angle_correction``)."""
 
 
 def ops_of(statements: list[Statement]) -> int:
@@ -280,6 +291,81 @@ class FunctionWriter:
             {"kind": "return", "value": "phi"},
         ]
 
+    # -- λ, the Newton angle below φ's last bit ---------------------------------------------------
+    @property
+    def corrects_angle(self) -> bool:
+        """Whether this precision's half-angle sine and cosine take λ (a Newton angle)."""
+        return PLAN_LABEL[self.precision] in self.plan.angle_correction()
+
+    def half_angle_corrected(self, expr: sp.Expr) -> sp.Expr:
+        """``expr`` with sin(φ/2) → sin(φ/2) + (λ/2) cos(φ/2) and cos(φ/2) → cos(φ/2) − (λ/2) sin(φ/2)
+        where the angle is a Newton iteration (see ``EvaluationPlan.angle_correction``)."""
+        if not self.corrects_angle:
+            return expr
+        sine, cosine = sp.sin(PHI_SYMBOL / 2), sp.cos(PHI_SYMBOL / 2)
+        return expr.xreplace({sine: sine + HALF_LOW * cosine, cosine: cosine - HALF_LOW * sine})
+
+    def low_helper(self, precision: Precision) -> str:
+        return f"symrot_{self.header}__phi_low{'' if precision == 'double' else '_f'}"
+
+    @property
+    def half_low_helper(self) -> str:
+        return f"symrot_{self.header}__half_low{self.suffix}"
+
+    def half_low_call(self, s_text: str, phi_text: str) -> str:
+        return f"{self.half_low_helper}({s_text}, {phi_text})"
+
+    def angle_low_functions(self) -> list[dict[str, Any]]:
+        """The helpers λ(s, φ) (one more Newton correction of φ; only in the precision whose ratio
+        and slope serve, see ``EvaluationPlan.angle_correction``) and λ/2 for this precision, 0
+        unless |λ| ≤ 4 ε φ."""
+        correction = self.plan.angle_correction()
+        label = PLAN_LABEL[self.precision]
+        if label not in correction:
+            return []
+        t = self.ctype
+        functions = []
+        angle = self.precision_plan.angle
+        if correction[label] == label and isinstance(angle, NewtonAngle):
+            step = ("(s - value) / slope * (value / (s > 0 ? s : 1))" if angle.reciprocal
+                    else "(s - value) / slope")
+            growth = self.printer.literal(sp.Float(ANGLE_CORRECTION_GROWTH))
+            statements: list[Statement] = [
+                self.let("t", PHI_SYMBOL**2),
+                {"kind": "declare", "type": t, "names": ["ratio", "slope"]},
+                self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
+                self.branch_value(angle.slope, T_SYMBOL, "slope"),
+                self.let("value", PHI_SYMBOL * sp.Symbol("ratio")),
+                {"kind": "return", "value": f"phi * slope > {growth} * s ? {step} : 0", "ops": 7},
+            ]
+            signature = f"{t} {self.low_helper(self.precision)}({t} s, {t} phi)"
+            functions.append({
+                "c_name": self.low_helper(self.precision), "equation": "11",
+                "summary": "internal: lambda, the Newton angle below the last bit of phi",
+                "notes": ["One more Newton correction of phi where phi p'/p exceeds "
+                           f"{ANGLE_CORRECTION_GROWTH:g} (0 elsewhere)."],
+                "ops": ops_of(statements), "signature": signature,
+                "statements": statements, "batch_signature": None, "output": None})
+        source: Precision = "double" if correction[label] == "float64" else "float"
+        bound = self.printer.literal(sp.Float(4 * self.precision_plan.epsilon, 17))
+        f = "" if self.precision == "double" else "f"
+        half = self.printer.literal(sp.Float(0.5))
+        statements = [
+            {"kind": "let", "type": t, "name": "correction", "ops": 0,
+             "value": f"({t}){self.low_helper(source)}((double)s, (double)phi)" if source != self.precision
+             else f"{self.low_helper(source)}(s, phi)"},
+            {"kind": "return", "ops": 4,
+             "value": f"fabs{f}(correction) <= {bound} * phi ? {half} * correction : 0"},
+        ]
+        functions.append({
+            "c_name": self.half_low_helper, "equation": "11",
+            "summary": "internal: lambda/2 for sin(phi/2) and cos(phi/2)",
+            "notes": ["Half of the Newton angle below the last bit of phi, 0 unless within 4 units of",
+                      "roundoff: sin(phi/2) + cos(phi/2) lambda/2 is accurate next to 2 pi."],
+            "ops": ops_of(statements), "signature": f"{t} {self.half_low_helper}({t} s, {t} phi)",
+            "statements": statements, "batch_signature": None, "output": None})
+        return functions
+
     def far_variable(self, far: FarStart) -> str:
         """v(s) of the far-field Newton start (symrot.newton_start), as C."""
         f = "" if self.precision == "double" else "f"
@@ -324,15 +410,21 @@ class FunctionWriter:
         statements.append({"kind": "declare", "type": self.ctype, "names": [f"c_{n}" for n in branches]})
         smallest = min(b.threshold for b in branches.values())  # type: ignore[union-attr]
         below = [self.set(f"c_{n}", horner(b.horner, X_SYMBOL)) for n, b in branches.items()]  # type: ignore[union-attr]
-        closed = [b.closed.subs(PHI, PHI_SYMBOL) for b in branches.values()]  # type: ignore[union-attr]
+        closed = [self.half_angle_corrected(b.closed.subs(PHI, PHI_SYMBOL))  # type: ignore[union-attr]
+                  for b in branches.values()]
         replacements, reduced = sp.cse(closed, symbols=sp.numbered_symbols("w"))
         above: list[Statement] = []
         if any(b.closed.has(PHI) for b in branches.values()):  # type: ignore[union-attr]
             above.append({"kind": "let", "type": self.ctype, "name": "phi",
                           "value": self.angle_call(self.c(sp.sqrt(X_SYMBOL))),
                           "ops": 2 + ops_of(self.angle_function()["statements"])})
-        if any(b.closed.has(S) for b in branches.values()):  # type: ignore[union-attr]
+        corrected = any(c.has(HALF_LOW) for c in closed)
+        if corrected or any(b.closed.has(S) for b in branches.values()):  # type: ignore[union-attr]
             above.append(self.let("s", sp.sqrt(X_SYMBOL)))
+        if corrected:
+            above.append({"kind": "let", "type": self.ctype, "name": "half_low",
+                          "value": self.half_low_call("s", "phi"),
+                          "ops": sum(ops_of(f["statements"]) for f in self.angle_low_functions())})
         above += [self.let(str(symbol), value) for symbol, value in replacements]
         for (name, branch), value in zip(branches.items(), reduced, strict=True):
             assert isinstance(branch, Branch)

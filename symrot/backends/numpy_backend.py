@@ -41,6 +41,7 @@ from ..plan import (
     S,
     evaluation_plan,
 )
+from ..plan_ir import ANGLE_CORRECTION_GROWTH
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 from .numpy_derivatives import derivative_lines, rate_lines
 from .templating import render
@@ -196,6 +197,19 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
     ]
 
 
+def _angle_low_lines(angle: NewtonAngle) -> list[str]:
+    """λ ≈ φ* − φ, one more Newton correction of the iterate φ where p grows fast enough for it to
+    help (0 elsewhere); see ``EvaluationPlan.angle_correction``."""
+    return [
+        "value = phi * _ratio(phi * phi)",
+        "slope = _slope(phi * phi, phi)",
+        f"useful = phi * slope > {ANGLE_CORRECTION_GROWTH!r} * s",
+        "low = (s - value) / numpy.where(useful, slope, 1.0)"
+        + (" * (value / numpy.where(s > 0, s, 1.0))" if angle.reciprocal else ""),
+        "return numpy.where(useful, low, 0.0).astype(s.dtype)",
+    ]
+
+
 def _far_variable(far: FarStart) -> str:
     """v(s) of the far-field Newton start (symrot.newton_start)."""
     if far.kind == "fold":
@@ -210,7 +224,7 @@ def _far_variable(far: FarStart) -> str:
 def module_context(plan: EvaluationPlan) -> dict[str, Any]:
     functions: list[dict[str, Any]] = []
     for label, precision in plan.precisions.items():
-        functions.extend(module_context_functions(precision, SUFFIX[label]))
+        functions.extend(module_context_functions(precision, SUFFIX[label], angle_low_helpers(plan)))
     p_max = plan.p_max
     e0_min = repr(plan.e0_min) if plan.e0_min is not None else None
     squared, inclusive = plan.boundary(53)  # float32 x compares exactly against the double bound
@@ -230,6 +244,7 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
                                          for label in plan.precisions},
             "derivative_lines": derivative_lines(), "rate_lines": rate_lines(),
+            "angle_low": angle_low_helpers(plan),
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()},
             "switch": {SUFFIX[label]: {n: branch_switch(c) for n, c in precision.coefficients.items()
@@ -237,12 +252,20 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
                        for label, precision in plan.precisions.items()}}
 
 
+def angle_low_helpers(plan: EvaluationPlan) -> dict[str, dict[str, str]]:
+    """{suffix: {"helper": its _angle_low function, "bound": 4 ε}} (``EvaluationPlan.angle_correction``)."""
+    return {SUFFIX[label]: {"helper": f"_angle_low_{SUFFIX[source]}",
+                            "bound": repr(4 * plan.precisions[label].epsilon)}
+            for label, source in plan.angle_correction().items()}
+
+
 def uses_phi(coefficient: Any) -> bool:
     """Whether the coefficient's code needs the angle φ (a Branch whose closed form has φ)."""
     return isinstance(coefficient, Branch) and coefficient.closed.has(PHI)
 
 
-def module_context_functions(precision: Any, suffix: str) -> list[dict[str, Any]]:
+def module_context_functions(precision: Any, suffix: str,
+                             angle_low: dict[str, dict[str, str]]) -> list[dict[str, Any]]:
     functions = []
     for name, coefficient in precision.coefficients.items():
         if isinstance(coefficient, Constant):
@@ -266,9 +289,15 @@ def module_context_functions(precision: Any, suffix: str) -> list[dict[str, Any]
         for helper, branch in (("_ratio", angle.ratio), ("_slope", angle.slope)):
             functions.append({"name": f"{helper}_{suffix}", "args": "t, phi",
                               "body": _branch_lines(branch, "t", "phi")})
-    angle_body = [line.replace("_ratio(phi * phi)", f"_ratio_{suffix}(phi * phi, phi)")
-                  .replace("_slope(", f"_slope_{suffix}(") for line in _angle_lines(angle)]
-    functions.append({"name": f"_angle_{suffix}", "args": "s, d", "body": angle_body})
+    def helpers(lines: list[str]) -> list[str]:
+        return [line.replace("_ratio(phi * phi)", f"_ratio_{suffix}(phi * phi, phi)")
+                .replace("_slope(", f"_slope_{suffix}(") for line in lines]
+
+    functions.append({"name": f"_angle_{suffix}", "args": "s, d", "body": helpers(_angle_lines(angle))})
+    if isinstance(angle, NewtonAngle) and any(low["helper"] == f"_angle_low_{suffix}"
+                                              for low in angle_low.values()):
+        functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi",
+                          "body": helpers(_angle_low_lines(angle))})
     functions.append({"name": f"_scale_{suffix}", "args": "e0, e_norm",
                       "body": _scale_lines(precision.quaternion_scale, suffix)})
     return functions
