@@ -93,37 +93,6 @@ static inline double symrot_det_h_one__phi(double s)
     return phi;
 }
 
-/* symrot_det_h_one__phi_low: internal: lambda, the Newton angle below the last bit of phi (eq 11).
- * One more Newton correction of phi where phi p'/p exceeds 4 (0 elsewhere).
- * ops: 57 */
-static inline double symrot_det_h_one__phi_low(double s, double phi)
-{
-    const double t = (phi*phi);
-    double ratio, slope;
-    if (t < 0.7851233626304374) {
-        ratio = t*(t*(t*(t*(t*(t*((-5.032990449379227e-15)*t - 41.0/254270016000000.0) + 19.0/1816214400000.0) + 1.0/349272000.0)) + 1.0/8400.0) - 1.0/60.0) + 1;
-    } else {
-        ratio = cbrt(6*phi - 6*sin(phi))/phi;
-    }
-    if (t < 1.5083706105984371) {
-        slope = t*(t*(t*(t*(t*(t*(t*(t*((-1.2684836118177708e-17)*t - 1.2818613276093299e-15) - 89.0/1178888256000000.0) - 41.0/19559232000000.0) + 19.0/165110400000.0) + 1.0/38808000.0)) + 1.0/1680.0) - 1.0/20.0) + 1;
-    } else {
-        slope = 2*(1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-    }
-    const double value = phi*ratio;
-    return phi * slope > 4.0 * s ? (s - value) / slope : 0;
-}
-
-/* symrot_det_h_one__half_low: internal: lambda/2 for sin(phi/2) and cos(phi/2) (eq 11).
- * Half of the Newton angle below the last bit of phi, 0 unless within 4 units of
- * roundoff: sin(phi/2) + cos(phi/2) lambda/2 is accurate next to 2 pi.
- * ops: 4 */
-static inline double symrot_det_h_one__half_low(double s, double phi)
-{
-    const double correction = symrot_det_h_one__phi_low(s, phi);
-    return fabs(correction) <= 8.881784197001252e-16 * phi ? 0.5 * correction : 0;
-}
-
 /* symrot_det_h_one_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
@@ -280,7 +249,7 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * H_across: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 707 */
+ * ops: 640 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -303,18 +272,14 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = sin(phi);
         const double w1 = cbrt(6*phi - 6*w0);
         const double w2 = (1.0/2.0)*phi;
         const double w3 = sin(w2);
-        const double w4 = cos(w2);
-        const double w5 = half_low*w4 + w3;
-        const double w6 = w5*(-half_low*w3 + w4);
+        const double w4 = w3*cos(w2);
         c_H_across = w0/w1;
         c_H_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w6 + (1.0/2.0)*sin(2*phi))/((w5*w5)*(phi - 2*w6));
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w4 + (1.0/2.0)*sin(2*phi))/((w3*w3)*(phi - 2*w4));
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -331,12 +296,12 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -346,29 +311,24 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             x_lanes[k] = x;
             if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double half_low = symrot_det_h_one__half_low(s, phi);
                 const double u0 = cbrt(6*(phi - sin(phi)));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double half_low = half_low_lanes[k];
             const double u0 = u0_lanes[k];
             const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
@@ -404,13 +364,12 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double a2_h = rint(0.5*a2_j - 0.25);
             const double a2_odd = a2_j - 2*a2_h;
             const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const double w0 = cos1*half_low + sin1;
-            const double w1 = w0*(cos1 - half_low*sin1);
+            const double w0 = cos1*sin1;
             c_H_across_lanes[k] = sin0/u0;
             poly_H_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
             c_H_1_lanes[k] = (1 - cos0)/(u0*u0);
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-            c_H_2_lanes[k] = (1.0/12.0)*(3*phi + (1.0/2.0)*sin2 - 8*w1)/((w0*w0)*(phi - 2*w1));
+            c_H_2_lanes[k] = (1.0/12.0)*(3*phi + (1.0/2.0)*sin2 - 8*w0)/((sin1*sin1)*(phi - 2*w0));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -450,7 +409,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
  * H_inverse_across: Horner degree 12 in x below x = 0.764824, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 664 */
+ * ops: 597 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -472,19 +431,15 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = sin(phi);
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = cos(w1);
-        const double w4 = half_low*w3 + w2;
-        const double w5 = (w4*w4);
-        const double w6 = 1.0/w5;
-        const double w7 = 6*phi;
-        const double w8 = w4*(-half_low*w2 + w3);
-        c_H_inverse_across = (1.0/4.0)*w0*w6*cbrt(6*phi - 6*w0);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w6*(-8*w5 + w7*w8 + pow(1 - 2*w5, 2) - 1)/pow(cbrt(w7 - 12*w8), 4);
+        const double w3 = (w2*w2);
+        const double w4 = 1.0/w3;
+        const double w5 = 6*phi;
+        const double w6 = w2*cos(w1);
+        c_H_inverse_across = (1.0/4.0)*w0*w4*cbrt(6*phi - 6*w0);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w4*(-8*w3 + w5*w6 + pow(1 - 2*w3, 2) - 1)/pow(cbrt(w5 - 12*w6), 4);
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -501,12 +456,12 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*(-half_low*sin(phi/2) + cos(phi/2))*(half_low*cos(phi/2) + sin(phi/2))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -516,17 +471,14 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             x_lanes[k] = x;
             if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double half_low = symrot_det_h_one__half_low(s, phi);
                 const double u0 = cbrt(6*(phi - sin(phi)));
-                const double u1 = cbrt(6*phi - 12*(-half_low*sin((1.0/2.0)*phi) + cos((1.0/2.0)*phi))*(half_low*cos((1.0/2.0)*phi) + sin((1.0/2.0)*phi)));
+                const double u1 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -534,7 +486,6 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
         }
@@ -542,7 +493,6 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double half_low = half_low_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -567,12 +517,11 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = cos0*half_low + sin0;
-            const double w1 = (w0*w0);
-            const double w2 = 1.0/w1;
-            c_H_inverse_across_lanes[k] = (1.0/4.0)*sin1*u0*w2;
+            const double w0 = (sin0*sin0);
+            const double w1 = 1.0/w0;
+            c_H_inverse_across_lanes[k] = (1.0/4.0)*sin1*u0*w1;
             poly_H_inverse_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.847696164362506e-14)*x - 2.227352392712e-13) - 2.7052088947240463e-12) - 3.316097701005811e-11) - 4.112699899093853e-10) - 11192989.0/2161295136000000.0) - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
-            c_H_inverse_2_lanes[k] = -1.0/2.0*w2*(6*phi*w0*(cos0 - half_low*sin0) - 8*w1 + ((1 - 2*w1)*(1 - 2*w1)) - 1)/(u1*u1*u1*u1);
+            c_H_inverse_2_lanes[k] = -1.0/2.0*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u1*u1*u1*u1);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -622,7 +571,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 12 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * G_2: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
- * ops: 639 */
+ * ops: 573 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -644,12 +593,9 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
         c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = cbrt(6*(phi - sin(phi)));
-        c_G_1 = (half_low*cos(w0) + sin(w0))/w1;
-        c_G_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w1*w1);
+        const double w0 = cbrt(6*(phi - sin(phi)));
+        c_G_1 = sin((1.0/2.0)*phi)/w0;
+        c_G_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w0*w0);
     }
     const double t = -c_G_2*x + 1;
     G[0] = c_G_2*(p[0]*p[0]) + t;
@@ -667,12 +613,12 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -682,29 +628,24 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             x_lanes[k] = x;
             if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double half_low = symrot_det_h_one__half_low(s, phi);
                 const double u0 = cbrt(6*(phi - sin(phi)));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double half_low = half_low_lanes[k];
             const double u0 = u0_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
@@ -716,8 +657,6 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double a1_a = (1.0/4.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
@@ -728,7 +667,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_G_1_lanes[k] = (cos0*half_low + sin0)/u0;
+            c_G_1_lanes[k] = sin0/u0;
             poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
             c_G_2_lanes[k] = 2*(sin1*sin1)/(u0*u0);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
@@ -768,7 +707,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
  * K_across: Horner degree 12 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * K_1: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
  * K_2: Horner degree 21 in x below x = 2.63022, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 710 */
+ * ops: 643 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -791,18 +730,14 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = cos(w0);
-        const double w3 = half_low*w2 + w1;
-        const double w4 = cbrt(6*(phi - sin(phi)));
-        const double w5 = cbrt(6*phi - 12*w3*(-half_low*w1 + w2));
-        const double w6 = (w5*w5);
-        c_K_across = w3/w4;
-        c_K_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w4*w4);
-        c_K_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0 : (-w3/w5 + (1.0/8.0)*w6/(w3*w3))/w6;
+        const double w2 = cbrt(6*(phi - sin(phi)));
+        const double w3 = cbrt(6*phi - 12*w1*cos(w0));
+        const double w4 = (w3*w3);
+        c_K_across = w1/w2;
+        c_K_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w2*w2);
+        c_K_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0 : (-w1/w3 + (1.0/8.0)*w4/(w1*w1))/w4;
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -819,12 +754,12 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*(-half_low*sin(phi/2) + cos(phi/2))*(half_low*cos(phi/2) + sin(phi/2))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -834,17 +769,14 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             x_lanes[k] = x;
             if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double half_low = symrot_det_h_one__half_low(s, phi);
                 const double u0 = cbrt(6*(phi - sin(phi)));
-                const double u1 = cbrt(6*phi - 12*(-half_low*sin((1.0/2.0)*phi) + cos((1.0/2.0)*phi))*(half_low*cos((1.0/2.0)*phi) + sin((1.0/2.0)*phi)));
+                const double u1 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -852,7 +784,6 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
         }
@@ -860,7 +791,6 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double phi = phi_lanes[k];
-            const double half_low = half_low_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -873,8 +803,6 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double a1_a = (1.0/4.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
@@ -885,13 +813,12 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = cos0*half_low + sin0;
-            const double w1 = (u1*u1);
-            c_K_across_lanes[k] = w0/u0;
+            const double w0 = (u1*u1);
+            c_K_across_lanes[k] = sin0/u0;
             poly_K_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
             c_K_1_lanes[k] = 2*(sin1*sin1)/(u0*u0);
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
-            c_K_2_lanes[k] = ((1.0/8.0)*w1/(w0*w0) - w0/u1)/w1;
+            c_K_2_lanes[k] = (-sin0/u1 + (1.0/8.0)*w0/(sin0*sin0))/w0;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -931,7 +858,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
  * H_inverse_across: Horner degree 12 in x below x = 0.764824, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 663 */
+ * ops: 596 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -947,19 +874,15 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = sin(phi);
         const double w1 = (1.0/2.0)*phi;
         const double w2 = sin(w1);
-        const double w3 = cos(w1);
-        const double w4 = half_low*w3 + w2;
-        const double w5 = (w4*w4);
-        const double w6 = 1.0/w5;
-        const double w7 = 6*phi;
-        const double w8 = w4*(-half_low*w2 + w3);
-        c_H_inverse_across = (1.0/4.0)*w0*w6*cbrt(6*phi - 6*w0);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w6*(-8*w5 + w7*w8 + pow(1 - 2*w5, 2) - 1)/pow(cbrt(w7 - 12*w8), 4);
+        const double w3 = (w2*w2);
+        const double w4 = 1.0/w3;
+        const double w5 = 6*phi;
+        const double w6 = w2*cos(w1);
+        c_H_inverse_across = (1.0/4.0)*w0*w4*cbrt(6*phi - 6*w0);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w4*(-8*w3 + w5*w6 + pow(1 - 2*w3, 2) - 1)/pow(cbrt(w5 - 12*w6), 4);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -975,7 +898,7 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * H_across: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 706 */
+ * ops: 639 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -992,18 +915,14 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = sin(phi);
         const double w1 = cbrt(6*phi - 6*w0);
         const double w2 = (1.0/2.0)*phi;
         const double w3 = sin(w2);
-        const double w4 = cos(w2);
-        const double w5 = half_low*w4 + w3;
-        const double w6 = w5*(-half_low*w3 + w4);
+        const double w4 = w3*cos(w2);
         c_H_across = w0/w1;
         c_H_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w6 + (1.0/2.0)*sin(2*phi))/((w5*w5)*(phi - 2*w6));
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w4 + (1.0/2.0)*sin(2*phi))/((w3*w3)*(phi - 2*w4));
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -1018,7 +937,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
  * nu: Horner degree 12 in x below x = 0.764824, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * ops: 594 */
+ * ops: 528 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1035,13 +954,9 @@ static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4]
         c_nu = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.4717768942862145e-15)*x - 3.1172082783912966e-14) - 3.9741810435255436e-13) - 5.1339188726594446e-12) - 6.740882557422226e-11) - 9.035261398610608e-10) - 1.244209181073502e-08) - 1312063.0/7380172800000.0) - 17753.0/6623232000.0) - 71.0/1612800.0) - 19.0/22400.0) - 1.0/40.0) + 1;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = cos(w0);
-        c_e_0 = -half_low*w1 + w2;
-        c_nu = x < 0.764824235244299 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.4717768942862145e-15)*x - 3.1172082783912966e-14) - 3.9741810435255436e-13) - 5.1339188726594446e-12) - 6.740882557422226e-11) - 9.035261398610608e-10) - 1.244209181073502e-08) - 1312063.0/7380172800000.0) - 17753.0/6623232000.0) - 71.0/1612800.0) - 19.0/22400.0) - 1.0/40.0) + 1 : 2*(half_low*w2 + w1)/cbrt(6*(phi - sin(phi)));
+        c_e_0 = cos(w0);
+        c_nu = x < 0.764824235244299 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.4717768942862145e-15)*x - 3.1172082783912966e-14) - 3.9741810435255436e-13) - 5.1339188726594446e-12) - 6.740882557422226e-11) - 9.035261398610608e-10) - 1.244209181073502e-08) - 1312063.0/7380172800000.0) - 17753.0/6623232000.0) - 71.0/1612800.0) - 19.0/22400.0) - 1.0/40.0) + 1 : 2*sin(w0)/cbrt(6*(phi - sin(phi)));
     }
     const double half_nu = (1.0/2.0)*c_nu;
     e[0] = c_e_0;
@@ -1188,7 +1103,7 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (-2*sin(phi/2)**2 + 1 - 4*sin(phi/2)**3*cos(phi/2)/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 851 */
+ * ops: 784 */
 static inline void symrot_det_h_one_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1212,24 +1127,20 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = sin(phi);
         const double w1 = cbrt(6*phi - 6*w0);
         const double w2 = (1.0/2.0)*phi;
         const double w3 = sin(w2);
-        const double w4 = cos(w2);
-        const double w5 = half_low*w4 + w3;
-        const double w6 = (w5*w5);
-        const double w7 = -half_low*w3 + w4;
-        const double w8 = w5*w7;
-        const double w9 = 2*w8;
-        const double w10 = 1.0/(phi - w9);
-        const double w11 = (1.0/8.0)/w6;
+        const double w4 = (w3*w3);
+        const double w5 = cos(w2);
+        const double w6 = w3*w5;
+        const double w7 = 2*w6;
+        const double w8 = 1.0/(phi - w7);
+        const double w9 = (1.0/8.0)/w4;
         c_R_1 = w0/w1;
         c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w11*(-4.0/3.0*w10*(w5*w5*w5)*w7 - 2*w6 + 1);
-        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w11*(-8.0/3.0*w10*(w5*w5*w5*w5) + w9)/cbrt(6*phi - 12*w8);
+        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w9*(-4.0/3.0*(w3*w3*w3)*w5*w8 - 2*w4 + 1);
+        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w9*(-8.0/3.0*(w3*w3*w3*w3)*w8 + w7)/cbrt(6*phi - 12*w6);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1276,7 +1187,7 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (-2*sin(phi/2)**2 + 1 - 4*sin(phi/2)**3*cos(phi/2)/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 852 */
+ * ops: 785 */
 static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1300,24 +1211,20 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = sin(phi);
         const double w1 = cbrt(6*phi - 6*w0);
         const double w2 = (1.0/2.0)*phi;
         const double w3 = sin(w2);
-        const double w4 = cos(w2);
-        const double w5 = half_low*w4 + w3;
-        const double w6 = (w5*w5);
-        const double w7 = -half_low*w3 + w4;
-        const double w8 = w5*w7;
-        const double w9 = 2*w8;
-        const double w10 = 1.0/(phi - w9);
-        const double w11 = (1.0/8.0)/w6;
+        const double w4 = (w3*w3);
+        const double w5 = cos(w2);
+        const double w6 = w3*w5;
+        const double w7 = 2*w6;
+        const double w8 = 1.0/(phi - w7);
+        const double w9 = (1.0/8.0)/w4;
         c_R_1 = w0/w1;
         c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w11*(-4.0/3.0*w10*(w5*w5*w5)*w7 - 2*w6 + 1);
-        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w11*(-8.0/3.0*w10*(w5*w5*w5*w5) + w9)/cbrt(6*phi - 12*w8);
+        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w9*(-4.0/3.0*(w3*w3*w3)*w5*w8 - 2*w4 + 1);
+        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w9*(-8.0/3.0*(w3*w3*w3*w3)*w8 + w7)/cbrt(6*phi - 12*w6);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1362,7 +1269,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 917 */
+ * ops: 850 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1387,31 +1294,27 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = 2*phi;
         const double w1 = sin(w0);
         const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = cos(w2);
-        const double w5 = half_low*w4 + w3;
-        const double w6 = -half_low*w3 + w4;
-        const double w7 = w5*w6;
-        const double w8 = 2*w7;
-        const double w9 = 1.0/(phi - w8);
-        const double w10 = (w5*w5);
-        const double w11 = 1.0/w10;
-        const double w12 = w11*w9;
-        const double w13 = 6*phi;
-        const double w14 = w13 - 12*w7;
-        const double w15 = w6/(w5*w5*w5);
-        const double w16 = cbrt(w14);
-        const double w17 = w1 + w13 - 16*w7;
+        const double w3 = cos(w2);
+        const double w4 = sin(w2);
+        const double w5 = w3*w4;
+        const double w6 = 2*w5;
+        const double w7 = 1.0/(phi - w6);
+        const double w8 = (w4*w4);
+        const double w9 = 1.0/w8;
+        const double w10 = w7*w9;
+        const double w11 = 6*phi;
+        const double w12 = w11 - 12*w5;
+        const double w13 = w3/(w4*w4*w4);
+        const double w14 = cbrt(w12);
+        const double w15 = w1 + w11 - 16*w5;
         c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w12*(3*phi + (1.0/2.0)*w1 - 8*w7);
-        c_H_0_x = (1.0/48.0)*w11*w14*(-3.0/2.0*w15 + 2*w9);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w11*(-8.0/3.0*(w5*w5*w5*w5)*w9 + w8)/w16;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w12*w16*(-1.0/2.0*w11*(8*w10 + cos(w0) - 1) + (1.0/4.0)*w15*w17 + (1.0/2.0)*w17*w9);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w1 - 8*w5);
+        c_H_0_x = (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w7);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w4*w4*w4*w4)*w7 + w6)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w7 - 1.0/2.0*w9*(8*w8 + cos(w0) - 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1461,7 +1364,7 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 923 */
+ * ops: 856 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1486,31 +1389,27 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = 2*phi;
         const double w1 = sin(w0);
         const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = cos(w2);
-        const double w5 = half_low*w4 + w3;
-        const double w6 = -half_low*w3 + w4;
-        const double w7 = w5*w6;
-        const double w8 = 2*w7;
-        const double w9 = 1.0/(phi - w8);
-        const double w10 = (w5*w5);
-        const double w11 = 1.0/w10;
-        const double w12 = w11*w9;
-        const double w13 = 6*phi;
-        const double w14 = w13 - 12*w7;
-        const double w15 = w6/(w5*w5*w5);
-        const double w16 = cbrt(w14);
-        const double w17 = w1 + w13 - 16*w7;
+        const double w3 = cos(w2);
+        const double w4 = sin(w2);
+        const double w5 = w3*w4;
+        const double w6 = 2*w5;
+        const double w7 = 1.0/(phi - w6);
+        const double w8 = (w4*w4);
+        const double w9 = 1.0/w8;
+        const double w10 = w7*w9;
+        const double w11 = 6*phi;
+        const double w12 = w11 - 12*w5;
+        const double w13 = w3/(w4*w4*w4);
+        const double w14 = cbrt(w12);
+        const double w15 = w1 + w11 - 16*w5;
         c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w12*(3*phi + (1.0/2.0)*w1 - 8*w7);
-        c_H_0_x = (1.0/48.0)*w11*w14*(-3.0/2.0*w15 + 2*w9);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w11*(-8.0/3.0*(w5*w5*w5*w5)*w9 + w8)/w16;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w12*w16*(-1.0/2.0*w11*(8*w10 + cos(w0) - 1) + (1.0/4.0)*w15*w17 + (1.0/2.0)*w17*w9);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w1 - 8*w5);
+        c_H_0_x = (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w7);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w4*w4*w4*w4)*w7 + w6)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w7 - 1.0/2.0*w9*(8*w8 + cos(w0) - 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1562,7 +1461,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
  * H_inverse_0_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 2.63022, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 715 */
+ * ops: 648 */
 static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1585,27 +1484,23 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
         c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.497844255354877e-25)*x + 7.196733448736306e-24) + 7.96467075122581e-23) + 8.807039512596957e-22) + 9.729237867259716e-21) + 1.0736521110134332e-19) + 1.1833776459135935e-18) + 1.3025203655982459e-17) + 1.4313863004846702e-16) + 1.5701034167431574e-15) + 1.718530004160428e-14) + 1.8761222591988522e-13) + 2.0417396933193335e-12) + 2.213352732046947e-11) + 2.3875903447241837e-10) + 2.559013270547286e-09) + 11192989.0/411675264000000.0) + 604523.0/2118916800000.0) + 3293.0/1121120000.0) + 947.0/32340000.0) + 23.0/84000.0) + 3.0/1400.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = cos(w0);
-        const double w3 = half_low*w2 + w1;
-        const double w4 = (w3*w3);
-        const double w5 = 1.0/w4;
-        const double w6 = 6*phi;
-        const double w7 = -half_low*w1 + w2;
-        const double w8 = w3*w7;
-        const double w9 = cbrt(w6 - 12*w8);
-        const double w10 = 1 - 2*w4;
-        const double w11 = (w10*w10) - 8*w4 + w6*w8 - 1;
-        const double w12 = 2*w8;
-        const double w13 = (w3*w3*w3*w3);
-        const double w14 = 1.0/(phi - w12);
-        const double w15 = (8.0/3.0)*w14;
-        c_H_inverse_2 = -1.0/2.0*w11*w5/(w9*w9*w9*w9);
-        c_H_inverse_0_x = (1.0/4.0)*w5*(w12 - w13*w15)/w9;
-        c_H_inverse_2_x = -1.0/96.0*w14*(3*phi*w10 - 4*w10*w8 - w11*w15*w4 - w11*w7/w3 - w12)/w13;
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/w2;
+        const double w4 = 6*phi;
+        const double w5 = cos(w0);
+        const double w6 = w1*w5;
+        const double w7 = cbrt(w4 - 12*w6);
+        const double w8 = 1 - 2*w2;
+        const double w9 = -8*w2 + w4*w6 + (w8*w8) - 1;
+        const double w10 = 2*w6;
+        const double w11 = (w1*w1*w1*w1);
+        const double w12 = 1.0/(phi - w10);
+        const double w13 = (8.0/3.0)*w12;
+        c_H_inverse_2 = -1.0/2.0*w3*w9/(w7*w7*w7*w7);
+        c_H_inverse_0_x = (1.0/4.0)*w3*(w10 - w11*w13)/w7;
+        c_H_inverse_2_x = -1.0/96.0*w12*(3*phi*w8 - w10 - w13*w2*w9 - 4*w6*w8 - w5*w9/w1)/w11;
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_inverse_0_x;
@@ -1652,7 +1547,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 881 */
+ * ops: 814 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1672,32 +1567,28 @@ static inline void symrot_det_h_one_angular_acceleration(const double p[3], cons
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double half_low = symrot_det_h_one__half_low(s, phi);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = cos(w0);
-        const double w3 = half_low*w2 + w1;
-        const double w4 = (w3*w3);
-        const double w5 = 1.0/w4;
-        const double w6 = 6*phi;
-        const double w7 = -half_low*w1 + w2;
-        const double w8 = w3*w7;
-        const double w9 = w6 - 12*w8;
-        const double w10 = cbrt(w9);
-        const double w11 = 2*phi;
-        const double w12 = sin(w11);
-        const double w13 = 2*w8;
-        const double w14 = 1.0/(phi - w13);
-        const double w15 = w14*w5;
-        const double w16 = w7/(w3*w3*w3);
-        const double w17 = w12 + w6 - 16*w8;
-        c_H_0 = (1.0/4.0)*(w10*w10)*w5;
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/w2;
+        const double w4 = 6*phi;
+        const double w5 = cos(w0);
+        const double w6 = w1*w5;
+        const double w7 = w4 - 12*w6;
+        const double w8 = cbrt(w7);
+        const double w9 = 2*phi;
+        const double w10 = sin(w9);
+        const double w11 = 2*w6;
+        const double w12 = 1.0/(phi - w11);
+        const double w13 = w12*w3;
+        const double w14 = w5/(w1*w1*w1);
+        const double w15 = w10 + w4 - 16*w6;
+        c_H_0 = (1.0/4.0)*w3*(w8*w8);
         c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w15*(3*phi + (1.0/2.0)*w12 - 8*w8);
-        c_H_0_x = (1.0/48.0)*w5*w9*(2*w14 - 3.0/2.0*w16);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w5*(w13 - 8.0/3.0*w14*(w3*w3*w3*w3))/w10;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w15*((1.0/2.0)*w14*w17 + (1.0/4.0)*w16*w17 - 1.0/2.0*w5*(8*w4 + cos(w11) - 1));
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w13*(3*phi + (1.0/2.0)*w10 - 8*w6);
+        c_H_0_x = (1.0/48.0)*w3*w7*(2*w12 - 3.0/2.0*w14);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w3*(-8.0/3.0*(w1*w1*w1*w1)*w12 + w11)/w8;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w13*w8*((1.0/2.0)*w12*w15 + (1.0/4.0)*w14*w15 - 1.0/2.0*w3*(8*w2 + cos(w9) - 1));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1890,16 +1781,6 @@ static inline float symrot_det_h_one__phi_f(float s)
     return phi;
 }
 
-/* symrot_det_h_one__half_low_f: internal: lambda/2 for sin(phi/2) and cos(phi/2) (eq 11).
- * Half of the Newton angle below the last bit of phi, 0 unless within 4 units of
- * roundoff: sin(phi/2) + cos(phi/2) lambda/2 is accurate next to 2 pi.
- * ops: 4 */
-static inline float symrot_det_h_one__half_low_f(float s, float phi)
-{
-    const float correction = (float)symrot_det_h_one__phi_low((double)s, (double)phi);
-    return fabsf(correction) <= 4.7683716e-07F * phi ? 0.5F * correction : 0;
-}
-
 /* symrot_det_h_one_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831850051879883]
@@ -1927,7 +1808,7 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 482 */
+ * ops: 473 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1949,15 +1830,11 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
         c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = sinf(phi);
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
-        const float w3 = cosf(w1);
-        const float w4 = half_low*w3 + w2;
         c_R_1 = w0/cbrtf(6*phi - 6*w0);
-        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*(w4*w4)/powf(cbrtf(6*phi - 12*w4*(-half_low*w2 + w3)), 2);
+        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*(w2*w2)/powf(cbrtf(6*phi - 12*w2*cosf(w1)), 2);
     }
     const float t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -1975,12 +1852,12 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*(-half_low*sin(phi/2) + cos(phi/2))*(half_low*cos(phi/2) + sin(phi/2))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1990,17 +1867,14 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             x_lanes[k] = x;
             if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float half_low = symrot_det_h_one__half_low_f(s, phi);
                 const float u0 = cbrtf(6*(phi - sinf(phi)));
-                const float u1 = cbrtf(6*phi - 12*(-half_low*sinf((1.0F/2.0F)*phi) + cosf((1.0F/2.0F)*phi))*(half_low*cosf((1.0F/2.0F)*phi) + sinf((1.0F/2.0F)*phi)));
+                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -2008,7 +1882,6 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
         }
@@ -2016,7 +1889,6 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float half_low = half_low_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             const float a0_a = phi;
@@ -2039,11 +1911,9 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = sin0/u0;
             poly_R_1_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-            c_R_2_lanes[k] = 2*((cos1*half_low + sin1)*(cos1*half_low + sin1))/(u1*u1);
+            c_R_2_lanes[k] = 2*(sin1*sin1)/(u1*u1);
             poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2081,7 +1951,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 522 */
+ * ops: 512 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2104,18 +1974,14 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = sinf(phi);
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
-        const float w3 = cosf(w1);
-        const float w4 = half_low*w3 + w2;
-        const float w5 = (w4*w4);
-        const float w6 = w4*(-half_low*w2 + w3);
+        const float w3 = (w2*w2);
+        const float w4 = w2*cosf(w1);
         c_H_across = w0/cbrtf(6*phi - 6*w0);
-        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w5/powf(cbrtf(6*phi - 12*w6), 2);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w6 + (1.0F/2.0F)*sinf(2*phi))/(w5*(phi - 2*w6));
+        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w3/powf(cbrtf(6*phi - 12*w4), 2);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(w3*(phi - 2*w4));
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -2132,12 +1998,12 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*(-half_low*sin(phi/2) + cos(phi/2))*(half_low*cos(phi/2) + sin(phi/2))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2147,17 +2013,14 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             x_lanes[k] = x;
             if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float half_low = symrot_det_h_one__half_low_f(s, phi);
                 const float u0 = cbrtf(6*(phi - sinf(phi)));
-                const float u1 = cbrtf(6*phi - 12*(-half_low*sinf((1.0F/2.0F)*phi) + cosf((1.0F/2.0F)*phi))*(half_low*cosf((1.0F/2.0F)*phi) + sinf((1.0F/2.0F)*phi)));
+                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -2165,7 +2028,6 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
         }
@@ -2173,7 +2035,6 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float half_low = half_low_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             const float a0_a = phi;
@@ -2208,14 +2069,13 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float a2_h = rintf(0.5F*a2_j - 0.25F);
             const float a2_odd = a2_j - 2*a2_h;
             const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const float w0 = cos1*half_low + sin1;
-            const float w1 = (w0*w0);
-            const float w2 = w0*(cos1 - half_low*sin1);
+            const float w0 = (sin1*sin1);
+            const float w1 = cos1*sin1;
             c_H_across_lanes[k] = sin0/u0;
             poly_H_across_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-            c_H_1_lanes[k] = 2*w1/(u1*u1);
+            c_H_1_lanes[k] = 2*w0/(u1*u1);
             poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = (1.0F/12.0F)*(3*phi + (1.0F/2.0F)*sin2 - 8*w2)/(w1*(phi - 2*w2));
+            c_H_2_lanes[k] = (1.0F/12.0F)*(3*phi + (1.0F/2.0F)*sin2 - 8*w1)/(w0*(phi - 2*w1));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2255,7 +2115,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 499 */
+ * ops: 489 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2277,19 +2137,15 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = sinf(phi);
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
-        const float w3 = cosf(w1);
-        const float w4 = half_low*w3 + w2;
-        const float w5 = (w4*w4);
-        const float w6 = 1.0F/w5;
-        const float w7 = 6*phi;
-        const float w8 = w4*(-half_low*w2 + w3);
-        c_H_inverse_across = (1.0F/4.0F)*w0*w6*cbrtf(6*phi - 6*w0);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w6*(-8*w5 + w7*w8 + powf(1 - 2*w5, 2) - 1)/powf(cbrtf(w7 - 12*w8), 4);
+        const float w3 = (w2*w2);
+        const float w4 = 1.0F/w3;
+        const float w5 = 6*phi;
+        const float w6 = w2*cosf(w1);
+        c_H_inverse_across = (1.0F/4.0F)*w0*w4*cbrtf(6*phi - 6*w0);
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -2306,12 +2162,12 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*(-half_low*sin(phi/2) + cos(phi/2))*(half_low*cos(phi/2) + sin(phi/2))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2321,17 +2177,14 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             x_lanes[k] = x;
             if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float half_low = symrot_det_h_one__half_low_f(s, phi);
                 const float u0 = cbrtf(6*(phi - sinf(phi)));
-                const float u1 = cbrtf(6*phi - 12*(-half_low*sinf((1.0F/2.0F)*phi) + cosf((1.0F/2.0F)*phi))*(half_low*cosf((1.0F/2.0F)*phi) + sinf((1.0F/2.0F)*phi)));
+                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -2339,7 +2192,6 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
         }
@@ -2347,7 +2199,6 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float half_low = half_low_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2372,12 +2223,11 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float w0 = cos0*half_low + sin0;
-            const float w1 = (w0*w0);
-            const float w2 = 1.0F/w1;
-            c_H_inverse_across_lanes[k] = (1.0F/4.0F)*sin1*u0*w2;
+            const float w0 = (sin0*sin0);
+            const float w1 = 1.0F/w0;
+            c_H_inverse_across_lanes[k] = (1.0F/4.0F)*sin1*u0*w1;
             poly_H_inverse_across_lanes[k] = x*(x*(x*(x*((-8.811724e-07F)*x - 1.2201092e-05F) - 23.0F/126000.0F) - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
-            c_H_inverse_2_lanes[k] = -1.0F/2.0F*w2*(6*phi*w0*(cos0 - half_low*sin0) - 8*w1 + ((1 - 2*w1)*(1 - 2*w1)) - 1)/(u1*u1*u1*u1);
+            c_H_inverse_2_lanes[k] = -1.0F/2.0F*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u1*u1*u1*u1);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2427,7 +2277,7 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * G_2: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
- * ops: 465 */
+ * ops: 456 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2449,14 +2299,10 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
         c_G_2 = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        const float w3 = cbrtf(6*(phi - sinf(phi)));
-        c_G_1 = (half_low*w2 + w1)/w3;
-        c_G_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (half_low*w1 - w2 + 1)/(w3*w3);
+        const float w1 = cbrtf(6*(phi - sinf(phi)));
+        c_G_1 = sinf(w0)/w1;
+        c_G_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - cosf(w0))/(w1*w1);
     }
     const float t = -c_G_2*x + 1;
     G[0] = c_G_2*(p[0]*p[0]) + t;
@@ -2474,12 +2320,12 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2489,29 +2335,24 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             x_lanes[k] = x;
             if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float half_low = symrot_det_h_one__half_low_f(s, phi);
                 const float u0 = cbrtf(6*(phi - sinf(phi)));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float half_low = half_low_lanes[k];
             const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
@@ -2525,9 +2366,9 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_G_1_lanes[k] = (cos0*half_low + sin0)/u0;
+            c_G_1_lanes[k] = sin0/u0;
             poly_G_1_lanes[k] = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-            c_G_2_lanes[k] = (-cos0 + half_low*sin0 + 1)/(u0*u0);
+            c_G_2_lanes[k] = (1 - cos0)/(u0*u0);
             poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2565,7 +2406,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
  * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
  * K_1: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 527 */
+ * ops: 517 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2588,19 +2429,15 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        const float w3 = half_low*w2 + w1;
-        const float w4 = cbrtf(6*(phi - sinf(phi)));
-        const float w5 = half_low*w1 - w2;
-        const float w6 = cbrtf(6*phi + 12*w3*w5);
-        const float w7 = (w6*w6);
-        c_K_across = w3/w4;
-        c_K_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (w5 + 1)/(w4*w4);
-        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w3/w6 + (1.0F/8.0F)*w7/(w3*w3))/w7;
+        const float w2 = cbrtf(6*(phi - sinf(phi)));
+        const float w3 = cosf(w0);
+        const float w4 = cbrtf(6*phi - 12*w1*w3);
+        const float w5 = (w4*w4);
+        c_K_across = w1/w2;
+        c_K_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - w3)/(w2*w2);
+        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w4 + (1.0F/8.0F)*w5/(w1*w1))/w5;
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2617,12 +2454,12 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, half_low, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*(-half_low*sin(phi/2) + cos(phi/2))*(half_low*cos(phi/2) + sin(phi/2))).
+ * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], half_low_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2632,17 +2469,14 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             x_lanes[k] = x;
             if (!(x <= 11.2431345F) || x < 0.7648242F) {
                 phi_lanes[k] = 0;
-                half_low_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float half_low = symrot_det_h_one__half_low_f(s, phi);
                 const float u0 = cbrtf(6*(phi - sinf(phi)));
-                const float u1 = cbrtf(6*phi - 12*(-half_low*sinf((1.0F/2.0F)*phi) + cosf((1.0F/2.0F)*phi))*(half_low*cosf((1.0F/2.0F)*phi) + sinf((1.0F/2.0F)*phi)));
+                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
-                half_low_lanes[k] = half_low;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
             }
@@ -2650,7 +2484,6 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             phi_lanes[k] = 0;
-            half_low_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
         }
@@ -2658,7 +2491,6 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float phi = phi_lanes[k];
-            const float half_low = half_low_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2673,13 +2505,12 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = cos0*half_low + sin0;
-            const float w1 = (u1*u1);
-            c_K_across_lanes[k] = w0/u0;
+            const float w0 = (u1*u1);
+            c_K_across_lanes[k] = sin0/u0;
             poly_K_across_lanes[k] = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-            c_K_1_lanes[k] = (-cos0 + half_low*sin0 + 1)/(u0*u0);
+            c_K_1_lanes[k] = (1 - cos0)/(u0*u0);
             poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = ((1.0F/8.0F)*w1/(w0*w0) - w0/u1)/w1;
+            c_K_2_lanes[k] = (-sin0/u1 + (1.0F/8.0F)*w0/(sin0*sin0))/w0;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2719,7 +2550,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 498 */
+ * ops: 488 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2735,19 +2566,15 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = sinf(phi);
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
-        const float w3 = cosf(w1);
-        const float w4 = half_low*w3 + w2;
-        const float w5 = (w4*w4);
-        const float w6 = 1.0F/w5;
-        const float w7 = 6*phi;
-        const float w8 = w4*(-half_low*w2 + w3);
-        c_H_inverse_across = (1.0F/4.0F)*w0*w6*cbrtf(6*phi - 6*w0);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w6*(-8*w5 + w7*w8 + powf(1 - 2*w5, 2) - 1)/powf(cbrtf(w7 - 12*w8), 4);
+        const float w3 = (w2*w2);
+        const float w4 = 1.0F/w3;
+        const float w5 = 6*phi;
+        const float w6 = w2*cosf(w1);
+        c_H_inverse_across = (1.0F/4.0F)*w0*w4*cbrtf(6*phi - 6*w0);
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -2763,7 +2590,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
  * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 521 */
+ * ops: 511 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2780,18 +2607,14 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = sinf(phi);
         const float w1 = (1.0F/2.0F)*phi;
         const float w2 = sinf(w1);
-        const float w3 = cosf(w1);
-        const float w4 = half_low*w3 + w2;
-        const float w5 = (w4*w4);
-        const float w6 = w4*(-half_low*w2 + w3);
+        const float w3 = (w2*w2);
+        const float w4 = w2*cosf(w1);
         c_H_across = w0/cbrtf(6*phi - 6*w0);
-        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w5/powf(cbrtf(6*phi - 12*w6), 2);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w6 + (1.0F/2.0F)*sinf(2*phi))/(w5*(phi - 2*w6));
+        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w3/powf(cbrtf(6*phi - 12*w4), 2);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(w3*(phi - 2*w4));
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2806,7 +2629,7 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
  * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * ops: 412 */
+ * ops: 401 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2823,13 +2646,9 @@ static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4]
         c_nu = x*(x*(x*(x*(x*((-1.2442092e-08F)*x - 1.7778216e-07F) - 2.6804134e-06F) - 71.0F/1612800.0F) - 19.0F/22400.0F) - 1.0F/40.0F) + 1;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        c_e_0 = -half_low*w1 + w2;
-        c_nu = 2*(half_low*w2 + w1)/cbrtf(6*(phi - sinf(phi)));
+        c_e_0 = cosf(w0);
+        c_nu = 2*sinf(w0)/cbrtf(6*(phi - sinf(phi)));
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
     e[0] = c_e_0;
@@ -2974,7 +2793,7 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 664 */
+ * ops: 654 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2998,24 +2817,20 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = sinf(phi);
         const float w1 = phi - w0;
         const float w2 = (1.0F/2.0F)*phi;
         const float w3 = sinf(w2);
-        const float w4 = cosf(w2);
-        const float w5 = half_low*w4 + w3;
-        const float w6 = w5*(-half_low*w3 + w4);
-        const float w7 = cbrtf(6*phi - 12*w6);
-        const float w8 = (w5*w5);
-        const float w9 = 2*w8;
-        const float w10 = (1.0F/8.0F)/w8;
-        const float w11 = 2*w6;
+        const float w4 = w3*cosf(w2);
+        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w6 = (w3*w3);
+        const float w7 = 2*w6;
+        const float w8 = (1.0F/8.0F)/w6;
+        const float w9 = 2*w4;
         c_R_1 = w0/cbrtf(6*w1);
-        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w9/(w7*w7);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w10*(-2.0F/3.0F*w0*w8/w1 - w9 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w10*(w11 - 8.0F/3.0F*(w5*w5*w5*w5)/(phi - w11))/w7;
+        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -3062,7 +2877,7 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 665 */
+ * ops: 655 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3086,24 +2901,20 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = sinf(phi);
         const float w1 = phi - w0;
         const float w2 = (1.0F/2.0F)*phi;
         const float w3 = sinf(w2);
-        const float w4 = cosf(w2);
-        const float w5 = half_low*w4 + w3;
-        const float w6 = w5*(-half_low*w3 + w4);
-        const float w7 = cbrtf(6*phi - 12*w6);
-        const float w8 = (w5*w5);
-        const float w9 = 2*w8;
-        const float w10 = (1.0F/8.0F)/w8;
-        const float w11 = 2*w6;
+        const float w4 = w3*cosf(w2);
+        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w6 = (w3*w3);
+        const float w7 = 2*w6;
+        const float w8 = (1.0F/8.0F)/w6;
+        const float w9 = 2*w4;
         c_R_1 = w0/cbrtf(6*w1);
-        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w9/(w7*w7);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w10*(-2.0F/3.0F*w0*w8/w1 - w9 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w10*(w11 - 8.0F/3.0F*(w5*w5*w5*w5)/(phi - w11))/w7;
+        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -3148,7 +2959,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 793 */
+ * ops: 783 */
 static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3173,31 +2984,27 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        const float w3 = half_low*w2 + w1;
-        const float w4 = (w3*w3);
-        const float w5 = 6*phi;
-        const float w6 = -half_low*w1 + w2;
-        const float w7 = w3*w6;
-        const float w8 = w5 - 12*w7;
-        const float w9 = cbrtf(w8);
-        const float w10 = 2*phi;
-        const float w11 = sinf(w10);
-        const float w12 = 2*w7;
-        const float w13 = 1.0F/(phi - w12);
-        const float w14 = 1.0F/w4;
-        const float w15 = w13*w14;
-        const float w16 = w6/(w3*w3*w3);
-        const float w17 = w11 + w5 - 16*w7;
-        c_H_1 = 2*w4/(w9*w9);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w15*(3*phi + (1.0F/2.0F)*w11 - 8*w7);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w14*w8*(2*w13 - 3.0F/2.0F*w16);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w14*(w12 - 8.0F/3.0F*w13*(w3*w3*w3*w3))/w9;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w15*w9*((1.0F/2.0F)*w13*w17 - 1.0F/2.0F*w14*(8*w4 + cosf(w10) - 1) + (1.0F/4.0F)*w16*w17);
+        const float w2 = (w1*w1);
+        const float w3 = 6*phi;
+        const float w4 = cosf(w0);
+        const float w5 = w1*w4;
+        const float w6 = w3 - 12*w5;
+        const float w7 = cbrtf(w6);
+        const float w8 = 2*phi;
+        const float w9 = sinf(w8);
+        const float w10 = 2*w5;
+        const float w11 = 1.0F/(phi - w10);
+        const float w12 = 1.0F/w2;
+        const float w13 = w11*w12;
+        const float w14 = w4/(w1*w1*w1);
+        const float w15 = w3 - 16*w5 + w9;
+        c_H_1 = 2*w2/(w7*w7);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w13*(3*phi - 8*w5 + (1.0F/2.0F)*w9);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w6*(2*w11 - 3.0F/2.0F*w14);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w12*(-8.0F/3.0F*(w1*w1*w1*w1)*w11 + w10)/w7;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w13*w7*((1.0F/2.0F)*w11*w15 - 1.0F/2.0F*w12*(8*w2 + cosf(w8) - 1) + (1.0F/4.0F)*w14*w15);
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3247,7 +3054,7 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 799 */
+ * ops: 789 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3272,31 +3079,27 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        const float w3 = half_low*w2 + w1;
-        const float w4 = (w3*w3);
-        const float w5 = 6*phi;
-        const float w6 = -half_low*w1 + w2;
-        const float w7 = w3*w6;
-        const float w8 = w5 - 12*w7;
-        const float w9 = cbrtf(w8);
-        const float w10 = 2*phi;
-        const float w11 = sinf(w10);
-        const float w12 = 2*w7;
-        const float w13 = 1.0F/(phi - w12);
-        const float w14 = 1.0F/w4;
-        const float w15 = w13*w14;
-        const float w16 = w6/(w3*w3*w3);
-        const float w17 = w11 + w5 - 16*w7;
-        c_H_1 = 2*w4/(w9*w9);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w15*(3*phi + (1.0F/2.0F)*w11 - 8*w7);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w14*w8*(2*w13 - 3.0F/2.0F*w16);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w14*(w12 - 8.0F/3.0F*w13*(w3*w3*w3*w3))/w9;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w15*w9*((1.0F/2.0F)*w13*w17 - 1.0F/2.0F*w14*(8*w4 + cosf(w10) - 1) + (1.0F/4.0F)*w16*w17);
+        const float w2 = (w1*w1);
+        const float w3 = 6*phi;
+        const float w4 = cosf(w0);
+        const float w5 = w1*w4;
+        const float w6 = w3 - 12*w5;
+        const float w7 = cbrtf(w6);
+        const float w8 = 2*phi;
+        const float w9 = sinf(w8);
+        const float w10 = 2*w5;
+        const float w11 = 1.0F/(phi - w10);
+        const float w12 = 1.0F/w2;
+        const float w13 = w11*w12;
+        const float w14 = w4/(w1*w1*w1);
+        const float w15 = w3 - 16*w5 + w9;
+        c_H_1 = 2*w2/(w7*w7);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w13*(3*phi - 8*w5 + (1.0F/2.0F)*w9);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w6*(2*w11 - 3.0F/2.0F*w14);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w12*(-8.0F/3.0F*(w1*w1*w1*w1)*w11 + w10)/w7;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w13*w7*((1.0F/2.0F)*w11*w15 - 1.0F/2.0F*w12*(8*w2 + cosf(w8) - 1) + (1.0F/4.0F)*w14*w15);
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3348,7 +3151,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
  * H_inverse_0_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 4.61948, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 562 */
+ * ops: 552 */
 static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3371,27 +3174,23 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
         c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.4978443e-25F)*x + 7.196733e-24F) + 7.964671e-23F) + 8.807039e-22F) + 9.729238e-21F) + 1.0736521e-19F) + 1.1833776e-18F) + 1.3025204e-17F) + 1.4313863e-16F) + 1.5701034e-15F) + 1.71853e-14F) + 1.8761223e-13F) + 2.0417396e-12F) + 2.2133528e-11F) + 2.3875904e-10F) + 2.5590132e-09F) + 2.7188879e-08F) + 2.8529814e-07F) + 2.9372413e-06F) + 2.9282623e-05F) + 23.0F/84000.0F) + 3.0F/1400.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        const float w3 = half_low*w2 + w1;
-        const float w4 = (w3*w3);
-        const float w5 = 1.0F/w4;
-        const float w6 = 6*phi;
-        const float w7 = -half_low*w1 + w2;
-        const float w8 = w3*w7;
-        const float w9 = cbrtf(w6 - 12*w8);
-        const float w10 = 1 - 2*w4;
-        const float w11 = (w10*w10) - 8*w4 + w6*w8 - 1;
-        const float w12 = 2*w8;
-        const float w13 = (w3*w3*w3*w3);
-        const float w14 = 1.0F/(phi - w12);
-        const float w15 = (8.0F/3.0F)*w14;
-        c_H_inverse_2 = -1.0F/2.0F*w11*w5/(w9*w9*w9*w9);
-        c_H_inverse_0_x = (1.0F/4.0F)*w5*(w12 - w13*w15)/w9;
-        c_H_inverse_2_x = -1.0F/96.0F*w14*(3*phi*w10 - 4*w10*w8 - w11*w15*w4 - w11*w7/w3 - w12)/w13;
+        const float w2 = (w1*w1);
+        const float w3 = 1.0F/w2;
+        const float w4 = 6*phi;
+        const float w5 = cosf(w0);
+        const float w6 = w1*w5;
+        const float w7 = cbrtf(w4 - 12*w6);
+        const float w8 = 1 - 2*w2;
+        const float w9 = -8*w2 + w4*w6 + (w8*w8) - 1;
+        const float w10 = 2*w6;
+        const float w11 = (w1*w1*w1*w1);
+        const float w12 = 1.0F/(phi - w10);
+        const float w13 = (8.0F/3.0F)*w12;
+        c_H_inverse_2 = -1.0F/2.0F*w3*w9/(w7*w7*w7*w7);
+        c_H_inverse_0_x = (1.0F/4.0F)*w3*(w10 - w11*w13)/w7;
+        c_H_inverse_2_x = -1.0F/96.0F*w12*(3*phi*w8 - w10 - w13*w2*w9 - 4*w6*w8 - w5*w9/w1)/w11;
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_inverse_0_x;
@@ -3438,7 +3237,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 809 */
+ * ops: 799 */
 static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3458,33 +3257,29 @@ static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], con
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float half_low = symrot_det_h_one__half_low_f(s, phi);
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = cosf(w0);
-        const float w3 = half_low*w2 + w1;
-        const float w4 = (w3*w3);
-        const float w5 = 1.0F/w4;
-        const float w6 = 6*phi;
-        const float w7 = -half_low*w1 + w2;
-        const float w8 = w3*w7;
-        const float w9 = w6 - 12*w8;
-        const float w10 = cbrtf(w9);
-        const float w11 = (w10*w10);
-        const float w12 = 2*phi;
-        const float w13 = sinf(w12);
-        const float w14 = 2*w8;
-        const float w15 = 1.0F/(phi - w14);
-        const float w16 = w15*w5;
-        const float w17 = w7/(w3*w3*w3);
-        const float w18 = w13 + w6 - 16*w8;
-        c_H_0 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1 : (1.0F/4.0F)*w11*w5;
-        c_H_1 = 2*w4/w11;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w16*(3*phi + (1.0F/2.0F)*w13 - 8*w8);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w5*w9*(2*w15 - 3.0F/2.0F*w17);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w5*(w14 - 8.0F/3.0F*w15*(w3*w3*w3*w3))/w10;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w10*w16*((1.0F/2.0F)*w15*w18 + (1.0F/4.0F)*w17*w18 - 1.0F/2.0F*w5*(8*w4 + cosf(w12) - 1));
+        const float w2 = (w1*w1);
+        const float w3 = 1.0F/w2;
+        const float w4 = 6*phi;
+        const float w5 = cosf(w0);
+        const float w6 = w1*w5;
+        const float w7 = w4 - 12*w6;
+        const float w8 = cbrtf(w7);
+        const float w9 = (w8*w8);
+        const float w10 = 2*phi;
+        const float w11 = sinf(w10);
+        const float w12 = 2*w6;
+        const float w13 = 1.0F/(phi - w12);
+        const float w14 = w13*w3;
+        const float w15 = w5/(w1*w1*w1);
+        const float w16 = w11 + w4 - 16*w6;
+        c_H_0 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1 : (1.0F/4.0F)*w3*w9;
+        c_H_1 = 2*w2/w9;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w14*(3*phi + (1.0F/2.0F)*w11 - 8*w6);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w3*w7*(2*w13 - 3.0F/2.0F*w15);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w3*(-8.0F/3.0F*(w1*w1*w1*w1)*w13 + w12)/w8;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w14*w8*((1.0F/2.0F)*w13*w16 + (1.0F/4.0F)*w15*w16 - 1.0F/2.0F*w3*(8*w2 + cosf(w10) - 1));
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

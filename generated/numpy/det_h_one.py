@@ -1488,14 +1488,6 @@ def _angle_64(s, d):
     return phi
 
 
-def _angle_low_64(s, phi):
-    value = phi * _ratio_64(phi * phi, phi)
-    slope = _slope_64(phi * phi, phi)
-    useful = phi * slope > 4.0 * s
-    low = (s - value) / numpy.where(useful, slope, 1.0)
-    return numpy.where(useful, low, 0.0).astype(s.dtype)
-
-
 def _scale_64(e0, e_norm):
     phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
     t = phi * phi
@@ -2847,8 +2839,6 @@ _COEFFICIENTS = {
 }
 _ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
-_ANGLE_LOW = {"64": _angle_low_64, "32": _angle_low_64}
-_ANGLE_LOW_BOUND = {"64": 8.881784197001252e-16, "32": 4.76837158203125e-07}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
@@ -2971,13 +2961,7 @@ def _prepare(p, names):
     if any(table[name] and (span is None or span[1] >= switch[name]) for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        sin_half, cos_half = numpy.sin(half), numpy.cos(half)
-        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
-            low = _ANGLE_LOW[suffix](numpy.asarray(s, numpy.float64), numpy.asarray(phi, numpy.float64))
-            low = numpy.where(numpy.abs(low) <= _ANGLE_LOW_BOUND[suffix] * phi, 0.5 * low, 0.0)
-            low = low.astype(p.dtype)
-            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
-        return p, (x, phi, s, d, sin_half, cos_half, span), valid, suffix
+        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half), span), valid, suffix
     return p, (x, None, s, d, None, None, span), valid, suffix
 
 
