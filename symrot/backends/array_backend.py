@@ -40,6 +40,7 @@ from ..plan import (
     NewtonAngle,
     S,
     evaluation_plan,
+    half_angle,
 )
 from ..plan_ir import ANGLE_CORRECTION_GROWTH
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
@@ -97,11 +98,12 @@ def _mp_float(expression: Any) -> str:
 
 
 def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
-                 half_angles: bool = False) -> list[str]:
+                 half_angles: bool = False, corrected: bool = False) -> list[str]:
     """Statements returning the Branch value from ``variable`` (t) and the state, branch-free.
 
     Polynomial below ``branch.threshold`` on t (t replaced by 0 above it), closed form above it on
-    the state with the switch's own values substituted below it (double where)."""
+    the state with the switch's own values substituted below it (double where). ``corrected``: sin φ
+    and cos φ through the half angles, which carry λ (``EvaluationPlan.angle_correction``)."""
     switch, horner = branch.threshold, branch.horner
     threshold = switch
     lines = [f"small = {variable} < {switch!r}"]
@@ -110,7 +112,7 @@ def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
     lines.append(f"series = {_literal(horner[-1])} + 0.0 * {variable}")
     for c in reversed(horner[:-1]):
         lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
-    closed = branch.closed
+    closed = half_angle(branch.closed) if corrected else branch.closed
     if half_angles:
         closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
     safe_phi = mpmath.mpf(branch.safe_phi)
@@ -188,7 +190,8 @@ def _far_variable(far: FarStart) -> str:
     return f"s / (s + {far.scale!r})"
 
 
-def _coefficient_lines(coefficient: Any, suffix: str, complement: sp.Rational | None) -> list[str]:
+def _coefficient_lines(coefficient: Any, suffix: str, complement: sp.Rational | None,
+                       corrected: bool) -> list[str]:
     if isinstance(coefficient, Constant):
         return [f"return _xp.full_like(x, {_literal(coefficient.value)})"]
     if isinstance(coefficient, Algebraic):
@@ -202,7 +205,7 @@ def _coefficient_lines(coefficient: Any, suffix: str, complement: sp.Rational | 
             value = f"({value}) + 0.0 * x"
         body.append(f"return _narrow({value}, s)" if suffix == "32" else f"return {value}")
         return body
-    return branch_lines(coefficient, "x", complement, half_angles=True)
+    return branch_lines(coefficient, "x", complement, half_angles=True, corrected=corrected)
 
 
 def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
@@ -226,7 +229,8 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
         suffix = SUFFIX[label]
         for name, coefficient in precision.coefficients.items():
             functions.append({"name": f"_{name}_{suffix}", "args": "x, phi, s, d, sin_half, cos_half",
-                              "body": _coefficient_lines(coefficient, suffix, plan.complement)})
+                              "body": _coefficient_lines(coefficient, suffix, plan.complement,
+                                                         label in plan.angle_correction())})
         angle = precision.angle
         if isinstance(angle, NewtonAngle):
             for helper, branch in (("_ratio", angle.ratio), ("_slope", angle.slope)):

@@ -40,6 +40,7 @@ from ..algebraic import S, X
 from ..errors import NonFiniteLiteral
 from ..newton_start import FarStart
 from ..parsing import PHI
+from ..plan import half_angle
 from ..plan_ir import (
     ANGLE_CORRECTION_GROWTH,
     Algebraic,
@@ -299,11 +300,13 @@ class FunctionWriter:
 
     def half_angle_corrected(self, expr: sp.Expr) -> sp.Expr:
         """``expr`` with sin(φ/2) → sin(φ/2) + (λ/2) cos(φ/2) and cos(φ/2) → cos(φ/2) − (λ/2) sin(φ/2)
-        where the angle is a Newton iteration (see ``EvaluationPlan.angle_correction``)."""
+        where the angle is a Newton iteration (see ``EvaluationPlan.angle_correction``), sin φ and
+        cos φ written through them first (:func:`symrot.plan.half_angle`)."""
         if not self.corrects_angle:
             return expr
         sine, cosine = sp.sin(PHI_SYMBOL / 2), sp.cos(PHI_SYMBOL / 2)
-        return expr.xreplace({sine: sine + HALF_LOW * cosine, cosine: cosine - HALF_LOW * sine})
+        halves = half_angle(expr.xreplace({PHI_SYMBOL: PHI})).xreplace({PHI: PHI_SYMBOL})
+        return halves.xreplace({sine: sine + HALF_LOW * cosine, cosine: cosine - HALF_LOW * sine})
 
     def low_helper(self, precision: Precision) -> str:
         return f"symrot_{self.header}__phi_low{'' if precision == 'double' else '_f'}"

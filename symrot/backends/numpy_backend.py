@@ -40,6 +40,7 @@ from ..plan import (
     NewtonAngle,
     S,
     evaluation_plan,
+    half_angle,
 )
 from ..plan_ir import ANGLE_CORRECTION_GROWTH
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
@@ -99,7 +100,8 @@ def branch_switch(coefficient: Any) -> float:
     return coefficient.smallest_switch[0] if isinstance(coefficient, Branch) else 0.0
 
 
-def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = False) -> list[str]:
+def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = False,
+                  corrected: bool = False) -> list[str]:
     """Statements returning the Branch value from ``variable`` (t) and ``phi``: the Horner
     polynomial on the lanes with t < threshold, the closed form on the others (each computed on
     its own lanes only, so neither can divide by zero and no work is wasted). The switch is the
@@ -108,9 +110,11 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
 
     With ``half_angles`` (the coefficient functions) the argument ``span`` = (min t, max t) of a
     block whose lanes are all inside the range (None otherwise, see the template's _span) lets a
-    block on one side of the switch take its branch on all lanes, without masks or indexing."""
+    block on one side of the switch take its branch on all lanes, without masks or indexing.
+    ``corrected``: the angle's half-angle sine and cosine carry λ (``EvaluationPlan.angle_correction``),
+    and sin φ, cos φ are printed through them (:func:`symrot.plan.half_angle`)."""
     threshold, horner = branch.smallest_switch
-    closed = branch.closed
+    closed = half_angle(branch.closed) if corrected else branch.closed
     if half_angles:  # sin(φ/2), cos(φ/2) come precomputed, shared by the coefficients of a tensor
         closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
     symbols = [symbol for symbol in (X, S, D, SIN_HALF, COS_HALF) if closed.has(symbol)]
@@ -281,7 +285,7 @@ def module_context_functions(precision: Any, suffix: str,
                 value = f"({value}) + 0.0 * x"
             body.append(f"return numpy.asarray({value}).astype(numpy.float{suffix}, copy=False)")
         else:
-            body = _branch_lines(coefficient, "x", "phi", half_angles=True)
+            body = _branch_lines(coefficient, "x", "phi", half_angles=True, corrected=suffix in angle_low)
         functions.append({"name": f"_{name}_{suffix}",
                           "args": "x, phi, s, d, sin_half, cos_half, span=None", "body": body})
     angle = precision.angle
