@@ -199,21 +199,23 @@ _HYPERBOLIC = (sp.sinh, sp.cosh, sp.tanh, sp.coth, sp.sech, sp.csch)
 
 
 def _plain_hyperbolic(expr: sp.Expr) -> bool:
-    """Whether ``expr`` has no hyperbolic function, or hyperbolic functions of one argument and no
-    root of φ beside them: the other shapes are where ``solveset`` spent seconds to minutes and
-    returned no finite set (a Union, ConditionSet or Complement, which leaves the analysis numeric
-    anyway). Measured on p′ of the corpus and 96 hypothesis functions: tanh(φ/3)√(2φ²/3 + 1)
-    with tanh φ/(φ²/3 + 1) took 7.9 s, √(φ²/2 + 1) sinh 2φ with cos(2φ) asinh(φ/4) 8.7 s, and
-    cosh(3φ/2) beside tanh(φ/4) and tanh(φ/3) ran past its 90 s bound; with one argument and no
-    root of φ outside them (√(1 − tanh²φ) is allowed), solveset returned its empty or finite set
-    within 0.1 s (sinh φ, sinh(sin φ), asin(tanh φ))."""
-    calls = expr.atoms(*_HYPERBOLIC)
+    """Whether ``expr`` has no root of φ beside its trigonometric and hyperbolic functions, and its
+    hyperbolic functions (if any) share one argument: the other shapes are where ``solveset``
+    spent seconds to minutes and returned no finite set (a Union, ConditionSet or Complement, which
+    leaves the analysis numeric anyway). Measured on p′ of the corpus and 96 hypothesis
+    functions: tanh(φ/3)√(2φ²/3 + 1) with tanh φ/(φ²/3 + 1) took 7.9 s, √(φ²/2 + 1) sinh 2φ with
+    cos(2φ) asinh(φ/4) 8.7 s, and cosh(3φ/2) beside tanh(φ/4) and tanh(φ/3) ran past its 90 s
+    bound; √(φ²/3 + 1) asin(φ/3) with cos φ asin(φ/4) (rows 140 and 142) ran past 15 s under load.
+    Roots of the calls themselves are allowed (√(1 − tanh²φ), √(1 − sin²φ/4)): with those shapes
+    solveset returned its empty or finite set within 0.5 s (sinh φ, sinh(sin φ), asin(tanh φ),
+    2 asin(sin(φ)/2))."""
+    calls = expr.atoms(*_HYPERBOLIC, *_PERIODIC)
     if not calls:
         return True
     opaque = {call: sp.Dummy() for call in calls}
     roots = any(not power.exp.is_integer and power.base.xreplace(opaque).has(PHI)
                 for power in expr.atoms(sp.Pow))
-    return len({call.args[0] for call in calls}) <= 1 and not roots
+    return len({call.args[0] for call in expr.atoms(*_HYPERBOLIC)}) <= 1 and not roots
 
 
 def _events(expr: sp.Expr, extra: tuple[float, ...] = ()) -> list[tuple[mpmath.mpf, str, bool]]:
