@@ -96,6 +96,10 @@ ANGLE_CORRECTION_GROWTH = 4.0
 (``EvaluationPlan.angle_correction``): λ's error is about (k + ½) ε s/p′ for a residual k units of
 roundoff off, φ's rounding ½ ε φ, so λ gains where φ p′/p > 2k + 1 (k ≈ 1–2 for the plans' ratios)."""
 
+ANGLE_CORRECTION_LIMIT = 4
+"""λ is applied while |λ| ≤ ANGLE_CORRECTION_LIMIT ε φ (``EvaluationPlan.angle_correction_bound``):
+a larger λ means the iterate φ was not converged and one Newton correction would not be exact."""
+
 
 @dataclass(frozen=True)
 class ClosedAngle:
@@ -179,8 +183,8 @@ class EvaluationPlan:
         for the precisions whose angle is a Newton iteration: λ is the part of the exact angle φ*
         below the last bit of the iterate φ, one more Newton correction of φ, and backends print
         sin(φ/2) + cos(φ/2) λ/2 and cos(φ/2) − sin(φ/2) λ/2 for the half-angle sine and cosine
-        while |λ| ≤ 4 ε φ. float64's helpers serve float32 too when float64 has them: a float32
-        residual s − p(φ) is as uncertain as the rounding of φ itself.
+        while |λ| ≤ :meth:`angle_correction_bound` φ. float64's helpers serve float32 too when
+        float64 has them: a float32 residual s − p(φ) is as uncertain as the rounding of φ itself.
 
         Next to 2π (ν → 0) sin(φ/2) is far better conditioned in s than in φ when p grows faster
         than φ: the half ulp of φ's rounding moved R₁ = sin φ/p of cosh(3φ/2)(2 tanh(φ/4) +
@@ -195,6 +199,11 @@ class EvaluationPlan:
         if not newton or not self.grows_faster_than_angle():
             return {}
         return {label: "float64" if "float64" in newton else label for label in newton}
+
+    def angle_correction_bound(self, label: str) -> float:
+        """|λ|/φ above which precision ``label`` leaves the half angles uncorrected:
+        :data:`ANGLE_CORRECTION_LIMIT` units of its roundoff."""
+        return ANGLE_CORRECTION_LIMIT * self.precisions[label].epsilon
 
     def grows_faster_than_angle(self) -> bool:
         """Whether φ p′/p exceeds :data:`ANGLE_CORRECTION_GROWTH` anywhere in the range (on 256

@@ -48,7 +48,7 @@ def header_source(plan: EvaluationPlan, name: str, expression: str | None = None
         if plan.complement is not None:
             functions.append(writer.complement_function())
         functions.append(writer.angle_function())
-        functions += writer.angle_low_functions()
+        functions += writer.angle_low_functions
         public = [writer.function(spec) for spec in FUNCTIONS]
         for spec, function in zip(FUNCTIONS, public, strict=True):
             if function["batch_signature"]:

@@ -32,6 +32,7 @@ counted by ``sympy.count_ops`` (a call such as ``sin`` counts one; Newton iterat
 from __future__ import annotations
 
 import math
+from functools import cached_property
 from typing import Any
 
 import sympy as sp
@@ -43,6 +44,7 @@ from ..parsing import PHI
 from ..plan import half_angle
 from ..plan_ir import (
     ANGLE_CORRECTION_GROWTH,
+    ANGLE_CORRECTION_LIMIT,
     Algebraic,
     Branch,
     ClosedAngle,
@@ -318,10 +320,11 @@ class FunctionWriter:
     def half_low_call(self, s_text: str, phi_text: str) -> str:
         return f"{self.half_low_helper}({s_text}, {phi_text})"
 
+    @cached_property
     def angle_low_functions(self) -> list[dict[str, Any]]:
         """The helpers λ(s, φ) (one more Newton correction of φ; only in the precision whose ratio
         and slope serve, see ``EvaluationPlan.angle_correction``) and λ/2 for this precision, 0
-        unless |λ| ≤ 4 ε φ."""
+        unless |λ| ≤ ``EvaluationPlan.angle_correction_bound`` φ."""
         correction = self.plan.angle_correction()
         label = PLAN_LABEL[self.precision]
         if label not in correction:
@@ -350,7 +353,7 @@ class FunctionWriter:
                 "ops": ops_of(statements), "signature": signature,
                 "statements": statements, "batch_signature": None, "output": None})
         source: Precision = "double" if correction[label] == "float64" else "float"
-        bound = self.printer.literal(sp.Float(4 * self.precision_plan.epsilon, 17))
+        bound = self.printer.literal(sp.Float(self.plan.angle_correction_bound(label), 17))
         f = "" if self.precision == "double" else "f"
         half = self.printer.literal(sp.Float(0.5))
         statements = [
@@ -363,7 +366,8 @@ class FunctionWriter:
         functions.append({
             "c_name": self.half_low_helper, "equation": "11",
             "summary": "internal: lambda/2 for sin(phi/2) and cos(phi/2)",
-            "notes": ["Half of the Newton angle below the last bit of phi, 0 unless within 4 units of",
+            "notes": ["Half of the Newton angle below the last bit of phi, 0 unless within "
+                      f"{ANGLE_CORRECTION_LIMIT} units of",
                       "roundoff: sin(phi/2) + cos(phi/2) lambda/2 is accurate next to 2 pi."],
             "ops": ops_of(statements), "signature": f"{t} {self.half_low_helper}({t} s, {t} phi)",
             "statements": statements, "batch_signature": None, "output": None})
@@ -427,7 +431,7 @@ class FunctionWriter:
         if corrected:
             above.append({"kind": "let", "type": self.ctype, "name": "half_low",
                           "value": self.half_low_call("s", "phi"),
-                          "ops": sum(ops_of(f["statements"]) for f in self.angle_low_functions())})
+                          "ops": sum(ops_of(f["statements"]) for f in self.angle_low_functions)})
         above += [self.let(str(symbol), value) for symbol, value in replacements]
         for (name, branch), value in zip(branches.items(), reduced, strict=True):
             assert isinstance(branch, Branch)

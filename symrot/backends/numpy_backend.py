@@ -257,9 +257,10 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
 
 
 def angle_low_helpers(plan: EvaluationPlan) -> dict[str, dict[str, str]]:
-    """{suffix: {"helper": its _angle_low function, "bound": 4 ε}} (``EvaluationPlan.angle_correction``)."""
+    """{suffix: {"helper": its _angle_low function, "bound": the largest |λ|/φ applied}}
+    (``EvaluationPlan.angle_correction``, ``angle_correction_bound``)."""
     return {SUFFIX[label]: {"helper": f"_angle_low_{SUFFIX[source]}",
-                            "bound": repr(4 * plan.precisions[label].epsilon)}
+                            "bound": repr(plan.angle_correction_bound(label))}
             for label, source in plan.angle_correction().items()}
 
 
