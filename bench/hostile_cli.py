@@ -13,16 +13,29 @@ worker process of :mod:`symrot.cli.worker`) in a scratch directory, two at a tim
 ``tests/test_hostile_cli.py`` runs :data:`QUICK` with a small budget and :data:`HEAVY` as a slow
 test; ``python bench/hostile_cli.py [BUDGET]`` runs those and :data:`EXTRA` with the default
 budget of 60 s and prints one line per input (status, seconds, the last line of stderr).
+
+:func:`run_all_preloaded` is the quick tier's runner: the same command line (``symrot.cli.main``
+on ``sys.argv``, its worker process and budget included), each input in a process forked from a
+server that imported ``symrot.cli`` once (:func:`serve`), so that 166 inputs do not pay 166
+interpreter and SymPy start-ups (about 1.4 s each on this machine). What start-up itself does is tested by
+:func:`run_all` (``HEAVY``, the long run) and by tests/test_install.py.
 """
 
 from __future__ import annotations
 
+import json
+import os
+import queue
+import signal
 import subprocess
 import sys
 import tempfile
 import time
+import traceback
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, NoReturn
 
 MARGIN = 12.0
 """Seconds allowed beyond the budget: interpreter start-up and the worker's grace period on a
@@ -219,6 +232,108 @@ def run_all(corpus: list[list[str]], budget: float, workers: int = 2) -> list[Ou
     with tempfile.TemporaryDirectory(prefix="symrot-hostile-") as scratch, \
             ThreadPoolExecutor(max_workers=workers) as pool:
         return list(pool.map(lambda args: run_one(args, budget, scratch), corpus))
+
+
+def serve() -> None:
+    """The preloaded server of :func:`run_all_preloaded`: imports ``symrot.cli`` once, then for
+    each request on stdin (one JSON object per line: args, budget, directory, stderr path) forks a
+    child that runs the command (:func:`_command_in_child`), waits for it at most the budget plus
+    ``10 * MARGIN`` (then kills it: status -9), and answers ``[status, seconds]`` on stdout."""
+    import symrot.cli  # noqa: F401 - imported once here, inherited by every child
+
+    for line in sys.stdin:
+        request = json.loads(line)
+        started = time.monotonic()
+        pid = os.fork()
+        if pid == 0:
+            _command_in_child(request)
+        status = _wait_or_kill(pid, request["budget"] + 10 * MARGIN)
+        print(json.dumps([status, time.monotonic() - started]), flush=True)
+
+
+def _command_in_child(request: dict[str, Any]) -> NoReturn:
+    """``symrot --timeout BUDGET *args`` in the request's directory as the console script runs it
+    (``symrot.cli.main`` reading ``sys.argv``, through its worker process), stdin and stdout on
+    /dev/null, stderr into the request's file; ends the process with the command's status."""
+    code = 70
+    try:
+        os.chdir(request["directory"])
+        null = os.open(os.devnull, os.O_RDWR)
+        err = os.open(request["stderr"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+        for target, fd in ((0, null), (1, null), (2, err)):
+            os.dup2(fd, target)
+        sys.stdin = open(0, encoding="utf-8", closefd=False)  # noqa: SIM115 - the process's own
+        sys.stdout = open(1, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+        sys.stderr = open(2, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+        sys.argv = ["symrot", "--timeout", f"{request['budget']:g}", *request["args"]]
+        from symrot.cli import main
+
+        code = main()
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+    except BaseException:  # reported like an uncaught exception of the real command
+        traceback.print_exc()
+        code = 1
+    finally:
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        finally:
+            os._exit(code)
+
+
+def _wait_or_kill(pid: int, seconds: float) -> int:
+    """The exit status of child ``pid`` as :mod:`subprocess` gives it (−N for signal N), killing
+    it after ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            return os.waitstatus_to_exitcode(status)
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            return -9
+        time.sleep(0.005)
+
+
+def run_all_preloaded(corpus: list[list[str]], budget: float, workers: int = 2) -> list[Outcome]:
+    """Every input of ``corpus`` like :func:`run_all`, each in a process forked from one of
+    ``workers`` servers (:func:`serve`) that have ``symrot.cli`` imported, started with
+    ``PYTHONHASHSEED=0`` as the ``symrot`` command re-executes itself."""
+    pending: queue.Queue[tuple[int, list[str]]] = queue.Queue()
+    for item in enumerate(corpus):
+        pending.put(item)
+    outcomes: dict[int, Outcome] = {}
+    server_code = (f"import sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); "
+                   "import hostile_cli; hostile_cli.serve()")
+    with tempfile.TemporaryDirectory(prefix="symrot-hostile-") as scratch:
+        def drive() -> None:
+            with subprocess.Popen([sys.executable, "-c", server_code], stdin=subprocess.PIPE,
+                                  stdout=subprocess.PIPE, text=True, cwd=scratch,
+                                  env=dict(os.environ, PYTHONHASHSEED="0")) as server:
+                assert server.stdin is not None and server.stdout is not None
+                while True:
+                    try:
+                        index, args = pending.get_nowait()
+                    except queue.Empty:
+                        break
+                    stderr_path = Path(scratch) / f"stderr-{index}.txt"
+                    server.stdin.write(json.dumps({"args": args, "budget": budget, "directory": scratch,
+                                                   "stderr": str(stderr_path)}) + "\n")
+                    server.stdin.flush()
+                    reply = server.stdout.readline()
+                    if not reply:
+                        raise RuntimeError(f"the preloaded server ended while running {args!r}")
+                    status, seconds = json.loads(reply)
+                    stderr = stderr_path.read_text(encoding="utf-8", errors="replace")
+                    outcomes[index] = Outcome(tuple(args), status, seconds, stderr)
+                server.stdin.close()
+
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            for future in [pool.submit(drive) for _ in range(workers)]:
+                future.result()
+    return [outcomes[index] for index in range(len(corpus))]
 
 
 def main(argv: list[str]) -> int:

@@ -1,6 +1,9 @@
 """Reliability of the command line under hostile input (issue 17): the corpus of
-``bench/hostile_cli.py``, each input a subprocess with a small budget, answered in time with
-exit 0 or 2 and no traceback. The long version: ``python bench/hostile_cli.py``."""
+``bench/hostile_cli.py``, each input its own process with a small budget, answered in time with
+exit 0 or 2 and no traceback. The quick inputs run in processes forked from a server that has
+imported ``symrot.cli`` (``hostile_cli.run_all_preloaded``: the same ``main`` on ``sys.argv``, worker
+and budget included, without 166 interpreter start-ups); the heavy ones as ``python -m symrot``
+subprocesses. The long version: ``python bench/hostile_cli.py``."""
 
 from __future__ import annotations
 
@@ -39,8 +42,16 @@ def test_outcomes_are_judged() -> None:
     assert judge(("x",), -9, 1.0, "Traceback (most recent call last):").problems(10)[0] == "exit -9"
 
 
+def test_the_preloaded_runner_reports_what_the_command_did() -> None:
+    ok, refused, unknown = hostile_cli.run_all_preloaded(
+        [["derive", "phi"], ["derive", "__import__('os')"], ["no-such-command"]], QUICK_BUDGET)
+    assert (ok.status, ok.problems(QUICK_BUDGET)) == (0, [])
+    assert refused.status == 2 and "unknown function '__import__'" in refused.stderr
+    assert unknown.status == 2 and "invalid choice" in unknown.stderr
+
+
 def test_quick_hostile_inputs_exit_0_or_2_in_time_without_traceback() -> None:
-    outcomes = hostile_cli.run_all(hostile_cli.QUICK, QUICK_BUDGET)
+    outcomes = hostile_cli.run_all_preloaded(hostile_cli.QUICK, QUICK_BUDGET)
     assert _report(outcomes, QUICK_BUDGET) == []
     # nothing the injections name was executed: no file appeared in the scratch directories
     assert not (Path.cwd() / "pwned").exists()
