@@ -159,6 +159,8 @@ class GeneratingFunction:
         phi = mpmath.mpf(guess) if guess is not None and 0 < guess < high else min(s, high / 2)
         for _ in range(20 * mpmath.mp.dps):
             residual = self.value(phi) - s
+            if residual == 0:  # exact at this precision (the Newton step would be φ itself, which
+                return phi     # the bracket test below would take for a step outside and bisect)
             if residual > 0:
                 high = phi
             else:
