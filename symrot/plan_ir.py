@@ -153,6 +153,11 @@ class PrecisionPlan:
     dc/dx may overflow earlier (Wiener–Milenkovic's −256/(x + 16)³ beyond 2^341), and must not move
     the domain of the other functions."""
 
+    def uses_angle(self) -> bool:
+        """Whether some coefficient's closed form needs the angle φ (and its half-angle sine and
+        cosine); algebraic plans (Cayley, Wiener–Milenkovic, the tangent family) never do."""
+        return any(isinstance(c, Branch) and c.closed.has(PHI) for c in self.coefficients.values())
+
 
 @dataclass(frozen=True)
 class EvaluationPlan:
@@ -179,8 +184,9 @@ class EvaluationPlan:
                      if all(n + "_across" in plan.coefficients for plan in self.precisions.values()))
 
     def angle_correction(self) -> dict[str, str]:
-        """{precision: the precision whose Newton helpers (``ratio``, ``slope``) give λ = φ* − φ}
-        for the precisions whose angle is a Newton iteration: λ is the part of the exact angle φ*
+        """{precision: the precision whose angle gives λ = φ* − φ (its Newton helpers ``ratio`` and
+        ``slope`` when it iterates, else its closed angle)} for the precisions whose angle is a
+        Newton iteration, and for a float32 closed angle (below): λ is the part of the exact angle φ*
         below the last bit of the iterate φ, one more Newton correction of φ, and backends print
         sin(φ/2) + cos(φ/2) λ/2 and cos(φ/2) − sin(φ/2) λ/2 for the half-angle sine and cosine
         while |λ| ≤ :meth:`angle_correction_bound` φ. float64's helpers serve float32 too when
@@ -193,12 +199,25 @@ class EvaluationPlan:
 
         λ is used only where φ p′/p > :data:`ANGLE_CORRECTION_GROWTH`: its own error, that of the
         residual s − p(φ) divided by p′, exceeds the half ulp of φ's rounding where p grows no
-        faster than φ (cbrt(6(φ − sin φ)) at φ ≈ 1: H⁻¹ 3.4 ulp from NumPy with λ, 1.8 without)."""
+        faster than φ (cbrt(6(φ − sin φ)) at φ ≈ 1: H⁻¹ 3.4 ulp from NumPy with λ, 1.8 without).
+
+        A float32 closed angle takes λ = φ₆₄(s) − φ, float64's angle (closed, or one Newton step
+        from φ with float64's helpers) minus its own, wherever it is used: that λ is exact to
+        float32's eyes. 2 sinh(3φ/2)/3 at φ = 6.283: float32 ``pdot`` was 1.8·10⁶ ulp off. Only
+        where p grows that fast next to 2π, where sin(φ/2) is ill conditioned in φ (not at the
+        tangent family's poles, where it is not: there λ would only cost time), and not for p whose
+        plan has a complement d (float32's d would have to be widened exactly)."""
+        if not self.grows_faster_than_angle():
+            return {}
         newton = [label for label, precision in self.precisions.items()
                   if isinstance(precision.angle, NewtonAngle)]
-        if not newton or not self.grows_faster_than_angle():
-            return {}
-        return {label: "float64" if "float64" in newton else label for label in newton}
+        correction = {label: "float64" if "float64" in newton else label for label in newton}
+        narrow = self.precisions.get("float32")
+        if (narrow is not None and isinstance(narrow.angle, ClosedAngle) and "float64" in self.precisions
+                and self.complement is None and narrow.uses_angle()
+                and _grows_faster_than_angle(self.p, self.phi_max, where_half_sine_is_ill=True)):
+            correction["float32"] = "float64"
+        return correction
 
     def angle_correction_bound(self, label: str) -> float:
         """|λ|/φ above which precision ``label`` leaves the half angles uncorrected:
@@ -225,14 +244,20 @@ class EvaluationPlan:
 
 
 @lru_cache(maxsize=64)
-def _grows_faster_than_angle(p: sp.Expr, phi_max: float) -> bool:
-    """See ``EvaluationPlan.grows_faster_than_angle``."""
+def _grows_faster_than_angle(p: sp.Expr, phi_max: float, where_half_sine_is_ill: bool = False) -> bool:
+    """See ``EvaluationPlan.grows_faster_than_angle``; with ``where_half_sine_is_ill``, only at
+    angles where sin(φ/2) is ill conditioned in φ, |(φ/2) cot(φ/2)| > ANGLE_CORRECTION_GROWTH
+    (φ > 5.8: next to 2π)."""
     end = phi_max if math.isfinite(phi_max) else 4 * math.pi
     growth = sp.lambdify(PHI, PHI * sp.diff(p, PHI) / p, modules=[mpmath_namespace(), "mpmath"])
     with mpmath.workdps(30):
         for k in range(1, 257):
+            angle = mpmath.mpf(end) * k / 257
+            half_sine_condition = abs(angle / 2 * mpmath.cot(angle / 2))
+            if where_half_sine_is_ill and not half_sine_condition > ANGLE_CORRECTION_GROWTH:
+                continue
             try:
-                value = growth(mpmath.mpf(end) * k / 257)
+                value = growth(angle)
             except (ZeroDivisionError, ValueError, OverflowError):
                 continue
             if isinstance(value, mpmath.mpf) and value > ANGLE_CORRECTION_GROWTH:

@@ -11,6 +11,11 @@ module and from the C header. Measured (NumPy = C), sin φ in units of its condi
 2.79, 3.90 (1.77, 6.14, 9.68 without λ). float64's λ is only as good as its residual s − p(φ):
 p evaluates cosh(3φ/2) at the rounded 3φ/2, about 5 units of roundoff at 2π, so its bound here is
 4.5 (the docs' target is 4); float32 takes λ from the float64 helpers and is held to the target.
+
+A float32 closed angle takes λ = φ₆₄(s) − φ from float64's closed angle (``CLOSED``, 2 sinh(3φ/2)/3,
+φ = 2 asinh(3s/2)/3) in NumPy: float32 sin φ 0.0 condition numbers off at the three angles (2.88,
+3.44 and 4.93 without λ; its ``pdot`` was 1.8·10⁶ ulp off at 6.283); its float64 angle takes no λ,
+and C's float functions keep free of double (no λ).
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import ctypes
 import shutil
 import subprocess
 import tempfile
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -37,30 +43,35 @@ from .c_harness import STRICT_C
 from .helpers import mp_function
 
 EXPRESSION = "2*cosh(3*phi/2)*tanh(phi/4) + 3*cosh(3*phi/2)*tanh(phi/3)/2"
+CLOSED = "2*sinh(3*phi/2)/3"
 ANGLES = ("6.2831", "6.28318", "6.2831852")
 TARGET = {"float64": 4.5, "float32": 4.0}
 FORMATS = {"float64": (np.float64, ctypes.c_double, ""), "float32": (np.float32, ctypes.c_float, "_f")}
+CASES = [(EXPRESSION, label, backend) for label in FORMATS for backend in ("numpy", "c")] + [
+    (CLOSED, "float32", "numpy")]
+"""The C header's float functions of a closed angle stay free of double: no λ there (below)."""
 
 
-@pytest.fixture(scope="module")
-def plan() -> Any:
-    return evaluation_plan(derive(EXPRESSION).derivation, "corrected")
+@cache
+def plan_of(expression: str) -> Any:
+    return evaluation_plan(derive(expression).derivation, "corrected")
 
 
-@pytest.fixture(scope="module")
-def numpy_module(plan: Any) -> Any:
+@cache
+def numpy_module(expression: str) -> Any:
     namespace: dict[str, Any] = {"__name__": "corrected"}
-    exec(compile(module_source(plan), "corrected.py", "exec"), namespace)
+    exec(compile(module_source(plan_of(expression)), "corrected.py", "exec"), namespace)
     return namespace
 
 
-@pytest.fixture(scope="module")
-def c_library(plan: Any) -> Any:
+@cache
+def c_library(expression: str) -> Any:
     compiler = shutil.which("gcc") or shutil.which("cc")
     if compiler is None:
         pytest.skip("no C compiler")
     directory = Path(tempfile.mkdtemp())
-    (directory / "symrot_corrected.h").write_text(header_source(plan, "corrected"), encoding="utf-8")
+    (directory / "symrot_corrected.h").write_text(header_source(plan_of(expression), "corrected"),
+                                                   encoding="utf-8")
     (directory / "unit.c").write_text(
         '#include "symrot_corrected.h"\n'
         "void r64(const double p[3], double r[9]) { symrot_corrected_rotation_matrix(p, r); }\n"
@@ -72,22 +83,22 @@ def c_library(plan: Any) -> Any:
     return ctypes.CDLL(str(library))
 
 
-def _exact_angle(s: float) -> mpmath.mpf:
-    p = mp_function(parse_expression(EXPRESSION))
+def _exact_angle(expression: str, s: float) -> mpmath.mpf:
+    p = mp_function(parse_expression(expression))
     with mpmath.workdps(60):
         return mpmath.findroot(lambda phi: p(phi) - mpmath.mpf(s), mpmath.mpf(6.28318))
 
 
-def _checks(label: str) -> list[tuple[float, mpmath.mpf, mpmath.mpf]]:
-    """(s in the format, sin φ*, its condition number in s) at each angle."""
+def _checks(expression: str, label: str) -> list[tuple[float, mpmath.mpf, mpmath.mpf]]:
+    """(s in the format, φ*, the condition number of sin φ in s) at each angle."""
     dtype = FORMATS[label][0]
-    p = mp_function(parse_expression(EXPRESSION))
-    slope = mp_function(sp.diff(parse_expression(EXPRESSION), PHI))
+    p = mp_function(parse_expression(expression))
+    slope = mp_function(sp.diff(parse_expression(expression), PHI))
     out = []
     for text in ANGLES:
         with mpmath.workdps(60):
             s = float(dtype(float(p(mpmath.mpf(text)))))
-            phi = _exact_angle(s)
+            phi = _exact_angle(expression, s)
             kappa = abs(mpmath.mpf(s) * mpmath.cos(phi) / (slope(phi) * mpmath.sin(phi)))
             out.append((s, phi, kappa))
     return out
@@ -108,20 +119,33 @@ def _rotation_c(library: Any, s: float, label: str) -> np.ndarray:
     return np.array(list(r), dtype=dtype).reshape(3, 3)
 
 
-@pytest.mark.parametrize("backend", ["numpy", "c"])
-@pytest.mark.parametrize("label", list(FORMATS))
-def test_sine_and_cosine_next_to_two_pi_are_within_their_condition(
-        backend: str, label: str, plan: Any, numpy_module: Any, request: pytest.FixtureRequest) -> None:
-    assert label in plan.angle_correction()  # a Newton angle: the case this file is about
+@pytest.mark.parametrize("expression, label, backend", CASES,
+                         ids=[f"{'newton' if e == EXPRESSION else 'closed'}-{label}-{backend}"
+                              for e, label, backend in CASES])
+def test_sine_and_cosine_next_to_two_pi_are_within_their_condition(expression: str, label: str,
+                                                                    backend: str) -> None:
+    plan = plan_of(expression)
+    assert label in plan.angle_correction()  # the case this file is about
     dtype = FORMATS[label][0]
-    library = request.getfixturevalue("c_library") if backend == "c" else None
     worst = []
-    for s, phi, kappa in _checks(label):
-        rotation = _rotation_numpy(numpy_module, s, dtype) if backend == "numpy" else \
-            _rotation_c(library, s, label)
+    for s, phi, kappa in _checks(expression, label):
+        rotation = _rotation_numpy(numpy_module(expression), s, dtype) if backend == "numpy" else \
+            _rotation_c(c_library(expression), s, label)
         with mpmath.workdps(60):
             sine, cosine = mpmath.sin(phi), mpmath.cos(phi)
         excess = _ulps(rotation[2, 1], sine, dtype) / max(1.0, float(kappa))
         worst.append((excess, float(phi), _ulps(rotation[1, 1], cosine, dtype)))
     assert max(w[0] for w in worst) <= TARGET[label], worst
     assert max(w[2] for w in worst) <= 4.0, worst  # cos φ ≈ 1 there: within a few ulp outright
+
+
+def test_a_closed_float64_angle_takes_no_correction() -> None:
+    assert plan_of(CLOSED).angle_correction() == {"float32": "float64"}
+
+
+def test_c_float_functions_of_a_closed_angle_use_no_double() -> None:
+    """λ = φ₆₄(s) − φ would need double in the float functions (emulated on a single-precision
+    FPU): the C backend leaves it out there, and the header's float part has no double."""
+    text = header_source(plan_of(CLOSED), "corrected")
+    float_part = "\n".join(line for line in text.splitlines() if "_f(" in line or "float" in line)
+    assert "half_low" not in text and "(double)" not in float_part

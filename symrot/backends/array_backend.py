@@ -246,6 +246,9 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
             assert isinstance(angle, ClosedAngle)
             expression = angle.expression.subs(S, sp.Symbol("s"))
             closed_angles[suffix] = [f"return {print_array(expression)} + 0.0 * s"]
+            if label in plan.angle_correction().values():  # a closed angle serving float32
+                functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi",
+                                  "body": [f"return _angle_{suffix}(s, None) - phi"]})
         functions.append({"name": f"_scale_{suffix}", "args": "e0, e_norm",
                           "body": _scale_lines(precision.quaternion_scale, suffix)})
     squared, inclusive = plan.boundary(53)

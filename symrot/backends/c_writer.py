@@ -295,10 +295,18 @@ class FunctionWriter:
         ]
 
     # -- λ, the Newton angle below φ's last bit ---------------------------------------------------
+    @cached_property
+    def angle_correction(self) -> dict[str, str]:
+        """``EvaluationPlan.angle_correction`` without a float closed angle's λ: that λ is float64's
+        angle minus φ, and a header's float functions with closed angles stay free of double (a
+        single-precision FPU emulates double; the named headers are checked for it)."""
+        return {label: source for label, source in self.plan.angle_correction().items()
+                if not (label == "float32" and isinstance(self.plan.precisions[label].angle, ClosedAngle))}
+
     @property
     def corrects_angle(self) -> bool:
-        """Whether this precision's half-angle sine and cosine take λ (a Newton angle)."""
-        return PLAN_LABEL[self.precision] in self.plan.angle_correction()
+        """Whether this precision's half-angle sine and cosine take λ."""
+        return PLAN_LABEL[self.precision] in self.angle_correction
 
     def half_angle_corrected(self, expr: sp.Expr) -> sp.Expr:
         """``expr`` with sin(φ/2) → sin(φ/2) + (λ/2) cos(φ/2) and cos(φ/2) → cos(φ/2) − (λ/2) sin(φ/2)
@@ -325,18 +333,19 @@ class FunctionWriter:
         """The helpers λ(s, φ) (one more Newton correction of φ; only in the precision whose ratio
         and slope serve, see ``EvaluationPlan.angle_correction``) and λ/2 for this precision, 0
         unless |λ| ≤ ``EvaluationPlan.angle_correction_bound`` φ."""
-        correction = self.plan.angle_correction()
+        correction = self.angle_correction
         label = PLAN_LABEL[self.precision]
-        if label not in correction:
-            return []
         t = self.ctype
         functions = []
         angle = self.precision_plan.angle
+        signature = f"{t} {self.low_helper(self.precision)}({t} s, {t} phi)"
+        if label not in correction:
+            return []
         if correction[label] == label and isinstance(angle, NewtonAngle):
             step = ("(s - value) / slope * (value / (s > 0 ? s : 1))" if angle.reciprocal
                     else "(s - value) / slope")
             growth = self.printer.literal(sp.Float(ANGLE_CORRECTION_GROWTH))
-            statements: list[Statement] = [
+            statements = [
                 self.let("t", PHI_SYMBOL**2),
                 {"kind": "declare", "type": t, "names": ["ratio", "slope"]},
                 self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
@@ -344,7 +353,6 @@ class FunctionWriter:
                 self.let("value", PHI_SYMBOL * sp.Symbol("ratio")),
                 {"kind": "return", "value": f"phi * slope > {growth} * s ? {step} : 0", "ops": 7},
             ]
-            signature = f"{t} {self.low_helper(self.precision)}({t} s, {t} phi)"
             functions.append({
                 "c_name": self.low_helper(self.precision), "equation": "11",
                 "summary": "internal: lambda, the Newton angle below the last bit of phi",

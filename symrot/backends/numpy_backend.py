@@ -299,10 +299,10 @@ def module_context_functions(precision: Any, suffix: str,
                 .replace("_slope(", f"_slope_{suffix}(") for line in lines]
 
     functions.append({"name": f"_angle_{suffix}", "args": "s, d", "body": helpers(_angle_lines(angle))})
-    if isinstance(angle, NewtonAngle) and any(low["helper"] == f"_angle_low_{suffix}"
-                                              for low in angle_low.values()):
-        functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi",
-                          "body": helpers(_angle_low_lines(angle))})
+    if any(low["helper"] == f"_angle_low_{suffix}" for low in angle_low.values()):
+        body = (helpers(_angle_low_lines(angle)) if isinstance(angle, NewtonAngle)
+                else [f"return _angle_{suffix}(s, None) - phi"])  # a closed angle serving float32
+        functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi", "body": body})
     functions.append({"name": f"_scale_{suffix}", "args": "e0, e_norm",
                       "body": _scale_lines(precision.quaternion_scale, suffix)})
     return functions
