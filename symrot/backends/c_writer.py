@@ -335,17 +335,17 @@ class FunctionWriter:
         unless |λ| ≤ ``EvaluationPlan.angle_correction_bound`` φ."""
         correction = self.angle_correction
         label = PLAN_LABEL[self.precision]
+        if label not in correction:
+            return []
         t = self.ctype
         functions = []
         angle = self.precision_plan.angle
-        signature = f"{t} {self.low_helper(self.precision)}({t} s, {t} phi)"
-        if label not in correction:
-            return []
         if correction[label] == label and isinstance(angle, NewtonAngle):
             step = ("(s - value) / slope * (value / (s > 0 ? s : 1))" if angle.reciprocal
                     else "(s - value) / slope")
             growth = self.printer.literal(sp.Float(ANGLE_CORRECTION_GROWTH))
-            statements = [
+            signature = f"{t} {self.low_helper(self.precision)}({t} s, {t} phi)"
+            statements: list[Statement] = [
                 self.let("t", PHI_SYMBOL**2),
                 {"kind": "declare", "type": t, "names": ["ratio", "slope"]},
                 self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
