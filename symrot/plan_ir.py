@@ -137,6 +137,11 @@ class QuaternionScale:
     branch: Branch | None
 
 
+def uses_angle(coefficient: Coefficient) -> bool:
+    """Whether the coefficient's code needs the angle φ (a Branch whose closed form has φ)."""
+    return isinstance(coefficient, Branch) and coefficient.closed.has(PHI)
+
+
 @dataclass(frozen=True)
 class PrecisionPlan:
     dtype: str
@@ -155,8 +160,8 @@ class PrecisionPlan:
 
     def uses_angle(self) -> bool:
         """Whether some coefficient's closed form needs the angle φ (and its half-angle sine and
-        cosine); algebraic plans (Cayley, Wiener–Milenkovic, the tangent family) never do."""
-        return any(isinstance(c, Branch) and c.closed.has(PHI) for c in self.coefficients.values())
+        cosine); algebraic plans (Cayley, Wiener–Milenkovic) never do."""
+        return any(uses_angle(c) for c in self.coefficients.values())
 
 
 @dataclass(frozen=True)

@@ -42,7 +42,7 @@ from ..plan import (
     evaluation_plan,
     half_angle,
 )
-from ..plan_ir import ANGLE_CORRECTION_GROWTH
+from ..plan_ir import ANGLE_CORRECTION_GROWTH, uses_angle
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 from .numpy_derivatives import derivative_lines, rate_lines
 from .templating import render
@@ -265,8 +265,8 @@ def angle_low_helpers(plan: EvaluationPlan) -> dict[str, dict[str, str]]:
 
 
 def uses_phi(coefficient: Any) -> bool:
-    """Whether the coefficient's code needs the angle φ (a Branch whose closed form has φ)."""
-    return isinstance(coefficient, Branch) and coefficient.closed.has(PHI)
+    """Whether the coefficient's code needs the angle φ (``plan_ir.uses_angle``)."""
+    return uses_angle(coefficient)
 
 
 def module_context_functions(precision: Any, suffix: str,
