@@ -284,6 +284,10 @@ def _mp(number: sp.Expr) -> mpmath.mpf:
     return mpmath.mpf(sp.N(number, mpmath.mp.dps + 10)._to_mpmath(mpmath.mp.prec + 30))
 
 
+_CROSS_SIGN = ((0, -1, 1), (1, 0, -1), (-1, 1, 0))
+"""(p×)_ij = _CROSS_SIGN[i][j] p_k with k = 3 − i − j the third index (i ≠ j)."""
+
+
 class Reference:
     """High-precision values of every C function at an exact (binary) input p, from the core.
 
@@ -302,11 +306,19 @@ class Reference:
         self.series = {name: derivation.series_in_x(name, SERIES_TERMS) for name in self.closed}
         self.phi_series = derivation.phi_of_p(2 * SERIES_TERMS)
         self._cache: dict[str, dict[str, mpmath.mpf]] = {}
+        self._angles: dict[str, mpmath.mpf] = {}
 
     def _digits(self, s: mpmath.mpf) -> int:
         return 60 + (0 if s >= 1 else int(3 * -mpmath.log10(s)))
 
     def angle(self, s: mpmath.mpf) -> mpmath.mpf:
+        """φ(s), memoized per s (every function of a grid point asks for it)."""
+        key = mpmath.nstr(s, 40)
+        if key not in self._angles:
+            self._angles[key] = self._solve_angle(s)
+        return self._angles[key]
+
+    def _solve_angle(self, s: mpmath.mpf) -> mpmath.mpf:
         if s < SERIES_BELOW:
             return mpmath.fsum(_mp(c) * s**k for k, c in enumerate(self.phi_series) if c != 0)
         with mpmath.workdps(self._digits(s)):
@@ -347,12 +359,16 @@ class Reference:
             tensor = {"pdot": "H_inverse", "omega": "H"}.get(function.name) or TENSOR_OF[function.name]
             a, b, c = (self.coefficients(s, [f"{tensor}_{k}" for k in range(3)])[f"{tensor}_{k}"]
                        for k in range(3))
-            P = mpmath.matrix([[0, -pv[2], pv[1]], [pv[2], 0, -pv[0]], [-pv[1], pv[0], 0]])
-            T = a * mpmath.eye(3) + b * P + c * (P * P)
+            # T = a I + b (p×) + c (p×)², (p×)² = p pᵀ − |p|² I, entry by entry (mpmath's matrix
+            # products converted each scalar through repr and were a third of the fixture's time)
+            x = s * s
+            T = [[(a - c * x if i == j else 0) + c * pv[i] * pv[j]
+                  + b * _CROSS_SIGN[i][j] * pv[3 - i - j if i != j else 0] for j in range(3)]
+                 for i in range(3)]
             if function.kind == "matrix":
-                return [T[i, j] for i in range(3) for j in range(3)]
-            w = T * mpmath.matrix([mpmath.mpf(float(c)) for c in v])
-            return [w[i] for i in range(3)]
+                return [T[i][j] for i in range(3) for j in range(3)]
+            w = [mpmath.mpf(float(c)) for c in v]
+            return [mpmath.fsum(T[i][j] * w[j] for j in range(3)) for i in range(3)]
 
 
 def ulp_errors(function: CFunction, got: np.ndarray, exact: list[mpmath.mpf], precision: str) -> float:
