@@ -4,7 +4,7 @@ Each producer maps a registry entry (or the whole registry) to ``{relative path:
 is deterministic (sorted, no timestamps), so a rerun is byte-identical, and ``--check`` fails with
 a unified diff and the fix command when ``generated/`` is stale.
 
-Run as ``python -m symrot.generate [--check] [--only PREFIX] DIR``.
+Run as ``python -m symrot.generate [--check] [--only PREFIX[,PREFIX…]] [--name NAME] DIR``.
 """
 
 from __future__ import annotations
@@ -153,14 +153,43 @@ def _run_task(task: tuple[str, ...], selected: tuple[str, ...]) -> dict[str, Con
         return out
 
 
-def render(only: str | None = None, jobs: int = 1) -> dict[str, Content]:
+def names_of(prefix: str) -> tuple[str, ...]:
+    """The parameterizations that have a file under the per-name ``prefix`` (:data:`PER_NAME`)."""
+    from .backends.c_backend import COVERED
+
+    return tuple(COVERED) if prefix == "c/" else tuple(NAMED)
+
+
+def name_of(relative: str) -> str:
+    """The parameterization a per-name file belongs to: numpy/NAME.py, jax/NAME.py, torch/NAME.py,
+    c/symrot_NAME.h."""
+    prefix, _, file = relative.partition("/")
+    stem = Path(file).stem
+    return stem.removeprefix("symrot_") if prefix == "c" else stem
+
+
+def stale_names(root: Path) -> list[str]:
+    """Files under the per-name prefixes that belong to no parameterization which has one (left
+    behind by a renamed or removed entry; ``make generate`` deletes them)."""
+    return sorted(relative for prefix in PER_NAME for relative in owned(root, [prefix])
+                  if name_of(relative) not in names_of(prefix))
+
+
+def selected_prefixes(only: str | None) -> list[str]:
+    """The producer prefixes that start with one of the comma-separated ``only`` (all without it)."""
+    starts = only.split(",") if only else [""]
+    return [prefix for prefix, _ in producers() if any(prefix.startswith(start) for start in starts)]
+
+
+def render(only: str | None = None, jobs: int = 1, name: str | None = None) -> dict[str, Content]:
     """Every selected file; with ``jobs`` > 1 the work runs in that many forked processes (the
-    result does not depend on how it is split: every task is deterministic)."""
+    result does not depend on how it is split: every task is deterministic). With ``name``, only
+    that parameterization's files of the per-name producers (one task)."""
     from .cli.progress import each
 
     files: dict[str, Content] = {}
-    selected = [prefix for prefix, _ in producers() if not only or prefix.startswith(only)]
-    tasks = _tasks(selected)
+    selected = selected_prefixes(only)
+    tasks = [("names", name)] if name is not None else _tasks(selected)
     if jobs <= 1:
         for task in each(tasks, "symrot.generate"):
             files.update(_run_task(task, tuple(selected)))
@@ -210,10 +239,15 @@ def write(root: Path, files: dict[str, Content], prefixes: list[str]) -> None:
             path.write_bytes(data)
 
 
-def check(root: Path, files: dict[str, Content], prefixes: list[str]) -> list[str]:
-    """Unified diffs between ``root`` and what would be generated (empty when current)."""
+def check(root: Path, files: dict[str, Content], prefixes: list[str], name: str | None = None) -> list[str]:
+    """Unified diffs between ``root`` and what would be generated (empty when current); with
+    ``name``, of that parameterization's files only."""
     diffs = []
-    for relative in sorted(owned(root, prefixes) | set(files)):
+    existing = owned(root, prefixes)
+    if name is not None:
+        existing = {relative for relative in existing
+                    if relative.split("/")[0] + "/" in PER_NAME and name_of(relative) == name}
+    for relative in sorted(existing | set(files)):
         path = root / relative
         old_bytes = path.read_bytes() if path.exists() else b""
         new_content = files.get(relative, "")
@@ -235,19 +269,30 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m symrot.generate")
     parser.add_argument("directory", nargs="?", default="generated")
     parser.add_argument("--check", action="store_true", help="compare instead of writing")
-    parser.add_argument("--only", help="only producers whose prefix starts with this")
+    parser.add_argument("--only", help="only producers whose prefix starts with this "
+                        "(several: comma-separated)")
+    parser.add_argument("--name", help="only this parameterization's files of the per-name producers "
+                        f"({', '.join(PER_NAME)})")
     parser.add_argument("--list", action="store_true", help="list producer prefixes")
     parser.add_argument("--jobs", type=int, default=None,
                         help="worker processes (default: the CPUs available, at most 4; 1: none)")
     args = parser.parse_args(argv)
-    prefixes = [prefix for prefix, _ in producers() if not args.only or prefix.startswith(args.only)]
+    prefixes = selected_prefixes(args.only)
     if args.list:
         print("\n".join(prefixes))
         return 0
     root = Path(args.directory)
-    files = render(args.only, args.jobs if args.jobs is not None else default_jobs())
+    if args.name is not None:
+        if args.name not in {*names_of("c/"), *names_of("numpy/")}:
+            print(f"error: {args.name!r} has no per-name files", file=sys.stderr)
+            return 2
+        if not args.check:
+            print("error: --name only checks (make generate writes every file)", file=sys.stderr)
+            return 2
+        prefixes = [prefix for prefix in prefixes if prefix in PER_NAME]
+    files = render(args.only, args.jobs if args.jobs is not None else default_jobs(), args.name)
     if args.check:
-        diffs = check(root, files, prefixes)
+        diffs = check(root, files, prefixes, args.name)
         if diffs:
             sys.stdout.writelines(d if d.endswith("\n") else d + "\n" for d in diffs[:20])
             print(f"generated/ is stale ({len(diffs)} files differ). Fix: make generate",
