@@ -207,8 +207,6 @@ def _module_and_reference(adapter: Adapter, source: str, key: str) -> tuple[Modu
 ILL_CONDITIONED_EDGE = {
     "det_h_one": "eq 35 folds at 2π (p′ ~ (2π − φ)²/p²): the Newton angle is only backward stable, "
                  "its error grows as 1/p′ (R′ 48–158 ulp at 0.9 φ_max, 1e17 at φ_max − 1e-6)",
-    "4*atanh(phi/4)": "the closed inverse 4 tanh(s/4) differentiates as 1 − tanh², which cancels "
-                      "at the pole (R′ ~1e5 ulp at φ_max − 1e-6)",
 }
 """Where the plan's forms lose the derivative near φ_max in float64 (not a backend matter): the
 last angle is then φ_max/2 (measured values: docs/autodiff.md)."""
