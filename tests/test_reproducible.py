@@ -36,7 +36,10 @@ from tests.blas_core import openblas_core
 from symrot.api import derive
 from symrot.backends.numpy_backend import module_source
 from symrot.plan import evaluation_plan
+import mpmath.libmp
+import sympy.external.gmpy
 sys.stdout.write(str(openblas_core()) + "\\0")
+sys.stdout.write(mpmath.libmp.BACKEND + " " + sympy.external.gmpy.GROUND_TYPES + "\\0")
 for name in sys.argv[1:]:
     sys.stdout.write(module_source(evaluation_plan(derive(name).derivation, name)))
     sys.stdout.write("\\0")
@@ -51,13 +54,15 @@ def _numpy_dispatched_features() -> list[str]:
 
 
 def _other_machine() -> dict[str, str]:
-    """An environment in which this CPU computes like another one: NumPy without its SIMD targets
+    """An environment in which this CPU computes like another machine: NumPy without its SIMD targets
     beyond the baseline (as on a CPU without AVX2/AVX-512) and OpenBLAS with another kernel set on
     one thread, chosen to differ from the set OpenBLAS picks for this CPU (Haswell and Zen, tried
     here before, are that set or its copy on AMD EPYC: they repeated the native run)."""
     native = (openblas_core() or "").lower()
     machine = {"OPENBLAS_CORETYPE": "Nehalem" if native == "sandybridge" else "Sandybridge",
-               "OPENBLAS_NUM_THREADS": "1"}
+               "OPENBLAS_NUM_THREADS": "1",
+               # and without GMP: mpmath's and SymPy's pure-Python integers (an install without gmpy2)
+               "MPMATH_NOGMPY": "1", "SYMPY_GROUND_TYPES": "python"}
     features = " ".join(_numpy_dispatched_features())
     if features:
         machine["NPY_DISABLE_CPU_FEATURES"] = features
@@ -71,7 +76,8 @@ def test_generated_numpy_modules_are_the_same_on_another_cpu() -> None:
     result = subprocess.run([sys.executable, "-c", RENDER, *NAMES], capture_output=True, text=True,
                             env=env, cwd=ROOT, timeout=600, check=False)
     assert result.returncode == 0, result.stderr[-2000:]
-    core, *rendered = result.stdout.split("\0")[:-1]
+    core, integers, *rendered = result.stdout.split("\0")[:-1]
+    assert integers == "python python", integers  # mpmath's and SymPy's integers without GMP
     if openblas_core() is not None:  # the variant took effect: OpenBLAS runs other kernels
         assert core.lower() == machine["OPENBLAS_CORETYPE"].lower(), (core, machine)
     for name, text in zip(NAMES, rendered, strict=True):
