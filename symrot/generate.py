@@ -121,7 +121,7 @@ PER_NAME = ("numpy/", "c/", "jax/", "torch/")
 (a name's NumPy, JAX and PyTorch modules and C header share one task, so its plan is computed once)."""
 
 
-def _tasks(selected: list[str]) -> list[tuple[str, ...]]:
+def tasks(selected: list[str]) -> list[tuple[str, ...]]:
     """Independent units of work: ("names", name) for the per-name producers, longest first (the
     tangent and sine families of the C headers), then (prefix,) for every other producer."""
     from .backends.c_backend import COVERED
@@ -130,8 +130,8 @@ def _tasks(selected: list[str]) -> list[tuple[str, ...]]:
     array_prefixes = ("numpy/", "jax/", "torch/")
     if any(prefix in selected for prefix in array_prefixes):
         names += [name for name in NAMED if name not in names]
-    tasks: list[tuple[str, ...]] = [("names", name) for name in reversed(names)]
-    return tasks + [(prefix,) for prefix in selected if prefix not in PER_NAME]
+    per_name: list[tuple[str, ...]] = [("names", name) for name in reversed(names)]
+    return per_name + [(prefix,) for prefix in selected if prefix not in PER_NAME]
 
 
 def _run_task(task: tuple[str, ...], selected: tuple[str, ...]) -> dict[str, Content]:
@@ -189,16 +189,16 @@ def render(only: str | None = None, jobs: int = 1, name: str | None = None) -> d
 
     files: dict[str, Content] = {}
     selected = selected_prefixes(only)
-    tasks = [("names", name)] if name is not None else _tasks(selected)
+    work = [("names", name)] if name is not None else tasks(selected)
     if jobs <= 1:
-        for task in each(tasks, "symrot.generate"):
+        for task in each(work, "symrot.generate"):
             files.update(_run_task(task, tuple(selected)))
         return dict(sorted(files.items()))
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("fork")) as pool:
-        futures = [pool.submit(_run_task, task, tuple(selected)) for task in tasks]
+        futures = [pool.submit(_run_task, task, tuple(selected)) for task in work]
         for future in each(as_completed(futures), "symrot.generate", total=len(futures)):
             files.update(future.result())
     return dict(sorted(files.items()))

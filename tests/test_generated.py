@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
 SELECTED = [prefix for prefix, _ in generate.producers()]
 OTHERS = ",".join(prefix for prefix in SELECTED if prefix not in generate.PER_NAME)
-UNITS = [*(["--name", task[1]] for task in generate._tasks(SELECTED) if task[0] == "names"),
+UNITS = [*(["--name", task[1]] for task in generate.tasks(SELECTED) if task[0] == "names"),
          ["--only", OTHERS]]
 """One unit per parameterization; the other producers in one (they share their derivations)."""
 
