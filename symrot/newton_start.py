@@ -26,6 +26,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from fractions import Fraction
+from functools import lru_cache
 from typing import Any, Literal, NamedTuple
 
 import mpmath
@@ -173,6 +175,42 @@ def _series_switch(f: Callable[[Any], Any], series: tuple[sp.Expr, ...], phi_max
 
 
 MAX_ITERATIONS = 64
+RESIDUAL_ULPS = 4.0
+"""The largest error of the printed p(φ), in units of ε s, that widens a lane's tolerance."""
+EDGE_DENOMINATOR = 4
+"""Largest n of a fractional edge exponent k = 1/n (p_max − p ∝ (φ_max − φ)^k, k = 1/2 for asin)."""
+
+
+def edge_exponent(p: sp.Expr, p_max: float, phi_max: float) -> sp.Rational | None:
+    """k with p_max − p(φ) ∝ (φ_max − φ)^k at the end of a finite range, when k ≠ 1: the fold order
+    (k = 2, 3, 4 where p′(φ_max) = 0, :func:`fold_order`), or a fraction where p′ → ∞ (k = 1/2
+    at the edge of asin's domain, 2 cos(φ) asin(φ)/15 + … of docs/accuracy_hypothesis.md row 187),
+    estimated from the growth of p′ between φ_max − 10⁻¹⁰ φ_max and φ_max − 10⁻²⁰ φ_max at
+    DIGITS and accepted when within 0.02 of 1/n, n ≤ EDGE_DENOMINATOR.
+    None for an unbounded p or an ordinary edge. Newton in w = (φ_max − φ)^k, where p is regular,
+    then converges quadratically up to the edge (:func:`newton_step`)."""
+    if not (math.isfinite(p_max) and math.isfinite(phi_max)):
+        return None
+    order = fold_order(p, phi_max)
+    if order > 1:
+        return sp.Integer(order)
+    f_slope = _p_function(sp.diff(p, PHI))
+    with mpmath.workdps(DIGITS):
+        top = mpmath.mpf(phi_max)
+        near, nearer = mpmath.mpf(10) ** -10 * top, mpmath.mpf(10) ** -20 * top
+        try:
+            slopes = [mpmath.mpf(f_slope(top - gap)) for gap in (near, nearer)]
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return None
+        if not all(mpmath.isfinite(value) and value > 0 for value in slopes):
+            return None
+        growth = float(mpmath.log(slopes[1] / slopes[0]) / mpmath.log(near / nearer))
+    fraction = Fraction(1 - growth).limit_denominator(EDGE_DENOMINATOR)
+    if fraction.numerator != 1 or fraction.denominator < 2 or abs(float(fraction) - (1 - growth)) > 0.02:
+        return None
+    return sp.Rational(1, fraction.denominator)
+
+
 
 
 class NewtonCount(NamedTuple):
@@ -183,30 +221,28 @@ class NewtonCount(NamedTuple):
     unconverged: float
 
 
-def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], far: FarStart,
-                        angles: np.ndarray, phi_max: float, dtype: type,
-                        printed: tuple[Callable[[np.ndarray], np.ndarray],
-                                       Callable[[np.ndarray], np.ndarray]],
-                        reciprocal: bool, bracket_top: float) -> NewtonCount:
-    """Steps the printed safeguarded Newton iteration needs, counted by running it.
+class NewtonLanes(NamedTuple):
+    """The checks of :func:`measured_iterations`: s = p(θ) rounded to the precision, the exact angle
+    of that s, and how close to it an iterate must come."""
 
-    At every angle θ of ``angles`` the input s = p(θ) is rounded to ``dtype``; the start (reverted
-    series below ``far.switch``, the Chebyshev far start above) and the bracketed Newton steps are
-    evaluated as the backends do, with ``printed`` = (p(φ)/φ, p′(φ)) as the plan's branches print
-    them (evaluated with the ideal libm of :mod:`symrot.evaluation`), and with the steps of Newton
-    on 1/p if ``reciprocal`` (:class:`symrot.plan_ir.NewtonAngle`), in the bracket [0, ``bracket_top``]
-    (the largest value of ``dtype`` not above the exact φ_max).
-    The steps are one more than the first step count after which every lane is within 2 ε of the
-    exact angle of its rounded s, plus what one ε of s moves that angle (next to a fold Newton
-    converges only to there), or ``MAX_ITERATIONS`` if no count is; then ``unconverged`` is the
-    smallest s whose lane is still outside after ``MAX_ITERATIONS`` steps (the plan ends the
-    range below it), and ∞ otherwise. Near a pole of p where φ(s)
-    flattens (2 cos(2φ) atanh(3φ/2)/3 at φ = 2/3) the far start is poor in relative terms and Newton
-    falls back on bisection: nine steps left the angle 10⁻³ off there."""
+    sizes: np.ndarray
+    angles: np.ndarray
+    tolerance: np.ndarray
+
+
+def newton_lanes(p: sp.Expr, slope: sp.Expr, angles: np.ndarray, phi_max: float, dtype: type,
+                 ratio_model: Callable[[np.ndarray], np.ndarray]) -> NewtonLanes:
+    """At every angle of ``angles``: s = p(θ) rounded to ``dtype``, the exact angle θ* of that s
+    (DIGITS), and the tolerance 2 ε θ* + 2 ε s/p′(θ*) (1 + e) (what one ε of s moves the angle:
+    large next to a fold, p′ → 0), where e is the error in units of ε s, up to RESIDUAL_ULPS, of
+    the printed residual's p(φ) = φ·g(φ²) (``ratio_model`` = g as the plan prints it) at θ*
+    rounded: no iterate can pin the angle closer than the residual it is steered by (at
+    φ_max − 10⁻⁹ of the fold of row 57 of docs/accuracy_hypothesis.md, p(φ) is 3 ulp off in
+    float64 and the iterate 2.9 ε s/p′). A printed form that is wrong beyond rounding is not
+    excused: its lanes stay unconverged."""
     epsilon = float(np.finfo(dtype).eps)
-    ratio_model, slope_model = printed
     f, f_slope = _p_function(p), _p_function(slope)
-    sizes, exact, tolerance = [], [], []
+    sizes, exact, spreads = [], [], []
     with mpmath.workdps(DIGITS):
         for angle in angles:
             s = dtype(float(f(mpmath.mpf(float(angle)))))
@@ -214,15 +250,89 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
                 continue
             theta = angle_of_length(f, f_slope, mpmath.mpf(float(s)), mpmath.mpf(phi_max))
             rate = abs(f_slope(theta))
-            # 2 ε of the angle, plus what one ε of s moves it (large next to a fold, p′ → 0)
-            spread = float(s) / float(rate) if rate > 0 else math.inf
             sizes.append(s)
             exact.append(float(theta))
-            tolerance.append(2 * epsilon * (float(theta) + spread))
-    if not sizes:
+            spreads.append(float(s) / float(rate) if rate > 0 else math.inf)
+        rounded: np.ndarray = np.asarray(exact, dtype=dtype)
+        with np.errstate(all="ignore"):
+            ratio: np.ndarray = np.asarray(ratio_model(rounded), dtype=dtype)
+            printed: np.ndarray = np.asarray(rounded * ratio, dtype=dtype)
+        residual_error = [abs(float(value) - f(mpmath.mpf(float(angle)))) if np.isfinite(value) else 0.0
+                          for value, angle in zip(printed, rounded, strict=True)]
+    tolerance = [2 * epsilon * (theta + spread * (1 + min(float(error) / (epsilon * s), RESIDUAL_ULPS)))
+                 for theta, spread, error, s in zip(exact, spreads, residual_error, sizes, strict=True)]
+    return NewtonLanes(np.asarray(sizes, dtype=dtype), np.asarray(exact), np.asarray(tolerance))
+
+
+CHANGE, EDGE_STEP = sp.symbols("change u", real=True)
+"""The symbols of :func:`edge_step`: c = r/p′ and u = k c/δ, δ = φ_max − φ."""
+
+
+def edge_step(edge: sp.Rational) -> sp.Expr:
+    """The next iterate of Newton in w = δ^k (δ = φ_max − φ) from φ, as an expression in PHI, CHANGE
+    (c = r/p′, the step of Newton in φ) and EDGE_STEP (u = k c/δ; defined for u > −1).
+
+    w − k δ^(k−1) c = δ^k (1 + u) gives φ − δ((1 + u)^(1/k) − 1), written without the cancellation
+    of (1 + u)^(1/k) − 1 for small u (far from the edge, where φ_max − δ(…) would also lose φ's
+    digits): for k = 1/n, φ − c Σ_{j=1..n} C(n, j) u^(j−1)/n; for k = n,
+    φ − n c/Σ_{j=0..n−1} r^j with r = (1 + u)^(1/n). Both tend to Newton's φ − c as u → 0."""
+    if edge < 1:
+        n = int(1 / edge)
+        return PHI - CHANGE * sum(sp.binomial(n, j) / n * EDGE_STEP ** (j - 1) for j in range(1, n + 1))
+    n = int(edge)
+    root = (1 + EDGE_STEP) ** sp.Rational(1, n)
+    horner: sp.Expr = 1 + root
+    for _ in range(n - 2):  # 1 + r(1 + r(…)), kept as products of the root (not (1 + u)^(j/n))
+        horner = sp.Add(1, sp.Mul(root, horner, evaluate=False), evaluate=False)
+    return PHI - n * CHANGE / horner
+
+
+@lru_cache(maxsize=8)
+def _edge_step_function(edge: sp.Rational) -> Callable[..., Any]:
+    return sp.lambdify((PHI, CHANGE, EDGE_STEP), edge_step(edge), "numpy")
+
+
+def newton_step(phi: np.ndarray, change: np.ndarray, edge: sp.Rational | None,
+                top: float) -> tuple[np.ndarray, np.ndarray]:
+    """(step, defined) of the safeguarded iteration from φ with the plain Newton correction
+    ``change`` = r/p′: φ − change, or for an edge exponent k (:func:`edge_exponent`) Newton in
+    w = δ^k, δ = φ_max − φ (:func:`edge_step`), defined while δ > 0 and u = k·change/δ > −1 (the
+    step would leave the range)."""
+    dtype = phi.dtype.type
+    if edge is None:
+        return phi - change, np.ones(phi.shape, dtype=bool)
+    delta = (dtype(top) - phi).astype(dtype)
+    u = (dtype(float(edge)) * change / np.where(delta > 0, delta, 1.0)).astype(dtype)
+    defined = (delta > 0) & (u > -1)
+    step = np.asarray(_edge_step_function(edge)(phi, change, np.where(defined, u, 0.0).astype(dtype)))
+    return step.astype(dtype), defined
+
+
+def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarStart,
+                        printed: tuple[Callable[[np.ndarray], np.ndarray],
+                                       Callable[[np.ndarray], np.ndarray]],
+                        reciprocal: bool, bracket_top: float,
+                        edge: sp.Rational | None = None) -> NewtonCount:
+    """Steps the printed safeguarded Newton iteration needs, counted by running it.
+
+    On the checks of ``lanes`` (:func:`newton_lanes`) the start (reverted series below
+    ``far.switch``, the Chebyshev far start above) and the bracketed Newton steps are evaluated as
+    the backends do, with ``printed`` = (p(φ)/φ, p′(φ)) as the plan's branches print them
+    (evaluated with the ideal libm of :mod:`symrot.evaluation`), with the steps of Newton on 1/p if
+    ``reciprocal`` (:class:`symrot.plan_ir.NewtonAngle`) or in w = (φ_max − φ)^k for an ``edge``
+    exponent k (:func:`newton_step`), in the bracket [0, ``bracket_top``] (the largest value of the
+    precision not above the exact φ_max).
+    The steps are one more than the first step count after which every lane is within its
+    tolerance, or ``MAX_ITERATIONS`` if no count is; then ``unconverged`` is the
+    smallest s whose lane is still outside after ``MAX_ITERATIONS`` steps (the plan ends the
+    range below it), and ∞ otherwise. Near a pole of p where φ(s)
+    flattens (2 cos(2φ) atanh(3φ/2)/3 at φ = 2/3) the far start is poor in relative terms and Newton
+    falls back on bisection: nine steps left the angle 10⁻³ off there."""
+    ratio_model, slope_model = printed
+    s_values, theta, limit = lanes
+    if not len(s_values):
         return NewtonCount(0, math.inf)
-    s_values: np.ndarray = np.asarray(sizes, dtype=dtype)
-    theta, limit = np.asarray(exact), np.asarray(tolerance)
+    dtype = s_values.dtype.type
     coefficients = [float(c) for c in start]
     with np.errstate(all="ignore"):
         series = np.zeros_like(s_values)
@@ -240,11 +350,13 @@ def measured_iterations(p: sp.Expr, slope: sp.Expr, start: Sequence[sp.Expr], fa
             low = np.where(residual <= 0, phi, low)
             derivative: np.ndarray = np.asarray(slope_model(phi), dtype=dtype)
             safe = derivative > 0
+            if edge is not None:  # p′ = ∞ at an asin edge: a zero step would stay there
+                safe &= np.isfinite(derivative)
             change = (residual / np.where(safe, derivative, 1.0)).astype(dtype)
             if reciprocal:
                 change = (change * (value / np.where(s_values > 0, s_values, 1.0))).astype(dtype)
-            step = phi - change
-            inside = safe & (step >= low) & (step <= high)
+            step, defined = newton_step(phi, change, edge, bracket_top)
+            inside = safe & defined & (step >= low) & (step <= high)
             phi = np.where(inside, step, 0.5 * (low + high)).astype(dtype)
             converged = np.abs(phi.astype(np.float64) - theta) <= limit
             if np.all(converged):

@@ -69,7 +69,7 @@ from .measurement import (
     reference_values,
     with_length,
 )
-from .newton_start import START_TOLERANCE, far_start, measured_iterations
+from .newton_start import START_TOLERANCE, edge_exponent, far_start, measured_iterations, newton_lanes
 from .newton_start import FarStart as FarStart
 from .parsing import PHI
 from .plan_ir import (
@@ -712,10 +712,18 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
     reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
-    count = measured_iterations(p, derivation.scalars["p_prime"], start, far, grid, phi_max, dtype, printed,
-                                reciprocal, bracket_top)
+    lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0])
+    count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top)
+    edge = _edge_exponent(p, p_max, phi_max)
+    if edge is not None:
+        edge_count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, edge)
+        # p′ = ∞ at the edge (k < 1): a step in φ from the edge stays there, whatever was measured
+        if edge < 1 or (-edge_count.unconverged, edge_count.steps) < (-count.unconverged, count.steps):
+            count = edge_count
+        else:
+            edge = None
     iterations = max(newton_iterations(far.measured, float(np.finfo(dtype).eps)), count.steps)
-    return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal, count.unconverged)
+    return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal, count.unconverged, edge)
 
 
 def _branch_model(branch: Branch, dtype: type) -> Callable[[np.ndarray], np.ndarray]:
@@ -749,6 +757,8 @@ def newton_iterations(start_error: float, epsilon: float) -> int:
 
 _far_start = lru_cache(maxsize=64)(far_start)
 """The far start does not depend on the precision: both plans share one fit."""
+
+_edge_exponent = lru_cache(maxsize=64)(edge_exponent)
 
 
 def evaluation_plan(derivation: Derivation, name: str) -> EvaluationPlan:

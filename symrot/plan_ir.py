@@ -32,13 +32,14 @@ for the sine family, ``D`` = p_max² − x):
 ``ClosedAngle(expression)``
     φ = expression(S), S = |p| = √x, the closed-form inverse of p(φ) (e.g. 4 atan(S/4); for the
     sine family k asin(S/k) becomes k atan2(S, √D), accurate up to the fold).
-``NewtonAngle(start, ratio, slope, iterations, phi_max, far, reciprocal, converges_below)``
+``NewtonAngle(start, ratio, slope, iterations, phi_max, far, reciprocal, converges_below, edge)``
     φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s (on 1/(φ·g(φ²)) − 1/s if ``reciprocal``),
     started from the odd reverted series φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from
     the fold-aware interpolant ``far`` (:mod:`symrot.newton_start`) above it, where ``ratio`` = g
     (Branch in t = φ² for p(φ)/φ, Taylor-safe) and ``slope`` (Branch in t = φ² for p′(φ)).
     Safeguard: keep a bracket [lo, hi] ⊂ [0, phi_max] (``phi_max`` rounded down in the precision),
-    shrink it by the sign of r and bisect when a step leaves it.
+    shrink it by the sign of r and bisect when a step leaves it. With an ``edge`` exponent k the
+    steps are Newton's in w = (φ_max − φ)^k, where p is regular at a fold or an asin edge.
 ``QuaternionScale(algebraic, branch)``
     σ = p(φ)/sin(φ/2) of from_quaternion (:mod:`symrot.quaternion_plan`): algebraic in e₀, or a
     ``Branch`` in t = φ².
@@ -123,6 +124,13 @@ class NewtonAngle:
     converges_below: float
     """The smallest s = |p| of the plan's checks whose angle ``iterations`` steps do not reach
     (:func:`symrot.newton_start.measured_iterations`); the precision's range ends below it."""
+    edge: sp.Rational | None = None
+    """k where the steps are Newton's in w = (φ_max − φ)^k instead of φ
+    (:func:`symrot.newton_start.newton_step`): p_max − p ∝ (φ_max − φ)^k at the end of the range,
+    a fold (k = 2, 3, 4) or an edge where p′ → ∞ (k = 1/2 for asin). The step from φ with
+    δ = φ_max − φ and the Newton correction c = r/p′ is φ_max − δ q^(1/k), q = 1 + k c/δ, taken
+    while δ > 0, q > 0 and p′ is finite; Newton in φ converges only linearly next to a fold and
+    stalls at an asin edge (row 187 of docs/accuracy_hypothesis.md was NaN for φ > 0.99995)."""
 
 
 Coefficient = Constant | Algebraic | Branch

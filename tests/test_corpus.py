@@ -198,6 +198,8 @@ SAMPLE: dict[str, str | None] = {
     "sin(phi)/2 + sinh(phi)/2": None,
     # a pole at 2*pi: NaN in every output from |p|^2 = 2^32 before symrot/pole.py (126 NaN/Inf)
     "phi/cos(phi/4)": None,
+    # NaN in every output for |p| > 1.11415 (phi > 0.99995) before Newton in sqrt(1 - phi)
+    "4*phi/5 + asin(phi)/5": None,
 }
 
 

@@ -1,14 +1,27 @@
 """The plan's count of Newton steps (symrot.newton_start.measured_iterations) runs the printed
-iteration, and names the sizes whose angle the steps do not reach, so that the range ends there."""
+iteration, and names the sizes whose angle the steps do not reach, so that the range ends there;
+next to a fold or an asin edge the steps are Newton's in w = (φ_max − φ)^k (edge_step)."""
 
 from __future__ import annotations
 
 import math
 
+import mpmath
 import numpy as np
+import pytest
 import sympy as sp
 
-from symrot.newton_start import MAX_ITERATIONS, FarStart, measured_iterations
+from symrot.newton_start import (
+    CHANGE,
+    EDGE_STEP,
+    MAX_ITERATIONS,
+    FarStart,
+    edge_exponent,
+    edge_step,
+    far_start,
+    measured_iterations,
+    newton_lanes,
+)
 from symrot.parsing import PHI
 
 SERIES_ONLY = FarStart(kind="linear", scale=1.0, order=1, chebyshev=(0.0,), switch=math.inf, measured=0.0)
@@ -24,8 +37,9 @@ def _sinh_models(wrong_above: float) -> tuple:
 
 def test_every_angle_reached_counts_steps_and_no_limit() -> None:
     angles = np.geomspace(1e-3, 3.0, 40)
-    count = measured_iterations(sp.sinh(PHI), sp.cosh(PHI), [sp.Integer(1)], SERIES_ONLY, angles, 6.0,
-                                np.float64, _sinh_models(math.inf), False, 6.0)
+    models = _sinh_models(math.inf)
+    lanes = newton_lanes(sp.sinh(PHI), sp.cosh(PHI), angles, 6.0, np.float64, models[0])
+    count = measured_iterations(lanes, [sp.Integer(1)], SERIES_ONLY, models, False, 6.0)
     assert count.steps < MAX_ITERATIONS and count.unconverged == math.inf
 
 
@@ -33,8 +47,67 @@ def test_angles_the_steps_do_not_reach_end_the_range_at_the_smallest_size() -> N
     """A printed p(φ)/φ that is 10⁻⁶ too large above φ = 1 (as a form that loses digits there
     would be): those lanes converge to the wrong angle, whatever the count of steps."""
     angles = np.geomspace(1e-3, 3.0, 40)
-    count = measured_iterations(sp.sinh(PHI), sp.cosh(PHI), [sp.Integer(1)], SERIES_ONLY, angles, 6.0,
-                                np.float64, _sinh_models(1.0), False, 6.0)
+    models = _sinh_models(1.0)
+    lanes = newton_lanes(sp.sinh(PHI), sp.cosh(PHI), angles, 6.0, np.float64, models[0])
+    count = measured_iterations(lanes, [sp.Integer(1)], SERIES_ONLY, models, False, 6.0)
     first_wrong = float(np.sinh(angles[angles > 1.0][0]))
     assert count.steps == MAX_ITERATIONS
     assert math.isclose(count.unconverged, first_wrong, rel_tol=1e-12)
+
+
+def test_edge_exponent_names_folds_and_asin_edges_only() -> None:
+    assert edge_exponent(sp.asin(PHI), math.pi / 2, 1.0) == sp.Rational(1, 2)  # p′ = (1 − φ²)^(−1/2)
+    assert edge_exponent(sp.asin(PHI / 3) + PHI, math.asin(1.0) + 3, 3.0) == sp.Rational(1, 2)
+    assert edge_exponent(PHI - PHI**3 / 3, 2 / 3, 1.0) == 2  # p′ = 1 − φ²: a fold
+    assert edge_exponent(PHI - PHI**2 + PHI**3 / 3, 1 / 3, 1.0) == 3  # p′ = (1 − φ)²
+    assert edge_exponent(PHI, 1.0, 1.0) is None  # an ordinary end of the range
+    assert edge_exponent(sp.sinh(PHI), math.inf, 6.0) is None
+
+
+@pytest.mark.parametrize("edge", [sp.Rational(1, 2), sp.Rational(1, 3), sp.Integer(2), sp.Integer(3),
+                                  sp.Integer(4)])
+def test_edge_step_is_newton_in_w_without_cancellation(edge: sp.Rational) -> None:
+    """φ_max − δ(1 + u)^(1/k) at 50 digits (u = k c/δ, the Newton step in w = δ^k), and Newton's
+    φ − c in the limit of small steps, where φ_max − δ(…) would lose the digits."""
+    step = sp.lambdify((PHI, CHANGE, EDGE_STEP), edge_step(edge), "mpmath")
+    with mpmath.workdps(50):
+        top, k = mpmath.mpf(2), mpmath.mpf(edge.p) / edge.q
+        for phi, change in ((1.5, 0.1), (1.9, -0.05), (0.5, 0.3)):
+            delta = top - phi
+            u = k * mpmath.mpf(change) / delta
+            expected = top - delta * (1 + u) ** (1 / k)
+            assert abs(step(mpmath.mpf(phi), mpmath.mpf(change), u) - expected) < mpmath.mpf(10) ** -45
+    tiny = np.float64(1e-12)
+    phi = np.float64(1e-3)
+    numeric = sp.lambdify((PHI, CHANGE, EDGE_STEP), edge_step(edge), "numpy")
+    value = numeric(phi, tiny, float(edge) * tiny / 1.999)
+    assert abs(value - (phi - tiny)) <= 4 * np.spacing(phi)
+
+
+def _asin_lanes() -> tuple:
+    p = sp.asin(PHI)
+    models = (lambda phi: np.arcsin(phi) / phi, lambda phi: 1 / np.sqrt(1 - phi * phi))
+    angles = 1 - np.geomspace(1e-2, 1e-12, 11)
+    return p, models, newton_lanes(p, sp.diff(p, PHI), angles, 1.0, np.float64, models[0])
+
+
+def test_newton_in_phi_stalls_at_an_asin_edge_where_newton_in_w_converges() -> None:
+    """From a start at φ_max = 1, where p′ = ∞, a step in φ is zero and stays (row 187 of
+    docs/accuracy_hypothesis.md was NaN for φ > 0.99995); in w = √(1 − φ) the step is undefined
+    there, the iteration bisects and converges."""
+    _, models, lanes = _asin_lanes()
+    at_edge = FarStart(kind="linear", scale=math.pi / 2, order=1, chebyshev=(1.0,), switch=0.0, measured=1.0)
+    stalled = measured_iterations(lanes, [sp.Integer(1)], at_edge, models, False, 1.0)
+    assert stalled.steps == MAX_ITERATIONS and stalled.unconverged < math.pi / 2
+    edge = measured_iterations(lanes, [sp.Integer(1)], at_edge, models, False, 1.0, sp.Rational(1, 2))
+    assert edge.steps < 16 and edge.unconverged == math.inf
+
+
+def test_newton_in_w_needs_fewer_steps_from_the_far_start() -> None:
+    p, models, lanes = _asin_lanes()
+    series = tuple(sp.Rational((-1) ** k, math.factorial(2 * k + 1)) for k in range(8))  # φ = sin(s)
+    far = far_start(p, math.pi / 2, 1.0, series)
+    plain = measured_iterations(lanes, series, far, models, False, 1.0)
+    edge = measured_iterations(lanes, series, far, models, False, 1.0, sp.Rational(1, 2))
+    assert plain.unconverged == edge.unconverged == math.inf
+    assert edge.steps < plain.steps

@@ -44,7 +44,7 @@ from ..plan import (
 )
 from ..plan_ir import ANGLE_CORRECTION_GROWTH
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
-from .numpy_backend import SUFFIX, angle_low_helpers, print_expression, uses_phi
+from .numpy_backend import SUFFIX, angle_low_helpers, newton_step_lines, print_expression, uses_phi
 from .templating import render
 
 FRAMEWORKS = ("jax", "torch")
@@ -158,9 +158,7 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
         "    low = _where(residual <= 0, phi, low)",
         f"    slope = _slope_{suffix}(phi * phi, phi)",
         "    safe = slope > 0",
-        "    step = phi - residual / _where(safe, slope, 1.0)"
-        + (" * (value / _where(s > 0, s, 1.0))" if angle.reciprocal else ""),
-        "    inside = safe & (step >= low) & (step <= high)",
+        *newton_step_lines(angle, "_where", "_xp", print_array),
         "    phi = _where(inside, step, 0.5 * (low + high))",
         "return phi",
     ]

@@ -39,7 +39,7 @@ import sympy as sp
 
 from ..algebraic import S, X
 from ..errors import NonFiniteLiteral
-from ..newton_start import FarStart
+from ..newton_start import CHANGE, EDGE_STEP, FarStart, edge_step
 from ..parsing import PHI
 from ..plan import half_angle
 from ..plan_ir import (
@@ -245,18 +245,15 @@ class FunctionWriter:
         start = S_SYMBOL * horner(angle.start, s2)
         body: list[Statement] = [
             self.let("t", PHI_SYMBOL**2),
-            {"kind": "declare", "type": self.ctype, "names": ["ratio", "slope", "value", "residual", "step"]},
+            {"kind": "declare", "type": self.ctype,
+             "names": ["ratio", "slope", "value", "residual", "step", *(["change"] if angle.edge else [])]},
             self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
             self.branch_value(angle.slope, T_SYMBOL, "slope"),
             self.set("value", PHI_SYMBOL * sp.Symbol("ratio")),
             self.set("residual", "value - s", ops=1),
             {"kind": "if", "condition": "residual > 0", "then": [self.set("high", "phi")],
              "otherwise": [self.set("low", "phi")]},
-            self.set("step", "phi - residual / slope * (value / s_or_one)", ops=4) if angle.reciprocal
-            else self.set("step", PHI_SYMBOL - sp.Symbol("residual") / sp.Symbol("slope")),
-            {"kind": "if", "condition": "slope > 0 && step >= low && step <= high",
-             "then": [self.set("phi", "step")],
-             "otherwise": [self.set("phi", (sp.Symbol("low") + sp.Symbol("high")) / 2)]},
+            *self.newton_step(angle),
         ]
         phi_max = self.printer.literal(angle.phi_max)
         far = angle.far
@@ -292,6 +289,29 @@ class FunctionWriter:
             {"kind": "loop", "header": f"k = 0; k < {angle.iterations}; ++k", "body": body,
              "times": angle.iterations},
             {"kind": "return", "value": "phi"},
+        ]
+
+    def newton_step(self, angle: NewtonAngle) -> list[Statement]:
+        """The step of the safeguarded iteration and its acceptance: Newton in φ (on 1/p if
+        reciprocal) or, with an edge exponent k, in w = (φ_max − φ)^k
+        (:attr:`symrot.plan_ir.NewtonAngle.edge`); a rejected step bisects the bracket."""
+        bisect = {"kind": "if", "condition": "", "then": [self.set("phi", "step")],
+                  "otherwise": [self.set("phi", (sp.Symbol("low") + sp.Symbol("high")) / 2)]}
+        if angle.edge is None:
+            step = (self.set("step", "phi - residual / slope * (value / s_or_one)", ops=4) if angle.reciprocal
+                    else self.set("step", PHI_SYMBOL - sp.Symbol("residual") / sp.Symbol("slope")))
+            return [step, {**bisect, "condition": "slope > 0 && step >= low && step <= high"}]
+        top = self.printer.literal(angle.phi_max)
+        step = edge_step(angle.edge).xreplace({PHI: PHI_SYMBOL, EDGE_STEP: sp.Symbol("u", real=True),
+                                               CHANGE: sp.Symbol("change", real=True)})
+        return [
+            self.set("change", "residual / slope", ops=1),
+            {"kind": "let", "type": self.ctype, "name": "delta", "value": f"{top} - phi", "ops": 1},
+            {"kind": "let", "type": self.ctype, "name": "u", "ops": 4,
+             "value": f"delta > 0 ? {self.c(angle.edge)}*change/delta : 0"},
+            self.set("step", step),
+            {**bisect, "condition": "slope > 0 && isfinite(slope) && delta > 0 && u > -1 && step >= low "
+                                    "&& step <= high"},
         ]
 
     # -- λ, the Newton angle below φ's last bit ---------------------------------------------------

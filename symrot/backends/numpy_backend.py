@@ -29,7 +29,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from ..algebraic import D, X
-from ..newton_start import FarStart
+from ..newton_start import FarStart, edge_step
 from ..parsing import PHI
 from ..plan import (
     Algebraic,
@@ -193,11 +193,31 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
         "    low = numpy.where(residual <= 0, phi, low)",
         "    slope = _slope(phi * phi, phi)",
         "    safe = slope > 0",
-        "    step = phi - residual / numpy.where(safe, slope, 1.0)"
-        + (" * (value / numpy.where(s > 0, s, 1.0))" if angle.reciprocal else ""),
-        "    inside = safe & (step >= low) & (step <= high)",
+        *newton_step_lines(angle),
         "    phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)",
         "return phi",
+    ]
+
+
+def newton_step_lines(angle: NewtonAngle, where: str = "numpy.where", module: str = "numpy",
+                      printer: Callable[[sp.Expr], str] | None = None) -> list[str]:
+    """``step`` and ``inside`` of the safeguarded iteration: Newton in φ (on 1/p if reciprocal) or,
+    with an edge exponent k, in w = (φ_max − φ)^k (:func:`symrot.newton_start.edge_step`); every
+    operand is safe on every lane (the array backends pass their own ``where``, ``module`` and
+    printer)."""
+    if angle.edge is None:
+        return [f"    step = phi - residual / {where}(safe, slope, 1.0)"
+                + (f" * (value / {where}(s > 0, s, 1.0))" if angle.reciprocal else ""),
+                "    inside = safe & (step >= low) & (step <= high)"]
+    return [
+        f"    safe = safe & {module}.isfinite(slope)",
+        f"    change = residual / {where}(safe, slope, 1.0)",
+        f"    delta = {angle.phi_max!r} - phi",
+        f"    u = {float(angle.edge)!r} * change / {where}(delta > 0, delta, 1.0)",
+        "    defined = (delta > 0) & (u > -1.0)",
+        f"    u = {where}(defined, u, 0.0)",
+        f"    step = {(printer or print_expression)(edge_step(angle.edge))}",
+        "    inside = safe & defined & (step >= low) & (step <= high)",
     ]
 
 
