@@ -349,9 +349,7 @@ def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarSt
             high = np.where(residual > 0, phi, high)
             low = np.where(residual <= 0, phi, low)
             derivative: np.ndarray = np.asarray(slope_model(phi), dtype=dtype)
-            safe = derivative > 0
-            if edge is not None:  # p′ = ∞ at an asin edge: a zero step would stay there
-                safe &= np.isfinite(derivative)
+            safe = (derivative > 0) & np.isfinite(derivative)  # p′ = ∞: a zero step would stay there
             change = (residual / np.where(safe, derivative, 1.0)).astype(dtype)
             if reciprocal:
                 change = (change * (value / np.where(s_values > 0, s_values, 1.0))).astype(dtype)

@@ -122,6 +122,28 @@ def well_conditioned(expr: sp.Expr) -> sp.Expr:
     return expr.replace(lambda e: isinstance(e, sp.cos), lambda e: 1 - 2 * sp.sin(e.args[0] / 2) ** 2)
 
 
+def near_half_turn(expr: sp.Expr) -> sp.Expr:
+    """Replace k(1 + cos a) by 2k cos²(a/2), exact and accurate next to a = π, where 1 + cos a rounds
+    to 0: p′ of 4 tan(φ/2) cosh(φ/3)/7 + … has 4 cosh(φ/3)/(7 (cos φ + 1)), infinite in float64
+    within 3·10⁻⁹ of its pole at π (hypothesis row 113). The form is a candidate beside
+    :func:`well_conditioned`'s, whose 1 − 2 sin²(a/2) cancels there too."""
+    def parts(e: sp.Basic) -> tuple[sp.Expr, sp.Expr] | None:
+        """(k, a) when e = k + k cos(a) with a number k (SymPy distributes 7 (1 + cos φ))."""
+        if not (isinstance(e, sp.Add) and len(e.args) == 2):
+            return None
+        constant, term = sorted(e.args, key=lambda a: not a.is_number)
+        factor, cosine = term.as_coeff_Mul()
+        if constant.is_number and constant != 0 and factor == constant and isinstance(cosine, sp.cos):
+            return constant, cosine.args[0]
+        return None
+
+    def doubled(e: sp.Add) -> sp.Expr:
+        found = parts(e)
+        assert found is not None
+        return 2 * found[0] * sp.cos(found[1] / 2) ** 2
+    return expr.replace(lambda e: parts(e) is not None, doubled)
+
+
 def half_angle(expr: sp.Expr) -> sp.Expr:
     """sin φ → 2 sin(φ/2) cos(φ/2), cos φ → 1 − 2 sin²(φ/2): every call on the one argument φ/2, so
     that a compiler can evaluate them with a single sincos (and 1 − cos φ stays accurate)."""
@@ -259,7 +281,8 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     (:func:`_branch_for`). ``extra_forms``: more candidates, already in the backends' variables
     (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part)."""
     forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
-    forms += ([well_conditioned(closed)] if closed.has(sp.cos) else []) + [closed]
+    forms += [well_conditioned(closed), near_half_turn(closed)] if closed.has(sp.cos) else []
+    forms.append(closed)
     plain = tuple(dict.fromkeys([closed, *forms]))
     forms += [with_length(form, argument) for form in forms]
     pole = pole_factor(argument, phi_max) if argument != PHI else None

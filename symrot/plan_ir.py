@@ -38,7 +38,8 @@ for the sine family, ``D`` = p_max² − x):
     the fold-aware interpolant ``far`` (:mod:`symrot.newton_start`) above it, where ``ratio`` = g
     (Branch in t = φ² for p(φ)/φ, Taylor-safe) and ``slope`` (Branch in t = φ² for p′(φ)).
     Safeguard: keep a bracket [lo, hi] ⊂ [0, phi_max] (``phi_max`` rounded down in the precision),
-    shrink it by the sign of r and bisect when a step leaves it. With an ``edge`` exponent k the
+    shrink it by the sign of r and bisect when a step leaves it or p′ is not finite (a zero step
+    from where the printed p′ overflows would stay there). With an ``edge`` exponent k the
     steps are Newton's in w = (φ_max − φ)^k, where p is regular at a fold or an asin edge.
 ``QuaternionScale(algebraic, branch)``
     σ = p(φ)/sin(φ/2) of from_quaternion (:mod:`symrot.quaternion_plan`): algebraic in e₀, or a
@@ -128,9 +129,10 @@ class NewtonAngle:
     """k where the steps are Newton's in w = (φ_max − φ)^k instead of φ
     (:func:`symrot.newton_start.newton_step`): p_max − p ∝ (φ_max − φ)^k at the end of the range,
     a fold (k = 2, 3, 4) or an edge where p′ → ∞ (k = 1/2 for asin). The step from φ with
-    δ = φ_max − φ and the Newton correction c = r/p′ is φ_max − δ q^(1/k), q = 1 + k c/δ, taken
-    while δ > 0, q > 0 and p′ is finite; Newton in φ converges only linearly next to a fold and
-    stalls at an asin edge (row 187 of docs/accuracy_hypothesis.md was NaN for φ > 0.99995)."""
+    δ = φ_max − φ and the Newton correction c = r/p′ is φ_max − δ(1 + u)^(1/k), u = k c/δ, printed
+    without cancellation (:func:`symrot.newton_start.edge_step`) and taken while δ > 0 and u > −1;
+    Newton in φ converges only linearly next to a fold and overshoots past an asin edge (row 187
+    of docs/accuracy_hypothesis.md was NaN for φ > 0.99995)."""
 
 
 Coefficient = Constant | Algebraic | Branch

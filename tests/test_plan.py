@@ -8,7 +8,18 @@ import pytest
 import sympy as sp
 
 from symrot.api import derive
-from symrot.plan import CHEAP_TERMS, Algebraic, Branch, ClosedAngle, Constant, NewtonAngle, X, evaluation_plan
+from symrot.parsing import PHI
+from symrot.plan import (
+    CHEAP_TERMS,
+    Algebraic,
+    Branch,
+    ClosedAngle,
+    Constant,
+    NewtonAngle,
+    X,
+    evaluation_plan,
+    near_half_turn,
+)
 
 
 @pytest.fixture(scope="module")
@@ -193,3 +204,20 @@ def test_hyperbolic_inverses_are_inverse_hyperbolic_functions(text: str, expecte
     assert not inverse.has(sp.log)
     for dtype in (np.float64, np.float32):
         assert closed_angle_error(inverse, p, 2 * np.pi, dtype) <= ANGLE_TOLERANCE_ULP
+
+
+def test_one_plus_cosine_is_written_through_the_half_angle_next_to_a_half_turn() -> None:
+    """k(1 + cos a) → 2k cos²(a/2) (exact), and other sums of a cosine are left: in float64,
+    1 + cos φ is 0 within 3·10⁻⁹ of π, and p′ of hypothesis row 113 was infinite there."""
+    slope = 4 * sp.cosh(PHI / 3) / (7 * (sp.cos(PHI) + 1)) + 1 / (1 - sp.cos(PHI)) + 2 / (3 + 2 * sp.cos(PHI))
+    rewritten = near_half_turn(slope)
+    assert rewritten == (2 * sp.cosh(PHI / 3) / (7 * sp.cos(PHI / 2) ** 2) + 1 / (1 - sp.cos(PHI))
+                         + 2 / (3 + 2 * sp.cos(PHI)))
+    near_pi = np.pi - 3e-9
+    with np.errstate(divide="ignore"):
+        plain, half = (float(sp.lambdify(PHI, e, "numpy")(near_pi))
+                       for e in (1 / (1 + sp.cos(PHI)), near_half_turn(1 / (1 + sp.cos(PHI)))))
+    with mpmath.workdps(30):
+        exact = 1 / (1 + mpmath.cos(mpmath.mpf(near_pi)))
+    assert not np.isfinite(plain) or abs(plain / float(exact) - 1) > 1e-3
+    assert abs(half / float(exact) - 1) < 1e-13

@@ -84,7 +84,7 @@ static inline double symrot_det_h_one__phi(double s)
             low = phi;
         }
         step = phi - residual/slope;
-        if (slope > 0 && step >= low && step <= high) {
+        if (slope > 0 && isfinite(slope) && step >= low && step <= high) {
             phi = step;
         } else {
             phi = (1.0/2.0)*high + (1.0/2.0)*low;
@@ -1772,7 +1772,7 @@ static inline float symrot_det_h_one__phi_f(float s)
             low = phi;
         }
         step = phi - residual/slope;
-        if (slope > 0 && step >= low && step <= high) {
+        if (slope > 0 && isfinite(slope) && step >= low && step <= high) {
             phi = step;
         } else {
             phi = (1.0F/2.0F)*high + (1.0F/2.0F)*low;

@@ -1482,6 +1482,7 @@ def _angle_64(s, d):
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
         safe = slope > 0
+        safe = safe & numpy.isfinite(slope)
         step = phi - residual / numpy.where(safe, slope, 1.0)
         inside = safe & (step >= low) & (step <= high)
         phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)
@@ -2738,6 +2739,7 @@ def _angle_32(s, d):
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)
         safe = slope > 0
+        safe = safe & numpy.isfinite(slope)
         step = phi - residual / numpy.where(safe, slope, 1.0)
         inside = safe & (step >= low) & (step <= high)
         phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)

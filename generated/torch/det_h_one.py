@@ -1030,6 +1030,7 @@ def _newton_64(s):
         low = _where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
         safe = slope > 0
+        safe = safe & _xp.isfinite(slope)
         step = phi - residual / _where(safe, slope, 1.0)
         inside = safe & (step >= low) & (step <= high)
         phi = _where(inside, step, 0.5 * (low + high))
@@ -1817,6 +1818,7 @@ def _newton_32(s):
         low = _where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)
         safe = slope > 0
+        safe = safe & _xp.isfinite(slope)
         step = phi - residual / _where(safe, slope, 1.0)
         inside = safe & (step >= low) & (step <= high)
         phi = _where(inside, step, 0.5 * (low + high))

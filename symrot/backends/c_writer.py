@@ -300,7 +300,8 @@ class FunctionWriter:
         if angle.edge is None:
             step = (self.set("step", "phi - residual / slope * (value / s_or_one)", ops=4) if angle.reciprocal
                     else self.set("step", PHI_SYMBOL - sp.Symbol("residual") / sp.Symbol("slope")))
-            return [step, {**bisect, "condition": "slope > 0 && step >= low && step <= high"}]
+            return [step, {**bisect,
+                           "condition": "slope > 0 && isfinite(slope) && step >= low && step <= high"}]
         top = self.printer.literal(angle.phi_max)
         step = edge_step(angle.edge).xreplace({PHI: PHI_SYMBOL, EDGE_STEP: sp.Symbol("u", real=True),
                                                CHANGE: sp.Symbol("change", real=True)})

@@ -205,12 +205,14 @@ def newton_step_lines(angle: NewtonAngle, where: str = "numpy.where", module: st
     with an edge exponent k, in w = (φ_max − φ)^k (:func:`symrot.newton_start.edge_step`); every
     operand is safe on every lane (the array backends pass their own ``where``, ``module`` and
     printer)."""
+    finite = f"    safe = safe & {module}.isfinite(slope)"  # p′ = ∞: a zero step would stay
     if angle.edge is None:
-        return [f"    step = phi - residual / {where}(safe, slope, 1.0)"
+        return [finite,
+                f"    step = phi - residual / {where}(safe, slope, 1.0)"
                 + (f" * (value / {where}(s > 0, s, 1.0))" if angle.reciprocal else ""),
                 "    inside = safe & (step >= low) & (step <= high)"]
     return [
-        f"    safe = safe & {module}.isfinite(slope)",
+        finite,
         f"    change = residual / {where}(safe, slope, 1.0)",
         f"    delta = {angle.phi_max!r} - phi",
         f"    u = {float(angle.edge)!r} * change / {where}(delta > 0, delta, 1.0)",
