@@ -241,4 +241,40 @@ def _divided(total: sp.Expr, pole: PoleFactor) -> sp.Expr:
         if remainder != 0 or divided == 0:
             break
         quotient, power = divided, power + 1
-    return total if power == 0 else quotient * BoundedPower(pole.through_s, power)
+    if power == 0:
+        return _divided_through_base_angle(total, pole)
+    return quotient * BoundedPower(pole.through_s, power)
+
+
+def _divided_through_base_angle(total: sp.Expr, pole: PoleFactor) -> sp.Expr:
+    """A vanishing sum of sines and cosines of multiples of one base angle h, whose f = sin(mh) or
+    cos(mh) is not a generator of it, as (sum/f)·(N/(D·s)): both written as polynomials in sin h,
+    cos h (``expand_trig``) and the quotient cancelled. SymPy's simplification writes
+    cos(3φ/2) = cos(φ/2)(2 cos φ − 1), so det H of 2 tan(3φ/2)/(3(3φ²/2 + 1)) has (2 cos φ − 1)⁴,
+    which vanishes at the pole π/3 (hypothesis row 159; 8·10⁵ ulp at |p|² = 2³², where the range
+    ended); the quotient is 1/cos(φ/2)."""
+    if not isinstance(pole.factor, (sp.sin, sp.cos)):
+        return total
+    calls = total.atoms(sp.sin, sp.cos) | {pole.factor}
+    multiples = [sp.nsimplify(call.args[0] / PHI) for call in calls]
+    if not all(m.is_Rational and m != 0 for m in multiples):
+        return total
+    base = sp.Rational(sp.igcd(*(m.p for m in multiples)), sp.ilcm(*(m.q for m in multiples)))
+    if max(abs(m / base) for m in multiples) > 4 * MAX_MULTIPLE:
+        return total
+    h = sp.Dummy("h")
+
+    def in_base(expr: sp.Expr) -> sp.Expr:
+        return sp.expand_trig(expr.replace(
+            lambda z: isinstance(z, (sp.sin, sp.cos)) and z.has(PHI),
+            lambda z: type(z)(sp.nsimplify(z.args[0] / PHI) / base * h)))
+
+    ratio = bounded(2.0, None, lambda: sp.cancel(in_base(total) / in_base(pole.factor)))
+    if ratio is None:
+        return total
+    quotient = ratio.subs(h, base * PHI)
+    with mpmath.workdps(ZERO_DIGITS):
+        value = _value(quotient, pole.phi_max)
+    if value is None or value == 0:  # not a multiple of f after all
+        return total
+    return quotient * BoundedPower(pole.through_s, 1)

@@ -104,6 +104,28 @@ def test_multiples_of_the_factor_angle_that_vanish_with_it_are_expanded() -> Non
         assert _relative_error(form, p, theta) > 1e4
 
 
+def test_a_vanishing_sum_of_other_multiples_of_the_base_angle_is_divided_by_the_factor() -> None:
+    """p = 2 tan(3φ/2)/(3(3φ²/2 + 1)), a pole at π/3: SymPy writes cos(3φ/2) in det H as
+    cos(φ/2)(2 cos φ − 1), where cos(3φ/2) is no generator to divide by. Through the base angle
+    φ/2, 2 cos φ − 1 = f/cos(φ/2), and det H keeps its digits next to the pole (the range of
+    hypothesis row 159 ended at |p|² = 2³², det H 8·10⁵ ulp off there)."""
+    p = _p("2*tan(3*phi/2)/(3*(3*phi**2/2 + 1))")
+    pole = pole_factor(p, math.pi / 3)
+    assert pole is not None and pole.factor == sp.cos(3 * PHI / 2)
+    det_h = (-9 * (3 * PHI**2 + 2) ** 4 * (2 * sp.cos(PHI) - 1) ** 4 * sp.cos(PHI / 2) ** 4
+             / (8 * (2 * sp.cos(PHI / 2) - 1) ** 2 * (2 * sp.cos(PHI / 2) + 1) ** 2
+                * (-3 * PHI**2 + 2 * PHI * sp.sin(3 * PHI) - 2)))
+    rewritten = with_pole_factor(det_h, pole)
+    assert rewritten.has(S) and not rewritten.has(sp.cos(PHI))
+    identity = sp.lambdify(PHI, rewritten.subs(S, p).doit() - det_h, modules=[mpmath_namespace(), "mpmath"])
+    with mpmath.workdps(60):
+        for angle in ("0.3", "0.7", "1.0"):
+            assert abs(identity(mpmath.mpf(angle))) < mpmath.mpf(10) ** -45
+        theta = mpmath.pi / 3 - mpmath.mpf("1.37e-8")
+        assert _relative_error(rewritten, p, theta) <= 8
+        assert _relative_error(det_h, p, theta) > 1e4
+
+
 def _slope_through_s(p: sp.Expr, phi_max: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
     """(p′, p′ with the edge's factor written through s), after checking that the factor vanishes at
     φ_max and that its form through s equals it where s = p (at 0.1, 0.5 and 0.9 φ_max)."""
