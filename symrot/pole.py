@@ -76,6 +76,9 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     factor of its denominator (written as a quotient, :func:`as_quotients`), else None."""
     if not mpmath.isfinite(phi_max) or phi_max <= 0:
         return None
+    tangent = _tangent_pole(p, phi_max)
+    if tangent is not None:
+        return tangent
     quotient = bounded(2.0, None, lambda: sp.together(as_quotients(p)))
     if quotient is None:
         return None
@@ -119,17 +122,46 @@ def _linear_call(p: sp.Expr, functions: tuple[type[sp.Function], ...],
     if len(calls) != 1:
         return None
     call = calls[0]
+    factor = sp.expand(1 - call.args[0] ** 2)
+    found = _weight_and_rest(p, call, factor if vanishing is None else vanishing(call.args[0]), phi_max)
+    if found is None:
+        return None
+    return _LinearCall(call, found[0], found[1], factor, found[2])
+
+
+def _weight_and_rest(p: sp.Expr, call: sp.Expr, vanishing: sp.Expr,
+                     phi_max: float) -> tuple[sp.Expr, sp.Expr, mpmath.mpf] | None:
+    """(B, A, root) with p = A + B·call, for the root of ``vanishing`` next to ``phi_max`` where A
+    and B are finite and B nonzero, else None."""
     level = sp.Dummy("L")
     linear = p.xreplace({call: level})
     if not linear.is_polynomial(level) or sp.degree(linear, level) != 1:
         return None
     weight, rest = sp.diff(linear, level), linear.subs(level, 0)
-    factor = sp.expand(1 - call.args[0] ** 2)
     with mpmath.workdps(ZERO_DIGITS):
-        root = _root_near(factor if vanishing is None else vanishing(call.args[0]), phi_max)
+        root = _root_near(vanishing, phi_max)
         if root is None or _value(weight, root) in (None, 0) or _value(rest, root) is None:
             return None
-    return _LinearCall(call, weight, rest, factor, root)
+    return weight, rest, root
+
+
+def _tangent_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """p = A + B·tan(aφ) with cos(aφ_max) = 0 (the one tangent whose cosine vanishes there, A and B
+    finite, B nonzero): f = cos(aφ) = B sin(aφ)/(s − A). The quotient route N/(D·s) keeps A·cos(aφ)
+    from the rounded angle inside N: for 8 sinh(φ) cosh(2φ/3)/11 + 9 tan(2φ/3)/(22(3φ²/4 + 1))
+    (hypothesis row 94) det H was 291 ulp off at |p|² = 2³², where the range ended. s − A loses
+    digits only where B tan(aφ) is small beside A, far from the pole; the plan measures both."""
+    calls = [call for call in p.atoms(sp.tan) if call.has(PHI)]
+    with mpmath.workdps(ZERO_DIGITS):
+        vanishing = [call for call in calls if _root_near(sp.cos(call.args[0]), phi_max) is not None]
+    if len(vanishing) != 1:
+        return None
+    call = vanishing[0]
+    found = _weight_and_rest(p, call, sp.cos(call.args[0]), phi_max)
+    if found is None:
+        return None
+    weight, rest, root = found
+    return PoleFactor(sp.cos(call.args[0]), weight * sp.sin(call.args[0]) / (S - rest), root)
 
 
 def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:

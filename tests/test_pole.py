@@ -126,6 +126,25 @@ def test_a_vanishing_sum_of_other_multiples_of_the_base_angle_is_divided_by_the_
         assert _relative_error(det_h, p, theta) > 1e4
 
 
+def test_a_tangent_beside_other_terms_writes_its_cosine_through_s_minus_the_rest() -> None:
+    """p = A + B tan(2φ/3), a pole at 3π/4 (hypothesis row 94): cos(2φ/3) = B sin(2φ/3)/(s − A),
+    with no A·cos(2φ/3) from the rounded angle inside (det H was 291 ulp off at |p|² = 2³² through
+    N/(D·s), and the range ended there)."""
+    p = _p("8*sinh(phi)*cosh(2*phi/3)/11 + 9*tan(2*phi/3)/(22*(3*phi**2/4 + 1))")
+    pole = pole_factor(p, 3 * math.pi / 4)
+    assert pole is not None and pole.factor == sp.cos(2 * PHI / 3)
+    assert not pole.through_s.has(sp.cos(2 * PHI / 3))
+    slope = sp.diff(p, PHI)
+    rewritten = with_pole_factor(slope, pole)
+    identity = sp.lambdify(PHI, rewritten.subs(S, p) - slope, modules=[mpmath_namespace(), "mpmath"])
+    with mpmath.workdps(60):
+        for angle in ("0.5", "1.5", "2.3"):
+            assert abs(identity(mpmath.mpf(angle))) < mpmath.mpf(10) ** -40
+        theta = 3 * mpmath.pi / 4 - mpmath.mpf("1.37e-8")
+        assert _relative_error(rewritten, p, theta) <= 8
+        assert _relative_error(slope, p, theta) > 1e4
+
+
 def _slope_through_s(p: sp.Expr, phi_max: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
     """(p′, p′ with the edge's factor written through s), after checking that the factor vanishes at
     φ_max and that its form through s equals it where s = p (at 0.1, 0.5 and 0.9 φ_max)."""
