@@ -211,8 +211,6 @@ def edge_exponent(p: sp.Expr, p_max: float, phi_max: float) -> sp.Rational | Non
     return sp.Rational(1, fraction.denominator)
 
 
-
-
 class NewtonCount(NamedTuple):
     """What :func:`measured_iterations` found: the steps to print, and the smallest s = |p| whose
     angle those steps do not reach (∞ when every checked angle is reached)."""
