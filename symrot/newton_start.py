@@ -181,19 +181,19 @@ EDGE_DENOMINATOR = 4
 """Largest n of a fractional edge exponent k = 1/n (p_max − p ∝ (φ_max − φ)^k, k = 1/2 for asin)."""
 
 
-def edge_exponent(p: sp.Expr, p_max: float, phi_max: float) -> sp.Rational | None:
+def edge_exponent(p: sp.Expr, far: FarStart, phi_max: float) -> sp.Rational | None:
     """k with p_max − p(φ) ∝ (φ_max − φ)^k at the end of a finite range, when k ≠ 1: the fold order
-    (k = 2, 3, 4 where p′(φ_max) = 0, :func:`fold_order`), or a fraction where p′ → ∞ (k = 1/2
-    at the edge of asin's domain, 2 cos(φ) asin(φ)/15 + … of docs/accuracy_hypothesis.md row 187),
-    estimated from the growth of p′ between φ_max − 10⁻¹⁰ φ_max and φ_max − 10⁻²⁰ φ_max at
-    DIGITS and accepted when within 0.02 of 1/n, n ≤ EDGE_DENOMINATOR.
-    None for an unbounded p or an ordinary edge. Newton in w = (φ_max − φ)^k, where p is regular,
-    then converges quadratically up to the edge (:func:`newton_step`)."""
-    if not (math.isfinite(p_max) and math.isfinite(phi_max)):
+    the far start found (k = 2, 3, 4 where p′(φ_max) = 0, :func:`fold_order`), or a fraction where
+    p′ → ∞ (k = 1/2 at the edge of asin's domain, 2 cos(φ) asin(φ)/15 + … of
+    docs/accuracy_hypothesis.md row 187), estimated from the growth of p′ between
+    φ_max − 10⁻¹⁰ φ_max and φ_max − 10⁻²⁰ φ_max at DIGITS and accepted when within 0.02 of 1/n,
+    n ≤ EDGE_DENOMINATOR. None for an unbounded p (``far.kind`` "ratio") or an ordinary edge.
+    Newton in w = (φ_max − φ)^k, where p is regular, then converges quadratically up to the edge
+    (:func:`newton_step`)."""
+    if far.kind == "fold":
+        return sp.Integer(far.order)
+    if far.kind == "ratio" or not math.isfinite(phi_max):
         return None
-    order = fold_order(p, phi_max)
-    if order > 1:
-        return sp.Integer(order)
     f_slope = _p_function(sp.diff(p, PHI))
     with mpmath.workdps(DIGITS):
         top = mpmath.mpf(phi_max)

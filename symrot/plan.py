@@ -737,7 +737,7 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
     reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
     lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0])
     count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top)
-    edge = _edge_exponent(p, p_max, phi_max)
+    edge = _edge_exponent(p, far, phi_max)
     if edge is not None:
         edge_count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, edge)
         # p′ = ∞ at the edge (k < 1): steps in φ overshoot past it and bisect (43 steps for asin(φ)

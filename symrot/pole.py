@@ -123,26 +123,25 @@ def _linear_call(p: sp.Expr, functions: tuple[type[sp.Function], ...],
         return None
     call = calls[0]
     factor = sp.expand(1 - call.args[0] ** 2)
-    found = _weight_and_rest(p, call, factor if vanishing is None else vanishing(call.args[0]), phi_max)
+    with mpmath.workdps(ZERO_DIGITS):
+        root = _root_near(factor if vanishing is None else vanishing(call.args[0]), phi_max)
+    found = _weight_and_rest(p, call, root) if root is not None else None
     if found is None:
         return None
-    return _LinearCall(call, found[0], found[1], factor, found[2])
+    return _LinearCall(call, found[0], found[1], factor, root)
 
 
-def _weight_and_rest(p: sp.Expr, call: sp.Expr, vanishing: sp.Expr,
-                     phi_max: float) -> tuple[sp.Expr, sp.Expr, mpmath.mpf] | None:
-    """(B, A, root) with p = A + B·call, for the root of ``vanishing`` next to ``phi_max`` where A
-    and B are finite and B nonzero, else None."""
+def _weight_and_rest(p: sp.Expr, call: sp.Expr, root: mpmath.mpf) -> tuple[sp.Expr, sp.Expr] | None:
+    """(B, A) with p = A + B·call, both finite at ``root`` and B nonzero there, else None."""
     level = sp.Dummy("L")
     linear = p.xreplace({call: level})
     if not linear.is_polynomial(level) or sp.degree(linear, level) != 1:
         return None
     weight, rest = sp.diff(linear, level), linear.subs(level, 0)
     with mpmath.workdps(ZERO_DIGITS):
-        root = _root_near(vanishing, phi_max)
-        if root is None or _value(weight, root) in (None, 0) or _value(rest, root) is None:
+        if _value(weight, root) in (None, 0) or _value(rest, root) is None:
             return None
-    return weight, rest, root
+    return weight, rest
 
 
 def _tangent_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
@@ -151,16 +150,16 @@ def _tangent_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     from the rounded angle inside N: for 8 sinh(φ) cosh(2φ/3)/11 + 9 tan(2φ/3)/(22(3φ²/4 + 1))
     (hypothesis row 94) det H was 291 ulp off at |p|² = 2³², where the range ended. s − A loses
     digits only where B tan(aφ) is small beside A, far from the pole; the plan measures both."""
-    calls = [call for call in p.atoms(sp.tan) if call.has(PHI)]
     with mpmath.workdps(ZERO_DIGITS):
-        vanishing = [call for call in calls if _root_near(sp.cos(call.args[0]), phi_max) is not None]
+        roots = {call: _root_near(sp.cos(call.args[0]), phi_max) for call in p.atoms(sp.tan) if call.has(PHI)}
+    vanishing = [(call, root) for call, root in roots.items() if root is not None]
     if len(vanishing) != 1:
         return None
-    call = vanishing[0]
-    found = _weight_and_rest(p, call, sp.cos(call.args[0]), phi_max)
+    call, root = vanishing[0]
+    found = _weight_and_rest(p, call, root)
     if found is None:
         return None
-    weight, rest, root = found
+    weight, rest = found
     return PoleFactor(sp.cos(call.args[0]), weight * sp.sin(call.args[0]) / (S - rest), root)
 
 
@@ -292,7 +291,7 @@ def _divided_through_base_angle(total: sp.Expr, pole: PoleFactor) -> sp.Expr:
     if not all(m.is_Rational and m != 0 for m in multiples):
         return total
     base = sp.Rational(sp.igcd(*(m.p for m in multiples)), sp.ilcm(*(m.q for m in multiples)))
-    if max(abs(m / base) for m in multiples) > 4 * MAX_MULTIPLE:
+    if max(abs(m / base) for m in multiples) > 2 * MAX_MULTIPLE:  # row 159 needs 6 (sin 3φ, h = φ/2)
         return total
     h = sp.Dummy("h")
 

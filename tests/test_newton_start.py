@@ -5,6 +5,7 @@ next to a fold or an asin edge the steps are Newton's in w = (φ_max − φ)^k (
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import mpmath
 import numpy as np
@@ -55,13 +56,25 @@ def test_angles_the_steps_do_not_reach_end_the_range_at_the_smallest_size() -> N
     assert math.isclose(count.unconverged, first_wrong, rel_tol=1e-12)
 
 
+def _far(kind: Literal["fold", "linear", "ratio"], order: int = 1) -> FarStart:
+    return FarStart(kind=kind, scale=1.0, order=order, chebyshev=(0.0,), switch=math.inf, measured=0.0)
+
+
 def test_edge_exponent_names_folds_and_asin_edges_only() -> None:
-    assert edge_exponent(sp.asin(PHI), math.pi / 2, 1.0) == sp.Rational(1, 2)  # p′ = (1 − φ²)^(−1/2)
-    assert edge_exponent(sp.asin(PHI / 3) + PHI, math.asin(1.0) + 3, 3.0) == sp.Rational(1, 2)
-    assert edge_exponent(PHI - PHI**3 / 3, 2 / 3, 1.0) == 2  # p′ = 1 − φ²: a fold
-    assert edge_exponent(PHI - PHI**2 + PHI**3 / 3, 1 / 3, 1.0) == 3  # p′ = (1 − φ)²
-    assert edge_exponent(PHI, 1.0, 1.0) is None  # an ordinary end of the range
-    assert edge_exponent(sp.sinh(PHI), math.inf, 6.0) is None
+    linear = _far("linear")
+    assert edge_exponent(sp.asin(PHI), linear, 1.0) == sp.Rational(1, 2)  # p′ = (1 − φ²)^(−1/2)
+    assert edge_exponent(sp.asin(PHI / 3) + PHI, linear, 3.0) == sp.Rational(1, 2)
+    assert edge_exponent(PHI, linear, 1.0) is None  # an ordinary end of the range
+    assert edge_exponent(PHI - PHI**3 / 3, _far("fold", 2), 1.0) == 2  # the far start's fold order
+    assert edge_exponent(sp.sinh(PHI), _far("ratio"), 6.0) is None  # unbounded p
+
+
+def test_the_far_start_finds_the_fold_order_of_the_edge() -> None:
+    """p′ = 1 − φ² and (1 − φ)²: folds of order 2 and 3, which ``edge_exponent`` takes from it."""
+    for p, p_max, order in ((PHI - PHI**3 / 3, 2 / 3, 2), (PHI - PHI**2 + PHI**3 / 3, 1 / 3, 3)):
+        far = far_start(p, p_max, 1.0, (sp.Integer(1),))
+        assert (far.kind, far.order) == ("fold", order)
+        assert edge_exponent(p, far, 1.0) == order
 
 
 @pytest.mark.parametrize("edge", [sp.Rational(1, 2), sp.Rational(1, 3), sp.Integer(2), sp.Integer(3),
