@@ -15,7 +15,8 @@ The backends have s = |p| as rounded input, so f = N/(D·s) is available to a fe
 D are away from zero (for the logarithm, f = (1 + u)² exp(−2 (s − A)/B)): :func:`with_pole_factor`
 writes f, and every sum in a form that is a polynomial multiple of f, through it, as one bounded
 factor (:class:`symrot.functions.BoundedPower`: SymPy would merge (φ/s)³ with the form's other
-powers of s into φ³/s⁵, which overflows float32 next to the pole while the value does not). The plan
+powers of s into φ³/s⁵, which overflows float32 next to the pole while the value does not). The
+call atanh(u) or asin(u) itself, whose slope is infinite at the edge, becomes (s − A)/B. The plan
 measures those forms beside the others (:func:`symrot.plan.plan_branch`) and takes them where they
 are more accurate.
 """
@@ -58,11 +59,15 @@ _QUOTIENTS = {
 
 
 class PoleFactor(NamedTuple):
-    """p = N/(D·f) with f(φ_max) = 0 (simple): ``factor`` f and ``through_s`` = N/(D·s)."""
+    """p = N/(D·f) with f(φ_max) = 0 (simple): ``factor`` f and ``through_s`` = N/(D·s). For
+    p = A + B·F(u) with F = atanh, asin or acos (the edge is u² = 1), also the ``call`` F(u) and
+    ``call_through_s`` = (s − A)/B."""
 
     factor: sp.Expr
     through_s: sp.Expr
     phi_max: mpmath.mpf
+    call: sp.Expr | None = None
+    call_through_s: sp.Expr | None = None
 
 
 def as_quotients(expr: sp.Expr) -> sp.Expr:
@@ -116,19 +121,21 @@ class _LinearCall(NamedTuple):
 
 def _linear_call(p: sp.Expr, functions: tuple[type[sp.Function], ...],
                  vanishing: Callable[[sp.Expr], sp.Expr] | None, phi_max: float) -> _LinearCall | None:
-    """p linear in its one call of ``functions`` with 1 − u² (or ``vanishing``(u), a factor of it)
-    zero at ``phi_max`` and the weight and rest finite there (the weight nonzero), else None."""
-    calls = [call for call in p.atoms(*functions) if call.has(PHI)]
-    if len(calls) != 1:
-        return None
-    call = calls[0]
-    factor = sp.expand(1 - call.args[0] ** 2)
+    """p linear in the one call of ``functions`` whose 1 − u² (or ``vanishing``(u), a factor of it)
+    is zero at ``phi_max`` (other calls go into the rest), with the weight and rest finite there
+    (the weight nonzero), else None."""
+    calls = sorted((call for call in p.atoms(*functions) if call.has(PHI)), key=sp.default_sort_key)
     with mpmath.workdps(ZERO_DIGITS):
-        root = _root_near(factor if vanishing is None else vanishing(call.args[0]), phi_max)
-    found = _weight_and_rest(p, call, root) if root is not None else None
+        roots = [(call, _root_near(sp.expand(1 - call.args[0] ** 2) if vanishing is None
+                                   else vanishing(call.args[0]), phi_max)) for call in calls]
+    edges = [(call, root) for call, root in roots if root is not None]
+    if len(edges) != 1:  # other calls (asin(φ/4) beside the edge of asin(φ/3)) belong to A
+        return None
+    call, root = edges[0]
+    found = _weight_and_rest(p, call, root)
     if found is None:
         return None
-    return _LinearCall(call, found[0], found[1], factor, root)
+    return _LinearCall(call, found[0], found[1], sp.expand(1 - call.args[0] ** 2), root)
 
 
 def _weight_and_rest(p: sp.Expr, call: sp.Expr, root: mpmath.mpf) -> tuple[sp.Expr, sp.Expr] | None:
@@ -174,7 +181,7 @@ def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         return None
     inner = found.call.args[0]
     through_s = (1 + inner) ** 2 * sp.exp(-2 * (S - found.rest) / found.weight)
-    return PoleFactor(1 - inner**2, through_s, found.root)
+    return PoleFactor(1 - inner**2, through_s, found.root, found.call, (S - found.rest) / found.weight)
 
 
 def _arcsine_edge(p: sp.Expr, phi_max: float) -> PoleFactor | None:
@@ -188,7 +195,7 @@ def _arcsine_edge(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         return None
     angle = (S - found.rest) / found.weight
     through_s = (sp.cos(angle) if isinstance(found.call, sp.asin) else sp.sin(angle)) ** 2
-    return PoleFactor(found.factor, through_s, found.root)
+    return PoleFactor(found.factor, through_s, found.root, found.call, angle)
 
 
 def _value(expr: sp.Expr, phi: mpmath.mpf) -> mpmath.mpf | None:
@@ -216,10 +223,12 @@ def _root_near(factor: sp.Expr, phi_max: float) -> mpmath.mpf | None:
 
 def with_pole_factor(form: sp.Expr, pole: PoleFactor) -> sp.Expr:
     """``form`` with the pole's factor f, and every sum that is f^k times a polynomial quotient,
-    written through s (f = N/(D·s)); a form with neither is returned as it is. For f = cos(aφ) (or
-    sin(aφ)), the multiples sin(naφ), cos(naφ) (n ≤ :data:`MAX_MULTIPLE`) that vanish with it are
-    first expanded into powers of f: for p = φ/cos(φ/4), sin(φ/2) = 2 sin(φ/4) cos(φ/4) next to
-    the pole at 2π, where sin(φ/2) from φ̂ has lost as many digits as f."""
+    written through s (f = N/(D·s)), and the edge's call F(u) as (s − A)/B (3 sin φ/(2 cos(φ/4)
+    atanh(3φ/2)) of hypothesis row 88 becomes sin φ/s); a form with none of them is returned as it
+    is. For f = cos(aφ) (or sin(aφ)), the multiples sin(naφ), cos(naφ) (n ≤ :data:`MAX_MULTIPLE`)
+    that vanish with it are first expanded into powers of f: for p = φ/cos(φ/4),
+    sin(φ/2) = 2 sin(φ/4) cos(φ/4) next to the pole at 2π, where sin(φ/2) from φ̂ has lost as many
+    digits as f."""
     quotients = _expanded_multiples(as_quotients(form), pole)
     rewritten = _rewrite(quotients, pole)
     return form if rewritten == quotients else rewritten
@@ -247,6 +256,8 @@ def _expanded_multiples(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
 def _rewrite(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
     if expr == pole.factor:
         return BoundedPower(pole.through_s, 1)
+    if pole.call_through_s is not None and expr == pole.call:
+        return pole.call_through_s
     if not expr.args or not expr.has(PHI):
         return expr
     rebuilt = expr.func(*(_rewrite(arg, pole) for arg in expr.args))

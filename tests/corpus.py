@@ -116,6 +116,10 @@ CORPUS: tuple[Entry, ...] = (
     # the edge of asin's domain without a closed inverse: Newton in φ from the far start stalled
     # next to φ_max = 1 (p′ → ∞), and the float64 range ended at |p| = 1.11415 < p_max = 1.11416
     Entry("4*phi/5 + asin(phi)/5", "inverse trigonometric", "slope", False, "1"),
+    # a logarithmic pole in a product (hypothesis row 88): sin φ/p simplifies to
+    # 3 sin φ/(2 cos(φ/4) atanh(3φ/2)), and atanh from the rounded angle next to 2/3 cost float64
+    # rotation_matrix 102 ulp and omega 195 ulp before atanh(3φ/2) was written as 3s/(2 cos(φ/4))
+    Entry("2*cos(phi/4)*atanh(3*phi/2)/3", "inverse hyperbolic", "pole", False, "2/3"),
 )
 
 

@@ -216,3 +216,31 @@ def test_an_arcsine_edge_writes_one_minus_u_squared_through_s(text: str) -> None
         assert _relative_error(rewritten, p, theta) <= 4 * (1 + condition), rewritten
         # in φ̂: 800-2100 times the condition number (5.6·10⁷ to 1.9·10⁸ ulp)
         assert _relative_error(slope, p, theta) > 100 * (1 + condition)
+
+
+EDGE_CALLS = {  # p = A + B F(u), F = atanh or asin, with the edge u² = 1 at φ_max: φ_max
+    "2*cos(phi/4)*atanh(3*phi/2)/3": "2/3",  # hypothesis row 88
+    "2*sqrt(phi**2/3 + 1)*asin(phi/3) + 4*cos(phi)*asin(phi/4)/3": "3",  # row 140: two asin calls
+    "cos(phi)*asin(phi)": "1",  # row 189
+}
+
+
+@pytest.mark.parametrize("text", list(EDGE_CALLS))
+def test_the_edge_call_itself_is_written_through_s(text: str) -> None:
+    """F(u) next to its edge from the rounded φ̂ loses digits like the factor 1 − u² (F′ → ∞):
+    sin φ/p of row 88 simplifies to 3 sin φ/(2 cos(φ/4) atanh(3φ/2)), 6·10⁶ ulp off at
+    2/3 − 1.37·10⁻⁹ (row 88 measured `rotation_matrix` 102 ulp at 2/3 − 10⁻⁶). With F(u) = (s − A)/B
+    the form keeps its value and its digits; of several calls of F only the one whose edge is φ_max
+    is rewritten (row 140: asin(φ/4) stays in A)."""
+    p, phi_max = _p(text), sp.sympify(EDGE_CALLS[text])
+    pole = pole_factor(p, float(phi_max))
+    assert pole is not None and pole.call is not None and pole.call_through_s is not None
+    assert sp.simplify(pole.call_through_s.subs(S, p) - pole.call) == 0
+    form = sp.simplify(sp.sin(PHI) / p)
+    rewritten = with_pole_factor(form, pole)
+    assert rewritten.has(S) and not rewritten.has(pole.call)
+    assert sp.simplify(rewritten.subs(S, p) - form) == 0
+    with mpmath.workdps(60):
+        theta = mpmath.mpf(sp.N(phi_max, 60)) - mpmath.mpf("1e-9") * mpmath.mpf("1.37")
+        assert _relative_error(rewritten, p, theta) <= 4, rewritten
+        assert _relative_error(form, p, theta) > 100
