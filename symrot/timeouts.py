@@ -40,6 +40,8 @@ from contextlib import AbstractContextManager, _GeneratorContextManager, context
 from types import FrameType
 from typing import Any, TypeVar
 
+from sympy.core import random as sympy_random
+
 from .errors import SymrotTimeout
 
 T = TypeVar("T")
@@ -53,6 +55,8 @@ alone took 3.7 s beside a CI run, and once a base-angle reduction that took at m
 other runs (hypothesis row 1) stopped a plan at its 5 s safety bound while a benchmark shared the
 machine (cause not found: garbage collection paused the process for at most 0.14 s).
 The bound only stops hangs; the size caps decide what is attempted."""
+SYMPY_SEED = 0
+"""The state of SymPy's random generator at the start of every :func:`bounded` step."""
 _deterministic = threading.local()
 _reporting_unraisable = threading.local()
 
@@ -165,6 +169,25 @@ _CLEANUP_CODE = frozenset({alarm.__wrapped__.__code__, time_limit.__wrapped__.__
                            _GeneratorContextManager.__exit__.__code__})
 
 
+@contextmanager
+def seeded_sympy_random(seed: int = SYMPY_SEED) -> Iterator[None]:
+    """In the body, SymPy's random generator (``sympy.core.random.rng``) starts from ``seed``; its
+    state is restored afterwards. SymPy's multivariate factorization (Wang's algorithm,
+    ``dmp_zz_wang``) draws random evaluation points, so its run time depends on the generator's
+    state, which is seeded from the OS at import and advanced by everything that ran before: the
+    base-angle reduction of det H of φ³/4 + sin(2φ) cos(φ/4)/2 (hypothesis row 72) took 0.4–1.1 s
+    in 18 of 21 processes and 21–29 s in 3, past its 15 s safety bound (the emit failed). The
+    factorization is unique, so the seed changes the time, not the result; seeded, a step's time
+    depends on its input alone."""
+    rng = sympy_random.rng
+    state = rng.getstate()
+    rng.seed(seed)
+    try:
+        yield
+    finally:
+        rng.setstate(state)
+
+
 def bounded(seconds: float, fallback: T, func: Callable[..., T], *args: Any) -> T:
     """Return ``func(*args)`` if it finishes within ``seconds``, else ``fallback``.
 
@@ -177,7 +200,8 @@ def bounded(seconds: float, fallback: T, func: Callable[..., T], *args: Any) -> 
     marker = object()
     strict = is_deterministic()
     try:
-        with time_limit(seconds * SAFETY_FACTOR if strict else seconds, "simplification", marker):
+        with seeded_sympy_random(), \
+                time_limit(seconds * SAFETY_FACTOR if strict else seconds, "simplification", marker):
             return func(*args)
     except SymrotTimeout as exc:
         if getattr(exc, "marker", None) is marker:
