@@ -89,7 +89,7 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         return None
     numerator, denominator = sp.fraction(quotient)
     if not denominator.has(PHI):
-        return _logarithmic_pole(p, phi_max) or _arcsine_edge(p, phi_max)
+        return _logarithmic_pole(p, phi_max) or _log_pole(p, phi_max) or _arcsine_edge(p, phi_max)
     factored = bounded(2.0, None, sp.factor_list, denominator)
     if factored is None:
         return None
@@ -184,6 +184,34 @@ def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     return PoleFactor(1 - inner**2, through_s, found.root, found.call, (S - found.rest) / found.weight)
 
 
+def _log_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """p = A + B·log(N/D) with a simple zero of D (or of N) at φ_max: atanh written as a logarithm,
+    log((1 + φ/2)/(1 − φ/2)) (corpus entry 21). f = D is N·exp(−(s − A)/B) through s (N·exp((s − A)/B)
+    when N vanishes), the factor of p′ = B (N′/N − D′/D); the call itself is (s − A)/B."""
+    calls = [call for call in p.atoms(sp.log) if call.has(PHI)]
+    if len(calls) != 1:
+        return None
+    call = calls[0]
+    fraction = bounded(2.0, None, lambda: sp.fraction(sp.together(call.args[0])))
+    if fraction is None:
+        return None
+    numerator, denominator = fraction
+    with mpmath.workdps(ZERO_DIGITS):
+        roots = [(part, _root_near(part, phi_max)) for part in (denominator, numerator) if part.has(PHI)]
+        edges = [(part, root) for part, root in roots if root is not None]
+        if len(edges) != 1 or _value(sp.diff(edges[0][0], PHI), edges[0][1]) in (None, 0):
+            return None  # no edge of this call at φ_max, or not a simple zero
+        factor, root = edges[0]
+        found = _weight_and_rest(p, call, root)
+    if found is None:
+        return None
+    weight, rest = found
+    level = (S - rest) / weight
+    other = numerator if factor is denominator else denominator
+    through_s = other * sp.exp(-level if factor is denominator else level)
+    return PoleFactor(factor, through_s, root, call, level)
+
+
 def _arcsine_edge(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     """p = A + B·asin(u) (or acos(u)) with u(φ_max)² = 1: p stays finite, but p′ = A′ + B′ asin(u)
     + B u′/√(1 − u²) → ∞, and f = 1 − u², in p′ and the coefficients built from it, loses digits
@@ -256,7 +284,7 @@ def _expanded_multiples(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
 def _rewrite(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
     if expr == pole.factor:
         return BoundedPower(pole.through_s, 1)
-    if pole.call_through_s is not None and expr == pole.call:
+    if pole.call_through_s is not None and _is_the_call(expr, pole.call):
         return pole.call_through_s
     if not expr.args or not expr.has(PHI):
         return expr
@@ -264,6 +292,16 @@ def _rewrite(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
     if expr.is_Add and rebuilt == expr:
         return _divided(expr, pole)
     return rebuilt
+
+
+def _is_the_call(expr: sp.Expr, call: sp.Expr | None) -> bool:
+    """``expr`` is the edge's ``call``; for a logarithm, also when SymPy wrote its argument in
+    another form (log((φ/2 + 1)/(1 − φ/2)) becomes log(−(φ + 2)/(φ − 2)) in sin φ/p)."""
+    if expr == call:
+        return True
+    if not (isinstance(call, sp.log) and isinstance(expr, sp.log) and expr.has(PHI)):
+        return False
+    return bool(bounded(1.0, None, lambda: sp.cancel(expr.args[0] / call.args[0])) == 1)
 
 
 def _divided(total: sp.Expr, pole: PoleFactor) -> sp.Expr:

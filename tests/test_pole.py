@@ -244,3 +244,31 @@ def test_the_edge_call_itself_is_written_through_s(text: str) -> None:
         theta = mpmath.mpf(sp.N(phi_max, 60)) - mpmath.mpf("1e-9") * mpmath.mpf("1.37")
         assert _relative_error(rewritten, p, theta) <= 4, rewritten
         assert _relative_error(form, p, theta) > 100
+
+
+LOG_POLES = {  # p = A + B log(N/D), a simple zero of D (or N) at φ_max: φ_max
+    "log((1 + phi/2)/(1 - phi/2))": "2",  # corpus entry 21, 2 atanh(φ/2) as SymPy does not write it
+    "phi/3 - 2*log(1 - phi/3)/3": "3",
+}
+
+
+@pytest.mark.parametrize("text", list(LOG_POLES))
+def test_a_logarithm_writes_its_vanishing_part_and_itself_through_s(text: str) -> None:
+    """Corpus entry 21 missed in float32 (`tangent_det` 3.9·10⁵ ulp, `omega` 2.8·10³ ulp at 2): p′
+    holds 2 − φ from the rounded angle. Through s, 2 − φ = (2 + φ) exp(−s) (D = N exp(−(s − A)/B)),
+    within 4 (1 + s/B) ulp at φ_max − 1.37·10⁻⁹ where the form in φ̂ is 10⁴ ulp off, and the call
+    itself, in whatever form SymPy wrote its argument, is (s − A)/B."""
+    p, phi_max = _p(text), sp.sympify(LOG_POLES[text])
+    slope, rewritten = _slope_through_s(p, phi_max)
+    (call,) = p.atoms(sp.log)
+    weight = sp.lambdify(PHI, sp.diff(p.xreplace({call: S}), S), "mpmath")
+    p_of = sp.lambdify(PHI, p, "mpmath")
+    with mpmath.workdps(60):
+        theta = mpmath.mpf(sp.N(phi_max, 60)) - mpmath.mpf("1e-9") * mpmath.mpf("1.37")
+        condition = float(abs(p_of(theta) / weight(theta)))
+        assert _relative_error(rewritten, p, theta) <= 4 * (1 + condition), rewritten
+        assert _relative_error(slope, p, theta) > 1e4
+    pole = pole_factor(p, float(phi_max))
+    assert pole is not None
+    form = sp.simplify(sp.sin(PHI) / p)
+    assert not with_pole_factor(form, pole).has(sp.log)
