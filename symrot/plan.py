@@ -144,6 +144,15 @@ def near_half_turn(expr: sp.Expr) -> sp.Expr:
     return expr.replace(lambda e: parts(e) is not None, doubled)
 
 
+def gudermannian(expr: sp.Expr) -> sp.Expr:
+    """Replace asin(tanh a) by atan(sinh a), the same function (the Gudermannian), accurate for large
+    a, where tanh a rounds next to 1 and asin's slope 1/√(1 − u²) = cosh a multiplies its rounding:
+    asin(tanh φ) (corpus entry 28) was 80 ulp off at φ = 6.27, beyond the Newton angle's residual
+    tolerance, so the float64 range ended at |p| = 1.56686 < p_max = 1.56706 (NaN up to 2π)."""
+    return expr.replace(lambda e: isinstance(e, sp.asin) and isinstance(e.args[0], sp.tanh),
+                        lambda e: sp.atan(sp.sinh(e.args[0].args[0])))
+
+
 def half_angle(expr: sp.Expr) -> sp.Expr:
     """sin φ → 2 sin(φ/2) cos(φ/2), cos φ → 1 − 2 sin²(φ/2): every call on the one argument φ/2, so
     that a compiler can evaluate them with a single sincos (and 1 − cos φ stays accurate)."""
@@ -224,6 +233,21 @@ def _solvable_shape(p: sp.Expr) -> bool:
     return not p.xreplace({outermost[0]: sp.Dummy()}).has(PHI)
 
 
+def _exact_angle(p_of: Callable[[mpmath.mpf], mpmath.mpf], slope_of: Callable[[mpmath.mpf], mpmath.mpf],
+                 angle: mpmath.mpf, s: mpmath.mpf) -> mpmath.mpf | None:
+    """The angle whose p is ``s`` (the rounded p(``angle``)): Newton from ``angle`` at the current
+    precision, independent of the inverse being judged. That inverse's own value at 40 digits was
+    the reference before: a form that cancels (√(2√(4s² + 1) − 2)/2 for φ√(1 + φ²), corpus entry 9)
+    gave 0 or divided by zero there at s = 10⁻³⁰⁰, and the emit ended in an internal error."""
+    phi = angle
+    try:
+        for _ in range(4):  # from within 2⁻²⁴ (float32's rounding of s): 2⁻⁴⁸, 2⁻⁹⁶, 2⁻¹⁹²
+            phi = phi - (p_of(phi) - s) / slope_of(phi)
+    except (ZeroDivisionError, ValueError):
+        return None
+    return phi if mpmath.isfinite(phi) else None
+
+
 def closed_angle_error(inverse: sp.Expr, p: sp.Expr, phi_max: float, dtype: type) -> float:
     """Worst error of the closed inverse φ(s) evaluated in ``dtype`` (ideal libm,
     :mod:`symrot.evaluation`), in ulp of φ, beyond one rounding of s inside the formula (the
@@ -241,15 +265,14 @@ def closed_angle_error(inverse: sp.Expr, p: sp.Expr, phi_max: float, dtype: type
     with mpmath.workdps(40):
         p_of = sp.lambdify(PHI, p, modules=[mpmath_namespace(), "mpmath"])
         slope_of = sp.lambdify(PHI, sp.diff(p, PHI), modules=[mpmath_namespace(), "mpmath"])
-        exact_of = sp.lambdify(S, inverse, modules=[mpmath_namespace(), "mpmath"])
         worst = 0.0
         for angle in angles:
             s = dtype(float(p_of(mpmath.mpf(float(angle)))))
             if not np.isfinite(s) or s == 0:
                 continue
             value = float(model(s))
-            exact = exact_of(mpmath.mpf(float(s)))
-            if not mpmath.isfinite(exact) or exact == 0:
+            exact = _exact_angle(p_of, slope_of, mpmath.mpf(float(angle)), mpmath.mpf(float(s)))
+            if exact is None or exact == 0:
                 continue
             if not math.isfinite(value):
                 return math.inf
@@ -283,6 +306,8 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
     forms += [well_conditioned(closed), near_half_turn(closed)] if closed.has(sp.cos) else []
     forms.append(closed)
+    if closed.has(sp.asin):
+        forms.append(gudermannian(closed))
     plain = tuple(dict.fromkeys([closed, *forms]))
     forms += [with_length(form, argument) for form in forms]
     pole = pole_factor(argument, phi_max) if argument != PHI else None

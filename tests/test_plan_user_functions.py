@@ -200,3 +200,19 @@ def test_newton_next_to_a_pole_steps_on_the_reciprocal_below_the_pole() -> None:
             with np.errstate(all="ignore"):  # the modules' functions are wrapped so; p overflows at the top
                 got = float(namespace["_angle"](np.array([size], dtype=dtype))[0])  # type: ignore[operator]
             assert abs(got - exact) <= 4 * float(np.finfo(dtype).eps) * exact, (dtype, gap, got, exact)
+
+
+def test_a_closed_inverse_that_cancels_is_rejected_not_crashed() -> None:
+    """Corpus entry 9, φ√(1 + φ²): the inverse √(2√(4s² + 1) − 2)/2 and its rationalized form
+    cancel for small s. They were judged against their own value at 40 digits, which is 0 (or a
+    division by zero, and the emit ended in an internal error) at s = 10⁻³⁰⁰; the reference is now
+    the angle refined by Newton on p itself, and both forms are rejected (float64 gives 0 there)."""
+    from symrot.plan import ANGLE_TOLERANCE_ULP, angle_forms
+
+    p = PHI * sp.sqrt(1 + PHI**2)
+    inverse = closed_inverse(p, sp.Integer(1))
+    assert inverse is not None
+    forms = list(angle_forms(inverse))
+    assert len(forms) >= 2
+    for form in forms:
+        assert closed_angle_error(form, p, 2 * float(np.pi), np.float64) > ANGLE_TOLERANCE_ULP, form
