@@ -45,6 +45,7 @@ from ..plan import (
 from ..plan_ir import ANGLE_CORRECTION_GROWTH
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 from .numpy_backend import SUFFIX, angle_low_helpers, newton_step_lines, print_expression, uses_phi
+from .subexpressions import common_subexpressions
 from .templating import render
 
 FRAMEWORKS = ("jax", "torch")
@@ -127,7 +128,7 @@ def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
         if closed.has(symbol):
             lines.append(f"{names[symbol]} = _where(small, {value}, {names[symbol]})")
     closed = closed.subs(PHI, sp.Symbol("phi"))
-    replacements, (reduced,) = sp.cse([closed], symbols=sp.numbered_symbols("w"))
+    replacements, (reduced,) = common_subexpressions([closed], "w")
     for symbol, value in replacements:
         lines.append(f"{symbol} = {print_array(value)}")
     lines.append(f"closed = {print_array(reduced)}")

@@ -28,6 +28,7 @@ from ..plan_ir import EvaluationPlan
 from .c_functions import P, vector_entries
 from .c_printer import Precision
 from .c_writer import FunctionWriter, Statement, ops_of
+from .subexpressions import common_subexpressions
 
 DERIVATIVES = {"rotation_derivative": ("R", 1, "d(R a)/dp"),
                "rotation_transpose_derivative": ("R", -1, "d(R^T a)/dp"),
@@ -97,7 +98,7 @@ class DerivativeWriter(FunctionWriter):
         body, scalars, names = self.scalars(tensor, sign, set(tensor_derivative().terms))
         statements += body
         matrix = tensor_derivative().matrix(sp.Matrix(P), _vector("a"), scalars)
-        replacements, entries = sp.cse(list(matrix), symbols=sp.numbered_symbols("dw"))
+        replacements, entries = common_subexpressions(list(matrix), "dw")
         statements += [self.let(str(symbol), value) for symbol, value in replacements]
         statements += [self.set(f"D[{i}]", entry) for i, entry in enumerate(entries)]
         notes = ["Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.",
@@ -116,8 +117,7 @@ class DerivativeWriter(FunctionWriter):
         cross, first = vector_entries(scalars[VALUES[0]], scalars[VALUES[1]], scalars[VALUES[2]], given, w)
         rate = rate_value(sp.Matrix(P), _vector("pdot"), scalars)
         statements += [self.let(f"w{i}", cross[i]) for i in range(3)]
-        replacements, entries = sp.cse([first[i] + rate[i] for i in range(3)],
-                                       symbols=sp.numbered_symbols("dw"))
+        replacements, entries = common_subexpressions([first[i] + rate[i] for i in range(3)], "dw")
         statements += [self.let(str(symbol), value) for symbol, value in replacements]
         statements += [self.set(f"alpha[{i}]", entry) for i, entry in enumerate(entries)]
         notes = ["alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).",

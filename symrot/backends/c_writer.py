@@ -65,6 +65,7 @@ from .c_functions import (
     tensor_entries,
 )
 from .c_printer import Precision, SymrotCPrinter, horner
+from .subexpressions import common_subexpressions
 
 # -- statements ------------------------------------------------------------------------------------
 Statement = dict[str, Any]
@@ -216,7 +217,7 @@ class FunctionWriter:
     def branch_value(self, branch: Branch, variable: sp.Symbol, target: str) -> Statement:
         """if (t < threshold) target = Horner(t) else target = closed(phi) (phi > 0 there)."""
         closed = branch.closed.subs(PHI, PHI_SYMBOL)
-        replacements, (reduced,) = sp.cse([closed], symbols=sp.numbered_symbols(f"{target}_w"))
+        replacements, (reduced,) = common_subexpressions([closed], f"{target}_w")
         otherwise = [self.let(str(symbol), value) for symbol, value in replacements]
         otherwise.append(self.set(target, reduced))
         return {"kind": "if", "condition": f"{variable} < {self.printer.literal(branch.threshold)}",
@@ -448,7 +449,7 @@ class FunctionWriter:
         below = [self.set(f"c_{n}", horner(b.horner, X_SYMBOL)) for n, b in branches.items()]  # type: ignore[union-attr]
         closed = [self.half_angle_corrected(b.closed.subs(PHI, PHI_SYMBOL))  # type: ignore[union-attr]
                   for b in branches.values()]
-        replacements, reduced = sp.cse(closed, symbols=sp.numbered_symbols("w"))
+        replacements, reduced = common_subexpressions(closed, "w")
         above: list[Statement] = []
         if any(b.closed.has(PHI) for b in branches.values()):  # type: ignore[union-attr]
             above.append({"kind": "let", "type": self.ctype, "name": "phi",

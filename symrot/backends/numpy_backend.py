@@ -45,6 +45,7 @@ from ..plan import (
 from ..plan_ir import ANGLE_CORRECTION_GROWTH, uses_angle
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 from .numpy_derivatives import derivative_lines, rate_lines
+from .subexpressions import common_subexpressions
 from .templating import render
 
 TENSORS = ("R", "H", "H_inverse", "G", "K")
@@ -119,7 +120,7 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
         closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
     symbols = [symbol for symbol in (X, S, D, SIN_HALF, COS_HALF) if closed.has(symbol)]
     closed = closed.subs(PHI, sp.Symbol("phi"))
-    replacements, (reduced,) = sp.cse([closed], symbols=sp.numbered_symbols("w"))
+    replacements, (reduced,) = common_subexpressions([closed], "w")
     closed_lines = [f"{symbol} = {print_expression(value)}" for symbol, value in replacements]
     series_lines = [f"series = {_literal(horner[-1])}"]
     for c in reversed(horner[:-1]):
