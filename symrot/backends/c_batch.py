@@ -52,6 +52,7 @@ from .c_functions import (
 from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
 from .c_sincos import TRIG, SinCosWriter
 from .c_writer import HALF_LOW, PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
+from .subexpressions import common_subexpressions
 
 BLOCK = "SYMROT_BATCH_BLOCK"
 DEFAULT_BLOCK = 32
@@ -127,7 +128,7 @@ class BatchWriter:
             elif isinstance(coefficient, Branch):
                 form = coefficient.closed.subs({PHI: PHI_SYMBOL, X: X_SYMBOL})
                 closed[name] = self.vectorize(writer.half_angle_corrected(form), lanes)
-        replacements, reduced = sp.cse(list(closed.values()), symbols=sp.numbered_symbols("w"))
+        replacements, reduced = common_subexpressions(list(closed.values()), "w")
         used: set[sp.Basic] = set().union(*(e.free_symbols for e in closed.values()))
         if lanes.trig:
             used.add(PHI_SYMBOL)
