@@ -125,9 +125,10 @@ def _linear_call(p: sp.Expr, functions: tuple[type[sp.Function], ...],
     is zero at ``phi_max`` (other calls go into the rest), with the weight and rest finite there
     (the weight nonzero), else None."""
     calls = sorted((call for call in p.atoms(*functions) if call.has(PHI)), key=sp.default_sort_key)
+    factors = {call: sp.expand(1 - call.args[0] ** 2) for call in calls}
     with mpmath.workdps(ZERO_DIGITS):
-        roots = [(call, _root_near(sp.expand(1 - call.args[0] ** 2) if vanishing is None
-                                   else vanishing(call.args[0]), phi_max)) for call in calls]
+        roots = [(call, _root_near(factor if vanishing is None else vanishing(call.args[0]), phi_max))
+                 for call, factor in factors.items()]
     edges = [(call, root) for call, root in roots if root is not None]
     if len(edges) != 1:  # other calls (asin(φ/4) beside the edge of asin(φ/3)) belong to A
         return None
@@ -135,7 +136,7 @@ def _linear_call(p: sp.Expr, functions: tuple[type[sp.Function], ...],
     found = _weight_and_rest(p, call, root)
     if found is None:
         return None
-    return _LinearCall(call, found[0], found[1], sp.expand(1 - call.args[0] ** 2), root)
+    return _LinearCall(call, found[0], found[1], factors[call], root)
 
 
 def _weight_and_rest(p: sp.Expr, call: sp.Expr, root: mpmath.mpf) -> tuple[sp.Expr, sp.Expr] | None:
