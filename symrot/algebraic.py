@@ -77,6 +77,15 @@ def tidy_radicals(expr: sp.Expr) -> sp.Expr:
     return sp.factor(combined)
 
 
+def _whole_multiples(expr: sp.Expr, angle: sp.Symbol) -> bool:
+    """Whether every sin/cos/tan in ``expr`` has an argument k·``angle`` with k a whole number."""
+    for atom in expr.atoms(sp.sin, sp.cos, sp.tan):
+        k = sp.cancel(atom.args[0] / angle)
+        if not k.is_Integer:
+            return False
+    return True
+
+
 @lru_cache(maxsize=1024)
 def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     """c(φ(s)) with multiple and half angles of the base angle expanded, before simplification;
@@ -96,6 +105,10 @@ def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
         if base is None:
             return sp.expand_trig(closed.subs(PHI, inverse))
         factor, function = base
+        in_theta = closed.subs(PHI, factor * THETA)
+        if _whole_multiples(in_theta, THETA):
+            # sin/cos(kθ) with whole k are polynomials in sin θ, cos θ: no half-angle radicals
+            return sp.expand_trig(in_theta).subs(THETA, function)
         # φ = factor·θ; write θ = 2η so that half angles of θ are whole angles of η
         e = sp.expand_trig(closed.subs(PHI, 2 * factor * eta))
         e = _half_angle_radicals(e.subs(eta, THETA / 2), THETA / 2)
@@ -121,6 +134,11 @@ def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     only a safety net (:mod:`symrot.timeouts`)."""
     expanded = expanded_in_s(closed, inverse)
     if expanded is None or reduction_size(closed, inverse) > REDUCTION_OPS:
+        return None
+    if expanded.atoms(sp.Function):
+        # a function of s left after the expansion (atan(s) in cos φ for φ = asin(atan(s)), the
+        # inverse of tan(sin φ)): SymPy evaluates trig(inverse trig) itself, and no simplification
+        # turns what is left algebraic; simplify took 0.5-4 s on each of 22 such coefficients
         return None
 
     def reduce() -> sp.Expr:
