@@ -200,12 +200,22 @@ GOOD = ("meets", "conditioned")
 SEVERITY = ("meets", "conditioned", "misses", "NaN-in-range")
 
 
+def commit() -> str:
+    """The checked-out commit of this tree (short), with ``+uncommitted`` when symrot/, bench/ or tests/
+    differ from it."""
+    def git(*words: str) -> str:
+        return subprocess.run(["git", "-C", str(ROOT), *words], capture_output=True, text=True,
+                              check=False).stdout.strip()
+    dirty = git("status", "--porcelain", "--untracked-files=no", "symrot", "bench", "tests")
+    return (git("rev-parse", "--short", "HEAD") or "unknown") + ("+uncommitted" if dirty else "")
+
+
 def corpus_worker(index: int, points: int) -> dict[str, Any]:
     """Emit corpus entry ``index`` and sweep its derivatives; a JSON-ready result (emit failures
     included). Progress goes to standard error (the last line says where a timed-out worker was)."""
     entry = CORPUS[index]
     result: dict[str, Any] = {"index": index, "expression": entry.expression, "category": entry.category,
-                              "edge": entry.edge, "closed_inverse": entry.closed_inverse}
+                              "edge": entry.edge, "closed_inverse": entry.closed_inverse, "commit": commit()}
     function = entry.generating_function()
     result["phi_max_reference"] = float(function.phi_max)
     print("in the emit", file=sys.stderr, flush=True)
@@ -257,16 +267,14 @@ def _failure(result: dict[str, Any]) -> str:
 
 def corpus_report(results: list[dict[str, Any]], command: str, points: int) -> str:
     """The Markdown report of a corpus run: header, summary per entry, every function, the misses."""
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, check=False).stdout.strip() or "unknown"
-    dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no", "symrot",
-                            "bench", "tests"], capture_output=True, text=True, check=False).stdout.strip()
+    measured = sorted({r["commit"] for r in results if "commit" in r})
     verdicts = {r["index"]: {label: entry_verdict(r, label) for label in DTYPES} for r in results}
     both = sum(all(v[label] in GOOD for label in DTYPES) for v in verdicts.values())
     per = {label: sum(v[label] in GOOD for v in verdicts.values()) for label in DTYPES}
     lines = ["# Accuracy of the derivatives of issue 19 for the user-function corpus", "",
-             f"Produced by `{command}` at commit {commit}{' (with uncommitted changes)' if dirty else ''} on "
-             f"{datetime.date.today().isoformat()}: each entry of tests/corpus.py emitted to a NumPy module "
+             f"Produced by `{command}` at commit {commit()} on {datetime.date.today().isoformat()}"
+             + (f" (entries measured at {', '.join(measured)})" if measured else "")
+             + ": each entry of tests/corpus.py emitted to a NumPy module "
              "through the public API (as bench/accuracy_corpus.py does), its six derivative functions swept "
              f"as bench/accuracy_derivatives.py sweeps the named parameterizations (`accuracy.sweep(φ_max, "
              f"{points})` with p = 0 and 1e-300, random unit axes and a, ṗ, p̈; float64 and float32; φ_max "
@@ -311,11 +319,11 @@ def corpus_report(results: list[dict[str, Any]], command: str, points: int) -> s
                     continue
                 nan = f"; {t['nonfinite']} NaN" if t["nonfinite"] else ""
                 v = tally_verdict(t)
-                cells += [f"{t['ulp']:.3g} ({t['at']:.6g}; κ {t['kappa']:.2g}{nan})",
+                cells += [f"{t['ulp']:.3g} ({t['at']:.8g}; κ {t['kappa']:.2g}{nan})",
                           v if v in GOOD else f"**{v}**"]
                 if v not in GOOD:
                     misses.append(f"| {r['index']} | `{r['expression']}` | {f} | {label} | {t['ulp']:.3g} | "
-                                  f"{t['at']:.6g} | {t['kappa']:.2g} | {v} |")
+                                  f"{t['at']:.8g} | {t['kappa']:.2g} | {v} |")
             lines.append(f"| {r['index']} | {f} | {' | '.join(cells)} |")
     lines += ["", "## Misses", "", "| # | p(φ) | function | precision | ulp | at φ | κ | verdict |",
               "|---|---|---|---|---|---|---|---|", *misses]
