@@ -246,6 +246,12 @@ def emit(expression: str, name: str) -> tuple[Any, str, float]:
     return plan, source, time.perf_counter() - start
 
 
+def one_line(error: BaseException) -> str:
+    """``Type: first line of the message`` (at most 300 characters of it)."""
+    lines = str(error).splitlines()
+    return f"{type(error).__name__}: {lines[0][:300] if lines else ''}"
+
+
 def worker(index: int, points: int, with_c: bool) -> dict[str, Any]:
     """Measure corpus entry ``index``; a JSON-ready result (emit failures included)."""
     entry = CORPUS[index]
@@ -261,7 +267,7 @@ def measure_expression(function: GeneratingFunction, name: str, points: int, wit
     try:
         plan, _source, seconds = emit(function.expression, name)
     except Exception as error:  # any exception of the emit is the measurement
-        result["emit_error"] = f"{type(error).__name__}: {str(error).splitlines()[0][:300]}"
+        result["emit_error"] = one_line(error)
         result["traceback"] = traceback.format_exc()[-2000:]
         return result
     result["emit_seconds"] = seconds
@@ -296,8 +302,27 @@ def _c_library(plan: Any, name: str, directory: Path) -> tuple[Any, str | None, 
         build = compile_all(config, [name], directory, directory)["gcc-O2-nofma"]
         return build.load(), name, info
     except Exception as error:  # recorded, the NumPy measurement goes on
-        info["error"] = f"{type(error).__name__}: {str(error).splitlines()[0][:300]}"
+        info["error"] = one_line(error)
         return None, None, info
+
+
+def run_worker(command: list[str], index: int, timeout: float) -> dict[str, Any]:
+    """Run the worker ``command`` for corpus entry ``index`` in its own process; its JSON result (the
+    last line of its standard output), or one with ``worker_error`` when it fails or outlasts
+    ``timeout`` seconds (then the last line of its standard error, if any, says where it was)."""
+    base: dict[str, Any] = {"index": index, "expression": CORPUS[index].expression}
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, check=False)
+        result = json.loads(done.stdout.strip().splitlines()[-1]) if done.returncode == 0 else {
+            **base, "worker_error": f"worker exit {done.returncode}: {done.stderr.strip().splitlines()[-1:]}"}
+    except subprocess.TimeoutExpired as expired:
+        stderr = expired.stderr.decode(errors="replace") if isinstance(expired.stderr, bytes) \
+            else (expired.stderr or "")
+        last = stderr.strip().splitlines()[-1:]
+        result = {**base, "worker_error": f"timeout after {timeout:g} s" + (f" ({last[0]})" if last else "")}
+    for key in ("category", "edge", "closed_inverse"):
+        result.setdefault(key, getattr(CORPUS[index], key))
+    return result
 
 
 # -- report ----------------------------------------------------------------------------------------
@@ -420,17 +445,7 @@ def main(argv: list[str] | None = None) -> int:
         command = [sys.executable, __file__, "--worker", str(index), "--points", str(args.points)]
         command += ["--no-c"] if args.no_c else []
         start = time.perf_counter()
-        try:
-            done = subprocess.run(command, capture_output=True, text=True, timeout=WORKER_TIMEOUT,
-                                  check=False)
-            result = json.loads(done.stdout.strip().splitlines()[-1]) if done.returncode == 0 else {
-                "index": index, "expression": CORPUS[index].expression,
-                "worker_error": f"worker exit {done.returncode}: {done.stderr.strip().splitlines()[-1:]}"}
-        except subprocess.TimeoutExpired:
-            result = {"index": index, "expression": CORPUS[index].expression,
-                      "worker_error": f"timeout after {WORKER_TIMEOUT} s"}
-        for key in ("category", "edge", "closed_inverse"):
-            result.setdefault(key, getattr(CORPUS[index], key))
+        result = run_worker(command, index, WORKER_TIMEOUT)
         results.append(result)
         print(f"{index} {CORPUS[index].expression}: {time.perf_counter() - start:.0f} s "
               f"{result.get('emit_error') or result.get('worker_error') or ''}", flush=True)

@@ -12,16 +12,34 @@ Target ≤ 8 ulp, or 8 κ ulp ("conditioned") where the radial condition number 
 κ is the larger of its radial condition and the cancellation (|H p̈| + |Ḣ ṗ|)/|α| of its two terms
 (tests/test_derivatives.py: acceleration_condition).
 
-Run: ``python bench/accuracy_derivatives.py [--points N] [--names a,b]`` (prints a Markdown table).
+Corpus mode (``--corpus``, or ``--only I,J`` for entries of tests/corpus.py): each user generating
+function is emitted to a NumPy module in a temporary directory through the public API, as
+bench/accuracy_corpus.py does (:func:`accuracy_corpus.emit`), each in its own worker process with a
+time limit, and the same six functions are measured over the same sweep (φ_max and |p|_max the
+smaller of the reference's and the plan's) against the reference's p(φ) of the entry. Outputs that
+are not finite inside the range are counted (verdict NaN-in-range); an emit that fails or outlasts
+the limit is recorded (emit-failed, with its one-line reason) and the run goes on.
+
+Run: ``python bench/accuracy_derivatives.py [--points N] [--names a,b]`` (prints a Markdown table);
+``python bench/accuracy_derivatives.py --corpus [--only I,J] [--points N] [--out FILE.md] [--json FILE.json]
+[--resume] [--timeout S]`` (--resume: entries already in the --json file are not measured again; the
+file is rewritten after every entry).
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
+import json
+import subprocess
 import sys
+import tempfile
+import time
 import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import mpmath
 import numpy as np
@@ -30,8 +48,11 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
+from accuracy import load_module as emitted_module  # noqa: E402
 from accuracy import sweep  # noqa: E402
+from accuracy_corpus import emit, one_line, run_worker  # noqa: E402
 
+from tests.corpus import CORPUS  # noqa: E402
 from tests.reference import GeneratingFunction, Reference  # noqa: E402
 from tests.test_derivatives import _as_array as _array  # noqa: E402
 from tests.test_derivatives import _ulp, acceleration_condition, radial_condition  # noqa: E402
@@ -51,16 +72,38 @@ def load(name: str) -> ModuleType:
     return load_module(ROOT / "generated" / "numpy" / f"{name}.py", f"bench_{name}")
 
 
-def measure(name: str, points: int, seed: int = 19) -> dict[tuple[str, str], tuple[float, float, float]]:
+WorstPoint = tuple[float, float, float]
+"""(ulp, at φ, κ) of the worst point of one (function, precision)."""
+
+
+@dataclass
+class Swept:
+    """The worst points of one module over the sweep, its non-finite outputs and errors."""
+
+    worst: dict[tuple[str, str], WorstPoint] = field(default_factory=dict)
+    nonfinite: dict[tuple[str, str], int] = field(default_factory=dict)
+    points: dict[tuple[str, str], int] = field(default_factory=dict)
+    errors: list[str] = field(default_factory=list)
+
+
+def measure(name: str, points: int, seed: int = 19) -> dict[tuple[str, str], WorstPoint]:
     """{(function, precision): (ulp, at φ, κ)} at the worst ulp/κ; NaN inside the range counts as inf.
     κ (radial condition of the derivative, tests/test_derivatives.py) is measured only where ulp > 8."""
-    module = load(name)
-    function = GeneratingFunction(NAMED[name])
+    return measure_module(load(name), GeneratingFunction(NAMED[name]), points, seed).worst
+
+
+def measure_module(module: ModuleType, function: GeneratingFunction, points: int, seed: int = 19,
+                   phi_max: float | None = None, p_max: float | None = None, strict: bool = True) -> Swept:
+    """The sweep of :func:`measure` for any emitted module of ``function`` (φ_max, |p|_max: the
+    reference's unless given). ``strict``: a floating-point warning or an exception stops the sweep (the
+    named parameterizations); otherwise it is recorded, the outputs count as non-finite and a point
+    whose reference fails is skipped (the corpus)."""
     reference = Reference(function)
     rng = np.random.default_rng(seed)
-    phi_max = float(function.phi_max)
-    p_max = float(function.p_max())
-    worst: dict[tuple[str, str], tuple[float, float, float]] = {}
+    phi_max = float(function.phi_max) if phi_max is None else phi_max
+    p_max = float(function.p_max()) if p_max is None else p_max
+    swept = Swept()
+    worst = swept.worst
     for angle in sweep(min(phi_max, 4 * np.pi), points):
         axis = rng.normal(size=3)
         axis /= np.linalg.norm(axis)
@@ -79,28 +122,56 @@ def measure(name: str, points: int, seed: int = 19) -> dict[tuple[str, str], tup
                 continue  # beyond the documented domain of unbounded p: NaN by design
             ins = [v.astype(dtype) for v in (a, pdot, pddot)]
             exact = [list(v.astype(np.float64)) for v in (p, *ins)]
-            values = {}
-            with warnings.catch_warnings():
-                warnings.simplefilter("error")
-                for f in FUNCTIONS:
-                    values[f] = getattr(module, f)(p, ins[0])
-                values["angular_acceleration"] = module.angular_acceleration(p, ins[1], ins[2])
-            refs = {f: _array(reference.derivative(exact[0], exact[1], t)) for f, t in FUNCTIONS.items()}
-            _, alpha = reference.along(exact[0], exact[2], exact[3])
+            values = _evaluate(module, p, ins, strict, swept.errors, f"{label} φ={angle:.3g}")
+            try:
+                refs = {f: _array(reference.derivative(exact[0], exact[1], t)) for f, t in FUNCTIONS.items()}
+                _, alpha = reference.along(exact[0], exact[2], exact[3])
+            except Exception as error:
+                if strict:
+                    raise
+                swept.errors.append(f"reference {label} φ={angle:.3g}: {one_line(error)}")
+                continue
             refs["angular_acceleration"] = np.array([float(v) for v in alpha])
             for f, value in values.items():
+                key = (f, label)
+                swept.points[key] = swept.points.get(key, 0) + 1
+                finite = bool(np.all(np.isfinite(value)))
+                if not finite:
+                    swept.nonfinite[key] = swept.nonfinite.get(key, 0) + 1
                 ulp = _ulp(value, refs[f], dtype)
                 kappa = 1.0
-                if ulp > TARGET_ULP and f in FUNCTIONS:  # next to a singular edge: its radial κ
+                if ulp > TARGET_ULP and f in FUNCTIONS and (finite or strict):  # next to a singular edge
                     kappa = max(1.0, radial_condition(reference, np.array(exact[0]), np.array(exact[1]),
                                                       FUNCTIONS[f], refs[f]))
-                elif ulp > TARGET_ULP:  # α: radial κ or the cancellation of H p̈ and Ḣ ṗ
+                elif ulp > TARGET_ULP and (finite or strict):  # α: radial κ or the cancellation of its terms
                     kappa = max(1.0, acceleration_condition(reference, np.array(exact[0]), np.array(exact[2]),
                                                             np.array(exact[3]), refs[f]))
-                key = (f, label)
                 if ulp / kappa >= worst.get(key, (-1.0, 0.0, 1.0))[0] / worst.get(key, (0, 0, 1.0))[2]:
                     worst[key] = (ulp, float(angle), kappa)
-    return worst
+    return swept
+
+
+def _evaluate(module: ModuleType, p: np.ndarray, ins: list[np.ndarray], strict: bool, errors: list[str],
+              where: str) -> dict[str, np.ndarray]:
+    """The six derivative functions at one point (see :func:`measure_module` for ``strict``)."""
+    values: dict[str, np.ndarray] = {}
+    with warnings.catch_warnings():
+        if strict:
+            warnings.simplefilter("error")
+            for f in FUNCTIONS:
+                values[f] = getattr(module, f)(p, ins[0])
+            values["angular_acceleration"] = module.angular_acceleration(p, ins[1], ins[2])
+            return values
+        warnings.simplefilter("ignore")
+        with np.errstate(all="ignore"):
+            for f in (*FUNCTIONS, "angular_acceleration"):
+                try:
+                    values[f] = module.angular_acceleration(p, ins[1], ins[2]) \
+                        if f == "angular_acceleration" else getattr(module, f)(p, ins[0])
+                except Exception as error:  # a raising kernel is a measured failure
+                    errors.append(f"{f} {where}: {one_line(error)}")
+                    values[f] = np.full(3 if f == "angular_acceleration" else (3, 3), np.nan)
+    return values
 
 
 def table(results: dict[str, dict[tuple[str, str], tuple[float, float, float]]]) -> str:
@@ -120,11 +191,200 @@ def table(results: dict[str, dict[tuple[str, str], tuple[float, float, float]]])
     return "\n".join(lines) + "\n"
 
 
+# -- the user-function corpus (tests/corpus.py) --------------------------------------------------------
+
+ALL_FUNCTIONS = (*FUNCTIONS, "angular_acceleration")
+WORKER_TIMEOUT = 900.0
+"""Seconds for one corpus entry, emit and sweep (the emits of docs/accuracy_corpus.md take 8–35 s)."""
+GOOD = ("meets", "conditioned")
+SEVERITY = ("meets", "conditioned", "misses", "NaN-in-range")
+
+
+def commit() -> str:
+    """The checked-out commit of this tree (short), with ``+uncommitted`` when symrot/, bench/ or tests/
+    differ from it."""
+    def git(*words: str) -> str:
+        return subprocess.run(["git", "-C", str(ROOT), *words], capture_output=True, text=True,
+                              check=False).stdout.strip()
+    dirty = git("status", "--porcelain", "--untracked-files=no", "symrot", "bench", "tests")
+    return (git("rev-parse", "--short", "HEAD") or "unknown") + ("+uncommitted" if dirty else "")
+
+
+def corpus_worker(index: int, points: int) -> dict[str, Any]:
+    """Emit corpus entry ``index`` and sweep its derivatives; a JSON-ready result (emit failures
+    included). Progress goes to standard error (the last line says where a timed-out worker was)."""
+    entry = CORPUS[index]
+    result: dict[str, Any] = {"index": index, "expression": entry.expression, "category": entry.category,
+                              "edge": entry.edge, "closed_inverse": entry.closed_inverse, "commit": commit()}
+    function = entry.generating_function()
+    result["phi_max_reference"] = float(function.phi_max)
+    print("in the emit", file=sys.stderr, flush=True)
+    try:
+        plan, _source, seconds = emit(function.expression, f"corpus_{index:02d}")
+        with tempfile.TemporaryDirectory() as tmp:
+            module = emitted_module(plan, Path(tmp))
+    except Exception as error:  # any exception of the emit is the measurement
+        result["emit_error"] = one_line(error)
+        return result
+    result["emit_seconds"] = seconds
+    result["phi_max_plan"] = float(plan.phi_max)
+    print(f"in the sweep (emitted in {seconds:.0f} s)", file=sys.stderr, flush=True)
+    start = time.perf_counter()
+    phi_max = min(float(function.phi_max), float(plan.phi_max))
+    p_max = min(float(function.p_max()), float(plan.p_max))
+    swept = measure_module(module, function, points, phi_max=phi_max, p_max=p_max, strict=False)
+    result["sweep_seconds"] = time.perf_counter() - start
+    result["errors"] = swept.errors[:5]
+    result["tallies"] = [{"function": key[0], "precision": key[1], "ulp": ulp, "at": at, "kappa": kappa,
+                          "nonfinite": swept.nonfinite.get(key, 0), "points": swept.points.get(key, 0)}
+                         for key, (ulp, at, kappa) in swept.worst.items()]
+    return result
+
+
+def tally_verdict(t: dict[str, Any]) -> str:
+    """meets (≤ 8 ulp), conditioned (≤ 8 κ ulp), misses, or NaN-in-range (any non-finite output)."""
+    if t["nonfinite"]:
+        return "NaN-in-range"
+    if t["ulp"] <= TARGET_ULP:
+        return "meets"
+    return "conditioned" if t["ulp"] / t["kappa"] <= TARGET_ULP else "misses"
+
+
+def entry_verdict(result: dict[str, Any], label: str) -> str:
+    """The worst verdict of the six functions of one entry in one precision (emit-failed, or
+    incomplete when a function has no measured point)."""
+    if "tallies" not in result:
+        return "emit-failed"
+    mine = {t["function"]: tally_verdict(t) for t in result["tallies"] if t["precision"] == label}
+    if set(mine) != set(ALL_FUNCTIONS):
+        return "incomplete"
+    return max(mine.values(), key=SEVERITY.index)
+
+
+def _failure(result: dict[str, Any]) -> str:
+    return str(result.get("emit_error") or result.get("worker_error") or "no result").replace("|", "\\|")
+
+
+def corpus_report(results: list[dict[str, Any]], command: str, points: int) -> str:
+    """The Markdown report of a corpus run: header, summary per entry, every function, the misses."""
+    measured = sorted({r["commit"] for r in results if "commit" in r})
+    verdicts = {r["index"]: {label: entry_verdict(r, label) for label in DTYPES} for r in results}
+    both = sum(all(v[label] in GOOD for label in DTYPES) for v in verdicts.values())
+    per = {label: sum(v[label] in GOOD for v in verdicts.values()) for label in DTYPES}
+    lines = ["# Accuracy of the derivatives of issue 19 for the user-function corpus", "",
+             f"Produced by `{command}` at commit {commit()} on {datetime.date.today().isoformat()}"
+             + (f" (entries measured at {', '.join(measured)})" if measured else "")
+             + ": each entry of tests/corpus.py emitted to a NumPy module "
+             "through the public API (as bench/accuracy_corpus.py does), its six derivative functions swept "
+             f"as bench/accuracy_derivatives.py sweeps the named parameterizations (`accuracy.sweep(φ_max, "
+             f"{points})` with p = 0 and 1e-300, random unit axes and a, ṗ, p̈; float64 and float32; φ_max "
+             "and |p|_max the smaller of the reference's and the plan's) against the 60-digit reference of "
+             "tests/reference.py (differentiated again at 150 digits). Error: max |D − D_ref| / (ε max "
+             f"|D_ref|) at the worst point (the worst ulp/κ). *meets*: ≤ {TARGET_ULP:g} ulp; *conditioned*: "
+             f"≤ {TARGET_ULP:g} κ ulp, κ the radial condition number (for α also the cancellation of H p̈ and "
+             "Ḣ ṗ), computed only where the error exceeds 8 ulp; *misses* otherwise; *NaN-in-range*: a "
+             "non-finite output inside the range.", "",
+             f"**Summary**: {both} of {len(results)} entries meet the target (meets or conditioned, all six "
+             f"functions, no NaN) in both precisions; float64: {per['float64']} of {len(results)}, "
+             f"float32: {per['float32']} of {len(results)}.", "",
+             "## Entries", "",
+             "| # | p(φ) | edge | emit s | sweep s | φ_max ref / plan | float64 | float32 |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        head = f"| {r['index']} | `{r['expression']}` | {r.get('edge', '')} | "
+        if "tallies" not in r:
+            lines.append(head + f"emit-failed: {_failure(r)} | — | {r.get('phi_max_reference', 0):.6g} / — "
+                         "| emit-failed | emit-failed |")
+            continue
+        cells = [verdicts[r["index"]][label] for label in DTYPES]
+        cells = [c if c in GOOD else f"**{c}**" for c in cells]
+        lines.append(head + f"{r['emit_seconds']:.1f} | {r['sweep_seconds']:.0f} | "
+                     f"{r['phi_max_reference']:.6g} / {r['phi_max_plan']:.6g} | {' | '.join(cells)} |")
+    misses = []
+    lines += ["", "## Every function", "",
+              "| # | function | float64 ulp (at φ; κ) | float64 | float32 ulp (at φ; κ) | float32 |",
+              "|---|---|---|---|---|---|"]
+    for r in results:
+        if "tallies" not in r:
+            lines.append(f"| {r['index']} | all | emit-failed: {_failure(r)} | emit-failed | — "
+                         "| emit-failed |")
+            continue
+        by_key = {(t["function"], t["precision"]): t for t in r["tallies"]}
+        for f in ALL_FUNCTIONS:
+            cells = []
+            for label in DTYPES:
+                t = by_key.get((f, label))
+                if t is None:
+                    cells += ["—", "—"]
+                    continue
+                nan = f"; {t['nonfinite']} NaN" if t["nonfinite"] else ""
+                v = tally_verdict(t)
+                cells += [f"{t['ulp']:.3g} ({t['at']:.8g}; κ {t['kappa']:.2g}{nan})",
+                          v if v in GOOD else f"**{v}**"]
+                if v not in GOOD:
+                    misses.append(f"| {r['index']} | `{r['expression']}` | {f} | {label} | {t['ulp']:.3g} | "
+                                  f"{t['at']:.8g} | {t['kappa']:.2g} | {v} |")
+            lines.append(f"| {r['index']} | {f} | {' | '.join(cells)} |")
+    lines += ["", "## Misses", "", "| # | p(φ) | function | precision | ulp | at φ | κ | verdict |",
+              "|---|---|---|---|---|---|---|---|", *misses]
+    errors = [f"- {r['index']}: " + "; ".join(r["errors"]) for r in results if r.get("errors")]
+    if errors:
+        lines += ["", "Recorded kernel or reference errors (first five per entry):", "", *errors]
+    return "\n".join(lines) + "\n"
+
+
+def corpus_main(args: argparse.Namespace, argv: list[str]) -> int:
+    """Every entry of ``--only`` (or all) in its own worker process; the report to --out (or printed)."""
+    indices = [int(i) for i in args.only.split(",")] if args.only else list(range(len(CORPUS)))
+    done: dict[int, dict[str, Any]] = {}
+    if args.resume and args.json and Path(args.json).exists():
+        done = {r["index"]: r for r in json.loads(Path(args.json).read_text(encoding="utf-8"))
+                if "worker_error" not in r}
+    for index in indices:
+        if index in done:
+            continue
+        start = time.perf_counter()
+        command = [sys.executable, __file__, "--worker", str(index), "--points", str(args.points)]
+        result = run_worker(command, index, args.timeout)
+        if "worker_error" in result:
+            result["emit_error"] = result["worker_error"]
+        done[index] = result
+        found = {label: entry_verdict(result, label) for label in DTYPES}
+        print(f"{index} {CORPUS[index].expression}: {time.perf_counter() - start:.0f} s "
+              f"{found['float64']} / {found['float32']} {result.get('emit_error') or ''}", flush=True)
+        if args.json:
+            raw = json.dumps([done[i] for i in sorted(done)], indent=1)
+            Path(args.json).write_text(raw, encoding="utf-8")
+    results = [done[i] for i in sorted(done) if i in indices or args.resume]
+    command = "python bench/accuracy_derivatives.py " + " ".join(argv)
+    text = corpus_report(results, command.strip(), args.points)
+    if args.out:
+        Path(args.out).write_text(text, encoding="utf-8")
+    else:
+        print(text, end="")
+    return 0 if all(entry_verdict(r, label) in GOOD for r in results for label in DTYPES) else 1
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=12)
     parser.add_argument("--names", default=",".join(NAMED))
+    parser.add_argument("--corpus", action="store_true", help="the user-function corpus (tests/corpus.py)")
+    parser.add_argument("--only", help="corpus mode, these entries only: indices of tests/corpus.py, I,J,...")
+    parser.add_argument("--out", help="corpus mode: write the Markdown report here (default: print it)")
+    parser.add_argument("--json", help="corpus mode: the raw results, rewritten after every entry")
+    parser.add_argument("--resume", action="store_true",
+                        help="corpus mode: take the entries already in --json, do not measure them again")
+    parser.add_argument("--timeout", type=float, default=WORKER_TIMEOUT,
+                        help="corpus mode: seconds per entry")
+    parser.add_argument("--worker", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.worker is not None:
+        print(json.dumps(corpus_worker(args.worker, args.points)))
+        return 0
+    if args.corpus or args.only:
+        return corpus_main(args, argv)
     results = {name: measure(name, args.points) for name in args.names.split(",")}
     print(table(results), end="")
     return 0 if all(v[0] / v[2] <= TARGET_ULP for worst in results.values() for v in worst.values()) else 1
