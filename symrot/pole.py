@@ -319,7 +319,7 @@ def _rewrite(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
 def _is_the_call(expr: sp.Expr, call: sp.Expr | None) -> bool:
     """``expr`` is the edge's ``call``; for a logarithm, also when SymPy wrote its argument in
     another form (log((φ/2 + 1)/(1 − φ/2)) becomes log(−(φ + 2)/(φ − 2)) in sin φ/p)."""
-    if expr == call:
+    if expr == call or (call is not None and expr == as_quotients(call)):  # asinh(sin aφ/cos aφ)
         return True
     if not (isinstance(call, sp.log) and isinstance(expr, sp.log) and expr.has(PHI)):
         return False
