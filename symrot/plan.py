@@ -364,16 +364,16 @@ coefficient of s is well conditioned up to it (det H = μν² ~ 1/x² next to a 
 there, and they keep the floor max(|c|, |c(0)|)."""
 
 
-def tensor_part(derivation: Derivation, coefficient: str, unbounded: bool = False) -> TensorPart | None:
+def tensor_part(derivation: Derivation, coefficient: str, det_h_own_scale: bool = False) -> TensorPart | None:
     """The :class:`TensorPart` of a coefficient of R, H, H⁻¹, G or K (or of its across-axis part),
-    :data:`QUATERNION_PART` for ν, :data:`OWN_SCALE` for det H where p is ``unbounded`` (or det H
-    vanishes at φ_max), None for
-    the other scalars and the slopes. The norm is the largest eigenvalue modulus, max(|a|, |a − c|,
-    |b|) of the u-basis a I + b U + c U² (axial a, across the axis (a − c) ± i b; eqs 17, 23, 27)."""
+    :data:`QUATERNION_PART` for ν, :data:`OWN_SCALE` for det H with ``det_h_own_scale`` (p unbounded,
+    or det H → 0 at φ_max with p′ → ∞), None for the other scalars and the slopes. The norm is the
+    largest eigenvalue modulus, max(|a|, |a − c|, |b|) of the u-basis a I + b U + c U² (axial a,
+    across the axis (a − c) ± i b; eqs 17, 23, 27)."""
     if coefficient == "nu":
         return QUATERNION_PART
     if coefficient == "det_H":
-        return OWN_SCALE if unbounded else None
+        return OWN_SCALE if det_h_own_scale else None
     for tensor in derivation.tensors.values():
         names = (*tensor.coefficient_names(), tensor.across_name)
         if coefficient in names:
