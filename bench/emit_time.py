@@ -1,0 +1,136 @@
+"""How long `symrot derive EXPR --emit numpy|c` takes, for every corpus function and named family.
+
+Issue 16 asks for ≤ 10 s wall per emit of a user function (≤ 5 s for the paper's families). Each
+emit runs as a user would run it, as its own ``python -m symrot derive … --emit BACKEND`` process
+(with ``--timeout 600``, so that a slow emit is measured rather than cut at the CLI's 60 s default),
+one at a time. Reported: wall seconds and the CPU seconds of the process and its children (the
+CLI's worker), which the load of a shared machine inflates less than wall time; and the machine's
+load average before the run.
+
+Run: ``python bench/emit_time.py [--only I,J] [--names] [--backends numpy,c] [--out docs/emit_time.md]
+[--json FILE]``. ``--only`` takes indices of tests/corpus.py; ``--names`` adds the named
+parameterizations and the sine/tangent family headers of generated/c (their C emits).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from tests.corpus import CORPUS  # noqa: E402
+
+USER_TARGET_S = 10.0
+FAMILY_TARGET_S = 5.0
+TIMEOUT_S = 600
+
+
+def time_emit(expression: str, backend: str) -> dict[str, float | str]:
+    """Wall and CPU seconds of one ``symrot derive EXPR --emit BACKEND`` process, or its error."""
+    with tempfile.TemporaryDirectory() as out:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        run = subprocess.run([sys.executable, "-m", "symrot", "derive", expression, "--name", "timed",
+                              "--emit", backend, "--out", out, "--timeout", str(TIMEOUT_S), "-q"],
+                             capture_output=True, text=True, cwd=out, check=False)
+        wall = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    result: dict[str, float | str] = {"wall": wall, "cpu": cpu}
+    if run.returncode != 0:
+        result["error"] = (run.stderr.strip().splitlines() or [f"exit {run.returncode}"])[-1][:160]
+    return result
+
+
+def family_names() -> list[str]:
+    """The named parameterizations and the family members with a header under generated/c."""
+    from symrot.backends.c_backend import COVERED
+
+    return list(COVERED)
+
+
+def table(rows: list[dict[str, Any]], backends: list[str]) -> str:
+    head = "| # | p(φ) or name | " + " | ".join(f"{b} wall s | {b} CPU s" for b in backends) + " | target |"
+    lines = [head, "|" + "---|" * (3 + 2 * len(backends))]
+    for row in rows:
+        cells = []
+        for backend in backends:
+            timing = row[backend]
+            if "error" in timing:
+                cells += [f"**failed** ({timing['error']})", f"{timing['cpu']:.1f}"]
+            else:
+                cells += [f"{timing['wall']:.1f}", f"{timing['cpu']:.1f}"]
+        expression = f"`{row['expression']}`"
+        lines.append(f"| {row['index']} | {expression} | {' | '.join(cells)} | {row['target']:g} s |")
+    return "\n".join(lines) + "\n"
+
+
+def summary(rows: list[dict[str, Any]], backends: list[str]) -> str:
+    out = []
+    for kind, target in (("user", USER_TARGET_S), ("family", FAMILY_TARGET_S)):
+        chosen = [r for r in rows if r["kind"] == kind]
+        if not chosen:
+            continue
+        for backend in backends:
+            walls = sorted(float(r[backend]["wall"]) for r in chosen)
+            failed = sum("error" in r[backend] for r in chosen)
+            within = sum(float(r[backend]["wall"]) <= target and "error" not in r[backend] for r in chosen)
+            out.append(f"- {kind} functions, `--emit {backend}`: {within} of {len(chosen)} within "
+                       f"{target:g} s wall; median {walls[len(walls) // 2]:.1f} s, max {walls[-1]:.1f} s; "
+                       f"{failed} failed.")
+    return "\n".join(out) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", default=None, help="comma-separated indices of tests/corpus.py")
+    parser.add_argument("--names", action="store_true", help="also the named parameterizations and families")
+    parser.add_argument("--no-corpus", action="store_true")
+    parser.add_argument("--backends", default="numpy,c")
+    parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--json", type=Path, default=None)
+    args = parser.parse_args(argv)
+    backends = args.backends.split(",")
+    indices = [int(i) for i in args.only.split(",")] if args.only else list(range(len(CORPUS)))
+    work: list[tuple[str, str, str]] = [] if args.no_corpus else [
+        (str(i), CORPUS[i].expression, "user") for i in indices]
+    if args.names:
+        work += [("—", name, "family") for name in family_names()]
+    load = os.getloadavg()[0]
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                            cwd=ROOT, check=False).stdout.strip()
+    rows: list[dict[str, Any]] = []
+    for index, expression, kind in work:
+        row: dict[str, Any] = {"index": index, "expression": expression, "kind": kind,
+                                  "target": USER_TARGET_S if kind == "user" else FAMILY_TARGET_S}
+        for backend in backends:
+            row[backend] = time_emit(expression, backend)
+        rows.append(row)
+        print(f"{index} {expression}: " + ", ".join(
+            f"{b} {row[b]['wall']:.1f} s" for b in backends), flush=True)
+        if args.json:
+            args.json.write_text(json.dumps(rows, indent=1), encoding="utf-8")
+    command = "python bench/emit_time.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    report = (f"# Emit time\n\nProduced by `{command}` at commit {commit} "
+              f"({time.strftime('%Y-%m-%d')}; 1-minute load average {load:.2f} before the run, 2 cores). "
+              "Each emit is its own `python -m symrot derive EXPR --emit BACKEND --timeout 600` process, "
+              "one at a time; CPU s counts the process and its children.\n\n"
+              + summary(rows, backends) + "\n" + table(rows, backends))
+    print(report)
+    if args.out:
+        args.out.write_text(report, encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
