@@ -154,23 +154,21 @@ def measure_module(module: ModuleType, function: GeneratingFunction, points: int
 def _evaluate(module: ModuleType, p: np.ndarray, ins: list[np.ndarray], strict: bool, errors: list[str],
               where: str) -> dict[str, np.ndarray]:
     """The six derivative functions at one point (see :func:`measure_module` for ``strict``)."""
+    def call(f: str) -> np.ndarray:
+        return module.angular_acceleration(p, ins[1], ins[2]) if f == "angular_acceleration" \
+            else getattr(module, f)(p, ins[0])
+
     values: dict[str, np.ndarray] = {}
-    with warnings.catch_warnings():
-        if strict:
-            warnings.simplefilter("error")
-            for f in FUNCTIONS:
-                values[f] = getattr(module, f)(p, ins[0])
-            values["angular_acceleration"] = module.angular_acceleration(p, ins[1], ins[2])
-            return values
-        warnings.simplefilter("ignore")
-        with np.errstate(all="ignore"):
-            for f in (*FUNCTIONS, "angular_acceleration"):
-                try:
-                    values[f] = module.angular_acceleration(p, ins[1], ins[2]) \
-                        if f == "angular_acceleration" else getattr(module, f)(p, ins[0])
-                except Exception as error:  # a raising kernel is a measured failure
-                    errors.append(f"{f} {where}: {one_line(error)}")
-                    values[f] = np.full(3 if f == "angular_acceleration" else (3, 3), np.nan)
+    with warnings.catch_warnings(), np.errstate(**({} if strict else {"all": "ignore"})):
+        warnings.simplefilter("error" if strict else "ignore")
+        for f in (*FUNCTIONS, "angular_acceleration"):
+            try:
+                values[f] = call(f)
+            except Exception as error:  # a raising kernel is a measured failure (corpus mode)
+                if strict:
+                    raise
+                errors.append(f"{f} {where}: {one_line(error)}")
+                values[f] = np.full(3 if f == "angular_acceleration" else (3, 3), np.nan)
     return values
 
 

@@ -30,6 +30,9 @@ sys.path.insert(0, str(ROOT))
 
 from tests.corpus import CORPUS  # noqa: E402
 
+sys.path.insert(0, str(ROOT / "bench"))
+from accuracy_derivatives import commit as checked_out_commit  # noqa: E402
+
 USER_TARGET_S = 10.0
 FAMILY_TARGET_S = 5.0
 TIMEOUT_S = 600
@@ -107,8 +110,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.names:
         work += [("—", name, "family") for name in family_names()]
     load = os.getloadavg()[0]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                            cwd=ROOT, check=False).stdout.strip()
+    commit = checked_out_commit()
     rows: list[dict[str, Any]] = []
     for index, expression, kind in work:
         row: dict[str, Any] = {"index": index, "expression": expression, "kind": kind,
