@@ -21,13 +21,16 @@ from __future__ import annotations
 
 import ast
 import difflib
+import importlib
 import math
 import unicodedata
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Any
 
 import sympy as sp
+from sympy.core import random as sympy_random
 
 from .errors import ParseError
 from .functions import RealCbrt
@@ -37,6 +40,17 @@ DUMMY_BASE = 5_000_000
 the sets its algorithms iterate, and so the forms they return. Fixed when symrot is imported, so
 that equal input gives equal forms (with a fixed ``PYTHONHASHSEED``, see :mod:`symrot.entry`)."""
 sp.Dummy._base_dummy_index = DUMMY_BASE
+_SYMPY_ASSUMPTIONS: Any = importlib.import_module("sympy.core.assumptions")  # not sympy.core.assumptions()
+_SYMPY_ASSUMPTIONS.shuffle = lambda facts: None
+"""SymPy's assumptions system tries its facts in an order shuffled by a generator seeded from the OS
+at import, and the order decides whether a sign query answers or gives up; so ``factor`` and
+``cancel`` returned different sign arrangements in different processes (the base-angle reduction of
+K₂ of sinh φ: −(2 sin(φ/2) cosh φ − sinh φ)/… or (−2 sin(φ/2) cosh φ + sinh φ)/…, complexity 17
+or 18), and ``derive 'sinh(phi)' --emit numpy`` wrote one of two modules. SymPy shuffles only to
+expose order-dependence in its own tests; symrot keeps the facts in their listed order."""
+sympy_random.seed(0)
+"""SymPy's other generator (numeric checks such as ``equals``; Wang's factorization) is seeded from
+the OS too; :func:`symrot.timeouts.bounded` seeds it for its steps, this for the others."""
 
 PHI = sp.Symbol("phi", real=True)
 """The rotation angle symbol used throughout symrot."""
