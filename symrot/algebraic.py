@@ -77,6 +77,15 @@ def tidy_radicals(expr: sp.Expr) -> sp.Expr:
     return sp.factor(combined)
 
 
+def _whole_multiples(expr: sp.Expr, angle: sp.Symbol) -> bool:
+    """Whether every sin/cos/tan in ``expr`` has an argument k·``angle`` with k a whole number."""
+    for atom in expr.atoms(sp.sin, sp.cos, sp.tan):
+        k = sp.cancel(atom.args[0] / angle)
+        if not k.is_Integer:
+            return False
+    return True
+
+
 @lru_cache(maxsize=1024)
 def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     """c(φ(s)) with multiple and half angles of the base angle expanded, before simplification;
@@ -96,6 +105,10 @@ def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
         if base is None:
             return sp.expand_trig(closed.subs(PHI, inverse))
         factor, function = base
+        in_theta = closed.subs(PHI, factor * THETA)
+        if _whole_multiples(in_theta, THETA):
+            # sin/cos(kθ) with whole k are polynomials in sin θ, cos θ: no half-angle radicals
+            return sp.expand_trig(in_theta).subs(THETA, function)
         # φ = factor·θ; write θ = 2η so that half angles of θ are whole angles of η
         e = sp.expand_trig(closed.subs(PHI, 2 * factor * eta))
         e = _half_angle_radicals(e.subs(eta, THETA / 2), THETA / 2)
@@ -121,6 +134,11 @@ def reduce_to_x(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     only a safety net (:mod:`symrot.timeouts`)."""
     expanded = expanded_in_s(closed, inverse)
     if expanded is None or reduction_size(closed, inverse) > REDUCTION_OPS:
+        return None
+    if expanded.atoms(sp.Function):
+        # a function of s left after the expansion (atan(s) in cos φ for φ = asin(atan(s)), the
+        # inverse of tan(sin φ)): SymPy evaluates trig(inverse trig) itself, and no simplification
+        # turns what is left algebraic; simplify took 0.5-4 s on each of 22 such coefficients
         return None
 
     def reduce() -> sp.Expr:
@@ -259,6 +277,15 @@ D = sp.Symbol("d", nonnegative=True)
 """The complement d = p_max² − x, computed by the backends with compensated arithmetic."""
 
 
+@lru_cache(maxsize=256)
+def linear_scale(argument: sp.Expr) -> sp.Rational | None:
+    """k when ``argument`` is s/k with k a positive rational, else None. ``sp.cancel``, not
+    ``sp.simplify``: for atan(sinh s), the inverse of asinh(tan φ), simplify(s/sinh s) took 67 ms
+    and the plan asked 800 times (54 of its 76 s)."""
+    k = sp.cancel(S / argument)
+    return sp.Rational(k) if k.is_Rational and k > 0 else None
+
+
 def fold_complement(inverse: sp.Expr | None, p_max: float) -> sp.Rational | None:
     """p_max² when φ(s) = c·asin(s/k) with k² = p_max² rational (the sine family, eqs 31, 32, 36).
 
@@ -269,11 +296,10 @@ def fold_complement(inverse: sp.Expr | None, p_max: float) -> sp.Rational | None
     base = base_angle(inverse) if inverse is not None else None
     if base is None or not isinstance(base[1], sp.asin) or not math.isfinite(p_max):
         return None
-    argument = base[1].args[0]
-    k = sp.simplify(S / argument)
-    if not (k.is_Rational and k > 0) or abs(float(k) - p_max) > 1e-12 * p_max:
+    k = linear_scale(base[1].args[0])
+    if k is None or abs(float(k) - p_max) > 1e-12 * p_max:
         return None
-    return sp.Rational(k) ** 2
+    return k**2
 
 
 def with_complement(expr: sp.Expr, complement: sp.Rational) -> sp.Expr:
@@ -302,8 +328,8 @@ def closed_with_base_angle(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr:
     base = base_angle(inverse)
     if base is None or not isinstance(base[1], sp.atan):
         return closed
-    k = sp.simplify(S / base[1].args[0])
-    if not (k.is_Rational and k > 0):
+    k = linear_scale(base[1].args[0])
+    if k is None:
         return closed
     radius = sp.sqrt(k**2 + X)
     return _replace_base_trig(closed, PHI / base[0], S / radius, k / radius)

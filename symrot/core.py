@@ -16,7 +16,7 @@ audit). Scalars: p′, ν (15), ε (16), μ (21), det H (24) = μ ν².
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import mpmath
 import sympy as sp
@@ -59,9 +59,23 @@ class Tensor:
     u_basis: AxialTensor
     coefficients: tuple[sp.Expr, sp.Expr, sp.Expr]
     """Raw (unsimplified) coefficients on I, (p×), (p×)²."""
-    simplified: tuple[sp.Expr, sp.Expr, sp.Expr]
-    canonical: sp.Matrix
-    """Simplified components in a canonical basis {u, v, w} (eqs 17, 23, 27)."""
+
+    @cached_property
+    def simplified(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+        """The coefficients simplified (:func:`symrot.simplify.simplest`), on first use: a figure
+        needs only the scalars, a plan only these and the planar entry, a derivation sheet all."""
+        with stage("derivation"):
+            a, b, c = (simplest(c) for c in self.coefficients)
+        return a, b, c
+
+    @cached_property
+    def canonical(self) -> sp.Matrix:
+        """Simplified components in a canonical basis {u, v, w} (eqs 17, 23, 27), on first use."""
+        real, imag = self.u_basis.planar
+        with stage("derivation"):
+            return sp.Matrix([[simplest(self.u_basis.a), 0, 0],
+                              [0, simplest(real), -simplest(imag)],
+                              [0, simplest(imag), simplest(real)]])
 
     def coefficient_names(self) -> tuple[str, str, str]:
         return (f"{self.name}_0", f"{self.name}_1", f"{self.name}_2")
@@ -142,7 +156,10 @@ class Derivation:
         if name in across:
             return across[name].canonical[1, 1]
         if name not in self.slopes:
-            return self.simplified_coefficients()[name]
+            for tensor in self.tensors.values():  # simplify only the tensor that holds it
+                if name in tensor.coefficient_names():
+                    return tensor.simplified[tensor.coefficient_names().index(name)]
+            return self.scalars[name]
         if name not in self._slopes_simplified:
             parent = self.simplified_coefficients()[self.slopes[name][0]]
             quotient = sp.diff(parent, PHI) / (2 * self.p * self.scalars["p_prime"])
@@ -241,18 +258,7 @@ def tensor_definitions(p: sp.Expr) -> dict[str, AxialTensor]:
 
 
 def _build_tensor(name: str, u_basis: AxialTensor, p: sp.Expr) -> Tensor:
-    coefficients = u_basis.in_p_basis(p)
-    simplified = tuple(simplest(c) for c in coefficients)
-    real, imag = u_basis.planar
-    canonical = sp.Matrix(
-        [
-            [simplest(u_basis.a), 0, 0],
-            [0, simplest(real), -simplest(imag)],
-            [0, simplest(imag), simplest(real)],
-        ]
-    )
-    a, b, c = simplified
-    return Tensor(name, u_basis, coefficients, (a, b, c), canonical)
+    return Tensor(name, u_basis, u_basis.in_p_basis(p))
 
 
 def derive_function(function: ValidatedFunction) -> Derivation:

@@ -13,6 +13,7 @@ import argparse
 import difflib
 import sys
 from collections.abc import Callable, Iterable
+from functools import lru_cache
 from pathlib import Path
 
 from . import strict_json
@@ -33,6 +34,7 @@ def derivation_json() -> dict[str, str | bytes]:
     return out
 
 
+@lru_cache(maxsize=1)
 def latex_documents() -> dict[str, str | bytes]:
     """generated/latex/: Table 1 and the derivation sheets of the named parameterizations,
     each as a fragment (NAME.tex) and a complete document (NAME_standalone.tex)."""
@@ -116,14 +118,20 @@ def producers() -> list[tuple[str, Producer]]:
             ("jax/", jax_modules), ("torch/", torch_modules)]
 
 
+SHARED_DERIVATIONS = ("derivations/", "latex/", "renderings/")
+"""Producers run as one task, in one process: they derive the same named parameterizations, and the
+renderings typeset the very documents of ``latex/`` (:func:`latex_documents` is remembered)."""
+
 PER_NAME = ("numpy/", "c/", "jax/", "torch/")
 """Producers that are split into one task per parameterization when ``render`` runs in parallel
 (a name's NumPy, JAX and PyTorch modules and C header share one task, so its plan is computed once)."""
 
 
 def tasks(selected: list[str]) -> list[tuple[str, ...]]:
-    """Independent units of work: ("names", name) for the per-name producers, longest first (the
-    tangent and sine families of the C headers), then (prefix,) for every other producer."""
+    """Independent units of work, longest first (idle workers take the next one): the producers that
+    derive every named parameterization (the documents of :data:`SHARED_DERIVATIONS` as one task, the
+    figures), then ("names", name) for the per-name producers (the tangent and sine families of the C
+    headers first)."""
     from .backends.c_backend import COVERED
 
     names = [*COVERED] if "c/" in selected else []
@@ -131,13 +139,18 @@ def tasks(selected: list[str]) -> list[tuple[str, ...]]:
     if any(prefix in selected for prefix in array_prefixes):
         names += [name for name in NAMED if name not in names]
     per_name: list[tuple[str, ...]] = [("names", name) for name in reversed(names)]
-    return per_name + [(prefix,) for prefix in selected if prefix not in PER_NAME]
+    documents = tuple(prefix for prefix in SHARED_DERIVATIONS if prefix in selected)
+    rest = [(prefix,) for prefix in selected if prefix not in PER_NAME and prefix not in documents]
+    return ([documents] if documents else []) + rest + per_name
 
 
 def _run_task(task: tuple[str, ...], selected: tuple[str, ...]) -> dict[str, Content]:
     with deterministic():  # no result of a bounded step may depend on this machine's speed or load
         if task[0] != "names":
-            return dict(producers())[task[0]]()
+            made: dict[str, Content] = {}
+            for prefix in task:
+                made.update(dict(producers())[prefix]())
+            return made
         from .backends.c_backend import COVERED
 
         name = task[1]

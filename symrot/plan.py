@@ -364,15 +364,16 @@ coefficient of s is well conditioned up to it (det H = μν² ~ 1/x² next to a 
 there, and they keep the floor max(|c|, |c(0)|)."""
 
 
-def tensor_part(derivation: Derivation, coefficient: str, unbounded: bool = False) -> TensorPart | None:
+def tensor_part(derivation: Derivation, coefficient: str, det_h_own_scale: bool = False) -> TensorPart | None:
     """The :class:`TensorPart` of a coefficient of R, H, H⁻¹, G or K (or of its across-axis part),
-    :data:`QUATERNION_PART` for ν, :data:`OWN_SCALE` for det H where p is ``unbounded``, None for
-    the other scalars and the slopes. The norm is the largest eigenvalue modulus, max(|a|, |a − c|,
-    |b|) of the u-basis a I + b U + c U² (axial a, across the axis (a − c) ± i b; eqs 17, 23, 27)."""
+    :data:`QUATERNION_PART` for ν, :data:`OWN_SCALE` for det H with ``det_h_own_scale`` (p unbounded,
+    or det H → 0 at φ_max with p′ → ∞), None for the other scalars and the slopes. The norm is the
+    largest eigenvalue modulus, max(|a|, |a − c|, |b|) of the u-basis a I + b U + c U² (axial a,
+    across the axis (a − c) ± i b; eqs 17, 23, 27)."""
     if coefficient == "nu":
         return QUATERNION_PART
     if coefficient == "det_H":
-        return OWN_SCALE if unbounded else None
+        return OWN_SCALE if det_h_own_scale else None
     for tensor in derivation.tensors.values():
         names = (*tensor.coefficient_names(), tensor.across_name)
         if coefficient in names:
@@ -523,6 +524,13 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     x_of_phi = p ** 2
     p_max = float(limits.p_max_float)
     unbounded = not math.isfinite(p_max)  # p → ∞ at φ_max
+    # det H = μ ν² → 0 at φ_max because p′ → ∞ there (a logarithmic pole such as asinh(tan φ), where
+    # the analysis finds p′ → ∞ and a finite |p| 10⁻¹² from the edge; an arcsine edge): judged
+    # relative to itself, as where p is unbounded. Not where ν → 0 makes it vanish (2π): there no form
+    # is better, and the relative measure only lengthened the polynomials (rotation vector 7 → 10 terms)
+    at_edge = {(s.quantity, s.limit) for s in limits.singularities
+               if abs(s.phi_float - phi_max) <= 1e-12 * phi_max}
+    det_h_own_scale = unbounded or {("det_H", "0"), ("p_prime", "oo")} <= at_edge
     complement = fold_complement(inverse, p_max)
     # the algebraic search of one plan is capped by the size of what it simplifies (a few seconds
     # for every named parameterization; expressions whose forms never simplify would otherwise
@@ -571,7 +579,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
             extra = difference_forms(coefficients, tensor, complement) if tensor is not None else ()
             coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
                                                     inverse, complement,
-                                                    tensor_part(derivation, coefficient, unbounded),
+                                                    tensor_part(derivation, coefficient, det_h_own_scale),
                                                     extra)
         coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
                                                              dtype)

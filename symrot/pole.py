@@ -81,7 +81,7 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     factor of its denominator (written as a quotient, :func:`as_quotients`), else None."""
     if not mpmath.isfinite(phi_max) or phi_max <= 0:
         return None
-    tangent = _tangent_pole(p, phi_max)
+    tangent = _tangent_pole(p, phi_max) or _gudermannian_pole(p, phi_max)
     if tangent is not None:
         return tangent
     quotient = bounded(2.0, None, lambda: sp.together(as_quotients(p)))
@@ -169,6 +169,27 @@ def _tangent_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         return None
     weight, rest = found
     return PoleFactor(sp.cos(call.args[0]), weight * sp.sin(call.args[0]) / (S - rest), root)
+
+
+def _gudermannian_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
+    """p = A + B·asinh(tan(aφ)) with cos(aφ_max) = 0 (the inverse Gudermannian function: p → ∞ like
+    a logarithm, corpus entry 46): f = cos(aφ), the factor of p′ = A′ + B′ asinh(tan aφ) + aB/cos(aφ).
+    Through s, tan(aφ) = sinh((s − A)/B), so f = 1/cosh((s − A)/B), whose relative error is that of
+    (s − A)/B times tanh of it, a few ε; from the rounded φ̂, f loses ε φ_max/(φ_max − φ) (the
+    derivatives of asinh(tan φ) were 6·10⁵ ulp off at π/2 − 10⁻⁶). The call itself is (s − A)/B."""
+    calls = [call for call in p.atoms(sp.asinh) if isinstance(call.args[0], sp.tan) and call.has(PHI)]
+    with mpmath.workdps(ZERO_DIGITS):
+        roots = [(call, _root_near(sp.cos(call.args[0].args[0]), phi_max)) for call in calls]
+        edges = [(call, root) for call, root in roots if root is not None]
+        if len(edges) != 1:
+            return None
+        call, root = edges[0]
+        found = _weight_and_rest(p, call, root)
+    if found is None:
+        return None
+    weight, rest = found
+    level = (S - rest) / weight
+    return PoleFactor(sp.cos(call.args[0].args[0]), 1 / sp.cosh(level), root, call, level)
 
 
 def _logarithmic_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
@@ -298,7 +319,7 @@ def _rewrite(expr: sp.Expr, pole: PoleFactor) -> sp.Expr:
 def _is_the_call(expr: sp.Expr, call: sp.Expr | None) -> bool:
     """``expr`` is the edge's ``call``; for a logarithm, also when SymPy wrote its argument in
     another form (log((φ/2 + 1)/(1 − φ/2)) becomes log(−(φ + 2)/(φ − 2)) in sin φ/p)."""
-    if expr == call:
+    if expr == call or (call is not None and expr == as_quotients(call)):  # asinh(sin aφ/cos aφ)
         return True
     if not (isinstance(call, sp.log) and isinstance(expr, sp.log) and expr.has(PHI)):
         return False

@@ -205,3 +205,18 @@ def test_tensor_definitions_are_axial_tensors_of_phi_only() -> None:
     for tensor in tensor_definitions(4 * sp.tan(PHI / 4)).values():
         for component in (tensor.a, tensor.b, tensor.c):
             assert sp.sympify(component).free_symbols <= {PHI}
+
+
+def test_tensors_are_simplified_only_when_asked() -> None:
+    """A figure or the validity analysis needs the scalars and a few coefficients; the canonical
+    forms and the other tensors' coefficients are simplified on first use (a figure of 11 curves
+    spent 13 of its 25 s simplifying tensors it never drew)."""
+    from symrot.singularities import validity
+
+    derivation = derive_expression(3 * sp.sin(PHI / 3) + sp.sin(PHI) / 7)
+    validity(derivation)
+    assert all("canonical" not in tensor.__dict__ for tensor in derivation.tensors.values())
+    assert "simplified" not in derivation.tensors["G"].__dict__
+    real = derivation.tensors["K"].canonical[1, 1]
+    assert real == simplest(derivation.tensors["K"].u_basis.planar[0])
+    assert "simplified" not in derivation.tensors["K"].__dict__

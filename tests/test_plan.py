@@ -190,6 +190,20 @@ def test_the_reduction_to_x_is_sized_by_the_largest_multiple_angle() -> None:
     assert expanded_in_s(within, 6 * sp.atan(s / 6)) is not None
 
 
+def test_whole_multiples_of_the_base_angle_reduce_without_half_angle_radicals() -> None:
+    """sin φ/(5 tan(φ/5)) of 5 tan(φ/5) has only whole multiples of θ = atan(s/5): expanded in θ it
+    is algebraic in x. Through the half angle η = θ/2 (radicals √((1 ± cos θ)/2)) SymPy's simplify
+    found nothing, in 1–2 s; the R₁ of 3 tan(φ/3) was a branch with sin φ/s for the same reason."""
+    from symrot.algebraic import S, algebraic_in_x, reduce_to_x
+
+    closed = sp.sin(PHI) / (5 * sp.tan(PHI / 5))
+    reduced = reduce_to_x(closed, 5 * sp.atan(S / 5))
+    assert reduced is not None
+    assert sp.simplify(reduced - (X**2 - 250 * X + 3125) / (X + 25) ** sp.Rational(5, 2)) == 0
+    r_1 = algebraic_in_x(sp.sin(PHI) / (3 * sp.tan(PHI / 3)), 3 * sp.atan(S / 3), float("inf"))
+    assert r_1 is not None and sp.simplify(r_1 + (X - 27) / (X + 9) ** sp.Rational(3, 2)) == 0
+
+
 @pytest.mark.parametrize("text, expected", [
     ("sinh(phi)", "asinh(s)"), ("2*sinh(3*phi/2)/3", "2*asinh(3*s/2)/3"), ("tanh(phi)", "atanh(s)")])
 def test_hyperbolic_inverses_are_inverse_hyperbolic_functions(text: str, expected: str) -> None:

@@ -269,3 +269,33 @@ def test_a_logarithm_writes_its_vanishing_part_and_itself_through_s(text: str) -
     assert pole is not None
     form = sp.simplify(sp.sin(PHI) / p)
     assert not with_pole_factor(form, pole).has(sp.log)
+
+
+GUDERMANNIAN_POLES = {  # p = A + B asinh(tan(aφ)), cos(aφ_max) = 0: φ_max
+    "asinh(tan(phi))": "pi/2",  # corpus entry 46
+    "phi/3 + asinh(tan(phi/2))/2": "pi",
+}
+
+
+@pytest.mark.parametrize("text", list(GUDERMANNIAN_POLES))
+def test_the_inverse_gudermannian_writes_its_cosine_through_s(text: str) -> None:
+    """p′ of asinh(tan φ) is 1/cos φ: H⁻¹ and ṗ of corpus entry 46 were 2.2·10⁵ ulp off at
+    π/2 − 10⁻⁶ (NumPy and C, both precisions), with cos φ from the rounded φ̂. Through s,
+    tan(aφ) = sinh((s − A)/B) makes cos(aφ) = 1/cosh((s − A)/B), accurate to a few ulp."""
+    p, phi_max = _p(text), sp.sympify(GUDERMANNIAN_POLES[text])
+    pole = pole_factor(p, float(phi_max))
+    assert pole is not None and pole.call is not None and pole.call_through_s is not None
+    assert abs(sp.N(pole.factor.subs(PHI, phi_max), 40)) < 1e-35
+    with mpmath.workdps(50):
+        theta = mpmath.mpf(sp.N(phi_max, 50)) - mpmath.mpf("1e-7")
+        exact_s = sp.lambdify(PHI, p, modules=[mpmath_namespace(), "mpmath"])(theta)
+        through = sp.lambdify((S, PHI), pole.through_s, modules=[mpmath_namespace(), "mpmath"])
+        factor = sp.lambdify(PHI, pole.factor, modules=[mpmath_namespace(), "mpmath"])
+        assert abs(through(exact_s, theta) / factor(theta) - 1) < mpmath.mpf(10) ** -40
+    form = 1 / sp.diff(p, PHI)  # μ, the factor of H⁻¹ that vanishes at the pole
+    rewritten = with_pole_factor(form, pole)
+    assert rewritten.has(S)
+    with mpmath.workdps(60):
+        theta = mpmath.mpf(sp.N(phi_max, 60)) - mpmath.mpf("1e-6")
+        assert _relative_error(rewritten, p, theta) <= 4, rewritten
+        assert _relative_error(form, p, theta) > 1000

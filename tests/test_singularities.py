@@ -128,3 +128,22 @@ def test_solveset_is_tried_on_one_frequency_or_on_sines_and_cosines_only() -> No
 def test_sums_of_tangents_have_their_pole_as_the_edge(text: str, edge: sp.Expr) -> None:
     found = validity(derive_expression(parse_expression(text)))
     assert abs(found.phi_max_float - float(edge)) < 1e-12
+
+
+def test_infinitely_many_zeros_are_polished_only_near_the_smallest_angles() -> None:
+    """p′ = cos(sinh φ) cosh φ of sin(sinh φ) vanishes wherever sinh φ = π/2 + kπ: ~10⁵ zeros in
+    (0, 4π]. At most MAX_CANDIDATES brackets per quantity are polished (smallest angles first); the
+    edge is the first fold, asinh(π/2)."""
+    from symrot.singularities import MAX_CANDIDATES, QUANTITIES
+
+    result = validity(derive_expression(parse_expression("sin(sinh(phi))")))
+    assert abs(result.phi_max_float - float(sp.asinh(sp.pi / 2))) < 1e-12
+    assert len(result.singularities) <= 2 * len(QUANTITIES) * MAX_CANDIDATES  # fold: 2 entries each
+
+
+def test_the_scale_of_a_base_angle_is_read_without_simplify() -> None:
+    from symrot.algebraic import S, linear_scale
+
+    assert linear_scale(S / 4) == 4 and linear_scale(3 * S / 2) == sp.Rational(2, 3)
+    assert linear_scale(sp.sinh(S)) is None and linear_scale(-S) is None
+    assert linear_scale(sp.sqrt(2) * S) is None

@@ -301,10 +301,10 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
 
 /* symrot_sine_m6_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.212296, else (x*sqrt(36 - x) - 9*sqrt(36 - x))/(2*x - 54)
+ * H_inverse_across = sqrt(36 - x)*(x - 9)/(2*(x - 27)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 69 */
+ * ops: 54 */
 static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -320,14 +320,8 @@ static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv
         Hinv[8] = (double)NAN;
         return;
     }
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(36 - x)*(x - 9)/(x - 27);
     const double c_H_inverse_2 = -1.0/3.0*sqrt(36 - x)/(x - 27);
-    double c_H_inverse_across;
-    if (x < 0.21229610760805032) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.691783157804375e-11)*x - 4289069.0/1624959306694656.0) - 272213.0/3761479876608.0) - 35029.0/17414258688.0) - 1163.0/20155392.0) - 169.0/93312.0) - 19.0/216.0) + 1;
-    } else {
-        const double w0 = sqrt(36 - x);
-        c_H_inverse_across = (w0*x - 9*w0)/(2*x - 54);
-    }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -347,7 +341,7 @@ static inline void symrot_sine_m6_tangent_inverse(const double p[3], double Hinv
  */
 static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -370,17 +364,15 @@ static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            c_H_inverse_across_lanes[k] = (u0*x - 9*u0)/(2*x - 54);
-            poly_H_inverse_across_lanes[k] = 1 + (-19.0/216.0)*x;
-            c_H_inverse_2_lanes[k] = -1.0/3.0*u0/(x - 27);
+            const double w0 = u0/(x - 27);
+            c_H_inverse_across_lanes[k] = (1.0/2.0)*w0*(x - 9);
+            c_H_inverse_2_lanes[k] = -1.0/3.0*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const double v_H_inverse_across = x < 3.690968361342376e-14 ? poly_H_inverse_across : closed_H_inverse_across;
-            c_H_inverse_across_lanes[k] = !(x < 27.0) ? (double)NAN : v_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 27.0) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 27.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 27.0) ? (double)NAN : closed_H_inverse_2;
@@ -679,10 +671,10 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
 
 /* symrot_sine_m6_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.212296, else (x*sqrt(36 - x) - 9*sqrt(36 - x))/(2*x - 54)
+ * H_inverse_across = sqrt(36 - x)*(x - 9)/(2*(x - 27)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 68 */
+ * ops: 53 */
 static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -692,14 +684,8 @@ static inline void symrot_sine_m6_pdot(const double p[3], const double omega[3],
         pdot[2] = (double)NAN;
         return;
     }
+    const double c_H_inverse_across = (1.0/2.0)*sqrt(36 - x)*(x - 9)/(x - 27);
     const double c_H_inverse_2 = -1.0/3.0*sqrt(36 - x)/(x - 27);
-    double c_H_inverse_across;
-    if (x < 0.21229610760805032) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.691783157804375e-11)*x - 4289069.0/1624959306694656.0) - 272213.0/3761479876608.0) - 35029.0/17414258688.0) - 1163.0/20155392.0) - 169.0/93312.0) - 19.0/216.0) + 1;
-    } else {
-        const double w0 = sqrt(36 - x);
-        c_H_inverse_across = (w0*x - 9*w0)/(2*x - 54);
-    }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -1693,10 +1679,10 @@ static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, floa
 
 /* symrot_sine_m6_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 2.82094, else x*sqrt(36 - x)/(3*(x - 27)) + sqrt(36 - x)/6
+ * H_inverse_across = sqrt(36 - x)*(x - 9)/(2*(x - 27)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 69 */
+ * ops: 54 */
 static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1712,14 +1698,8 @@ static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv
         Hinv[8] = NAN;
         return;
     }
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(36 - x)*(x - 9)/(x - 27);
     const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(36 - x)/(x - 27);
-    float c_H_inverse_across;
-    if (x < 2.8209393F) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.6917835e-11F)*x - 2.639493e-09F) - 7.236859e-08F) - 2.0115126e-06F) - 5.770168e-05F) - 169.0F/93312.0F) - 19.0F/216.0F) + 1;
-    } else {
-        const float w0 = sqrtf(36 - x);
-        c_H_inverse_across = (1.0F/3.0F)*w0*x/(x - 27) + (1.0F/6.0F)*w0;
-    }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -1739,7 +1719,7 @@ static inline void symrot_sine_m6_tangent_inverse_f(const float p[3], float Hinv
  */
 static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1762,18 +1742,15 @@ static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float 
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            const float w0 = (1.0F/3.0F)*u0/(x - 27);
-            c_H_inverse_across_lanes[k] = (1.0F/6.0F)*u0 + w0*x;
-            poly_H_inverse_across_lanes[k] = 1;
-            c_H_inverse_2_lanes[k] = -w0;
+            const float w0 = u0/(x - 27);
+            c_H_inverse_across_lanes[k] = (1.0F/2.0F)*w0*(x - 9);
+            c_H_inverse_2_lanes[k] = -1.0F/3.0F*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const float v_H_inverse_across = x < 3.6909684e-14F ? poly_H_inverse_across : closed_H_inverse_across;
-            c_H_inverse_across_lanes[k] = !(x < 27.0F) ? NAN : v_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 27.0F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 27.0F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 27.0F) ? NAN : closed_H_inverse_2;
@@ -2072,10 +2049,10 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
 
 /* symrot_sine_m6_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 2.82094, else x*sqrt(36 - x)/(3*(x - 27)) + sqrt(36 - x)/6
+ * H_inverse_across = sqrt(36 - x)*(x - 9)/(2*(x - 27)) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = -sqrt(36 - x)/(3*(x - 27)) (algebraic in x)
- * ops: 68 */
+ * ops: 53 */
 static inline void symrot_sine_m6_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2085,14 +2062,8 @@ static inline void symrot_sine_m6_pdot_f(const float p[3], const float omega[3],
         pdot[2] = NAN;
         return;
     }
+    const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(36 - x)*(x - 9)/(x - 27);
     const float c_H_inverse_2 = -1.0F/3.0F*sqrtf(36 - x)/(x - 27);
-    float c_H_inverse_across;
-    if (x < 2.8209393F) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-9.6917835e-11F)*x - 2.639493e-09F) - 7.236859e-08F) - 2.0115126e-06F) - 5.770168e-05F) - 169.0F/93312.0F) - 19.0F/216.0F) + 1;
-    } else {
-        const float w0 = sqrtf(36 - x);
-        c_H_inverse_across = (1.0F/3.0F)*w0*x/(x - 27) + (1.0F/6.0F)*w0;
-    }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];

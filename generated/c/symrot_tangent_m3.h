@@ -79,9 +79,9 @@ static inline double symrot_tangent_m3_angle(const double p[3])
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
- * ops: 87 */
+ * ops: 71 */
 static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -97,14 +97,12 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
         R[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2;
+    const double c_R_1 = -(x - 27)/pow(x + 9, 3.0/2.0);
+    double c_R_2;
     if (x < 0.06877716192024325) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_R_1 = sin(phi)/s;
         c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double t = -c_R_2*x + 1;
@@ -123,12 +121,12 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi, u0 = (x + 9)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -136,27 +134,28 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 6.703903964971299e+153) || x < 1.0000000000000006e-14) {
-                s_lanes[k] = 0;
+            if (!(x < 6.703903964971299e+153)) {
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m3__phi(s);
-                s_lanes[k] = s;
+                const double u0 = pow(x + 9, -3.0/2.0);
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = phi;
+            const double u0 = u0_lanes[k];
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -166,19 +165,8 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_R_1_lanes[k] = sin0/s;
-            poly_R_1_lanes[k] = 1 + (-11.0/54.0)*x;
-            c_R_2_lanes[k] = 2*(sin1*sin1)/x;
+            c_R_1_lanes[k] = -u0*(x - 27);
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_R_2_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -186,9 +174,7 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double x = x_lanes[k];
             c_R_0_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 1.0000000000000006e-14 ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
             const double v_R_2 = x < 0.00021086444550021482 ? poly_R_2 : closed_R_2;
@@ -215,10 +201,10 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * H_across = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 98 */
+ * ops: 82 */
 static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -234,15 +220,13 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
+    const double c_H_across = -(x - 27)/pow(x + 9, 3.0/2.0);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
-    double c_H_across, c_H_1;
+    double c_H_1;
     if (x < 0.06877716192024325) {
-        c_H_across = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_H_across = sin(phi)/s;
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
@@ -260,12 +244,12 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
+ * Scalar pass: phi, u0 = (x + 9)**(-3/2), u1 = sqrt(x + 9).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -274,16 +258,14 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m3__phi(s);
-                const double u0 = sqrt(x + 9);
-                const double u1 = pow(x + 9, -3.0/2.0);
-                s_lanes[k] = s;
+                const double u0 = pow(x + 9, -3.0/2.0);
+                const double u1 = sqrt(x + 9);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -291,7 +273,6 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -299,11 +280,10 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = phi;
+            const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -313,29 +293,16 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_H_across_lanes[k] = sin0/s;
-            poly_H_across_lanes[k] = 1 + (-11.0/54.0)*x;
-            c_H_1_lanes[k] = 2*(sin1*sin1)/x;
+            c_H_across_lanes[k] = -u0*(x - 27);
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_H_1_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
-            c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
+            c_H_2_lanes[k] = u0*(u1 + 12)/(u1 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_across = c_H_across_lanes[k];
-            const double poly_H_across = poly_H_across_lanes[k];
-            const double v_H_across = x < 1.0000000000000006e-14 ? poly_H_across : closed_H_across;
-            c_H_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_H_across;
+            c_H_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.00021086444550021482 ? poly_H_1 : closed_H_1;
@@ -363,10 +330,10 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.131361, else (-x**2 + 9*x + 54*sqrt(x + 9) + 162)/(2*x*sqrt(x + 9) + 18*x + 54*sqrt(x + 9) + 162)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 89 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
+ * ops: 90 */
 static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -382,8 +349,15 @@ static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double H
         Hinv[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_across = -1.0/2.0*(x - 27)*(x + 3*sqrt(x + 9) + 9)/(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108);
-    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
+    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6));
+    double c_H_inverse_across;
+    if (x < 0.13136065202211897) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*(3299.0/793437161472.0 + (-13085.0/42845606719488.0)*x) - 451.0/7346640384.0) + 139.0/136048896.0) - 13.0/629856.0) + 7.0/11664.0) - 5.0/108.0) + 1;
+    } else {
+        const double w0 = sqrt(x + 9);
+        const double w1 = 54*w0 + 162;
+        c_H_inverse_across = (w1 - (x*x) + 9*x)/(2*w0*x + w1 + 18*x);
+    }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -399,11 +373,11 @@ static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double H
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(x + 9).
+ * Scalar pass: u0 = sqrt(x + 9), u1 = 1/sqrt(x + 9).
  */
 static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -413,28 +387,37 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const double u0 = sqrt(x + 9);
+                const double u1 = 1.0/sqrt(x + 9);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            const double w0 = u0*x;
-            c_H_inverse_across_lanes[k] = -1.0/2.0*(x - 27)*(3*u0 + x + 9)/(45*u0 + w0 + 12*x + 108);
-            c_H_inverse_2_lanes[k] = (1.0/18.0)*(72*u0 + 2*w0 + 27*x + 243)/(27*u0 + w0 + 9*x + 81);
+            const double u1 = u1_lanes[k];
+            const double w0 = 54*u0 + 162;
+            const double w1 = 2*u0*x;
+            c_H_inverse_across_lanes[k] = (w0 - (x*x) + 9*x)/(w0 + w1 + 18*x);
+            poly_H_inverse_across_lanes[k] = 1 + (-5.0/108.0)*x;
+            c_H_inverse_2_lanes[k] = (1.0/18.0)*u1*(72*u0 + w1 + 27*x + 243)/((u0 + 3)*(u0 + 6));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            c_H_inverse_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_across;
+            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const double v_H_inverse_across = x < 1.9011961863057328e-14 ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_2;
@@ -764,10 +747,10 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 0.131361, else (-x**2 + 9*x + 54*sqrt(x + 9) + 162)/(2*x*sqrt(x + 9) + 18*x + 54*sqrt(x + 9) + 162)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 88 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
+ * ops: 89 */
 static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -777,8 +760,15 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
         pdot[2] = (double)NAN;
         return;
     }
-    const double c_H_inverse_across = -1.0/2.0*(x - 27)*(x + 3*sqrt(x + 9) + 9)/(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108);
-    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
+    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6));
+    double c_H_inverse_across;
+    if (x < 0.13136065202211897) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*(3299.0/793437161472.0 + (-13085.0/42845606719488.0)*x) - 451.0/7346640384.0) + 139.0/136048896.0) - 13.0/629856.0) + 7.0/11664.0) - 5.0/108.0) + 1;
+    } else {
+        const double w0 = sqrt(x + 9);
+        const double w1 = 54*w0 + 162;
+        c_H_inverse_across = (w1 - (x*x) + 9*x)/(2*w0*x + w1 + 18*x);
+    }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -792,10 +782,10 @@ static inline void symrot_tangent_m3_pdot(const double p[3], const double omega[
  * Valid for every p with |p|^2 < 2^511 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * H_across = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 97 */
+ * ops: 81 */
 static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -805,15 +795,13 @@ static inline void symrot_tangent_m3_omega(const double p[3], const double pdot[
         omega[2] = (double)NAN;
         return;
     }
+    const double c_H_across = -(x - 27)/pow(x + 9, 3.0/2.0);
     const double c_H_2 = (sqrt(x + 9) + 12)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3));
-    double c_H_across, c_H_1;
+    double c_H_1;
     if (x < 0.06877716192024325) {
-        c_H_across = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_H_across = sin(phi)/s;
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
@@ -991,12 +979,12 @@ static inline int symrot_tangent_m3_rescale(const double p[3], double q[3])
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 3*(s**2/9 + 1)*sin(phi)/s)/(2*s**2*(x + 9))
+ * R_1_x = 3*(x - 27)/(2*(x + 9)**(5/2)) - 1/(x + 9)**(3/2) (algebraic in x)
  * R_2_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
- * ops: 284 */
+ * ops: 224 */
 static inline void symrot_tangent_m3_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1012,27 +1000,20 @@ static inline void symrot_tangent_m3_rotation_derivative(const double p[3], cons
         D[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const double c_R_1 = -(x - 27)/pow(x + 9, 3.0/2.0);
+    const double c_R_1_x = (3.0/2.0)*(x - 27)/pow(x + 9, 5.0/2.0) - 1/pow(x + 9, 3.0/2.0);
+    double c_R_2, c_R_2_x;
     if (x < 0.06877716192024325) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/s;
-        const double w1 = w0*sin(phi);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = (w3*w3);
-        const double w5 = (s*s);
-        const double w6 = (1.0/9.0)*w5 + 1;
-        const double w7 = (3.0/2.0)/(x + 9);
-        c_R_1 = w1;
-        c_R_2 = 2*w4/x;
-        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w7*(-3*w1*w6 - 6*w4 + 3)/w5;
-        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w7*(-12*w0*w4*w6 + 6*w3*cos(w2))/(s*s*s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w1*cos(w0) - 12*w2*((1.0/9.0)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1076,12 +1057,12 @@ static inline void symrot_tangent_m3_rotation_derivative(const double p[3], cons
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.0687772, else sin(phi)/s
+ * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.0687772, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 18 in x below x = 0.956738, else 3*(-6*sin(phi/2)**2 + 3 - 3*(s**2/9 + 1)*sin(phi)/s)/(2*s**2*(x + 9))
+ * R_1_x = 3*(x - 27)/(2*(x + 9)**(5/2)) - 1/(x + 9)**(3/2) (algebraic in x)
  * R_2_x: Horner degree 18 in x below x = 0.956738, else 3*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/9 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 9))
- * ops: 285 */
+ * ops: 225 */
 static inline void symrot_tangent_m3_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1097,27 +1078,20 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative(const double 
         D[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const double c_R_1 = -(x - 27)/pow(x + 9, 3.0/2.0);
+    const double c_R_1_x = (3.0/2.0)*(x - 27)/pow(x + 9, 5.0/2.0) - 1/pow(x + 9, 3.0/2.0);
+    double c_R_2, c_R_2_x;
     if (x < 0.06877716192024325) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1309.0/181398528.0 + (-8437.0/9795520512.0)*x) - 301.0/5038848.0) + 1225.0/2519424.0) - 5.0/1296.0) + 19.0/648.0) - 11.0/54.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(2717.0/1088391168.0 + (-46475.0/156728328192.0)*x) - 3773.0/181398528.0) + 287.0/1679616.0) - 385.0/279936.0) + 125.0/11664.0) - 17.0/216.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0;
     } else {
         const double phi = symrot_tangent_m3__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/s;
-        const double w1 = w0*sin(phi);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = (w3*w3);
-        const double w5 = (s*s);
-        const double w6 = (1.0/9.0)*w5 + 1;
-        const double w7 = (3.0/2.0)/(x + 9);
-        c_R_1 = w1;
-        c_R_2 = 2*w4/x;
-        c_R_1_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(7.760267286811171e-16 + (-9.344321174490229e-17)*x) - 6.4154559529101326e-15) + 5.276702031641454e-14) - 4.3151754363657393e-13) + 3.5058532140700626e-12) - 2.8270387366791054e-11) + 2.2599400502858314e-10) - 1.7883003876174839e-09) + 19168435.0/1371059415023616.0) - 303875.0/2821109907456.0) + 47905.0/58773123072.0) - 59059.0/9795520512.0) + 1309.0/30233088.0) - 1505.0/5038848.0) + 1225.0/629856.0) - 5.0/432.0) + 19.0/324.0) - 11.0/54.0 : w7*(-3*w1*w6 - 6*w4 + 3)/w5;
-        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : w7*(-12*w0*w4*w6 + 6*w3*cos(w2))/(s*s*s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 0.9567381777096958 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.621486639851894e-16 + (-3.154461970678718e-17)*x) - 2.168827535372963e-15) + 1.7853592190578515e-14) - 1.461414851797645e-13) + 1.1886027949924491e-12) - 9.596456592799234e-12) + 7.68239139083179e-11) - 6.089282913270157e-10) + 13079885.0/2742118830047232.0) - 46189.0/1253826625536.0) + 887315.0/3173748645888.0) - 325325.0/156728328192.0) + 2717.0/181398528.0) - 18865.0/181398528.0) + 287.0/419904.0) - 385.0/93312.0) + 125.0/5832.0) - 17.0/216.0 : (3.0/2.0)*(6*w1*cos(w0) - 12*w2*((1.0/9.0)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1326,11 +1300,11 @@ static inline void symrot_tangent_m3_tangent_transpose_derivative(const double p
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
  * H_inverse_0_x = 1/9 (algebraic in x)
  * H_inverse_1_x = 0 (constant)
- * H_inverse_2_x = (-x/(2*sqrt(x + 9)) - sqrt(x + 9) - 9 - 27/(2*sqrt(x + 9)))*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)**2) + (x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 224 */
+ * H_inverse_2_x = -(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(36*(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)**2) - (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(36*(x + 9)*(sqrt(x + 9) + 3)**2*(sqrt(x + 9) + 6)) + (x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) - (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(36*(x + 9)**(3/2)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
+ * ops: 264 */
 static inline void symrot_tangent_m3_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1346,9 +1320,9 @@ static inline void symrot_tangent_m3_tangent_inverse_derivative(const double p[3
         D[8] = (double)NAN;
         return;
     }
-    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
+    const double c_H_inverse_2 = (1.0/18.0)*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6));
     const double c_H_inverse_0_x = 1.0/9.0;
-    const double c_H_inverse_2_x = (1.0/18.0)*(-1.0/2.0*x/sqrt(x + 9) - sqrt(x + 9) - 9 - (27.0/2.0)/sqrt(x + 9))*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/pow(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81, 2) + (1.0/18.0)*(x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81);
+    const double c_H_inverse_2_x = -1.0/36.0*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/((x + 9)*(sqrt(x + 9) + 3)*pow(sqrt(x + 9) + 6, 2)) - 1.0/36.0*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/((x + 9)*pow(sqrt(x + 9) + 3, 2)*(sqrt(x + 9) + 6)) + (1.0/18.0)*(x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) - 1.0/36.0*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(pow(x + 9, 3.0/2.0)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6));
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_inverse_0_x;
     const double dw2 = a[1]*p[1];
@@ -1597,9 +1571,9 @@ static inline float symrot_tangent_m3_angle_f(const float p[3])
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * R_2: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
- * ops: 79 */
+ * ops: 67 */
 static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1615,17 +1589,13 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
         R[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2;
+    const float c_R_1 = -(x - 27)/powf(x + 9, 3.0F/2.0F);
+    float c_R_2;
     if (x < 0.48711845F) {
-        c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_R_1 = 2*w1*cosf(w0)/s;
-        c_R_2 = 2*(w1*w1)/x;
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     const float t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -1643,12 +1613,12 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi, u0 = (x + 9)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1656,26 +1626,27 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 9.223372e+18F) || x < 1e-14F) {
-                s_lanes[k] = 0;
+            if (!(x < 9.223372e+18F)) {
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m3__phi_f(s);
-                s_lanes[k] = s;
+                const float u0 = powf(x + 9, -3.0F/2.0F);
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1686,10 +1657,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1;
+            c_R_1_lanes[k] = -u0*(x - 27);
             c_R_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_R_2_lanes[k] = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
         }
@@ -1698,9 +1666,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             c_R_0_lanes[k] = !(x < 9.223372e+18F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 1e-14F ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
             const float v_R_2 = x < 0.036088683F ? poly_R_2 : closed_R_2;
@@ -1727,10 +1693,10 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 90 */
+ * ops: 78 */
 static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1746,18 +1712,14 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
+    const float c_H_across = -(x - 27)/powf(x + 9, 3.0F/2.0F);
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
-    float c_H_across, c_H_1;
+    float c_H_1;
     if (x < 0.48711845F) {
-        c_H_across = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_H_across = 2*w1*cosf(w0)/s;
-        c_H_1 = 2*(w1*w1)/x;
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1774,12 +1736,12 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = sqrt(x + 9), u1 = (x + 9)**(-3/2).
+ * Scalar pass: phi, u0 = (x + 9)**(-3/2), u1 = sqrt(x + 9).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1788,16 +1750,14 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m3__phi_f(s);
-                const float u0 = sqrtf(x + 9);
-                const float u1 = powf(x + 9, -3.0F/2.0F);
-                s_lanes[k] = s;
+                const float u0 = powf(x + 9, -3.0F/2.0F);
+                const float u1 = sqrtf(x + 9);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -1805,7 +1765,6 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -1813,7 +1772,6 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
@@ -1827,21 +1785,16 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_H_across_lanes[k] = 2*cos0*sin0/s;
-            poly_H_across_lanes[k] = 1;
+            c_H_across_lanes[k] = -u0*(x - 27);
             c_H_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_H_1_lanes[k] = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = u1*(u0 + 12)/(u0 + 3);
+            c_H_2_lanes[k] = u0*(u1 + 12)/(u1 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_across = c_H_across_lanes[k];
-            const float poly_H_across = poly_H_across_lanes[k];
-            const float v_H_across = x < 1e-14F ? poly_H_across : closed_H_across;
-            c_H_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_H_across;
+            c_H_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.036088683F ? poly_H_1 : closed_H_1;
@@ -1869,10 +1822,10 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 1.93909, else (-x**2 + 9*x + 54*sqrt(x + 9) + 162)/(2*x*sqrt(x + 9) + 18*x + 54*sqrt(x + 9) + 162)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 89 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
+ * ops: 90 */
 static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1888,8 +1841,15 @@ static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float H
         Hinv[8] = NAN;
         return;
     }
-    const float c_H_inverse_across = -1.0F/2.0F*(x - 27)*(x + 3*sqrtf(x + 9) + 9)/(x*sqrtf(x + 9) + 12*x + 45*sqrtf(x + 9) + 108);
-    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
+    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(sqrtf(x + 9)*(sqrtf(x + 9) + 3)*(sqrtf(x + 9) + 6));
+    float c_H_inverse_across;
+    if (x < 1.9390924F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*(4.1578594e-09F + (-3.0539887e-10F)*x) - 6.1388604e-08F) + 1.0216914e-06F) - 13.0F/629856.0F) + 7.0F/11664.0F) - 5.0F/108.0F) + 1;
+    } else {
+        const float w0 = sqrtf(x + 9);
+        const float w1 = 54*w0 + 162;
+        c_H_inverse_across = (w1 - (x*x) + 9*x)/(2*w0*x + w1 + 18*x);
+    }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -1905,11 +1865,11 @@ static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float H
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: u0 = sqrt(x + 9).
+ * Scalar pass: u0 = sqrt(x + 9), u1 = 1/sqrt(x + 9).
  */
 static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1919,28 +1879,37 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
                 u0_lanes[k] = 0;
+                u1_lanes[k] = 0;
             } else {
                 const float u0 = sqrtf(x + 9);
+                const float u1 = 1.0F/sqrtf(x + 9);
                 u0_lanes[k] = u0;
+                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             u0_lanes[k] = 0;
+            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            const float w0 = u0*x;
-            c_H_inverse_across_lanes[k] = -1.0F/2.0F*(x - 27)*(3*u0 + x + 9)/(45*u0 + w0 + 12*x + 108);
-            c_H_inverse_2_lanes[k] = (1.0F/18.0F)*(72*u0 + 2*w0 + 27*x + 243)/(27*u0 + w0 + 9*x + 81);
+            const float u1 = u1_lanes[k];
+            const float w0 = 54*u0 + 162;
+            const float w1 = 2*u0*x;
+            c_H_inverse_across_lanes[k] = (w0 - (x*x) + 9*x)/(w0 + w1 + 18*x);
+            poly_H_inverse_across_lanes[k] = 1;
+            c_H_inverse_2_lanes[k] = (1.0F/18.0F)*u1*(72*u0 + w1 + 27*x + 243)/((u0 + 3)*(u0 + 6));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            c_H_inverse_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_across;
+            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
+            const float v_H_inverse_across = x < 1.9011963e-14F ? poly_H_inverse_across : closed_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 9.223372e+18F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_2;
@@ -2270,10 +2239,10 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = -(x - 27)*(x + 3*sqrt(x + 9) + 9)/(2*(x*sqrt(x + 9) + 12*x + 45*sqrt(x + 9) + 108)) (algebraic in x)
+ * H_inverse_across: Horner degree 7 in x below x = 1.93909, else (-x**2 + 9*x + 54*sqrt(x + 9) + 162)/(2*x*sqrt(x + 9) + 18*x + 54*sqrt(x + 9) + 162)
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 88 */
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
+ * ops: 89 */
 static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2283,8 +2252,15 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
         pdot[2] = NAN;
         return;
     }
-    const float c_H_inverse_across = -1.0F/2.0F*(x - 27)*(x + 3*sqrtf(x + 9) + 9)/(x*sqrtf(x + 9) + 12*x + 45*sqrtf(x + 9) + 108);
-    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
+    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(sqrtf(x + 9)*(sqrtf(x + 9) + 3)*(sqrtf(x + 9) + 6));
+    float c_H_inverse_across;
+    if (x < 1.9390924F) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*(4.1578594e-09F + (-3.0539887e-10F)*x) - 6.1388604e-08F) + 1.0216914e-06F) - 13.0F/629856.0F) + 7.0F/11664.0F) - 5.0F/108.0F) + 1;
+    } else {
+        const float w0 = sqrtf(x + 9);
+        const float w1 = 54*w0 + 162;
+        c_H_inverse_across = (w1 - (x*x) + 9*x)/(2*w0*x + w1 + 18*x);
+    }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -2298,10 +2274,10 @@ static inline void symrot_tangent_m3_pdot_f(const float p[3], const float omega[
  * Valid for every p with |p|^2 < 2^63 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_across: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * H_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * H_2 = (sqrt(x + 9) + 12)/((x + 9)**(3/2)*(sqrt(x + 9) + 3)) (algebraic in x)
- * ops: 89 */
+ * ops: 77 */
 static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2311,18 +2287,14 @@ static inline void symrot_tangent_m3_omega_f(const float p[3], const float pdot[
         omega[2] = NAN;
         return;
     }
+    const float c_H_across = -(x - 27)/powf(x + 9, 3.0F/2.0F);
     const float c_H_2 = (sqrtf(x + 9) + 12)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3));
-    float c_H_across, c_H_1;
+    float c_H_1;
     if (x < 0.48711845F) {
-        c_H_across = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        c_H_across = 2*w1*cosf(w0)/s;
-        c_H_1 = 2*(w1*w1)/x;
+        c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2499,12 +2471,12 @@ static inline int symrot_tangent_m3_rescale_f(const float p[3], float q[3])
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * R_2: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 3*(x/9 + 1)*sin(phi)/s)/(2*x*(x + 9))
+ * R_1_x = 3*(x - 27)/(2*(x + 9)**(5/2)) - 1/(x + 9)**(3/2) (algebraic in x)
  * R_2_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
- * ops: 232 */
+ * ops: 192 */
 static inline void symrot_tangent_m3_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2520,26 +2492,17 @@ static inline void symrot_tangent_m3_rotation_derivative_f(const float p[3], con
         D[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const float c_R_1 = -(x - 27)/powf(x + 9, 3.0F/2.0F);
+    const float c_R_1_x = (3.0F/2.0F)*(x - 27)/powf(x + 9, 5.0F/2.0F) - 1/powf(x + 9, 3.0F/2.0F);
+    float c_R_2, c_R_2_x;
     if (x < 0.48711845F) {
-        c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/s;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = 1.0F/x;
-        const float w4 = (w2*w2);
-        const float w5 = 3*sinf(phi);
-        const float w6 = (3.0F/2.0F)/(x + 9);
-        c_R_1 = 2*w0*w2*cosf(w1);
-        c_R_2 = 2*w3*w4;
-        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w3*w6*(-w0*w5*((1.0F/9.0F)*x + 1) - 6*w4 + 3);
-        c_R_2_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w6*(-6*w0*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1) + w5)/(s*s*s);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        c_R_2_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2583,12 +2546,12 @@ static inline void symrot_tangent_m3_rotation_derivative_f(const float p[3], con
  * Valid for every p with |p|^2 < 2^32 (|phi| < 4.7123889803846897), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * R_1: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = -(x - 27)/(x + 9)**(3/2) (algebraic in x)
  * R_2: Horner degree 6 in x below x = 0.487118, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 13 in x below x = 1.93909, else 3*(-6*sin(phi/2)**2 + 3 - 3*(x/9 + 1)*sin(phi)/s)/(2*x*(x + 9))
+ * R_1_x = 3*(x - 27)/(2*(x + 9)**(5/2)) - 1/(x + 9)**(3/2) (algebraic in x)
  * R_2_x: Horner degree 9 in x below x = 0.956738, else 3*(3*sin(phi) - 6*(1 - cos(phi))*(s**2/9 + 1)/s)/(2*s**3*(x + 9))
- * ops: 233 */
+ * ops: 193 */
 static inline void symrot_tangent_m3_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2604,26 +2567,17 @@ static inline void symrot_tangent_m3_rotation_transpose_derivative_f(const float
         D[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const float c_R_1 = -(x - 27)/powf(x + 9, 3.0F/2.0F);
+    const float c_R_1_x = (3.0F/2.0F)*(x - 27)/powf(x + 9, 5.0F/2.0F) - 1/powf(x + 9, 3.0F/2.0F);
+    float c_R_2, c_R_2_x;
     if (x < 0.48711845F) {
-        c_R_1 = x*(x*(x*(x*(x*((7.2161556e-06F)*x - 301.0F/5038848.0F) + 1225.0F/2519424.0F) - 5.0F/1296.0F) + 19.0F/648.0F) - 11.0F/54.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((2.4963451e-06F)*x - 2.0799507e-05F) + 287.0F/1679616.0F) - 385.0F/279936.0F) + 125.0F/11664.0F) - 17.0F/216.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m3__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/s;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = 1.0F/x;
-        const float w4 = (w2*w2);
-        const float w5 = 3*sinf(phi);
-        const float w6 = (3.0F/2.0F)/(x + 9);
-        c_R_1 = 2*w0*w2*cosf(w1);
-        c_R_2 = 2*w3*w4;
-        c_R_1_x = x < 1.9390924F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5058532e-12F)*x - 2.8270388e-11F) + 2.25994e-10F) - 1.7883004e-09F) + 1.3980747e-08F) - 1.077147e-07F) + 8.1508347e-07F) - 6.0291845e-06F) + 4.3296932e-05F) - 1505.0F/5038848.0F) + 1225.0F/629856.0F) - 5.0F/432.0F) + 19.0F/324.0F) - 11.0F/54.0F : w3*w6*(-w0*w5*((1.0F/9.0F)*x + 1) - 6*w4 + 3);
-        c_R_2_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : w6*(-6*w0*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1) + w5)/(s*s*s);
+        c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
+        c_R_2_x = x < 0.95673823F ? x*(x*(x*(x*(x*(x*(x*(x*((4.769992e-09F)*x - 3.6838426e-08F) + 2.7957947e-07F) - 2.0757257e-06F) + 1.4978071e-05F) - 0.00010399754F) + 287.0F/419904.0F) - 385.0F/93312.0F) + 125.0F/5832.0F) - 17.0F/216.0F : (3.0F/2.0F)*(3*sinf(phi) - 6*(1 - cosf(phi))*((1.0F/9.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 9));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2826,11 +2780,11 @@ static inline void symrot_tangent_m3_tangent_transpose_derivative_f(const float 
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
+ * H_inverse_2 = (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
  * H_inverse_0_x = 1/9 (algebraic in x)
  * H_inverse_1_x = 0 (constant)
- * H_inverse_2_x = (-x/(2*sqrt(x + 9)) - sqrt(x + 9) - 9 - 27/(2*sqrt(x + 9)))*(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)**2) + (x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(18*(x*sqrt(x + 9) + 9*x + 27*sqrt(x + 9) + 81)) (algebraic in x)
- * ops: 224 */
+ * H_inverse_2_x = -(2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(36*(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)**2) - (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(36*(x + 9)*(sqrt(x + 9) + 3)**2*(sqrt(x + 9) + 6)) + (x/sqrt(x + 9) + 2*sqrt(x + 9) + 27 + 36/sqrt(x + 9))/(18*sqrt(x + 9)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) - (2*x*sqrt(x + 9) + 27*x + 72*sqrt(x + 9) + 243)/(36*(x + 9)**(3/2)*(sqrt(x + 9) + 3)*(sqrt(x + 9) + 6)) (algebraic in x)
+ * ops: 264 */
 static inline void symrot_tangent_m3_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2846,9 +2800,9 @@ static inline void symrot_tangent_m3_tangent_inverse_derivative_f(const float p[
         D[8] = NAN;
         return;
     }
-    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
+    const float c_H_inverse_2 = (1.0F/18.0F)*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(sqrtf(x + 9)*(sqrtf(x + 9) + 3)*(sqrtf(x + 9) + 6));
     const float c_H_inverse_0_x = 1.0F/9.0F;
-    const float c_H_inverse_2_x = (1.0F/18.0F)*(-1.0F/2.0F*x/sqrtf(x + 9) - sqrtf(x + 9) - 9 - (27.0F/2.0F)/sqrtf(x + 9))*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/powf(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81, 2) + (1.0F/18.0F)*(x/sqrtf(x + 9) + 2*sqrtf(x + 9) + 27 + 36/sqrtf(x + 9))/(x*sqrtf(x + 9) + 9*x + 27*sqrtf(x + 9) + 81);
+    const float c_H_inverse_2_x = -1.0F/36.0F*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/((x + 9)*(sqrtf(x + 9) + 3)*powf(sqrtf(x + 9) + 6, 2)) - 1.0F/36.0F*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/((x + 9)*powf(sqrtf(x + 9) + 3, 2)*(sqrtf(x + 9) + 6)) + (1.0F/18.0F)*(x/sqrtf(x + 9) + 2*sqrtf(x + 9) + 27 + 36/sqrtf(x + 9))/(sqrtf(x + 9)*(sqrtf(x + 9) + 3)*(sqrtf(x + 9) + 6)) - 1.0F/36.0F*(2*x*sqrtf(x + 9) + 27*x + 72*sqrtf(x + 9) + 243)/(powf(x + 9, 3.0F/2.0F)*(sqrtf(x + 9) + 3)*(sqrtf(x + 9) + 6));
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_inverse_0_x;
     const float dw2 = a[1]*p[1];

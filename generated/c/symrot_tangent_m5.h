@@ -75,9 +75,9 @@ static inline double symrot_tangent_m5_angle(const double p[3])
 /* symrot_tangent_m5_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
- * ops: 87 */
+ * ops: 73 */
 static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -93,17 +93,13 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
         R[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2;
+    const double c_R_1 = ((x*x) - 250*x + 3125)/pow(x + 25, 5.0/2.0);
+    double c_R_2;
     if (x < 0.11104807041853587) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        c_R_1 = 2*w1*cos(w0)/s;
-        c_R_2 = 2*(w1*w1)/x;
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -121,12 +117,12 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi, u0 = (x + 25)**(-5/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -134,26 +130,27 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 3.690968361342381e-14) {
-                s_lanes[k] = 0;
+            if (!(x <= 236.80339887498948)) {
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m5__phi(s);
-                s_lanes[k] = s;
+                const double u0 = pow(x + 25, -5.0/2.0);
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -164,10 +161,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1 + (-9.0/50.0)*x;
+            c_R_1_lanes[k] = u0*((x*x) - 250*x + 3125);
             c_R_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_R_2_lanes[k] = 1.0/2.0 + (-11.0/200.0)*x;
         }
@@ -176,9 +170,7 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double x = x_lanes[k];
             c_R_0_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 3.690968361342381e-14 ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_R_1;
+            c_R_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
             const double v_R_2 = x < 3.327466630718667e-08 ? poly_R_2 : closed_R_2;
@@ -203,10 +195,10 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
 
 /* symrot_tangent_m5_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 146 */
+ * ops: 132 */
 static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -222,9 +214,9 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
-    double c_H_across, c_H_1, c_H_2;
+    const double c_H_across = ((x*x) - 250*x + 3125)/pow(x + 25, 5.0/2.0);
+    double c_H_1, c_H_2;
     if (x < 0.11104807041853587) {
-        c_H_across = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
@@ -232,10 +224,8 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 2*w1*cos(w0)/s;
-        c_H_across = w2;
         c_H_1 = 2*(w1*w1)/x;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (-w2 + 25/(x + 25))/(s*s);
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25/(x + 25) - 2*w1*cos(w0)/s)/(s*s);
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -252,12 +242,12 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: s, phi, u0 = (x + 25)**(-5/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -265,26 +255,31 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 236.80339887498948) || x < 3.327466630718667e-08) {
+            if (!(x <= 236.80339887498948)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m5__phi(s);
+                const double u0 = pow(x + 25, -5.0/2.0);
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
+            const double u0 = u0_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -297,21 +292,17 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double w0 = 2*cos0*sin0/s;
-            c_H_across_lanes[k] = w0;
-            poly_H_across_lanes[k] = 1 + (-9.0/50.0)*x;
+            c_H_across_lanes[k] = u0*((x*x) - 250*x + 3125);
             c_H_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_H_1_lanes[k] = 1.0/2.0 + (-11.0/200.0)*x;
-            c_H_2_lanes[k] = (-w0 + 25/(x + 25))/(s*s);
+            c_H_2_lanes[k] = (-2*cos0*sin0/s + 25/(x + 25))/(s*s);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_across = c_H_across_lanes[k];
-            const double poly_H_across = poly_H_across_lanes[k];
-            const double v_H_across = x < 3.327466630718667e-08 ? poly_H_across : closed_H_across;
-            c_H_across_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_H_across;
+            c_H_across_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 3.327466630718667e-08 ? poly_H_1 : closed_H_1;
@@ -800,10 +791,10 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
 
 /* symrot_tangent_m5_omega: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 20 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/s**2
- * ops: 145 */
+ * ops: 131 */
 static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -813,9 +804,9 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
         omega[2] = (double)NAN;
         return;
     }
-    double c_H_across, c_H_1, c_H_2;
+    const double c_H_across = ((x*x) - 250*x + 3125)/pow(x + 25, 5.0/2.0);
+    double c_H_1, c_H_2;
     if (x < 0.11104807041853587) {
-        c_H_across = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
     } else {
@@ -823,10 +814,8 @@ static inline void symrot_tangent_m5_omega(const double p[3], const double pdot[
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = 2*w1*cos(w0)/s;
-        c_H_across = w2;
         c_H_1 = 2*(w1*w1)/x;
-        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (-w2 + 25/(x + 25))/(s*s);
+        c_H_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0 : (25/(x + 25) - 2*w1*cos(w0)/s)/(s*s);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -999,12 +988,12 @@ static inline int symrot_tangent_m5_rescale(const double p[3], double q[3])
 /* symrot_tangent_m5_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(x/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*x*(x + 25))
+ * R_1_x = (2*x - 250)/(x + 25)**(5/2) - 5*(x**2 - 250*x + 3125)/(2*(x + 25)**(7/2)) (algebraic in x)
  * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
- * ops: 300 */
+ * ops: 239 */
 static inline void symrot_tangent_m5_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1020,27 +1009,20 @@ static inline void symrot_tangent_m5_rotation_derivative(const double p[3], cons
         D[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const double c_R_1 = ((x*x) - 250*x + 3125)/pow(x + 25, 5.0/2.0);
+    const double c_R_1_x = (2*x - 250)/pow(x + 25, 5.0/2.0) - 5.0/2.0*((x*x) - 250*x + 3125)/pow(x + 25, 7.0/2.0);
+    double c_R_2, c_R_2_x;
     if (x < 0.11104807041853587) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/s;
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = w2*cos(w1);
-        const double w4 = 1.0/x;
-        const double w5 = (w2*w2);
-        const double w6 = 10*w3;
-        const double w7 = (5.0/2.0)/(x + 25);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4*w5;
-        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w4*w7*(-w0*w6*((1.0/25.0)*x + 1) - 10*w5 + 5);
-        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w7*(-20*w0*w5*((1.0/25.0)*(s*s) + 1) + w6)/(s*s*s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*(10*w1*cos(w0) - 20*w2*((1.0/25.0)*(s*s) + 1)/s)/((s*s*s)*(x + 25));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1082,12 +1064,12 @@ static inline void symrot_tangent_m5_rotation_derivative(const double p[3], cons
 /* symrot_tangent_m5_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.111048, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 21 in x below x = 3.13745, else 5*(-10*sin(phi/2)**2 + 5 - 10*(x/25 + 1)*sin(phi/2)*cos(phi/2)/s)/(2*x*(x + 25))
+ * R_1_x = (2*x - 250)/(x + 25)**(5/2) - 5*(x**2 - 250*x + 3125)/(2*(x + 25)**(7/2)) (algebraic in x)
  * R_2_x: Horner degree 21 in x below x = 3.13745, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
- * ops: 301 */
+ * ops: 240 */
 static inline void symrot_tangent_m5_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1103,27 +1085,20 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative(const double 
         D[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const double c_R_1 = ((x*x) - 250*x + 3125)/pow(x + 25, 5.0/2.0);
+    const double c_R_1_x = (2*x - 250)/pow(x + 25, 5.0/2.0) - 5.0/2.0*((x*x) - 250*x + 3125)/pow(x + 25, 7.0/2.0);
+    double c_R_2, c_R_2_x;
     if (x < 0.11104807041853587) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(40887.0/250000000000.0 + (-506649.0/62500000000000.0)*x) - 7959.0/2500000000.0) + 2947.0/50000000.0) - 253.0/250000.0) + 383.0/25000.0) - 9.0/50.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(91377.0/2500000000000.0 + (-1785927.0/1000000000000000.0)*x) - 36267.0/50000000000.0) + 34503.0/2500000000.0) - 2471.0/10000000.0) + 201.0/50000.0) - 11.0/200.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/s;
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = w2*cos(w1);
-        const double w4 = 1.0/x;
-        const double w5 = (w2*w2);
-        const double w6 = 10*w3;
-        const double w7 = (5.0/2.0)/(x + 25);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4*w5;
-        c_R_1_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.944055866499269e-28)*x - 2.216599752731364e-26) + 4.9137692640036e-25) - 1.08268905166884e-23) + 2.3695904279124e-22) - 5.1474841574508e-21) + 1.108873103472e-19) - 2.3663177676e-18) + 4.9959074088e-17) - 1.0419113068e-15) + 2.14234054944e-14) - 4.3325282e-13) + 8.591154e-12) - 1.66367916e-10) + 1955811.0/625000000000000.0) - 3546543.0/62500000000000.0) + 122661.0/125000000000.0) - 7959.0/500000000.0) + 2947.0/12500000.0) - 759.0/250000.0) + 383.0/12500.0) - 9.0/50.0 : w4*w7*(-w0*w6*((1.0/25.0)*x + 1) - 10*w5 + 5);
-        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : w7*(-20*w0*w5*((1.0/25.0)*(s*s) + 1) + w6)/(s*s*s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.055465003237703e-28)*x - 4.588724225028762e-27) + 1.01892215631492e-25) - 2.249182077260118e-24) + 4.9325729443452e-23) - 1.0739242859961e-21) + 2.319293435184e-20) - 4.963421320425e-19) + 1.051293480048e-17) - 2.2006228374e-16) + 4.544230152e-15) - 9.236044818e-14) + 1.84235324e-12) - 3.593319444e-11) + 4261543.0/6250000000000000.0) - 12501489.0/1000000000000000.0) + 274131.0/1250000000000.0) - 36267.0/10000000000.0) + 34503.0/625000000.0) - 7413.0/10000000.0) + 201.0/25000.0) - 11.0/200.0 : (5.0/2.0)*(10*w1*cos(w0) - 20*w2*((1.0/25.0)*(s*s) + 1)/s)/((s*s*s)*(x + 25));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1641,9 +1616,9 @@ static inline float symrot_tangent_m5_angle_f(const float p[3])
 /* symrot_tangent_m5_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/x
- * ops: 87 */
+ * ops: 73 */
 static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1659,15 +1634,12 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
         R[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2;
+    const float c_R_1 = ((x*x) - 250*x + 3125)/powf(x + 25, 5.0F/2.0F);
+    float c_R_2;
     if (x < 1.5711837F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        c_R_1 = 2*sinf(w0)*cosf(w0)/s;
         c_R_2 = (1 - cosf(phi))/x;
     }
     const float t = -c_R_2*x + 1;
@@ -1686,12 +1658,12 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi, u0 = (x + 25)**(-5/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1699,27 +1671,28 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
-                s_lanes[k] = 0;
+            if (!(x < 236.8034F)) {
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m5__phi_f(s);
-                s_lanes[k] = s;
+                const float u0 = powf(x + 25, -5.0F/2.0F);
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float u0 = u0_lanes[k];
+            const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1728,23 +1701,10 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float a1_a = phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1;
-            c_R_2_lanes[k] = (1 - cos1)/x;
+            c_R_1_lanes[k] = u0*((x*x) - 250*x + 3125);
+            c_R_2_lanes[k] = (1 - cos0)/x;
             poly_R_2_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1752,9 +1712,7 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             c_R_0_lanes[k] = !(x < 236.8034F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 3.6909684e-14F ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 236.8034F) ? NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 236.8034F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
             const float v_R_2 = x < 0.41316044F ? poly_R_2 : closed_R_2;
@@ -1779,10 +1737,10 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
 
 /* symrot_tangent_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
- * ops: 114 */
+ * ops: 100 */
 static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1798,21 +1756,19 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
-    float c_H_across, c_H_1, c_H_2;
+    const float c_H_across = ((x*x) - 250*x + 3125)/powf(x + 25, 5.0F/2.0F);
+    float c_H_1, c_H_2;
     if (x < 1.5711837F) {
-        c_H_across = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = 2*w1*cosf(w0)/s;
-        const float w3 = 1.0F/x;
-        c_H_across = w2;
-        c_H_1 = 2*(w1*w1)*w3;
-        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w3*(-w2 + 25/(x + 25));
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1829,12 +1785,12 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: s, phi, u0 = (x + 25)**(-5/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1842,26 +1798,31 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 236.8034F) || x < 3.6909684e-14F) {
+            if (!(x < 236.8034F)) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m5__phi_f(s);
+                const float u0 = powf(x + 25, -5.0F/2.0F);
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
+            const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1874,22 +1835,18 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = 2*cos0*sin0/s;
-            const float w1 = 1.0F/x;
-            c_H_across_lanes[k] = w0;
-            poly_H_across_lanes[k] = 1;
-            c_H_1_lanes[k] = 2*(sin0*sin0)*w1;
+            const float w0 = 1.0F/x;
+            c_H_across_lanes[k] = u0*((x*x) - 250*x + 3125);
+            c_H_1_lanes[k] = 2*(sin0*sin0)*w0;
             poly_H_1_lanes[k] = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w1*(-w0 + 25/(x + 25));
+            c_H_2_lanes[k] = w0*(-2*cos0*sin0/s + 25/(x + 25));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_across = c_H_across_lanes[k];
-            const float poly_H_across = poly_H_across_lanes[k];
-            const float v_H_across = x < 3.6909684e-14F ? poly_H_across : closed_H_across;
-            c_H_across_lanes[k] = !(x < 236.8034F) ? NAN : v_H_across;
+            c_H_across_lanes[k] = !(x < 236.8034F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.0081290705F ? poly_H_1 : closed_H_1;
@@ -2378,10 +2335,10 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
 
 /* symrot_tangent_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * H_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 9 in x below x = 3.13745, else (25/(x + 25) - 2*sin(phi/2)*cos(phi/2)/s)/x
- * ops: 113 */
+ * ops: 99 */
 static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2391,21 +2348,19 @@ static inline void symrot_tangent_m5_omega_f(const float p[3], const float pdot[
         omega[2] = NAN;
         return;
     }
-    float c_H_across, c_H_1, c_H_2;
+    const float c_H_across = ((x*x) - 250*x + 3125)/powf(x + 25, 5.0F/2.0F);
+    float c_H_1, c_H_2;
     if (x < 1.5711837F) {
-        c_H_across = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = 2*w1*cosf(w0)/s;
-        const float w3 = 1.0F/x;
-        c_H_across = w2;
-        c_H_1 = 2*(w1*w1)*w3;
-        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w3*(-w2 + 25/(x + 25));
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        c_H_1 = 2*w0*(w2*w2);
+        c_H_2 = x < 3.1374536F ? x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F : w0*(25/(x + 25) - 2*w2*cosf(w1)/s);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2578,12 +2533,12 @@ static inline int symrot_tangent_m5_rescale_f(const float p[3], float q[3])
 /* symrot_tangent_m5_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 8 in x below x = 1.57118, else 5*(5*cos(phi) - 5*(x/25 + 1)*sin(phi)/s)/(2*x*(x + 25))
+ * R_1_x = (2*x - 250)/(x + 25)**(5/2) - 5*(x**2 - 250*x + 3125)/(2*(x + 25)**(7/2)) (algebraic in x)
  * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
- * ops: 250 */
+ * ops: 227 */
 static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2599,26 +2554,19 @@ static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], con
         D[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const float c_R_1 = ((x*x) - 250*x + 3125)/powf(x + 25, 5.0F/2.0F);
+    const float c_R_1_x = (2*x - 250)/powf(x + 25, 5.0F/2.0F) - 5.0F/2.0F*((x*x) - 250*x + 3125)/powf(x + 25, 7.0F/2.0F);
+    float c_R_2, c_R_2_x;
     if (x < 1.5711837F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(3.1292977e-09F + (-1.6636792e-10F)*x) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/s;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = w2*cosf(w1);
-        const float w4 = 1.0F/x;
-        const float w5 = cosf(phi);
-        const float w6 = (5.0F/2.0F)/(x + 25);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = w4*(1 - w5);
-        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*w5);
-        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*(w2*w2)*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_2 = (1 - cosf(phi))/x;
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*(10*w1*cosf(w0) - 20*(w1*w1)*((1.0F/25.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 25));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2660,12 +2608,12 @@ static inline void symrot_tangent_m5_rotation_derivative_f(const float p[3], con
 /* symrot_tangent_m5_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 1.57118, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = (x**2 - 250*x + 3125)/(x + 25)**(5/2) (algebraic in x)
  * R_2: Horner degree 7 in x below x = 1.57118, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 8 in x below x = 1.57118, else 5*(5*cos(phi) - 5*(x/25 + 1)*sin(phi)/s)/(2*x*(x + 25))
+ * R_1_x = (2*x - 250)/(x + 25)**(5/2) - 5*(x**2 - 250*x + 3125)/(2*(x + 25)**(7/2)) (algebraic in x)
  * R_2_x: Horner degree 17 in x below x = 6.51179, else 5*(10*sin(phi/2)*cos(phi/2) - 20*(s**2/25 + 1)*sin(phi/2)**2/s)/(2*s**3*(x + 25))
- * ops: 251 */
+ * ops: 228 */
 static inline void symrot_tangent_m5_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2681,26 +2629,19 @@ static inline void symrot_tangent_m5_rotation_transpose_derivative_f(const float
         D[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const float c_R_1 = ((x*x) - 250*x + 3125)/powf(x + 25, 5.0F/2.0F);
+    const float c_R_1_x = (2*x - 250)/powf(x + 25, 5.0F/2.0F) - 5.0F/2.0F*((x*x) - 250*x + 3125)/powf(x + 25, 7.0F/2.0F);
+    float c_R_2, c_R_2_x;
     if (x < 1.5711837F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1.63548e-07F + (-8.106384e-09F)*x) - 3.1836e-06F) + 5.894e-05F) - 253.0F/250000.0F) + 383.0F/25000.0F) - 9.0F/50.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(3.65508e-08F + (-1.785927e-09F)*x) - 7.2534e-07F) + 1.38012e-05F) - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(3.1292977e-09F + (-1.6636792e-10F)*x) - 5.674469e-08F) + 9.81288e-07F) - 1.5918e-05F) + 2947.0F/12500000.0F) - 759.0F/250000.0F) + 383.0F/12500.0F) - 9.0F/50.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F;
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/s;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = w2*cosf(w1);
-        const float w4 = 1.0F/x;
-        const float w5 = cosf(phi);
-        const float w6 = (5.0F/2.0F)/(x + 25);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = w4*(1 - w5);
-        c_R_1_x = w4*w6*(-5*w0*((1.0F/25.0F)*x + 1)*sinf(phi) + 5*w5);
-        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : w6*(-20*w0*(w2*w2)*((1.0F/25.0F)*(s*s) + 1) + 10*w3)/(s*s*s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_2 = (1 - cosf(phi))/x;
+        c_R_2_x = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.932573e-23F)*x - 1.0739243e-21F) + 2.3192934e-20F) - 4.9634213e-19F) + 1.05129345e-17F) - 2.2006228e-16F) + 4.54423e-15F) - 9.2360445e-14F) + 1.8423533e-12F) - 3.5933194e-11F) + 6.8184686e-10F) - 1.2501489e-08F) + 2.193048e-07F) - 3.6267e-06F) + 5.52048e-05F) - 7413.0F/10000000.0F) + 201.0F/25000.0F) - 11.0F/200.0F : (5.0F/2.0F)*(10*w1*cosf(w0) - 20*(w1*w1)*((1.0F/25.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 25));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];

@@ -75,9 +75,9 @@ static inline double symrot_tangent_m6_angle(const double p[3])
 /* symrot_tangent_m6_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
- * ops: 87 */
+ * ops: 72 */
 static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -93,17 +93,13 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
         R[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2;
+    const double c_R_1 = 36*(x - 108)*(x - 12)/pow(x + 36, 3);
+    double c_R_2;
     if (x < 0.11094775628437428) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(131.0/13060694016.0 + (-19.0/52242776064.0)*x) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        c_R_1 = 2*w1*cos(w0)/s;
-        c_R_2 = 2*(w1*w1)/x;
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -121,12 +117,12 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -134,25 +130,21 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 3.327466629816501e-08) {
-                s_lanes[k] = 0;
+            if (!(x < 108.0) || x < 0.002202034702797594) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
@@ -164,10 +156,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = 1 + (-19.0/108.0)*x;
+            c_R_1_lanes[k] = 36*(x - 108)*(x - 12)/((x + 36)*(x + 36)*(x + 36));
             c_R_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_R_2_lanes[k] = x*(x*(x*((67.0/10077696.0)*x - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
         }
@@ -176,9 +165,7 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double x = x_lanes[k];
             c_R_0_lanes[k] = !(x < 108.0) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
-            const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 3.327466629816501e-08 ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 108.0) ? (double)NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 108.0) ? (double)NAN : closed_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
             const double v_R_2 = x < 0.002202034702797594 ? poly_R_2 : closed_R_2;
@@ -203,10 +190,10 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
 
 /* symrot_tangent_m6_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 88 */
+ * ops: 73 */
 static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -222,18 +209,14 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
         H[8] = (double)NAN;
         return;
     }
+    const double c_H_across = 36*(x - 108)*(x - 12)/pow(x + 36, 3);
     const double c_H_2 = 6912/pow(x + 36, 3);
-    double c_H_across, c_H_1;
+    double c_H_1;
     if (x < 0.11094775628437428) {
-        c_H_across = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(131.0/13060694016.0 + (-19.0/52242776064.0)*x) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        c_H_across = 2*w1*cos(w0)/s;
-        c_H_1 = 2*(w1*w1)/x;
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -250,12 +233,12 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -263,25 +246,21 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 3.327466629816501e-08) {
-                s_lanes[k] = 0;
+            if (!(x < 108.0) || x < 0.002202034702797594) {
                 phi_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
@@ -293,21 +272,17 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_H_across_lanes[k] = 2*cos0*sin0/s;
-            poly_H_across_lanes[k] = 1 + (-19.0/108.0)*x;
+            const double w0 = 1.0/((x + 36)*(x + 36)*(x + 36));
+            c_H_across_lanes[k] = 36*w0*(x - 108)*(x - 12);
             c_H_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_H_1_lanes[k] = x*(x*(x*((67.0/10077696.0)*x - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
-            c_H_2_lanes[k] = 6912/((x + 36)*(x + 36)*(x + 36));
+            c_H_2_lanes[k] = 6912*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_across = c_H_across_lanes[k];
-            const double poly_H_across = poly_H_across_lanes[k];
-            const double v_H_across = x < 3.327466629816501e-08 ? poly_H_across : closed_H_across;
-            c_H_across_lanes[k] = !(x < 108.0) ? (double)NAN : v_H_across;
+            c_H_across_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
             const double v_H_1 = x < 0.002202034702797594 ? poly_H_1 : closed_H_1;
@@ -333,10 +308,10 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
 
 /* symrot_tangent_m6_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.411778, else (9*x - 108)/(x - 108)
+ * H_inverse_across = 9*(x - 12)/(x - 108) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 65 */
+ * ops: 47 */
 static inline void symrot_tangent_m6_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -352,13 +327,8 @@ static inline void symrot_tangent_m6_tangent_inverse(const double p[3], double H
         Hinv[8] = (double)NAN;
         return;
     }
+    const double c_H_inverse_across = 9*(x - 12)/(x - 108);
     const double c_H_inverse_2 = (1.0/36.0)*(x - 396)/(x - 108);
-    double c_H_inverse_across;
-    if (x < 0.4117780186135704) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-1.0/21422803359744.0)*x - 1.0/198359290368.0) - 1.0/1836660096.0) - 1.0/17006112.0) - 1.0/157464.0) - 1.0/1458.0) - 2.0/27.0) + 1;
-    } else {
-        c_H_inverse_across = (9*x - 108)/(x - 108);
-    }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
@@ -377,7 +347,7 @@ static inline void symrot_tangent_m6_tangent_inverse(const double p[3], double H
  */
 static inline void symrot_tangent_m6_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -393,17 +363,14 @@ static inline void symrot_tangent_m6_tangent_inverse_batch(size_t n, const doubl
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double w0 = 1.0/(x - 108);
-            c_H_inverse_across_lanes[k] = w0*(9*x - 108);
-            poly_H_inverse_across_lanes[k] = 1 + (-2.0/27.0)*x;
+            c_H_inverse_across_lanes[k] = 9*w0*(x - 12);
             c_H_inverse_2_lanes[k] = (1.0/36.0)*w0*(x - 396);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const double v_H_inverse_across = x < 1.3623247444430473e-13 ? poly_H_inverse_across : closed_H_inverse_across;
-            c_H_inverse_across_lanes[k] = !(x < 108.0) ? (double)NAN : v_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 108.0) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 108.0) ? (double)NAN : closed_H_inverse_2;
@@ -441,9 +408,9 @@ static inline double symrot_tangent_m6_tangent_det(const double p[3])
 /* symrot_tangent_m6_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 7 in x below x = 0.213555, else sin(phi/2)/s
+ * G_1 = -(x - 108)/(x + 36)**(3/2) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 0.213555, else 2*sin(phi/4)**2/x
- * ops: 88 */
+ * ops: 71 */
 static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -459,14 +426,12 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
         G[8] = (double)NAN;
         return;
     }
-    double c_G_1, c_G_2;
+    const double c_G_1 = -(x - 108)/pow(x + 36, 3.0/2.0);
+    double c_G_2;
     if (x < 0.21355546857295174) {
-        c_G_1 = x*(x*(x*(x*(x*(x*(1309.0/1486016741376.0 + (-8437.0/320979616137216.0)*x) - 301.0/10319560704.0) + 1225.0/1289945088.0) - 5.0/165888.0) + 19.0/20736.0) - 11.0/432.0) + 1.0/2.0;
         c_G_2 = x*(x*(x*(x*(x*(x*(2717.0/17832200896512.0 + (-4.524722683259537e-12)*x) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_G_1 = sin((1.0/2.0)*phi)/s;
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
@@ -485,12 +450,12 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi, u0 = (x + 36)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -498,27 +463,28 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0) || x < 3.69096836134238e-14) {
-                s_lanes[k] = 0;
+            if (!(x < 108.0)) {
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
-                s_lanes[k] = s;
+                const double u0 = pow(x + 36, -3.0/2.0);
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double u0 = u0_lanes[k];
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -528,19 +494,8 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/4.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/432.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            c_G_1_lanes[k] = -u0*(x - 108);
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_G_2_lanes[k] = x*((125.0/746496.0)*x - 17.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -548,9 +503,7 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double x = x_lanes[k];
             c_G_0_lanes[k] = !(x < 108.0) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
-            const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 3.69096836134238e-14 ? poly_G_1 : closed_G_1;
-            c_G_1_lanes[k] = !(x < 108.0) ? (double)NAN : v_G_1;
+            c_G_1_lanes[k] = !(x < 108.0) ? (double)NAN : closed_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
             const double v_G_2 = x < 3.2144365899743845e-06 ? poly_G_2 : closed_G_2;
@@ -575,10 +528,10 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
 
 /* symrot_tangent_m6_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_across: Horner degree 7 in x below x = 0.213555, else sin(phi/2)/s
+ * K_across = -(x - 108)/(x + 36)**(3/2) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 0.213555, else 2*sin(phi/4)**2/x
  * K_2 = (sqrt(x + 36) + 24)/((x + 36)**(3/2)*(sqrt(x + 36) + 6)) (algebraic in x)
- * ops: 99 */
+ * ops: 82 */
 static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -594,15 +547,13 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
         K[8] = (double)NAN;
         return;
     }
+    const double c_K_across = -(x - 108)/pow(x + 36, 3.0/2.0);
     const double c_K_2 = (sqrt(x + 36) + 24)/(pow(x + 36, 3.0/2.0)*(sqrt(x + 36) + 6));
-    double c_K_across, c_K_1;
+    double c_K_1;
     if (x < 0.21355546857295174) {
-        c_K_across = x*(x*(x*(x*(x*(x*(1309.0/1486016741376.0 + (-8437.0/320979616137216.0)*x) - 301.0/10319560704.0) + 1225.0/1289945088.0) - 5.0/165888.0) + 19.0/20736.0) - 11.0/432.0) + 1.0/2.0;
         c_K_1 = x*(x*(x*(x*(x*(x*(2717.0/17832200896512.0 + (-4.524722683259537e-12)*x) - 3773.0/743008370688.0) + 287.0/1719926784.0) - 385.0/71663616.0) + 125.0/746496.0) - 17.0/3456.0) + 1.0/8.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_K_across = sin((1.0/2.0)*phi)/s;
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
@@ -620,12 +571,12 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = sqrt(x + 36), u1 = (x + 36)**(-3/2).
+ * Scalar pass: phi, u0 = (x + 36)**(-3/2), u1 = sqrt(x + 36).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -634,16 +585,14 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 108.0)) {
-                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
                 u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
-                const double u0 = sqrt(x + 36);
-                const double u1 = pow(x + 36, -3.0/2.0);
-                s_lanes[k] = s;
+                const double u0 = pow(x + 36, -3.0/2.0);
+                const double u1 = sqrt(x + 36);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -651,7 +600,6 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
             u1_lanes[k] = 0;
@@ -659,11 +607,10 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double a0_a = (1.0/4.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -673,29 +620,16 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/4.0)*phi;
-            const double a1_q = rint(a1_a*0.6366197723675814);
-            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
-            const double a1_z = a1_r*a1_r;
-            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
-            const double a1_h = rint(0.5*a1_j - 0.25);
-            const double a1_odd = a1_j - 2*a1_h;
-            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_K_across_lanes[k] = sin0/s;
-            poly_K_across_lanes[k] = 1.0/2.0 + (-11.0/432.0)*x;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
+            c_K_across_lanes[k] = -u0*(x - 108);
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = x*((125.0/746496.0)*x - 17.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = u1*(u0 + 24)/(u0 + 6);
+            c_K_2_lanes[k] = u0*(u1 + 24)/(u1 + 6);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_across = c_K_across_lanes[k];
-            const double poly_K_across = poly_K_across_lanes[k];
-            const double v_K_across = x < 3.327466629816501e-08 ? poly_K_across : closed_K_across;
-            c_K_across_lanes[k] = !(x < 108.0) ? (double)NAN : v_K_across;
+            c_K_across_lanes[k] = !(x < 108.0) ? (double)NAN : closed_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
             const double v_K_1 = x < 3.2144365899743845e-06 ? poly_K_1 : closed_K_1;
@@ -721,10 +655,10 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
 
 /* symrot_tangent_m6_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.411778, else (9*x - 108)/(x - 108)
+ * H_inverse_across = 9*(x - 12)/(x - 108) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 64 */
+ * ops: 46 */
 static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -734,13 +668,8 @@ static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[
         pdot[2] = (double)NAN;
         return;
     }
+    const double c_H_inverse_across = 9*(x - 12)/(x - 108);
     const double c_H_inverse_2 = (1.0/36.0)*(x - 396)/(x - 108);
-    double c_H_inverse_across;
-    if (x < 0.4117780186135704) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-1.0/21422803359744.0)*x - 1.0/198359290368.0) - 1.0/1836660096.0) - 1.0/17006112.0) - 1.0/157464.0) - 1.0/1458.0) - 2.0/27.0) + 1;
-    } else {
-        c_H_inverse_across = (9*x - 108)/(x - 108);
-    }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
     const double w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -752,10 +681,10 @@ static inline void symrot_tangent_m6_pdot(const double p[3], const double omega[
 
 /* symrot_tangent_m6_omega: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
+ * H_across = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 87 */
+ * ops: 72 */
 static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -765,18 +694,14 @@ static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[
         omega[2] = (double)NAN;
         return;
     }
+    const double c_H_across = 36*(x - 108)*(x - 12)/pow(x + 36, 3);
     const double c_H_2 = 6912/pow(x + 36, 3);
-    double c_H_across, c_H_1;
+    double c_H_1;
     if (x < 0.11094775628437428) {
-        c_H_across = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*(131.0/13060694016.0 + (-19.0/52242776064.0)*x) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
-        const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        c_H_across = 2*w1*cos(w0)/s;
-        c_H_1 = 2*(w1*w1)/x;
+        c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -790,8 +715,8 @@ static inline void symrot_tangent_m6_omega(const double p[3], const double pdot[
 /* symrot_tangent_m6_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -18*(x - 12)/(x + 36)**(3/2) (algebraic in x)
- * nu: Horner degree 7 in x below x = 0.213555, else 2*sin(phi/2)/s
- * ops: 40 */
+ * nu = -2*(x - 108)/(x + 36)**(3/2) (algebraic in x)
+ * ops: 24 */
 static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -803,14 +728,7 @@ static inline void symrot_tangent_m6_to_quaternion(const double p[3], double e[4
         return;
     }
     const double c_e_0 = -18*(x - 12)/pow(x + 36, 3.0/2.0);
-    double c_nu;
-    if (x < 0.21355546857295174) {
-        c_nu = x*(x*(x*(x*(x*(x*(1309.0/743008370688.0 + (-8437.0/160489808068608.0)*x) - 301.0/5159780352.0) + 1225.0/644972544.0) - 5.0/82944.0) + 19.0/10368.0) - 11.0/216.0) + 1;
-    } else {
-        const double phi = symrot_tangent_m6__phi(sqrt(x));
-        const double s = sqrt(x);
-        c_nu = 2*sin((1.0/2.0)*phi)/s;
-    }
+    const double c_nu = -2*(x - 108)/pow(x + 36, 3.0/2.0);
     const double half_nu = (1.0/2.0)*c_nu;
     e[0] = c_e_0;
     e[1] = half_nu*p[0];
@@ -949,12 +867,12 @@ static inline int symrot_tangent_m6_rescale(const double p[3], double q[3])
 /* symrot_tangent_m6_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 14 in x below x = 1.55153, else 3*(6*cos(phi) - 6*(x/36 + 1)*sin(phi)/s)/(x*(x + 36))
+ * R_1_x = -108*(x - 108)*(x - 12)/(x + 36)**4 + 36*(x - 108)/(x + 36)**3 + 36*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2_x: Horner degree 18 in x below x = 3.06078, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
- * ops: 272 */
+ * ops: 232 */
 static inline void symrot_tangent_m6_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -970,26 +888,20 @@ static inline void symrot_tangent_m6_rotation_derivative(const double p[3], cons
         D[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const double c_R_1 = 36*(x - 108)*(x - 12)/pow(x + 36, 3);
+    const double c_R_1_x = -108*(x - 108)*(x - 12)/pow(x + 36, 4) + 36*(x - 108)/pow(x + 36, 3) + 36*(x - 12)/pow(x + 36, 3);
+    double c_R_2, c_R_2_x;
     if (x < 0.11094775628437428) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(131.0/13060694016.0 + (-19.0/52242776064.0)*x) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.2789568319825784e-18 + (-4.3492240116545323e-20)*x) - 3.70633678108687e-17) + 1.0560568351749562e-15) - 2.9501213604203994e-14) + 4415.0/5484237660094464.0) - 241.0/11284439629824.0) + 193.0/352638738432.0) - 3157.0/235092492288.0) + 113.0/362797056.0) - 5.0/746496.0) + 163.0/1259712.0) - 11.0/5184.0) + 17.0/648.0) - 19.0/108.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.8009317595905015e-25 + (-9.099536165624757e-27)*x) - 8.547447067809546e-24) + 2.5833490980417515e-22) - 7.723660946333972e-21) + 2.281046993860788e-19) - 6.642954545950765e-18) + 1.903603647737431e-16) - 5.353304892295751e-15) + 1.4724015442942914e-13) - 89.0/22568879259648.0) + 649.0/6347497291776.0) - 133.0/52242776064.0) + 131.0/2176782336.0) - 1445.0/1088391168.0) + 67.0/2519424.0) - 43.0/93312.0) + 73.0/11664.0) - 11.0/216.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/s;
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = w2*cos(w1);
-        const double w4 = 1.0/x;
-        const double w5 = (w2*w2);
-        const double w6 = 1.0/(x + 36);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4*w5;
-        c_R_1_x = x < 1.55152626720702 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.2789568319825784e-18 + (-4.3492240116545323e-20)*x) - 3.70633678108687e-17) + 1.0560568351749562e-15) - 2.9501213604203994e-14) + 4415.0/5484237660094464.0) - 241.0/11284439629824.0) + 193.0/352638738432.0) - 3157.0/235092492288.0) + 113.0/362797056.0) - 5.0/746496.0) + 163.0/1259712.0) - 11.0/5184.0) + 17.0/648.0) - 19.0/108.0 : 3*w4*w6*(-6*w0*((1.0/36.0)*x + 1)*sin(phi) + 6*cos(phi));
-        c_R_2_x = x < 3.0607804813034707 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.8009317595905015e-25 + (-9.099536165624757e-27)*x) - 8.547447067809546e-24) + 2.5833490980417515e-22) - 7.723660946333972e-21) + 2.281046993860788e-19) - 6.642954545950765e-18) + 1.903603647737431e-16) - 5.353304892295751e-15) + 1.4724015442942914e-13) - 89.0/22568879259648.0) + 649.0/6347497291776.0) - 133.0/52242776064.0) + 131.0/2176782336.0) - 1445.0/1088391168.0) + 67.0/2519424.0) - 43.0/93312.0) + 73.0/11664.0) - 11.0/216.0 : 6*w6*(-12*w0*w5*((1.0/36.0)*(s*s) + 1) + 6*w3)/(s*s*s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 3.0607804813034707 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.8009317595905015e-25 + (-9.099536165624757e-27)*x) - 8.547447067809546e-24) + 2.5833490980417515e-22) - 7.723660946333972e-21) + 2.281046993860788e-19) - 6.642954545950765e-18) + 1.903603647737431e-16) - 5.353304892295751e-15) + 1.4724015442942914e-13) - 89.0/22568879259648.0) + 649.0/6347497291776.0) - 133.0/52242776064.0) + 131.0/2176782336.0) - 1445.0/1088391168.0) + 67.0/2519424.0) - 43.0/93312.0) + 73.0/11664.0) - 11.0/216.0 : 6*(6*w1*cos(w0) - 12*w2*((1.0/36.0)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1031,12 +943,12 @@ static inline void symrot_tangent_m6_rotation_derivative(const double p[3], cons
 /* symrot_tangent_m6_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)*cos(phi/2)/s
+ * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.110948, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 14 in x below x = 1.55153, else 3*(6*cos(phi) - 6*(x/36 + 1)*sin(phi)/s)/(x*(x + 36))
+ * R_1_x = -108*(x - 108)*(x - 12)/(x + 36)**4 + 36*(x - 108)/(x + 36)**3 + 36*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2_x: Horner degree 18 in x below x = 3.06078, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
- * ops: 273 */
+ * ops: 233 */
 static inline void symrot_tangent_m6_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1052,26 +964,20 @@ static inline void symrot_tangent_m6_rotation_transpose_derivative(const double 
         D[8] = (double)NAN;
         return;
     }
-    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const double c_R_1 = 36*(x - 108)*(x - 12)/pow(x + 36, 3);
+    const double c_R_1_x = -108*(x - 108)*(x - 12)/pow(x + 36, 4) + 36*(x - 108)/pow(x + 36, 3) + 36*(x - 12)/pow(x + 36, 3);
+    double c_R_2, c_R_2_x;
     if (x < 0.11094775628437428) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(113.0/2176782336.0 + (-451.0/235092492288.0)*x) - 1.0/746496.0) + 163.0/5038848.0) - 11.0/15552.0) + 17.0/1296.0) - 19.0/108.0) + 1;
         c_R_2 = x*(x*(x*(x*(x*(x*(131.0/13060694016.0 + (-19.0/52242776064.0)*x) - 289.0/1088391168.0) + 67.0/10077696.0) - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.2789568319825784e-18 + (-4.3492240116545323e-20)*x) - 3.70633678108687e-17) + 1.0560568351749562e-15) - 2.9501213604203994e-14) + 4415.0/5484237660094464.0) - 241.0/11284439629824.0) + 193.0/352638738432.0) - 3157.0/235092492288.0) + 113.0/362797056.0) - 5.0/746496.0) + 163.0/1259712.0) - 11.0/5184.0) + 17.0/648.0) - 19.0/108.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.8009317595905015e-25 + (-9.099536165624757e-27)*x) - 8.547447067809546e-24) + 2.5833490980417515e-22) - 7.723660946333972e-21) + 2.281046993860788e-19) - 6.642954545950765e-18) + 1.903603647737431e-16) - 5.353304892295751e-15) + 1.4724015442942914e-13) - 89.0/22568879259648.0) + 649.0/6347497291776.0) - 133.0/52242776064.0) + 131.0/2176782336.0) - 1445.0/1088391168.0) + 67.0/2519424.0) - 43.0/93312.0) + 73.0/11664.0) - 11.0/216.0;
     } else {
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = 1.0/s;
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = w2*cos(w1);
-        const double w4 = 1.0/x;
-        const double w5 = (w2*w2);
-        const double w6 = 1.0/(x + 36);
-        c_R_1 = 2*w0*w3;
-        c_R_2 = 2*w4*w5;
-        c_R_1_x = x < 1.55152626720702 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.2789568319825784e-18 + (-4.3492240116545323e-20)*x) - 3.70633678108687e-17) + 1.0560568351749562e-15) - 2.9501213604203994e-14) + 4415.0/5484237660094464.0) - 241.0/11284439629824.0) + 193.0/352638738432.0) - 3157.0/235092492288.0) + 113.0/362797056.0) - 5.0/746496.0) + 163.0/1259712.0) - 11.0/5184.0) + 17.0/648.0) - 19.0/108.0 : 3*w4*w6*(-6*w0*((1.0/36.0)*x + 1)*sin(phi) + 6*cos(phi));
-        c_R_2_x = x < 3.0607804813034707 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.8009317595905015e-25 + (-9.099536165624757e-27)*x) - 8.547447067809546e-24) + 2.5833490980417515e-22) - 7.723660946333972e-21) + 2.281046993860788e-19) - 6.642954545950765e-18) + 1.903603647737431e-16) - 5.353304892295751e-15) + 1.4724015442942914e-13) - 89.0/22568879259648.0) + 649.0/6347497291776.0) - 133.0/52242776064.0) + 131.0/2176782336.0) - 1445.0/1088391168.0) + 67.0/2519424.0) - 43.0/93312.0) + 73.0/11664.0) - 11.0/216.0 : 6*w6*(-12*w0*w5*((1.0/36.0)*(s*s) + 1) + 6*w3)/(s*s*s);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        c_R_2 = 2*w2/x;
+        c_R_2_x = x < 3.0607804813034707 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(2.8009317595905015e-25 + (-9.099536165624757e-27)*x) - 8.547447067809546e-24) + 2.5833490980417515e-22) - 7.723660946333972e-21) + 2.281046993860788e-19) - 6.642954545950765e-18) + 1.903603647737431e-16) - 5.353304892295751e-15) + 1.4724015442942914e-13) - 89.0/22568879259648.0) + 649.0/6347497291776.0) - 133.0/52242776064.0) + 131.0/2176782336.0) - 1445.0/1088391168.0) + 67.0/2519424.0) - 43.0/93312.0) + 73.0/11664.0) - 11.0/216.0 : 6*(6*w1*cos(w0) - 12*w2*((1.0/36.0)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1539,9 +1445,9 @@ static inline float symrot_tangent_m6_angle_f(const float p[3])
 /* symrot_tangent_m6_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 7 in x below x = 1.55153, else sin(phi)/s
+ * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
- * ops: 83 */
+ * ops: 68 */
 static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1557,14 +1463,12 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
         R[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2;
+    const float c_R_1 = 36*(x - 108)*(x - 12)/powf(x + 36, 3);
+    float c_R_2;
     if (x < 1.5515263F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_R_1 = sinf(phi)/s;
         c_R_2 = (1 - cosf(phi))/x;
     }
     const float t = -c_R_2*x + 1;
@@ -1583,12 +1487,12 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1596,25 +1500,21 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 3.6909684e-14F) {
-                s_lanes[k] = 0;
+            if (!(x < 108.0F) || x < 0.41177803F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m6__phi_f(s);
-                s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
@@ -1625,11 +1525,9 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float a0_j = a0_q - 4*rintf(0.25F*a0_q - 0.375F);
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
-            const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = sin0/s;
-            poly_R_1_lanes[k] = 1;
+            c_R_1_lanes[k] = 36*(x - 108)*(x - 12)/((x + 36)*(x + 36)*(x + 36));
             c_R_2_lanes[k] = (1 - cos0)/x;
             poly_R_2_lanes[k] = x*(x*(x*((67.0F/10077696.0F)*x - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
         }
@@ -1638,9 +1536,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float x = x_lanes[k];
             c_R_0_lanes[k] = !(x < 108.0F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
-            const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 3.6909684e-14F ? poly_R_1 : closed_R_1;
-            c_R_1_lanes[k] = !(x < 108.0F) ? NAN : v_R_1;
+            c_R_1_lanes[k] = !(x < 108.0F) ? NAN : closed_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
             const float v_R_2 = x < 0.41177803F ? poly_R_2 : closed_R_2;
@@ -1665,10 +1561,10 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
 
 /* symrot_tangent_m6_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 1.55153, else (36*x**2 - 4320*x + 46656)/(x**3 + 108*x**2 + 3888*x + 46656)
+ * H_across = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * H_1: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 84 */
+ * ops: 69 */
 static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1684,15 +1580,13 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
         H[8] = NAN;
         return;
     }
+    const float c_H_across = 36*(x - 108)*(x - 12)/powf(x + 36, 3);
     const float c_H_2 = 6912/powf(x + 36, 3);
-    float c_H_across, c_H_1;
+    float c_H_1;
     if (x < 1.5515263F) {
-        c_H_across = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        const float w0 = (x*x);
-        c_H_across = (36*w0 - 4320*x + 46656)/(108*w0 + (x*x*x) + 3888*x + 46656);
         c_H_1 = (1 - cosf(phi))/x;
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
@@ -1715,7 +1609,7 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1723,7 +1617,7 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 3.6909684e-14F) {
+            if (!(x < 108.0F) || x < 0.41177803F) {
                 phi_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
@@ -1750,20 +1644,17 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float a0_odd = a0_j - 2*a0_h;
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = (x*x);
-            c_H_across_lanes[k] = (36*w0 - 4320*x + 46656)/(108*w0 + (x*x*x) + 3888*x + 46656);
-            poly_H_across_lanes[k] = 1;
+            const float w0 = 1.0F/((x + 36)*(x + 36)*(x + 36));
+            c_H_across_lanes[k] = 36*w0*(x - 108)*(x - 12);
             c_H_1_lanes[k] = (1 - cos0)/x;
             poly_H_1_lanes[k] = x*(x*(x*((67.0F/10077696.0F)*x - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = 6912/((x + 36)*(x + 36)*(x + 36));
+            c_H_2_lanes[k] = 6912*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_across = c_H_across_lanes[k];
-            const float poly_H_across = poly_H_across_lanes[k];
-            const float v_H_across = x < 3.6909684e-14F ? poly_H_across : closed_H_across;
-            c_H_across_lanes[k] = !(x < 108.0F) ? NAN : v_H_across;
+            c_H_across_lanes[k] = !(x < 108.0F) ? NAN : closed_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
             const float v_H_1 = x < 0.41177803F ? poly_H_1 : closed_H_1;
@@ -1789,10 +1680,10 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
 
 /* symrot_tangent_m6_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 6 in x below x = 6.19603, else (9*x - 108)/(x - 108)
+ * H_inverse_across = 9*(x - 12)/(x - 108) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 62 */
+ * ops: 47 */
 static inline void symrot_tangent_m6_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1808,13 +1699,8 @@ static inline void symrot_tangent_m6_tangent_inverse_f(const float p[3], float H
         Hinv[8] = NAN;
         return;
     }
+    const float c_H_inverse_across = 9*(x - 12)/(x - 108);
     const float c_H_inverse_2 = (1.0F/36.0F)*(x - 396)/(x - 108);
-    float c_H_inverse_across;
-    if (x < 6.1960254F) {
-        c_H_inverse_across = x*(x*(x*(x*(x*((-5.041357e-12F)*x - 5.444666e-10F) - 5.880239e-08F) - 1.0F/157464.0F) - 1.0F/1458.0F) - 2.0F/27.0F) + 1;
-    } else {
-        c_H_inverse_across = (9*x - 108)/(x - 108);
-    }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
     Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
@@ -1833,7 +1719,7 @@ static inline void symrot_tangent_m6_tangent_inverse_f(const float p[3], float H
  */
 static inline void symrot_tangent_m6_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1849,17 +1735,14 @@ static inline void symrot_tangent_m6_tangent_inverse_f_batch(size_t n, const flo
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float w0 = 1.0F/(x - 108);
-            c_H_inverse_across_lanes[k] = w0*(9*x - 108);
-            poly_H_inverse_across_lanes[k] = 1;
+            c_H_inverse_across_lanes[k] = 9*w0*(x - 12);
             c_H_inverse_2_lanes[k] = (1.0F/36.0F)*w0*(x - 396);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
-            const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const float v_H_inverse_across = x < 1.3623247e-13F ? poly_H_inverse_across : closed_H_inverse_across;
-            c_H_inverse_across_lanes[k] = !(x < 108.0F) ? NAN : v_H_inverse_across;
+            c_H_inverse_across_lanes[k] = !(x < 108.0F) ? NAN : closed_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 108.0F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 108.0F) ? NAN : closed_H_inverse_2;
@@ -1897,9 +1780,9 @@ static inline float symrot_tangent_m6_tangent_det_f(const float p[3])
 /* symrot_tangent_m6_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 7 in x below x = 3.06078, else sin(phi/2)/s
+ * G_1 = -(x - 108)/(x + 36)**(3/2) (algebraic in x)
  * G_2: Horner degree 7 in x below x = 3.06078, else 2*sin(phi/4)**2/x
- * ops: 88 */
+ * ops: 71 */
 static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1915,14 +1798,12 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
         G[8] = NAN;
         return;
     }
-    float c_G_1, c_G_2;
+    const float c_G_1 = -(x - 108)/powf(x + 36, 3.0F/2.0F);
+    float c_G_2;
     if (x < 3.0607803F) {
-        c_G_1 = x*(x*(x*(x*(x*(x*(8.8087837e-10F + (-2.6285158e-11F)*x) - 2.9167909e-08F) + 9.496528e-07F) - 5.0F/165888.0F) + 19.0F/20736.0F) - 11.0F/432.0F) + 1.0F/2.0F;
         c_G_2 = x*(x*(x*(x*(x*(x*(1.5236482e-10F + (-4.5247226e-12F)*x) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_G_1 = sinf((1.0F/2.0F)*phi)/s;
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
@@ -1941,12 +1822,12 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi.
+ * Scalar pass: phi, u0 = (x + 36)**(-3/2).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1954,27 +1835,28 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 108.0F) || x < 3.6909684e-14F) {
-                s_lanes[k] = 0;
+            if (!(x < 108.0F)) {
                 phi_lanes[k] = 0;
+                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m6__phi_f(s);
-                s_lanes[k] = s;
+                const float u0 = powf(x + 36, -3.0F/2.0F);
                 phi_lanes[k] = phi;
+                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
             phi_lanes[k] = 0;
+            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float u0 = u0_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1984,19 +1866,8 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/4.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            c_G_1_lanes[k] = -u0*(x - 108);
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
             poly_G_2_lanes[k] = x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2004,9 +1875,7 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float x = x_lanes[k];
             c_G_0_lanes[k] = !(x < 108.0F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
-            const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 3.6909684e-14F ? poly_G_1 : closed_G_1;
-            c_G_1_lanes[k] = !(x < 108.0F) ? NAN : v_G_1;
+            c_G_1_lanes[k] = !(x < 108.0F) ? NAN : closed_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
             const float v_G_2 = x < 0.21355546F ? poly_G_2 : closed_G_2;
@@ -2031,10 +1900,10 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
 
 /* symrot_tangent_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_across: Horner degree 7 in x below x = 3.06078, else (-x*sqrt(x + 36) - 6*x + 108*sqrt(x + 36) + 648)/(x**2 + 6*x*sqrt(x + 36) + 72*x + 216*sqrt(x + 36) + 1296)
+ * K_across = -(x - 108)/(x + 36)**(3/2) (algebraic in x)
  * K_1: Horner degree 7 in x below x = 3.06078, else 2*sin(phi/4)**2/x
  * K_2 = (sqrt(x + 36) + 24)/((x + 36)**(3/2)*(sqrt(x + 36) + 6)) (algebraic in x)
- * ops: 99 */
+ * ops: 82 */
 static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2050,16 +1919,13 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
         K[8] = NAN;
         return;
     }
+    const float c_K_across = -(x - 108)/powf(x + 36, 3.0F/2.0F);
     const float c_K_2 = (sqrtf(x + 36) + 24)/(powf(x + 36, 3.0F/2.0F)*(sqrtf(x + 36) + 6));
-    float c_K_across, c_K_1;
+    float c_K_1;
     if (x < 3.0607803F) {
-        c_K_across = x*(x*(x*(x*(x*(x*(8.8087837e-10F + (-2.6285158e-11F)*x) - 2.9167909e-08F) + 9.496528e-07F) - 5.0F/165888.0F) + 19.0F/20736.0F) - 11.0F/432.0F) + 1.0F/2.0F;
         c_K_1 = x*(x*(x*(x*(x*(x*(1.5236482e-10F + (-4.5247226e-12F)*x) - 5.0780047e-09F) + 1.6686757e-07F) - 5.3723215e-06F) + 125.0F/746496.0F) - 17.0F/3456.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        const float w0 = 6*x;
-        const float w1 = sqrtf(x + 36);
-        c_K_across = (-w0 - w1*x + 108*w1 + 648)/(w0*w1 + 216*w1 + (x*x) + 72*x + 1296);
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
@@ -2077,12 +1943,12 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = sqrt(x + 36), u1 = (x + 36)**(-3/2).
+ * Scalar pass: phi, u0 = (x + 36)**(-3/2), u1 = sqrt(x + 36).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2097,8 +1963,8 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m6__phi_f(s);
-                const float u0 = sqrtf(x + 36);
-                const float u1 = powf(x + 36, -3.0F/2.0F);
+                const float u0 = powf(x + 36, -3.0F/2.0F);
+                const float u1 = sqrtf(x + 36);
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -2126,20 +1992,16 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float w0 = 6*x;
-            c_K_across_lanes[k] = (-u0*x + 108*u0 - w0 + 648)/(u0*w0 + 216*u0 + (x*x) + 72*x + 1296);
-            poly_K_across_lanes[k] = 1.0F/2.0F;
+            c_K_across_lanes[k] = -u0*(x - 108);
             c_K_1_lanes[k] = 2*(sin0*sin0)/x;
             poly_K_1_lanes[k] = x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = u1*(u0 + 24)/(u0 + 6);
+            c_K_2_lanes[k] = u0*(u1 + 24)/(u1 + 6);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float closed_K_across = c_K_across_lanes[k];
-            const float poly_K_across = poly_K_across_lanes[k];
-            const float v_K_across = x < 3.6909684e-14F ? poly_K_across : closed_K_across;
-            c_K_across_lanes[k] = !(x < 108.0F) ? NAN : v_K_across;
+            c_K_across_lanes[k] = !(x < 108.0F) ? NAN : closed_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
             const float v_K_1 = x < 0.21355546F ? poly_K_1 : closed_K_1;
@@ -2165,10 +2027,10 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
 
 /* symrot_tangent_m6_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 6 in x below x = 6.19603, else (9*x - 108)/(x - 108)
+ * H_inverse_across = 9*(x - 12)/(x - 108) (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (x - 396)/(36*(x - 108)) (algebraic in x)
- * ops: 61 */
+ * ops: 46 */
 static inline void symrot_tangent_m6_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2178,13 +2040,8 @@ static inline void symrot_tangent_m6_pdot_f(const float p[3], const float omega[
         pdot[2] = NAN;
         return;
     }
+    const float c_H_inverse_across = 9*(x - 12)/(x - 108);
     const float c_H_inverse_2 = (1.0F/36.0F)*(x - 396)/(x - 108);
-    float c_H_inverse_across;
-    if (x < 6.1960254F) {
-        c_H_inverse_across = x*(x*(x*(x*(x*((-5.041357e-12F)*x - 5.444666e-10F) - 5.880239e-08F) - 1.0F/157464.0F) - 1.0F/1458.0F) - 2.0F/27.0F) + 1;
-    } else {
-        c_H_inverse_across = (9*x - 108)/(x - 108);
-    }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
     const float w2 = -omega[0]*p[1] + omega[1]*p[0];
@@ -2196,10 +2053,10 @@ static inline void symrot_tangent_m6_pdot_f(const float p[3], const float omega[
 
 /* symrot_tangent_m6_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 7 in x below x = 1.55153, else (36*x**2 - 4320*x + 46656)/(x**3 + 108*x**2 + 3888*x + 46656)
+ * H_across = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * H_1: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
  * H_2 = 6912/(x + 36)**3 (algebraic in x)
- * ops: 83 */
+ * ops: 68 */
 static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2209,15 +2066,13 @@ static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[
         omega[2] = NAN;
         return;
     }
+    const float c_H_across = 36*(x - 108)*(x - 12)/powf(x + 36, 3);
     const float c_H_2 = 6912/powf(x + 36, 3);
-    float c_H_across, c_H_1;
+    float c_H_1;
     if (x < 1.5515263F) {
-        c_H_across = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_H_1 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        const float w0 = (x*x);
-        c_H_across = (36*w0 - 4320*x + 46656)/(108*w0 + (x*x*x) + 3888*x + 46656);
         c_H_1 = (1 - cosf(phi))/x;
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
@@ -2232,8 +2087,8 @@ static inline void symrot_tangent_m6_omega_f(const float p[3], const float pdot[
 /* symrot_tangent_m6_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -18*(x - 12)/(x + 36)**(3/2) (algebraic in x)
- * nu: Horner degree 7 in x below x = 3.06078, else 2*sin(phi/2)/s
- * ops: 40 */
+ * nu = -2*(x - 108)/(x + 36)**(3/2) (algebraic in x)
+ * ops: 24 */
 static inline void symrot_tangent_m6_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2245,14 +2100,7 @@ static inline void symrot_tangent_m6_to_quaternion_f(const float p[3], float e[4
         return;
     }
     const float c_e_0 = -18*(x - 12)/powf(x + 36, 3.0F/2.0F);
-    float c_nu;
-    if (x < 3.0607803F) {
-        c_nu = x*(x*(x*(x*(x*(x*(1.7617567e-09F + (-5.2570316e-11F)*x) - 5.8335818e-08F) + 1.8993056e-06F) - 5.0F/82944.0F) + 19.0F/10368.0F) - 11.0F/216.0F) + 1;
-    } else {
-        const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
-        const float s = sqrtf(x);
-        c_nu = 2*sinf((1.0F/2.0F)*phi)/s;
-    }
+    const float c_nu = -2*(x - 108)/powf(x + 36, 3.0F/2.0F);
     const float half_nu = (1.0F/2.0F)*c_nu;
     e[0] = c_e_0;
     e[1] = half_nu*p[0];
@@ -2391,12 +2239,12 @@ static inline int symrot_tangent_m6_rescale_f(const float p[3], float q[3])
 /* symrot_tangent_m6_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 1.55153, else sin(phi)/s
+ * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 9 in x below x = 3.06078, else 3*(6*cos(phi) - 6*(x/36 + 1)*sin(phi)/s)/(x*(x + 36))
+ * R_1_x = -108*(x - 108)*(x - 12)/(x + 36)**4 + 36*(x - 108)/(x + 36)**3 + 36*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2_x: Horner degree 13 in x below x = 6.19603, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
- * ops: 236 */
+ * ops: 212 */
 static inline void symrot_tangent_m6_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2412,26 +2260,19 @@ static inline void symrot_tangent_m6_rotation_derivative_f(const float p[3], con
         D[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const float c_R_1 = 36*(x - 108)*(x - 12)/powf(x + 36, 3);
+    const float c_R_1_x = -108*(x - 108)*(x - 12)/powf(x + 36, 4) + 36*(x - 108)/powf(x + 36, 3) + 36*(x - 12)/powf(x + 36, 3);
+    float c_R_2, c_R_2_x;
     if (x < 1.5515263F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*((8.050344e-13F)*x - 2.1356843e-11F) + 5.473023e-10F) - 1.3428757e-08F) + 3.114689e-07F) - 5.0F/746496.0F) + 163.0F/1259712.0F) - 11.0F/5184.0F) + 17.0F/648.0F) - 19.0F/108.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/s;
-        const float w1 = w0*sinf(phi);
-        const float w2 = 1.0F/x;
-        const float w3 = cosf(phi);
-        const float w4 = 1.0F/(x + 36);
-        const float w5 = (1.0F/2.0F)*phi;
-        const float w6 = sinf(w5);
-        c_R_1 = w1;
-        c_R_2 = w2*(1 - w3);
-        c_R_1_x = x < 3.0607803F ? x*(x*(x*(x*(x*(x*(x*(x*((8.050344e-13F)*x - 2.1356843e-11F) + 5.473023e-10F) - 1.3428757e-08F) + 3.114689e-07F) - 5.0F/746496.0F) + 163.0F/1259712.0F) - 11.0F/5184.0F) + 17.0F/648.0F) - 19.0F/108.0F : 3*w2*w4*(-6*w1*((1.0F/36.0F)*x + 1) + 6*w3);
-        c_R_2_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*w4*(-12*w0*(w6*w6)*((1.0F/36.0F)*(s*s) + 1) + 6*w6*cosf(w5))/(s*s*s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_2 = (1 - cosf(phi))/x;
+        c_R_2_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*(6*w1*cosf(w0) - 12*(w1*w1)*((1.0F/36.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2473,12 +2314,12 @@ static inline void symrot_tangent_m6_rotation_derivative_f(const float p[3], con
 /* symrot_tangent_m6_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 7 in x below x = 1.55153, else sin(phi)/s
+ * R_1 = 36*(x - 108)*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2: Horner degree 6 in x below x = 1.55153, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
- * R_1_x: Horner degree 9 in x below x = 3.06078, else 3*(6*cos(phi) - 6*(x/36 + 1)*sin(phi)/s)/(x*(x + 36))
+ * R_1_x = -108*(x - 108)*(x - 12)/(x + 36)**4 + 36*(x - 108)/(x + 36)**3 + 36*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2_x: Horner degree 13 in x below x = 6.19603, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
- * ops: 237 */
+ * ops: 213 */
 static inline void symrot_tangent_m6_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2494,26 +2335,19 @@ static inline void symrot_tangent_m6_rotation_transpose_derivative_f(const float
         D[8] = NAN;
         return;
     }
-    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    const float c_R_1 = 36*(x - 108)*(x - 12)/powf(x + 36, 3);
+    const float c_R_1_x = -108*(x - 108)*(x - 12)/powf(x + 36, 4) + 36*(x - 108)/powf(x + 36, 3) + 36*(x - 12)/powf(x + 36, 3);
+    float c_R_2, c_R_2_x;
     if (x < 1.5515263F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(5.1911485e-08F + (-1.9183939e-09F)*x) - 1.0F/746496.0F) + 163.0F/5038848.0F) - 11.0F/15552.0F) + 17.0F/1296.0F) - 19.0F/108.0F) + 1;
         c_R_2 = x*(x*(x*(x*(x*((1.0030095e-08F)*x - 2.6552954e-07F) + 67.0F/10077696.0F) - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*((8.050344e-13F)*x - 2.1356843e-11F) + 5.473023e-10F) - 1.3428757e-08F) + 3.114689e-07F) - 5.0F/746496.0F) + 163.0F/1259712.0F) - 11.0F/5184.0F) + 17.0F/648.0F) - 19.0F/108.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F;
     } else {
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = 1.0F/s;
-        const float w1 = w0*sinf(phi);
-        const float w2 = 1.0F/x;
-        const float w3 = cosf(phi);
-        const float w4 = 1.0F/(x + 36);
-        const float w5 = (1.0F/2.0F)*phi;
-        const float w6 = sinf(w5);
-        c_R_1 = w1;
-        c_R_2 = w2*(1 - w3);
-        c_R_1_x = x < 3.0607803F ? x*(x*(x*(x*(x*(x*(x*(x*((8.050344e-13F)*x - 2.1356843e-11F) + 5.473023e-10F) - 1.3428757e-08F) + 3.114689e-07F) - 5.0F/746496.0F) + 163.0F/1259712.0F) - 11.0F/5184.0F) + 17.0F/648.0F) - 19.0F/108.0F : 3*w2*w4*(-6*w1*((1.0F/36.0F)*x + 1) + 6*w3);
-        c_R_2_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*w4*(-12*w0*(w6*w6)*((1.0F/36.0F)*(s*s) + 1) + 6*w6*cosf(w5))/(s*s*s);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        c_R_2 = (1 - cosf(phi))/x;
+        c_R_2_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*(6*w1*cosf(w0) - 12*(w1*w1)*((1.0F/36.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
