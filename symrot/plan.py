@@ -34,7 +34,7 @@ import math
 from collections.abc import Callable
 from dataclasses import replace
 from functools import lru_cache
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import mpmath
 import numpy as np
@@ -387,21 +387,40 @@ def tensor_part(derivation: Derivation, coefficient: str, det_h_own_scale: bool 
 def tensor_floors(part: TensorPart, argument: sp.Expr, phi_max: float, dtype: type,
                   complement: sp.Rational | None) -> tuple[np.ndarray, ...]:
     """‖T‖/|p|^k at the exact angles of :func:`measured_inputs` (30 digits, NaN where it cannot be
-    evaluated): the size of the error of c_k that the tensor can absorb."""
-    inputs = measured_inputs(argument, phi_max, dtype, complement)
-    norm = sp.lambdify(PHI, part.norm, modules=[mpmath_namespace(), "mpmath"], cse=True)
-    p_of = sp.lambdify(PHI, argument, modules=[mpmath_namespace(), "mpmath"])
+    evaluated): the size of the error of c_k that the tensor can absorb. ‖T‖ and |p| are evaluated
+    once per tensor (:func:`_norm_and_length`) and shared by its parts c₀, c₁, c₂ and c₀ − c₂ x."""
     values = []
+    with mpmath.workdps(30):
+        for row in _norm_and_length(part.norm, argument, phi_max, dtype, complement):
+            floors = []
+            for norm, length in row:
+                try:
+                    floors.append(float(norm / length ** part.power))
+                except (ZeroDivisionError, OverflowError, ValueError, TypeError):
+                    floors.append(math.nan)
+            values.append(np.asarray(floors, dtype=np.float64))
+    return tuple(values)
+
+
+@lru_cache(maxsize=16)
+def _norm_and_length(norm: sp.Expr, argument: sp.Expr, phi_max: float, dtype: type,
+                     complement: sp.Rational | None) -> tuple[tuple[tuple[Any, Any], ...], ...]:
+    """(‖T‖, |p|) at the exact angles of :func:`measured_inputs`, 30 digits; (NaN, 1) where ‖T‖
+    or p cannot be evaluated (mpmath numbers, read-only)."""
+    inputs = measured_inputs(argument, phi_max, dtype, complement)
+    norm_of = sp.lambdify(PHI, norm, modules=[mpmath_namespace(), "mpmath"], cse=True)
+    p_of = sp.lambdify(PHI, argument, modules=[mpmath_namespace(), "mpmath"])
+    rows = []
     with mpmath.workdps(30):
         for thetas in inputs.exact:
             row = []
             for theta in thetas:
                 try:
-                    row.append(float(norm(theta) / abs(p_of(theta)) ** part.power))
+                    row.append((norm_of(theta), abs(p_of(theta))))
                 except (ZeroDivisionError, OverflowError, ValueError, TypeError):
-                    row.append(math.nan)
-            values.append(np.asarray(row, dtype=np.float64))
-    return tuple(values)
+                    row.append((mpmath.nan, mpmath.mpf(1)))
+            rows.append(tuple(row))
+    return tuple(rows)
 
 
 def _error_class(ulp: float) -> float:
