@@ -72,6 +72,11 @@ def build_configs() -> list[BuildConfig]:
     return configs
 
 
+def build_config(label: str) -> BuildConfig:
+    """The configuration of :func:`build_configs` called ``label`` (e.g. ``gcc-O2-nofma``)."""
+    return next(c for c in build_configs() if c.label == label)
+
+
 def missing_compilers() -> list[str]:
     return [name for name in ("gcc", "g++", "clang") if shutil.which(name) is None]
 
@@ -179,8 +184,10 @@ class Build:
         return Library(ctypes.CDLL(str(self.path)), self.headers)
 
 
-def compile_one(config: BuildConfig, source: Path, include_dir: Path, out_dir: Path) -> Path:
-    """Compile ``source`` with ``config``; raise with the compiler's message on failure."""
+def compile_one(config: BuildConfig, source: Path, include_dir: Path, out_dir: Path,
+                timeout: float = 300) -> Path:
+    """Compile ``source`` with ``config`` (at most ``timeout`` seconds); raise with the compiler's
+    message on failure."""
     suffix = ".bin" if config.executable else ".so"
     out = out_dir / f"{config.label}{suffix}"
     command = [config.compiler, *config.flags, f"-I{include_dir}", str(source)]
@@ -188,7 +195,7 @@ def compile_one(config: BuildConfig, source: Path, include_dir: Path, out_dir: P
         command += ["-DSYMROT_TEST_MAIN", "-o", str(out), "-lm"]
     else:
         command += ["-fPIC", "-shared", "-o", str(out), "-lm"]
-    result = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
+    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout, check=False)
     if result.returncode != 0:
         raise AssertionError(f"{config.label} failed:\n$ {' '.join(command)}\n{result.stderr[-6000:]}")
     return out

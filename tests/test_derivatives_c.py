@@ -9,22 +9,41 @@ tests/c_harness.py (gcc, -std=c99 -Wall -Wextra -Wpedantic -Wdouble-promotion -W
   10⁻⁶): every derivative within 8 ulp of the reference matrix's largest entry, double and float;
 * the NumPy modules (tested against the same reference in tests/test_derivatives.py) on random
   batches, for α and the Jacobians of compose and rescale, with the same NaN and status.
+
+Two user functions of tests/corpus.py (CORPUS_HEADERS) are emitted through the public API, compiled with
+gcc -O2 -ffp-contract=off and held to the same reference target, α included (the whole corpus:
+``bench/accuracy_derivatives.py --corpus --c``, docs/accuracy_derivatives_corpus_c.md).
 """
 
 from __future__ import annotations
 
 import ctypes
 import shutil
-import subprocess
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import mpmath
 import numpy as np
 import pytest
 
+from symrot.api import derive
+from symrot.backends.c_backend import header_source
+from symrot.plan import evaluation_plan
+
 from . import c_harness
-from .reference import Reference
-from .test_derivatives import FUNCTIONS, _as_array, _function, _ulp, module_of, radial_condition, sweep
+from .corpus import by_expression
+from .reference import GeneratingFunction, Reference
+from .test_derivatives import (
+    FUNCTIONS,
+    _as_array,
+    _function,
+    _ulp,
+    acceleration_condition,
+    module_of,
+    radial_condition,
+    sweep,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated" / "c"
@@ -41,10 +60,11 @@ SIGNATURES = {**{f: ((3, 3), (9,), False) for f in FUNCTIONS},
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
 
 
-def wrappers() -> str:
-    """t_NAME_FUNC[_f](n, in0, in1, in2, out0, out1, status): one exported loop per function."""
-    lines = ["#include <stddef.h>", *(f'#include "symrot_{n}.h"' for n in NAMES)]
-    for name in NAMES:
+def wrappers(names: Sequence[str] = NAMES) -> str:
+    """t_NAME_FUNC[_f](n, in0, in1, in2, out0, out1, status): one exported loop per function of the
+    headers symrot_NAME.h of ``names``."""
+    lines = ["#include <stddef.h>", *(f'#include "symrot_{n}.h"' for n in names)]
+    for name in names:
         for precision, t in CTYPE.items():
             for function, (inputs, outputs, has_status) in SIGNATURES.items():
                 arguments = [f"in{j} + {w}*i" for j, w in enumerate(inputs)]
@@ -59,25 +79,28 @@ def wrappers() -> str:
     return "\n".join(lines) + "\n"
 
 
-def _build(compiler: str, work: Path) -> Path:
+def build(config: c_harness.BuildConfig, work: Path, names: Sequence[str] = NAMES,
+          include: Path = GENERATED) -> ctypes.CDLL:
+    """The wrappers of ``names`` (headers in ``include``) compiled into ``work`` with ``config``
+    (tests/c_harness.py) and loaded."""
     source = work / "derivatives.c"
-    source.write_text(wrappers(), encoding="utf-8")
-    out = work / f"derivatives_{compiler}.so"
-    command = [compiler, *c_harness.STRICT_C, "-O2", "-fPIC", "-shared", f"-I{GENERATED}", str(source),
-               "-o", str(out), "-lm"]
-    result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
-    assert result.returncode == 0, f"$ {' '.join(command)}\n{result.stderr[-6000:]}"
-    return out
+    source.write_text(wrappers(names), encoding="utf-8")
+    return ctypes.CDLL(str(c_harness.compile_one(config, source, include, work, timeout=600)))
+
+
+def _build(compiler: str, work: Path) -> ctypes.CDLL:
+    config = c_harness.BuildConfig(f"derivatives_{compiler}", compiler, (*c_harness.STRICT_C, "-O2"))
+    return build(config, work)
 
 
 @pytest.fixture(scope="module")
 def library(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    return ctypes.CDLL(str(_build("gcc", tmp_path_factory.mktemp("derivatives_c"))))
+    return _build("gcc", tmp_path_factory.mktemp("derivatives_c"))
 
 
 @pytest.mark.skipif(shutil.which("clang") is None, reason="clang not installed")
 def test_headers_compile_strictly_with_clang(tmp_path: Path) -> None:
-    assert _build("clang", tmp_path).exists()
+    assert _build("clang", tmp_path)
 
 
 def call(library: ctypes.CDLL, name: str, function: str, precision: str,
@@ -105,8 +128,17 @@ def call(library: ctypes.CDLL, name: str, function: str, precision: str,
 def test_c_derivatives_within_8_ulp_of_the_reference(library: ctypes.CDLL, name: str) -> None:
     """Within 8 ulp of the reference matrix's largest entry, or 8 κ next to a singular edge."""
     function, _ = _function(name)
-    reference = Reference(function)
     limits = module_of(name)._DERIVATIVE_X_LIMIT  # the same plan, so the same documented domain
+    worst = worst_against_reference(library, name, function, limits, acceleration=False)
+    assert not {k: v for k, v in worst.items() if v > 8.0}, worst
+
+
+def worst_against_reference(library: ctypes.CDLL, name: str, function: GeneratingFunction,
+                            limits: dict[str, Any], acceleration: bool) -> dict[tuple[str, str], float]:
+    """Worst ulp / max(1, κ) of each (function, precision) of header ``name`` at p = 0, 1e-8, 0.6 φ_max
+    and φ_max − 10⁻⁶ (α too when ``acceleration``, κ as in tests/test_derivatives.py); asserts no NaN
+    inside the documented domain (|p|² below ``limits``, as ``_DERIVATIVE_X_LIMIT``) and NaN beyond."""
+    reference = Reference(function)
     rng = np.random.default_rng(23)
     p_max = float(function.p_max())
     worst: dict[tuple[str, str], float] = {}
@@ -133,6 +165,47 @@ def test_c_derivatives_within_8_ulp_of_the_reference(library: ctypes.CDLL, name:
                 if ulp > 8.0:  # next to a singular edge: within 8 κ (tests/test_derivatives.py)
                     ulp /= max(1.0, radial_condition(reference, p, a, tensor, expected))
                 worst[(f, precision)] = max(worst.get((f, precision), 0.0), ulp)
+            if acceleration and not beyond:
+                (got,), _ = call(library, name, "angular_acceleration", precision, p, a, a[::-1].copy())
+                alpha = np.array([float(v) for v in reference.along(list(p), list(a), list(a[::-1]))[1]])
+                assert np.all(np.isfinite(got)), ("angular_acceleration", angle, precision)
+                ulp = _ulp(got.reshape(3), alpha, dtype)
+                if ulp > 8.0:
+                    ulp /= max(1.0, acceleration_condition(reference, p, a, a[::-1].copy(), alpha))
+                key = ("angular_acceleration", precision)
+                worst[key] = max(worst.get(key, 0.0), ulp)
+    return worst
+
+
+CORPUS_HEADERS = {"corpus_cubic": "phi + phi**3", "corpus_asinh": "asinh(phi)"}
+"""Two functions of the user corpus (tests/corpus.py) outside the paper's families: a polynomial and an
+inverse hyperbolic p, both unbounded, with the ν edge at 2π and Newton's angle in C (no closed inverse
+is planned for them). bench/accuracy_derivatives.py --corpus --c measures the whole corpus."""
+
+
+@pytest.fixture(scope="module")
+def corpus_library(tmp_path_factory: pytest.TempPathFactory) -> tuple[ctypes.CDLL, dict[str, dict[str, Any]]]:
+    """The headers of CORPUS_HEADERS emitted through the public API and compiled with gcc -O2
+    -ffp-contract=off; (library, {header: the plan's derivative x limits})."""
+    work = tmp_path_factory.mktemp("derivatives_c_corpus")
+    limits = {}
+    for header, expression in CORPUS_HEADERS.items():
+        plan = evaluation_plan(derive(expression).derivation, header)
+        (work / f"symrot_{header}.h").write_text(header_source(plan, header), encoding="utf-8")
+        limits[header] = {label.removeprefix("float"): precision.derivative_x_limit
+                          for label, precision in plan.precisions.items()}
+    return build(c_harness.build_config("gcc-O2-nofma"), work, tuple(CORPUS_HEADERS), work), limits
+
+
+@pytest.mark.parametrize("header", CORPUS_HEADERS)
+def test_c_derivatives_of_corpus_functions(corpus_library: tuple[ctypes.CDLL, dict[str, dict[str, Any]]],
+                                           header: str) -> None:
+    """The five derivatives and α of a user function within 8 ulp of the reference (or 8 κ), no NaN
+    inside the range, double and float."""
+    library, limits = corpus_library
+    function = by_expression(CORPUS_HEADERS[header]).generating_function()
+    worst = worst_against_reference(library, header, function, limits[header], acceleration=True)
+    assert len(worst) == 12, worst
     assert not {k: v for k, v in worst.items() if v > 8.0}, worst
 
 
