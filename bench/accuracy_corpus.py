@@ -278,7 +278,7 @@ def measure_expression(function: GeneratingFunction, name: str, points: int, wit
         directory = Path(tmp)
         module = load_module(plan, directory)
         if with_c:
-            library, header, result["c"] = _c_library(plan, name, directory)
+            library, header, result["c"] = c_library(plan, name, directory)
         measurement = Measurement(function, plan, module, library, header, points)
         measurement.run()
     result["kernel_errors"] = measurement.errors[:5]
@@ -288,18 +288,22 @@ def measure_expression(function: GeneratingFunction, name: str, points: int, wit
     return result
 
 
-def _c_library(plan: Any, name: str, directory: Path) -> tuple[Any, str | None, dict[str, Any]]:
-    """Emit, time and compile the C header (gcc -O2 -ffp-contract=off); (library, header, info)."""
+def c_library(plan: Any, name: str, directory: Path,
+              load: Callable[[Path, str], Any] | None = None) -> tuple[Any, str | None, dict[str, Any]]:
+    """Emit and time the C header symrot_NAME.h into ``directory`` and compile it (gcc -O2
+    -ffp-contract=off); (library, header, info). ``load(directory, name)`` compiles and loads the
+    library (default: the kinematic wrappers of tests/c_harness.py)."""
     from symrot.backends.c_backend import header_source
-    from tests.c_harness import build_configs, compile_all
+    from tests.c_harness import build_config, compile_all
 
     info: dict[str, Any] = {}
     try:
         start = time.perf_counter()
         (directory / f"symrot_{name}.h").write_text(header_source(plan, name), encoding="utf-8")
         info["emit_seconds"] = time.perf_counter() - start
-        config = [c for c in build_configs() if c.label == "gcc-O2-nofma"]
-        build = compile_all(config, [name], directory, directory)["gcc-O2-nofma"]
+        if load is not None:
+            return load(directory, name), name, info
+        build = compile_all([build_config("gcc-O2-nofma")], [name], directory, directory)["gcc-O2-nofma"]
         return build.load(), name, info
     except Exception as error:  # recorded, the NumPy measurement goes on
         info["error"] = one_line(error)

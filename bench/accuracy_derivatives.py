@@ -20,15 +20,22 @@ smaller of the reference's and the plan's) against the reference's p(φ) of the 
 are not finite inside the range are counted (verdict NaN-in-range); an emit that fails or outlasts
 the limit is recorded (emit-failed, with its one-line reason) and the run goes on.
 
+With ``--c`` (corpus mode) the same worker also emits the entry's C header (as bench/accuracy_corpus.py
+does, :func:`accuracy_corpus.c_library`), compiles the derivative wrappers of tests/test_derivatives_c.py
+over it with gcc -O2 -ffp-contract=off (tests/c_harness.py) and measures the six C functions (double, and
+float with suffix ``_f``) at the same points against the same references, with the same verdicts; they
+are reported as backend "c" (columns C double, C float; ``c_tallies`` in the JSON).
+
 Run: ``python bench/accuracy_derivatives.py [--points N] [--names a,b]`` (prints a Markdown table);
 ``python bench/accuracy_derivatives.py --corpus [--only I,J] [--points N] [--out FILE.md] [--json FILE.json]
-[--resume] [--timeout S]`` (--resume: entries already in the --json file are not measured again; the
+[--resume] [--timeout S] [--c]`` (--resume: entries already in the --json file are not measured again; the
 file is rewritten after every entry).
 """
 
 from __future__ import annotations
 
 import argparse
+import ctypes
 import datetime
 import json
 import subprocess
@@ -50,13 +57,16 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 from accuracy import load_module as emitted_module  # noqa: E402
 from accuracy import sweep  # noqa: E402
-from accuracy_corpus import emit, one_line, run_worker  # noqa: E402
+from accuracy_corpus import c_library, emit, one_line, run_worker  # noqa: E402
 
+from tests.c_harness import build_config  # noqa: E402
 from tests.corpus import CORPUS  # noqa: E402
 from tests.reference import GeneratingFunction, Reference  # noqa: E402
 from tests.test_derivatives import _as_array as _array  # noqa: E402
 from tests.test_derivatives import _ulp, acceleration_condition, radial_condition  # noqa: E402
 from tests.test_derivatives import load as load_module  # noqa: E402
+from tests.test_derivatives_c import build as build_wrappers  # noqa: E402
+from tests.test_derivatives_c import call as call_c  # noqa: E402
 
 NAMED = {"rotation_vector": "phi", "linear": "sin(phi)", "euler_rodrigues": "2*sin(phi/2)",
          "cayley_gibbs_rodrigues": "2*tan(phi/2)", "wiener_milenkovic": "4*tan(phi/4)",
@@ -89,21 +99,24 @@ class Swept:
 def measure(name: str, points: int, seed: int = 19) -> dict[tuple[str, str], WorstPoint]:
     """{(function, precision): (ulp, at φ, κ)} at the worst ulp/κ; NaN inside the range counts as inf.
     κ (radial condition of the derivative, tests/test_derivatives.py) is measured only where ulp > 8."""
-    return measure_module(load(name), GeneratingFunction(NAMED[name]), points, seed).worst
+    return measure_module(load(name), GeneratingFunction(NAMED[name]), points, seed)["numpy"].worst
 
 
 def measure_module(module: ModuleType, function: GeneratingFunction, points: int, seed: int = 19,
-                   phi_max: float | None = None, p_max: float | None = None, strict: bool = True) -> Swept:
+                   phi_max: float | None = None, p_max: float | None = None, strict: bool = True,
+                   c: tuple[ctypes.CDLL, str] | None = None) -> dict[str, Swept]:
     """The sweep of :func:`measure` for any emitted module of ``function`` (φ_max, |p|_max: the
-    reference's unless given). ``strict``: a floating-point warning or an exception stops the sweep (the
-    named parameterizations); otherwise it is recorded, the outputs count as non-finite and a point
-    whose reference fails is skipped (the corpus)."""
+    reference's unless given), {backend: Swept}. ``strict``: a floating-point warning or an exception
+    stops the sweep (the named parameterizations); otherwise it is recorded, the outputs count as
+    non-finite and a point whose reference fails is skipped (the corpus). ``c``: (library of the
+    wrappers of tests/test_derivatives_c.py, header name) of the same plan, measured as backend "c" at
+    the same points against the same references (κ computed once per point and function)."""
     reference = Reference(function)
     rng = np.random.default_rng(seed)
     phi_max = float(function.phi_max) if phi_max is None else phi_max
     p_max = float(function.p_max()) if p_max is None else p_max
-    swept = Swept()
-    worst = swept.worst
+    backends = {"numpy": Swept(), **({"c": Swept()} if c is not None else {})}
+    swept = backends["numpy"]
     for angle in sweep(min(phi_max, 4 * np.pi), points):
         axis = rng.normal(size=3)
         axis /= np.linalg.norm(axis)
@@ -122,7 +135,9 @@ def measure_module(module: ModuleType, function: GeneratingFunction, points: int
                 continue  # beyond the documented domain of unbounded p: NaN by design
             ins = [v.astype(dtype) for v in (a, pdot, pddot)]
             exact = [list(v.astype(np.float64)) for v in (p, *ins)]
-            values = _evaluate(module, p, ins, strict, swept.errors, f"{label} φ={angle:.3g}")
+            outputs = {"numpy": _evaluate(module, p, ins, strict, swept.errors, f"{label} φ={angle:.3g}")}
+            if c is not None:
+                outputs["c"] = _evaluate_c(*c, p, ins)
             try:
                 refs = {f: _array(reference.derivative(exact[0], exact[1], t)) for f, t in FUNCTIONS.items()}
                 _, alpha = reference.along(exact[0], exact[2], exact[3])
@@ -132,23 +147,46 @@ def measure_module(module: ModuleType, function: GeneratingFunction, points: int
                 swept.errors.append(f"reference {label} φ={angle:.3g}: {one_line(error)}")
                 continue
             refs["angular_acceleration"] = np.array([float(v) for v in alpha])
-            for f, value in values.items():
-                key = (f, label)
-                swept.points[key] = swept.points.get(key, 0) + 1
-                finite = bool(np.all(np.isfinite(value)))
-                if not finite:
-                    swept.nonfinite[key] = swept.nonfinite.get(key, 0) + 1
-                ulp = _ulp(value, refs[f], dtype)
-                kappa = 1.0
-                if ulp > TARGET_ULP and f in FUNCTIONS and (finite or strict):  # next to a singular edge
-                    kappa = max(1.0, radial_condition(reference, np.array(exact[0]), np.array(exact[1]),
-                                                      FUNCTIONS[f], refs[f]))
-                elif ulp > TARGET_ULP and (finite or strict):  # α: radial κ or the cancellation of its terms
-                    kappa = max(1.0, acceleration_condition(reference, np.array(exact[0]), np.array(exact[2]),
-                                                            np.array(exact[3]), refs[f]))
-                if ulp / kappa >= worst.get(key, (-1.0, 0.0, 1.0))[0] / worst.get(key, (0, 0, 1.0))[2]:
-                    worst[key] = (ulp, float(angle), kappa)
-    return swept
+            kappas: dict[str, float] = {}
+            for backend, values in outputs.items():
+                tally = backends[backend]
+                for f, value in values.items():
+                    key = (f, label)
+                    tally.points[key] = tally.points.get(key, 0) + 1
+                    finite = bool(np.all(np.isfinite(value)))
+                    if not finite:
+                        tally.nonfinite[key] = tally.nonfinite.get(key, 0) + 1
+                    ulp = _ulp(value, refs[f], dtype)
+                    kappa = 1.0
+                    if ulp > TARGET_ULP and (finite or strict):
+                        if f not in kappas:
+                            kappas[f] = _condition(reference, f, exact, refs[f])
+                        kappa = kappas[f]
+                    worst = tally.worst
+                    if ulp / kappa >= worst.get(key, (-1.0, 0.0, 1.0))[0] / worst.get(key, (0, 0, 1.0))[2]:
+                        worst[key] = (ulp, float(angle), kappa)
+    return backends
+
+
+def _condition(reference: Reference, f: str, exact: list[list[float]], ref: np.ndarray) -> float:
+    """κ of ``f`` at p, a, ṗ, p̈ = ``exact``, at least 1: the radial condition next to a singular edge;
+    for α, the larger of it and the cancellation of its terms."""
+    p = np.array(exact[0])
+    if f in FUNCTIONS:
+        return max(1.0, radial_condition(reference, p, np.array(exact[1]), FUNCTIONS[f], ref))
+    return max(1.0, acceleration_condition(reference, p, np.array(exact[2]), np.array(exact[3]), ref))
+
+
+def _evaluate_c(library: ctypes.CDLL, header: str, p: np.ndarray, ins: list[np.ndarray]
+                ) -> dict[str, np.ndarray]:
+    """The six C derivative functions of ``header`` at one point, in the precision of ``p``."""
+    precision = "double" if p.dtype == np.float64 else "float"
+    values: dict[str, np.ndarray] = {}
+    for f in (*FUNCTIONS, "angular_acceleration"):
+        inputs = (p, ins[1], ins[2]) if f == "angular_acceleration" else (p, ins[0])
+        (out,), _ = call_c(library, header, f, precision, *inputs)
+        values[f] = out.reshape(3) if f == "angular_acceleration" else out.reshape(3, 3)
+    return values
 
 
 def _evaluate(module: ModuleType, p: np.ndarray, ins: list[np.ndarray], strict: bool, errors: list[str],
@@ -208,35 +246,55 @@ def commit() -> str:
     return (git("rev-parse", "--short", "HEAD") or "unknown") + ("+uncommitted" if dirty else "")
 
 
-def corpus_worker(index: int, points: int) -> dict[str, Any]:
-    """Emit corpus entry ``index`` and sweep its derivatives; a JSON-ready result (emit failures
-    included). Progress goes to standard error (the last line says where a timed-out worker was)."""
+def corpus_worker(index: int, points: int, with_c: bool = False) -> dict[str, Any]:
+    """Emit corpus entry ``index`` (and its C header, ``with_c``) and sweep its derivatives; a JSON-ready
+    result (emit failures included). Progress goes to standard error (the last line says where a
+    timed-out worker was)."""
     entry = CORPUS[index]
     result: dict[str, Any] = {"index": index, "expression": entry.expression, "category": entry.category,
                               "edge": entry.edge, "closed_inverse": entry.closed_inverse, "commit": commit()}
     function = entry.generating_function()
     result["phi_max_reference"] = float(function.phi_max)
     print("in the emit", file=sys.stderr, flush=True)
-    try:
-        plan, _source, seconds = emit(function.expression, f"corpus_{index:02d}")
-        with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp:
+        try:
+            plan, _source, seconds = emit(function.expression, f"corpus_{index:02d}")
             module = emitted_module(plan, Path(tmp))
-    except Exception as error:  # any exception of the emit is the measurement
-        result["emit_error"] = one_line(error)
-        return result
-    result["emit_seconds"] = seconds
-    result["phi_max_plan"] = float(plan.phi_max)
-    print(f"in the sweep (emitted in {seconds:.0f} s)", file=sys.stderr, flush=True)
-    start = time.perf_counter()
-    phi_max = min(float(function.phi_max), float(plan.phi_max))
-    p_max = min(float(function.p_max()), float(plan.p_max))
-    swept = measure_module(module, function, points, phi_max=phi_max, p_max=p_max, strict=False)
+        except Exception as error:  # any exception of the emit is the measurement
+            result["emit_error"] = one_line(error)
+            return result
+        result["emit_seconds"] = seconds
+        result["phi_max_plan"] = float(plan.phi_max)
+        c = None
+        if with_c:
+            print("in the C emit and compile", file=sys.stderr, flush=True)
+            library, header, result["c"] = c_library(plan, f"corpus_{index:02d}", Path(tmp),
+                                                     _derivative_library)
+            c = (library, header) if library is not None and header is not None else None
+        print(f"in the sweep (emitted in {seconds:.0f} s)", file=sys.stderr, flush=True)
+        start = time.perf_counter()
+        phi_max = min(float(function.phi_max), float(plan.phi_max))
+        p_max = min(float(function.p_max()), float(plan.p_max))
+        backends = measure_module(module, function, points, phi_max=phi_max, p_max=p_max, strict=False, c=c)
+    swept = backends["numpy"]
     result["sweep_seconds"] = time.perf_counter() - start
     result["errors"] = swept.errors[:5]
-    result["tallies"] = [{"function": key[0], "precision": key[1], "ulp": ulp, "at": at, "kappa": kappa,
-                          "nonfinite": swept.nonfinite.get(key, 0), "points": swept.points.get(key, 0)}
-                         for key, (ulp, at, kappa) in swept.worst.items()]
+    result["tallies"] = _tallies(swept)
+    if "c" in backends:
+        result["c_tallies"] = _tallies(backends["c"])
     return result
+
+
+def _derivative_library(directory: Path, name: str) -> ctypes.CDLL:
+    """The derivative wrappers of tests/test_derivatives_c.py over symrot_NAME.h in ``directory``,
+    compiled with gcc -O2 -ffp-contract=off (tests/c_harness.py) and loaded."""
+    return build_wrappers(build_config("gcc-O2-nofma"), directory, [name], directory)
+
+
+def _tallies(swept: Swept) -> list[dict[str, Any]]:
+    return [{"function": key[0], "precision": key[1], "ulp": ulp, "at": at, "kappa": kappa,
+             "nonfinite": swept.nonfinite.get(key, 0), "points": swept.points.get(key, 0)}
+            for key, (ulp, at, kappa) in swept.worst.items()]
 
 
 def tally_verdict(t: dict[str, Any]) -> str:
@@ -248,31 +306,62 @@ def tally_verdict(t: dict[str, Any]) -> str:
     return "conditioned" if t["ulp"] / t["kappa"] <= TARGET_ULP else "misses"
 
 
-def entry_verdict(result: dict[str, Any], label: str) -> str:
-    """The worst verdict of the six functions of one entry in one precision (emit-failed, or
-    incomplete when a function has no measured point)."""
-    if "tallies" not in result:
+def backends(with_c: bool) -> tuple[str, ...]:
+    return ("numpy", "c") if with_c else ("numpy",)
+
+
+TALLIES = {"numpy": "tallies", "c": "c_tallies"}
+"""backend → the key of its tallies in a corpus result."""
+TITLES = {("numpy", "float64"): "NumPy float64", ("numpy", "float32"): "NumPy float32",
+          ("c", "float64"): "C double", ("c", "float32"): "C float"}
+"""Column titles of a report with the C backend (without it: the precision)."""
+
+
+def entry_verdict(result: dict[str, Any], label: str, backend: str = "numpy") -> str:
+    """The worst verdict of the six functions of one entry in one precision and backend (emit-failed,
+    or incomplete when a function has no measured point)."""
+    if TALLIES[backend] not in result:
         return "emit-failed"
-    mine = {t["function"]: tally_verdict(t) for t in result["tallies"] if t["precision"] == label}
+    mine = {t["function"]: tally_verdict(t) for t in result[TALLIES[backend]] if t["precision"] == label}
     if set(mine) != set(ALL_FUNCTIONS):
         return "incomplete"
     return max(mine.values(), key=SEVERITY.index)
 
 
 def _failure(result: dict[str, Any]) -> str:
-    return str(result.get("emit_error") or result.get("worker_error") or "no result").replace("|", "\\|")
+    return _escape(str(result.get("emit_error") or result.get("worker_error") or "no result"))
 
 
-def corpus_report(results: list[dict[str, Any]], command: str, points: int) -> str:
-    """The Markdown report of a corpus run: header, summary per entry, every function, the misses."""
+def _escape(text: str) -> str:
+    """``text`` fit for a Markdown table cell."""
+    return text.replace("|", "\\|")
+
+
+def corpus_report(results: list[dict[str, Any]], command: str, points: int, with_c: bool = False) -> str:
+    """The Markdown report of a corpus run: header, summary per entry, every function, the misses
+    (``with_c``: the C backend as well, in columns C double and C float)."""
+    columns = [(b, label) for b in backends(with_c) for label in DTYPES]
+    title = {key: TITLES[key] if with_c else key[1] for key in columns}
     measured = sorted({r["commit"] for r in results if "commit" in r})
-    verdicts = {r["index"]: {label: entry_verdict(r, label) for label in DTYPES} for r in results}
-    both = sum(all(v[label] in GOOD for label in DTYPES) for v in verdicts.values())
-    per = {label: sum(v[label] in GOOD for v in verdicts.values()) for label in DTYPES}
+    verdicts = {r["index"]: {key: entry_verdict(r, key[1], key[0]) for key in columns} for r in results}
+    per = {key: sum(v[key] in GOOD for v in verdicts.values()) for key in columns}
+    both = {b: sum(all(v[(b, label)] in GOOD for label in DTYPES) for v in verdicts.values())
+            for b in backends(with_c)}
+    n = len(results)
+    f64, f32 = per[("numpy", "float64")], per[("numpy", "float32")]
+    summary = (f"**Summary**: {both['numpy']} of {n} entries meet the target (meets or conditioned, all six "
+               f"functions, no NaN) in both precisions; float64: {f64} of {n}, float32: {f32} of {n}.")
+    if with_c:
+        every = sum(all(c in GOOD for c in v.values()) for v in verdicts.values())
+        summary = (f"**Summary** (entries meeting the target: meets or conditioned, all six functions, no "
+                   f"NaN): NumPy {both['numpy']} of {n} in both precisions (float64 {f64}, float32 {f32}); "
+                   f"C {both['c']} of {n} in both (double {per[('c', 'float64')]}, float "
+                   f"{per[('c', 'float32')]}); NumPy and C, both precisions: {every} of {n}.")
     lines = ["# Accuracy of the derivatives of issue 19 for the user-function corpus", "",
              f"Produced by `{command}` at commit {commit()} on {datetime.date.today().isoformat()}"
              + (f" (entries measured at {', '.join(measured)})" if measured else "")
-             + ": each entry of tests/corpus.py emitted to a NumPy module "
+             + ": each entry of tests/corpus.py emitted to a NumPy module " + (
+                 "and a C header (gcc -O2 -ffp-contract=off, double and float) " if with_c else "") +
              "through the public API (as bench/accuracy_corpus.py does), its six derivative functions swept "
              f"as bench/accuracy_derivatives.py sweeps the named parameterizations (`accuracy.sweep(φ_max, "
              f"{points})` with p = 0 and 1e-300, random unit axes and a, ṗ, p̈; float64 and float32; φ_max "
@@ -281,37 +370,42 @@ def corpus_report(results: list[dict[str, Any]], command: str, points: int) -> s
              f"|D_ref|) at the worst point (the worst ulp/κ). *meets*: ≤ {TARGET_ULP:g} ulp; *conditioned*: "
              f"≤ {TARGET_ULP:g} κ ulp, κ the radial condition number (for α also the cancellation of H p̈ and "
              "Ḣ ṗ), computed only where the error exceeds 8 ulp; *misses* otherwise; *NaN-in-range*: a "
-             "non-finite output inside the range.", "",
-             f"**Summary**: {both} of {len(results)} entries meet the target (meets or conditioned, all six "
-             f"functions, no NaN) in both precisions; float64: {per['float64']} of {len(results)}, "
-             f"float32: {per['float32']} of {len(results)}.", "",
-             "## Entries", "",
-             "| # | p(φ) | edge | emit s | sweep s | φ_max ref / plan | float64 | float32 |",
-             "|---|---|---|---|---|---|---|---|"]
+             "non-finite output inside the range.", "", summary, "", "## Entries", "",
+             "| # | p(φ) | edge | emit s | " + ("C emit s | " if with_c else "")
+             + "sweep s | φ_max ref / plan | " + " | ".join(title[key] for key in columns) + " |",
+             "|---|---|---|---|---|---|" + "---|" * (len(columns) + with_c)]
     for r in results:
         head = f"| {r['index']} | `{r['expression']}` | {r.get('edge', '')} | "
         if "tallies" not in r:
-            lines.append(head + f"emit-failed: {_failure(r)} | — | {r.get('phi_max_reference', 0):.6g} / — "
-                         "| emit-failed | emit-failed |")
+            lines.append(head + f"emit-failed: {_failure(r)} | " + ("— | " if with_c else "") + "— | "
+                         f"{r.get('phi_max_reference', 0):.6g} / — | "
+                         + " | ".join(["emit-failed"] * len(columns)) + " |")
             continue
-        cells = [verdicts[r["index"]][label] for label in DTYPES]
+        c_emit = ""
+        if with_c:
+            c = r.get("c", {})
+            c_emit = (f"{c['emit_seconds']:.1f}" if "emit_seconds" in c else "—") \
+                + (f", failed: {_escape(c['error'])}" if "error" in c else "") + " | "
+        cells = [verdicts[r["index"]][key] for key in columns]
         cells = [c if c in GOOD else f"**{c}**" for c in cells]
-        lines.append(head + f"{r['emit_seconds']:.1f} | {r['sweep_seconds']:.0f} | "
+        lines.append(head + f"{r['emit_seconds']:.1f} | {c_emit}{r['sweep_seconds']:.0f} | "
                      f"{r['phi_max_reference']:.6g} / {r['phi_max_plan']:.6g} | {' | '.join(cells)} |")
     misses = []
     lines += ["", "## Every function", "",
-              "| # | function | float64 ulp (at φ; κ) | float64 | float32 ulp (at φ; κ) | float32 |",
-              "|---|---|---|---|---|---|"]
+              "| # | function | " + " | ".join(f"{title[k]} ulp (at φ; κ) | {title[k]}" for k in columns)
+              + " |",
+              "|---|---|" + "---|---|" * len(columns)]
     for r in results:
         if "tallies" not in r:
-            lines.append(f"| {r['index']} | all | emit-failed: {_failure(r)} | emit-failed | — "
-                         "| emit-failed |")
+            lines.append(f"| {r['index']} | all | emit-failed: {_failure(r)} | emit-failed | "
+                         + " | ".join(["—", "emit-failed"] * (len(columns) - 1)) + " |")
             continue
-        by_key = {(t["function"], t["precision"]): t for t in r["tallies"]}
+        by_key = {(backend, t["function"], t["precision"]): t for backend in ("numpy", "c")
+                  for t in r.get(TALLIES[backend], [])}
         for f in ALL_FUNCTIONS:
             cells = []
-            for label in DTYPES:
-                t = by_key.get((f, label))
+            for backend, label in columns:
+                t = by_key.get((backend, f, label))
                 if t is None:
                     cells += ["—", "—"]
                     continue
@@ -320,8 +414,8 @@ def corpus_report(results: list[dict[str, Any]], command: str, points: int) -> s
                 cells += [f"{t['ulp']:.3g} ({t['at']:.8g}; κ {t['kappa']:.2g}{nan})",
                           v if v in GOOD else f"**{v}**"]
                 if v not in GOOD:
-                    misses.append(f"| {r['index']} | `{r['expression']}` | {f} | {label} | {t['ulp']:.3g} | "
-                                  f"{t['at']:.8g} | {t['kappa']:.2g} | {v} |")
+                    misses.append(f"| {r['index']} | `{r['expression']}` | {f} | {title[(backend, label)]} | "
+                                  f"{t['ulp']:.3g} | {t['at']:.8g} | {t['kappa']:.2g} | {v} |")
             lines.append(f"| {r['index']} | {f} | {' | '.join(cells)} |")
     lines += ["", "## Misses", "", "| # | p(φ) | function | precision | ulp | at φ | κ | verdict |",
               "|---|---|---|---|---|---|---|---|", *misses]
@@ -337,30 +431,32 @@ def corpus_main(args: argparse.Namespace, argv: list[str]) -> int:
     done: dict[int, dict[str, Any]] = {}
     if args.resume and args.json and Path(args.json).exists():
         done = {r["index"]: r for r in json.loads(Path(args.json).read_text(encoding="utf-8"))
-                if "worker_error" not in r}
+                if "worker_error" not in r and (not args.c or "c" in r or "tallies" not in r)}
     for index in indices:
         if index in done:
             continue
         start = time.perf_counter()
         command = [sys.executable, __file__, "--worker", str(index), "--points", str(args.points)]
-        result = run_worker(command, index, args.timeout)
+        result = run_worker(command + (["--c"] if args.c else []), index, args.timeout)
         if "worker_error" in result:
             result["emit_error"] = result["worker_error"]
         done[index] = result
-        found = {label: entry_verdict(result, label) for label in DTYPES}
+        found = [entry_verdict(result, label, backend) for backend in backends(args.c)
+                 for label in DTYPES]
         print(f"{index} {CORPUS[index].expression}: {time.perf_counter() - start:.0f} s "
-              f"{found['float64']} / {found['float32']} {result.get('emit_error') or ''}", flush=True)
+              f"{' / '.join(found)} {result.get('emit_error') or ''}", flush=True)
         if args.json:
             raw = json.dumps([done[i] for i in sorted(done)], indent=1)
             Path(args.json).write_text(raw, encoding="utf-8")
     results = [done[i] for i in sorted(done) if i in indices or args.resume]
     command = "python bench/accuracy_derivatives.py " + " ".join(argv)
-    text = corpus_report(results, command.strip(), args.points)
+    text = corpus_report(results, command.strip(), args.points, args.c)
     if args.out:
         Path(args.out).write_text(text, encoding="utf-8")
     else:
         print(text, end="")
-    return 0 if all(entry_verdict(r, label) in GOOD for r in results for label in DTYPES) else 1
+    return 0 if all(entry_verdict(r, label, b) in GOOD for r in results for label in DTYPES
+                    for b in backends(args.c)) else 1
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -376,10 +472,12 @@ def main(argv: list[str] | None = None) -> int:
                         help="corpus mode: take the entries already in --json, do not measure them again")
     parser.add_argument("--timeout", type=float, default=WORKER_TIMEOUT,
                         help="corpus mode: seconds per entry")
+    parser.add_argument("--c", action="store_true",
+                        help="corpus mode: the C derivative functions as well (gcc -O2 -ffp-contract=off)")
     parser.add_argument("--worker", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker is not None:
-        print(json.dumps(corpus_worker(args.worker, args.points)))
+        print(json.dumps(corpus_worker(args.worker, args.points, args.c)))
         return 0
     if args.corpus or args.only:
         return corpus_main(args, argv)
