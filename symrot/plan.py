@@ -32,8 +32,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from contextlib import ExitStack, suppress
 from dataclasses import replace
-from functools import lru_cache
+from functools import lru_cache, partial
 from typing import Any, NamedTuple
 
 import mpmath
@@ -59,6 +60,7 @@ from .core import Derivation, derive_expression
 from .domain import FIRST_POWER, domain_limit
 from .errors import SymrotError
 from .evaluation import log_grid, model_function
+from .forked import in_child
 from .functions import RealCbrt, mpmath_namespace
 from .measurement import (
     EDGE_POINTS,
@@ -531,8 +533,26 @@ def _switch_values(variable_of_phi: sp.Expr, phi_max: float, dtype: type) -> np.
     return values
 
 
+class _SharedWork(NamedTuple):
+    """What the plans of both precisions read: the derivation, its range and closed inverse, and
+    the algebraic forms found once for both (:func:`_plan_for`)."""
+
+    derivation: Derivation
+    limits: Any
+    phi_max: float
+    p_max: float
+    inverse: sp.Expr | None
+    complement: sp.Rational | None
+    unbounded: bool
+    det_h_own_scale: bool
+    algebraic_forms: dict[str, sp.Expr | None]
+
+
 @lru_cache(maxsize=64)
 def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
+    """The plan of both precisions. The symbolic work they share (the algebraic search, the
+    simplified forms and series) is done first; then float32 is planned in a forked child while
+    this process plans float64 (:mod:`symrot.forked`), both from the same state."""
     from .singularities import validity
 
     derivation = derive_expression(p)
@@ -540,7 +560,6 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     limits = validity(derivation)
     phi_max = float(limits.phi_max_float) if np.isfinite(limits.phi_max_float) else 4 * float(np.pi)
     inverse = closed_inverse(p, derivation.kappa)
-    x_of_phi = p ** 2
     p_max = float(limits.p_max_float)
     unbounded = not math.isfinite(p_max)  # p → ∞ at φ_max
     # det H = μ ν² → 0 at φ_max because p′ → ∞ there (a logarithmic pole such as asinh(tan φ), where
@@ -551,87 +570,149 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                if abs(s.phi_float - phi_max) <= 1e-12 * phi_max}
     det_h_own_scale = unbounded or {("det_H", "0"), ("p_prime", "oo")} <= at_edge
     complement = fold_complement(inverse, p_max)
-    # the algebraic search of one plan is capped by the size of what it simplifies (a few seconds
-    # for every named parameterization; expressions whose forms never simplify would otherwise
-    # spend minutes): past ALGEBRAIC_WORK, coefficients get branches
-    algebraic_work = 0
-    algebraic_forms: dict[str, sp.Expr | None] = {}
-    precisions = {}
-    across = {t.across_name: name for name, t in derivation.tensors.items()}
-    for label, dtype in PRECISIONS.items():
-        coefficients: dict[str, Coefficient] = {}
-        slopes_unrepresentable = False
-        for coefficient, closed in derivation.planned_expressions().items():
-            tensor = across.get(coefficient)
-            if tensor is not None and isinstance(coefficients[tensor + "_0"], Constant):
-                continue  # c_0 exact: the backends compute t = c_0 - c_2 x, which loses nothing
-            constant = derivation.constant_value(coefficient)
-            if constant is not None:
-                coefficients[coefficient] = Constant(constant)
-                continue
-            if coefficient in derivation.slopes:  # after every parent: its parent's plan is known
-                try:
-                    coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max,
-                                                            dtype, inverse, complement, unbounded)
-                except UnplannableCoefficient:  # e.g. 1e-8*phi in float32: dc/dx ~ 1/kappa^4 overflows
-                    coefficients[coefficient] = Constant(sp.Integer(0))  # never used: see slope_limit
-                    slopes_unrepresentable = True
-                continue
-            if inverse is not None:
-                if coefficient not in algebraic_forms:  # the first precision searches, both use it
-                    simplest_form = derivation.simplified_form(coefficient)
-                    found = None
-                    for form in dict.fromkeys((simplest_form, closed)):
-                        size = reduction_size(form, inverse)
-                        if (found is not None or size > REDUCTION_OPS
-                                or algebraic_work + size > ALGEBRAIC_WORK):
-                            continue
-                        algebraic_work += size
-                        found = algebraic_in_x(form, inverse, p_max)
-                    algebraic_forms[coefficient] = found
-                algebraic = algebraic_forms[coefficient]
-                if algebraic is not None:
-                    coefficients[coefficient] = Algebraic(algebraic)
-                    continue
-            series = derivation.series_in_x(coefficient, MAX_TERMS)
-            simplest_form = derivation.simplified_form(coefficient)
-            extra = difference_forms(coefficients, tensor, complement) if tensor is not None else ()
-            coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
-                                                    inverse, complement,
-                                                    tensor_part(derivation, coefficient, det_h_own_scale),
-                                                    extra)
-        coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
-                                                             dtype)
-        scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
-        closed_angle = None if inverse is None or complement is not None else next(
-            (form for form in angle_forms(inverse)
-             if closed_angle_error(form, p, phi_max, dtype) <= ANGLE_TOLERANCE_ULP), None)
-        angle = (ClosedAngle(closed_angle) if closed_angle is not None
-                 else _newton_angle(derivation, phi_max, p_max, dtype,
-                                    _bracket_top(limits.phi_max, phi_max, dtype)))
-        if complement is not None:
-            assert inverse is not None
-            coefficients = {n: _use_complement(c, inverse, complement) for n, c in coefficients.items()}
-            angle = ClosedAngle(angle_with_complement(inverse))
-        elif inverse is not None:
-            coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
-                            if isinstance(c, Branch) else c for n, c in coefficients.items()}
-        if unbounded:  # x unbounded: (k x + a)^n overflows before the value does
-            coefficients = {n: Algebraic(with_bounded_powers(c.expression)) if isinstance(c, Algebraic) else c
-                            for n, c in coefficients.items()}
-        slopes = {n: c for n, c in coefficients.items() if n in derivation.slopes}
-        kinematic = {n: c for n, c in coefficients.items()
-                     if n not in derivation.slopes and n not in UNREAD_SCALARS}
-        limit = _domain_limit(derivation, kinematic, angle, inverse, phi_max, p_max, dtype)
-        if isinstance(angle, NewtonAngle):  # the angle's steps do not reach beyond this size
-            limit = min(limit, angle.converges_below ** 2)
-        slope_limit = min(limit, _domain_limit(derivation, slopes, angle, inverse, phi_max, p_max, dtype))
-        if slopes_unrepresentable:  # the derivative functions are NaN everywhere in this format
-            slope_limit = 0.0
-        precisions[label] = PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale,
-                                          limit, slope_limit)
+    algebraic_forms = _algebraic_forms(derivation, inverse, p_max)
+    _prepare_shared_work(derivation, algebraic_forms, inverse)
+    shared = _SharedWork(derivation, limits, phi_max, p_max, inverse, complement, unbounded, det_h_own_scale,
+                         algebraic_forms)
+    (first, first_dtype), *others = PRECISIONS.items()
+    with ExitStack() as children:
+        waits = {label: children.enter_context(in_child(partial(_precision_plan, shared, label, dtype)))
+                 for label, dtype in others}
+        precisions = {first: _precision_plan(shared, first, first_dtype)}
+        precisions.update({label: wait() for label, wait in waits.items()})
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
                           _p_max_squared(p, limits.phi_max, p_max))
+
+
+def _searched(derivation: Derivation) -> list[str]:
+    """The planned coefficients whose value is neither a constant nor a slope, in plan order: those
+    an algebraic form is searched for (an across-axis part only when c₀ is not constant)."""
+    across = {t.across_name: name for name, t in derivation.tensors.items()}
+    names = []
+    for coefficient in derivation.planned_expressions():
+        tensor = across.get(coefficient)
+        if tensor is not None and derivation.constant_value(tensor + "_0") is not None:
+            continue  # c_0 exact: the backends compute t = c_0 - c_2 x, which loses nothing
+        if derivation.constant_value(coefficient) is None and coefficient not in derivation.slopes:
+            names.append(coefficient)
+    return names
+
+
+def _algebraic_forms(derivation: Derivation, inverse: sp.Expr | None,
+                     p_max: float) -> dict[str, sp.Expr | None]:
+    """Each searched coefficient's form algebraic in x (and d), or None: with a closed inverse, the
+    simplest form and then the raw one are tried (:func:`symrot.algebraic.algebraic_in_x`). The search
+    of one plan is capped by the size of what it simplifies (a few seconds for every named
+    parameterization; expressions whose forms never simplify would otherwise spend minutes): past
+    ALGEBRAIC_WORK, coefficients get branches. Both precisions use the result."""
+    forms: dict[str, sp.Expr | None] = {}
+    if inverse is None:
+        return forms
+    work = 0
+    for coefficient in _searched(derivation):
+        closed = derivation.planned_expressions()[coefficient]
+        found = None
+        for form in dict.fromkeys((derivation.simplified_form(coefficient), closed)):
+            size = reduction_size(form, inverse)
+            if found is not None or size > REDUCTION_OPS or work + size > ALGEBRAIC_WORK:
+                continue
+            work += size
+            found = algebraic_in_x(form, inverse, p_max)
+        forms[coefficient] = found
+    return forms
+
+
+def _prepare_shared_work(derivation: Derivation, algebraic_forms: dict[str, sp.Expr | None],
+                         inverse: sp.Expr | None) -> None:
+    """Compute once, before the precisions part, the symbolic work that both plans read: the
+    simplified forms and series of the coefficients without an algebraic form and of their slopes,
+    the quaternion's scalar series and scale, and Newton's forms without a closed inverse (a step
+    that fails is left to the plan, which meets the same failure in its place)."""
+    for coefficient in _searched(derivation):
+        if algebraic_forms.get(coefficient) is None:
+            _prepare(derivation, coefficient)
+    for slope, (parent, _) in derivation.slopes.items():
+        if derivation.constant_value(slope) is None and algebraic_forms.get(parent) is None:
+            _prepare(derivation, slope)
+    warm: list[Callable[[], object]] = [lambda: _scale_forms(derivation.p),
+                                        lambda: _quaternion_scalar_series(derivation.p)]
+    if inverse is None:
+        warm.append(lambda: _newton_forms(derivation.p))
+    for step in warm:
+        with suppress(SymrotError):
+            step()
+
+
+def _prepare(derivation: Derivation, coefficient: str) -> None:
+    with suppress(SymrotError):
+        derivation.series_in_x(coefficient, MAX_TERMS)
+        derivation.simplified_form(coefficient)
+
+
+def _precision_plan(shared: _SharedWork, label: str, dtype: type[np.floating]) -> PrecisionPlan:
+    """The plan of every coefficient in one precision (see :func:`plan_branch`)."""
+    derivation, phi_max, p_max, inverse = shared.derivation, shared.phi_max, shared.p_max, shared.inverse
+    complement, unbounded, p = shared.complement, shared.unbounded, derivation.p
+    x_of_phi = p ** 2
+    across = {t.across_name: name for name, t in derivation.tensors.items()}
+    coefficients: dict[str, Coefficient] = {}
+    slopes_unrepresentable = False
+    for coefficient in derivation.planned_expressions():
+        tensor = across.get(coefficient)
+        if tensor is not None and isinstance(coefficients[tensor + "_0"], Constant):
+            continue  # c_0 exact: the backends compute t = c_0 - c_2 x, which loses nothing
+        constant = derivation.constant_value(coefficient)
+        if constant is not None:
+            coefficients[coefficient] = Constant(constant)
+            continue
+        if coefficient in derivation.slopes:  # after every parent: its parent's plan is known
+            try:
+                coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max,
+                                                        dtype, inverse, complement, unbounded)
+            except UnplannableCoefficient:  # e.g. 1e-8*phi in float32: dc/dx ~ 1/kappa^4 overflows
+                coefficients[coefficient] = Constant(sp.Integer(0))  # never used: see slope_limit
+                slopes_unrepresentable = True
+            continue
+        algebraic = shared.algebraic_forms.get(coefficient)
+        if algebraic is not None:
+            coefficients[coefficient] = Algebraic(algebraic)
+            continue
+        series = derivation.series_in_x(coefficient, MAX_TERMS)
+        simplest_form = derivation.simplified_form(coefficient)
+        extra = difference_forms(coefficients, tensor, complement) if tensor is not None else ()
+        coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
+                                                inverse, complement,
+                                                tensor_part(derivation, coefficient, shared.det_h_own_scale),
+                                                extra)
+    coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
+                                                         dtype)
+    scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
+    closed_angle = None if inverse is None or complement is not None else next(
+        (form for form in angle_forms(inverse)
+         if closed_angle_error(form, p, phi_max, dtype) <= ANGLE_TOLERANCE_ULP), None)
+    angle = (ClosedAngle(closed_angle) if closed_angle is not None
+             else _newton_angle(derivation, phi_max, p_max, dtype,
+                                _bracket_top(shared.limits.phi_max, phi_max, dtype)))
+    if complement is not None:
+        assert inverse is not None
+        coefficients = {n: _use_complement(c, inverse, complement) for n, c in coefficients.items()}
+        angle = ClosedAngle(angle_with_complement(inverse))
+    elif inverse is not None:
+        coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
+                        if isinstance(c, Branch) else c for n, c in coefficients.items()}
+    if unbounded:  # x unbounded: (k x + a)^n overflows before the value does
+        coefficients = {n: Algebraic(with_bounded_powers(c.expression)) if isinstance(c, Algebraic) else c
+                        for n, c in coefficients.items()}
+    slopes = {n: c for n, c in coefficients.items() if n in derivation.slopes}
+    kinematic = {n: c for n, c in coefficients.items()
+                 if n not in derivation.slopes and n not in UNREAD_SCALARS}
+    limit = _domain_limit(derivation, kinematic, angle, inverse, phi_max, p_max, dtype)
+    if isinstance(angle, NewtonAngle):  # the angle's steps do not reach beyond this size
+        limit = min(limit, angle.converges_below ** 2)
+    slope_limit = min(limit, _domain_limit(derivation, slopes, angle, inverse, phi_max, p_max, dtype))
+    if slopes_unrepresentable:  # the derivative functions are NaN everywhere in this format
+        slope_limit = 0.0
+    return PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale, limit, slope_limit)
 
 
 def difference_forms(coefficients: dict[str, Coefficient], tensor: str,
@@ -734,7 +815,7 @@ def _quaternion_scalar(derivation: Derivation, inverse: sp.Expr | None, compleme
         algebraic = algebraic_in_x(quaternion_scalar(), inverse, p_max)
         if algebraic is not None:
             return Algebraic(algebraic)
-    series = quaternion_scalar_series(derivation, MAX_TERMS)
+    series = _quaternion_scalar_series(derivation.p)
     return plan_branch(quaternion_scalar(), series, derivation.p ** 2, phi_max, dtype, derivation.p, inverse,
                        complement)
 
@@ -744,7 +825,19 @@ def _quaternion_scale(p: sp.Expr, phi_top: float, dtype: type) -> QuaternionScal
     algebraic, closed = _scale_forms(p)
     if algebraic is not None:
         return QuaternionScale(algebraic, None)
-    return QuaternionScale(None, plan_branch(closed, scale_series(p, MAX_TERMS), PHI ** 2, phi_top, dtype))
+    return QuaternionScale(None, plan_branch(closed, _scale_series(p), PHI ** 2, phi_top, dtype))
+
+
+@lru_cache(maxsize=64)
+def _quaternion_scalar_series(p: sp.Expr) -> list[sp.Expr]:
+    """e₀'s exact series in x (both precisions read it)."""
+    return quaternion_scalar_series(derive_expression(p), MAX_TERMS)
+
+
+@lru_cache(maxsize=64)
+def _scale_series(p: sp.Expr) -> list[sp.Expr]:
+    """σ's exact series in φ² (both precisions read it)."""
+    return scale_series(p, MAX_TERMS)
 
 
 @lru_cache(maxsize=64)
@@ -772,17 +865,25 @@ def _bracket_top(exact: sp.Expr, phi_max: float, dtype: type) -> float:
     return float(top)
 
 
-def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: type,
-                  bracket_top: float) -> NewtonAngle:
+@lru_cache(maxsize=64)
+def _newton_forms(p: sp.Expr) -> tuple[sp.Expr, list[sp.Expr], sp.Expr, list[sp.Expr], tuple[sp.Expr, ...]]:
+    """The symbolic part of :func:`_newton_angle`, the same for both precisions: Newton's ratio p/φ
+    and slope p′ (simplified, with their exact series in φ²) and the start's series φ(p)."""
     order = 2 * MAX_TERMS
-    p = derivation.p
+    derivation = derive_expression(p)
     ratio_series = coefficient_list(taylor_series(p / PHI, order), 0, order)[0::2]
     slope_series = derivation.taylor_in_phi("p_prime", order)[0::2]
-    ratio = plan_branch(sp.simplify(p / PHI), ratio_series, PHI ** 2, phi_max, dtype)
-    slope = plan_branch(derivation.simplified_coefficients()["p_prime"], slope_series, PHI ** 2,
-                        phi_max, dtype)
     reverted = derivation.phi_of_p(2 * START_TERMS)
-    start = tuple(reverted[1::2][:START_TERMS])
+    return (sp.simplify(p / PHI), ratio_series, derivation.simplified_coefficients()["p_prime"], slope_series,
+            tuple(reverted[1::2][:START_TERMS]))
+
+
+def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: type,
+                  bracket_top: float) -> NewtonAngle:
+    p = derivation.p
+    ratio_form, ratio_series, slope_form, slope_series, start = _newton_forms(p)
+    ratio = plan_branch(ratio_form, ratio_series, PHI ** 2, phi_max, dtype)
+    slope = plan_branch(slope_form, slope_series, PHI ** 2, phi_max, dtype)
     far = _far_start(p, p_max, phi_max, start)
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))

@@ -1806,9 +1806,9 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
 /* symrot_det_h_one_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
  * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 473 */
+ * ops: 474 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1831,10 +1831,11 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        c_R_1 = w0/cbrtf(6*phi - 6*w0);
-        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*(w2*w2)/powf(cbrtf(6*phi - 12*w2*cosf(w1)), 2);
+        const float w1 = 6*phi;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        c_R_1 = -w0/cbrtf(6*w0 - w1);
+        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*(w3*w3)/powf(cbrtf(w1 - 12*w3*cosf(w2)), 2);
     }
     const float t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -1852,7 +1853,7 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const float *p, float *R)
@@ -1872,7 +1873,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u0 = cbrtf(6*phi - 6*sinf(phi));
                 const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
@@ -1948,10 +1949,10 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
 
 /* symrot_det_h_one_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
  * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 512 */
+ * ops: 513 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1975,13 +1976,14 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = (w2*w2);
-        const float w4 = w2*cosf(w1);
-        c_H_across = w0/cbrtf(6*phi - 6*w0);
-        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w3/powf(cbrtf(6*phi - 12*w4), 2);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(w3*(phi - 2*w4));
+        const float w1 = 6*phi;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = (w3*w3);
+        const float w5 = w3*cosf(w2);
+        c_H_across = -w0/cbrtf(6*w0 - w1);
+        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w4/powf(cbrtf(w1 - 12*w5), 2);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w5 + (1.0F/2.0F)*sinf(2*phi))/(w4*(phi - 2*w5));
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1998,7 +2000,7 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, float *H)
@@ -2018,7 +2020,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u0 = cbrtf(6*phi - 6*sinf(phi));
                 const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
@@ -2112,7 +2114,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
 
 /* symrot_det_h_one_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*phi - 6*sin(phi))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
  * ops: 489 */
@@ -2144,7 +2146,7 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
         const float w4 = 1.0F/w3;
         const float w5 = 6*phi;
         const float w6 = w2*cosf(w1);
-        c_H_inverse_across = (1.0F/4.0F)*w0*w4*cbrtf(6*phi - 6*w0);
+        c_H_inverse_across = -1.0F/4.0F*w0*w4*cbrtf(6*w0 - w5);
         c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
@@ -2162,7 +2164,7 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
@@ -2182,7 +2184,7 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u0 = cbrtf(6*phi - 6*sinf(phi));
                 const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
@@ -2275,9 +2277,9 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
 /* symrot_det_h_one_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * G_2: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
- * ops: 456 */
+ * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*phi - 6*sin(phi))
+ * G_2: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*phi - 6*sin(phi))**2
+ * ops: 457 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2300,7 +2302,7 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = cbrtf(6*(phi - sinf(phi)));
+        const float w1 = cbrtf(6*phi - 6*sinf(phi));
         c_G_1 = sinf(w0)/w1;
         c_G_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - cosf(w0))/(w1*w1);
     }
@@ -2320,7 +2322,7 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p, float *G)
@@ -2339,7 +2341,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u0 = cbrtf(6*phi - 6*sinf(phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
@@ -2403,10 +2405,10 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
 
 /* symrot_det_h_one_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * K_1: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*(phi - sin(phi)))**2
+ * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*phi - 6*sin(phi))
+ * K_1: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*phi - 6*sin(phi))**2
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 517 */
+ * ops: 518 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2431,13 +2433,14 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = cbrtf(6*(phi - sinf(phi)));
-        const float w3 = cosf(w0);
-        const float w4 = cbrtf(6*phi - 12*w1*w3);
-        const float w5 = (w4*w4);
-        c_K_across = w1/w2;
-        c_K_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - w3)/(w2*w2);
-        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w4 + (1.0F/8.0F)*w5/(w1*w1))/w5;
+        const float w2 = 6*phi;
+        const float w3 = cbrtf(w2 - 6*sinf(phi));
+        const float w4 = cosf(w0);
+        const float w5 = -cbrtf(12*w1*w4 - w2);
+        const float w6 = (w5*w5);
+        c_K_across = w1/w3;
+        c_K_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - w4)/(w3*w3);
+        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w5 + (1.0F/8.0F)*w6/(w1*w1))/w6;
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2454,7 +2457,7 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *p, float *K)
@@ -2474,7 +2477,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*(phi - sinf(phi)));
+                const float u0 = cbrtf(6*phi - 6*sinf(phi));
                 const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
@@ -2547,7 +2550,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
 
 /* symrot_det_h_one_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*phi - 6*sin(phi))/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
  * ops: 488 */
@@ -2573,7 +2576,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
         const float w4 = 1.0F/w3;
         const float w5 = 6*phi;
         const float w6 = w2*cosf(w1);
-        c_H_inverse_across = (1.0F/4.0F)*w0*w4*cbrtf(6*phi - 6*w0);
+        c_H_inverse_across = -1.0F/4.0F*w0*w4*cbrtf(6*w0 - w5);
         c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
@@ -2587,10 +2590,10 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
 
 /* symrot_det_h_one_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
  * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 511 */
+ * ops: 512 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2608,13 +2611,14 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = (w2*w2);
-        const float w4 = w2*cosf(w1);
-        c_H_across = w0/cbrtf(6*phi - 6*w0);
-        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w3/powf(cbrtf(6*phi - 12*w4), 2);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w4 + (1.0F/2.0F)*sinf(2*phi))/(w3*(phi - 2*w4));
+        const float w1 = 6*phi;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = (w3*w3);
+        const float w5 = w3*cosf(w2);
+        c_H_across = -w0/cbrtf(6*w0 - w1);
+        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w4/powf(cbrtf(w1 - 12*w5), 2);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w5 + (1.0F/2.0F)*sinf(2*phi))/(w4*(phi - 2*w5));
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2628,8 +2632,8 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
 /* symrot_det_h_one_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
- * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * ops: 401 */
+ * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/cbrt(6*phi - 6*sin(phi))
+ * ops: 402 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2648,7 +2652,7 @@ static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4]
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = (1.0F/2.0F)*phi;
         c_e_0 = cosf(w0);
-        c_nu = 2*sinf(w0)/cbrtf(6*(phi - sinf(phi)));
+        c_nu = 2*sinf(w0)/cbrtf(6*phi - 6*sinf(phi));
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
     e[0] = c_e_0;
@@ -2788,12 +2792,12 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
 /* symrot_det_h_one_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
  * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 654 */
+ * ops: 655 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2818,18 +2822,18 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
-        const float w1 = phi - w0;
+        const float w1 = 6*phi;
         const float w2 = (1.0F/2.0F)*phi;
         const float w3 = sinf(w2);
         const float w4 = w3*cosf(w2);
-        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w5 = cbrtf(w1 - 12*w4);
         const float w6 = (w3*w3);
         const float w7 = 2*w6;
         const float w8 = (1.0F/8.0F)/w6;
         const float w9 = 2*w4;
-        c_R_1 = w0/cbrtf(6*w1);
+        c_R_1 = -w0/cbrtf(6*w0 - w1);
         c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/(phi - w0) - w7 + 1);
         c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
     }
     const float dw0 = a[1]*p[1];
@@ -2872,12 +2876,12 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
 /* symrot_det_h_one_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*(phi - sin(phi)))
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
  * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 655 */
+ * ops: 656 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2902,18 +2906,18 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float w0 = sinf(phi);
-        const float w1 = phi - w0;
+        const float w1 = 6*phi;
         const float w2 = (1.0F/2.0F)*phi;
         const float w3 = sinf(w2);
         const float w4 = w3*cosf(w2);
-        const float w5 = cbrtf(6*phi - 12*w4);
+        const float w5 = cbrtf(w1 - 12*w4);
         const float w6 = (w3*w3);
         const float w7 = 2*w6;
         const float w8 = (1.0F/8.0F)/w6;
         const float w9 = 2*w4;
-        c_R_1 = w0/cbrtf(6*w1);
+        c_R_1 = -w0/cbrtf(6*w0 - w1);
         c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/w1 - w7 + 1);
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/(phi - w0) - w7 + 1);
         c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
     }
     const float dw0 = a[1]*p[1];

@@ -1640,7 +1640,7 @@ static inline float symrot_sine_m3_angle_f(const float p[3])
 /* symrot_sine_m3_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -(4*x - 27)/27 (algebraic in x)
+ * R_1 = 1 - 4*x/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * ops: 88 */
 static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9])
@@ -1757,7 +1757,7 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
 
 /* symrot_sine_m3_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_across = -(4*x - 27)/27 (algebraic in x)
+ * H_across = 1 - 4*x/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * ops: 126 */
@@ -2340,7 +2340,7 @@ static inline void symrot_sine_m3_pdot_f(const float p[3], const float omega[3],
 
 /* symrot_sine_m3_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_across = -(4*x - 27)/27 (algebraic in x)
+ * H_across = 1 - 4*x/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 13 in x below x = 2.86277, else (-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/(sqrt(d)*x)
  * ops: 125 */
@@ -2541,7 +2541,7 @@ static inline int symrot_sine_m3_rescale_f(const float p[3], float q[3])
 /* symrot_sine_m3_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * R_1 = -(4*x - 27)/27 (algebraic in x)
+ * R_1 = 1 - 4*x/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)
@@ -2615,7 +2615,7 @@ static inline void symrot_sine_m3_rotation_derivative_f(const float p[3], const 
 /* symrot_sine_m3_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * R_1 = -(4*x - 27)/27 (algebraic in x)
+ * R_1 = 1 - 4*x/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)

@@ -1912,7 +1912,7 @@ static inline void symrot_sine_m4_omega_f(const float p[3], const float pdot[3],
 
 /* symrot_sine_m4_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * e_0 = -(x - 8)/8 (algebraic in x)
+ * e_0 = 1 - x/8 (algebraic in x)
  * nu = sqrt(d)/4 (algebraic in x)
  * ops: 35 */
 static inline void symrot_sine_m4_to_quaternion_f(const float p[3], float e[4])

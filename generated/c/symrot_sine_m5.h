@@ -1634,7 +1634,7 @@ static inline float symrot_sine_m5_angle_f(const float p[3])
 /* symrot_sine_m5_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
+ * R_1 = 16*x**2/3125 - 4*x/25 + 1 (algebraic in x)
  * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * ops: 68 */
 static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9])
@@ -1749,7 +1749,7 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
 
 /* symrot_sine_m5_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
+ * H_across = 16*x**2/3125 - 4*x/25 + 1 (algebraic in x)
  * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * ops: 85 */
@@ -2371,7 +2371,7 @@ static inline void symrot_sine_m5_pdot_f(const float p[3], const float omega[3],
 
 /* symrot_sine_m5_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
+ * H_across = 16*x**2/3125 - 4*x/25 + 1 (algebraic in x)
  * H_1: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 6 in x below x = 2.78761, else (1/cos(phi/5) - 2*sin(phi/2)*cos(phi/2)/s)/x
  * ops: 84 */
@@ -2562,7 +2562,7 @@ static inline int symrot_sine_m5_rescale_f(const float p[3], float q[3])
 /* symrot_sine_m5_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
+ * R_1 = 16*x**2/3125 - 4*x/25 + 1 (algebraic in x)
  * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)
@@ -2636,7 +2636,7 @@ static inline void symrot_sine_m5_rotation_derivative_f(const float p[3], const 
 /* symrot_sine_m5_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1 = (16*x**2 - 500*x + 3125)/3125 (algebraic in x)
+ * R_1 = 16*x**2/3125 - 4*x/25 + 1 (algebraic in x)
  * R_2: Horner degree 6 in x below x = 2.78761, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = 32*x/3125 - 4/25 (algebraic in x)

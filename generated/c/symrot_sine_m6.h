@@ -1788,7 +1788,7 @@ static inline float symrot_sine_m6_tangent_det_f(const float p[3])
 /* symrot_sine_m6_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1 = -(x - 27)/54 (algebraic in x)
+ * G_1 = 1/2 - x/54 (algebraic in x)
  * G_2: Horner degree 6 in x below x = 5.28621, else 2*sin(phi/4)**2/x
  * ops: 65 */
 static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
@@ -1903,7 +1903,7 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
 
 /* symrot_sine_m6_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_across = -(x - 27)/54 (algebraic in x)
+ * K_across = 1/2 - x/54 (algebraic in x)
  * K_1: Horner degree 6 in x below x = 5.28621, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 7 in x below x = 5.28621, else (-2*cos(phi/6) - cos(phi/2) + 3)/(216*sin(phi/6)**2*cos(phi/6))
  * ops: 85 */
@@ -2109,7 +2109,7 @@ static inline void symrot_sine_m6_omega_f(const float p[3], const float pdot[3],
 /* symrot_sine_m6_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -sqrt(36 - x)*(x - 9)/54 (algebraic in x)
- * nu = -(x - 27)/27 (algebraic in x)
+ * nu = 1 - x/27 (algebraic in x)
  * ops: 19 */
 static inline void symrot_sine_m6_to_quaternion_f(const float p[3], float e[4])
 {

@@ -1643,7 +1643,7 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
  * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = (sqrt(x + 1) + 1)/2 (algebraic in x)
+ * H_inverse_across = sqrt(x + 1)/2 + 1/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
  * ops: 56 */
@@ -2031,7 +2031,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
  * Valid for every p with |p|^2 < 2^63 (|phi| < 1.5707963267948966), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = (sqrt(x + 1) + 1)/2 (algebraic in x)
+ * H_inverse_across = sqrt(x + 1)/2 + 1/2 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = (2*sqrt(x + 1) + 1)/(2*(sqrt(x + 1) + 1)) (algebraic in x)
  * ops: 55 */

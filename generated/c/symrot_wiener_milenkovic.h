@@ -1436,7 +1436,7 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
  * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = -(x - 16)/16 (algebraic in x)
+ * H_inverse_across = 1 - x/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
  * ops: 41 */
@@ -1711,7 +1711,7 @@ static inline void symrot_wiener_milenkovic_root_tangent_f_batch(size_t n, const
  * Valid for every p with |p|^2 < 2^69 (|phi| < 6.2831853071795862), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
  * non-finite p, every output is NaN.
- * H_inverse_across = -(x - 16)/16 (algebraic in x)
+ * H_inverse_across = 1 - x/16 (algebraic in x)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2 = 1/8 (constant)
  * ops: 40 */

@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable
 
 from .. import budget
+from ..forked import die_with_parent
 
 GRACE_SECONDS = 1.5
 """How long the parent waits after the budget for the worker to report its own expiry."""
@@ -35,7 +36,6 @@ exhaustion (exit 2); below it, it is a genuine crash (exit 70, signal named)."""
 
 EXIT_ERROR = 2
 EXIT_INTERNAL = 70
-PR_SET_PDEATHSIG = 1
 
 
 def available() -> bool:
@@ -114,7 +114,7 @@ def _report_signal(number: int, peak: int, memory: int, where: str) -> int:
 def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int, parent: int) -> int:
     import resource
 
-    _die_with_parent(parent)
+    die_with_parent(parent)
     faulthandler.disable()  # a crash is reported by the parent in one line, not as a dump
     try:
         _, hard = resource.getrlimit(resource.RLIMIT_AS)
@@ -128,21 +128,6 @@ def _worker(command: Callable[[], int], shared: mmap.mmap, memory: int, parent: 
             sys.stderr.flush()
         except (OSError, ValueError):
             pass
-
-
-def _die_with_parent(parent: int) -> None:
-    """Linux: the worker gets SIGKILL when the parent dies, so none outlives a killed command.
-
-    A parent killed between the fork and the ``prctl`` call sends no signal: the worker then
-    already has another parent and ends at once."""
-    try:
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-    except (OSError, AttributeError):
-        pass
-    if os.getppid() != parent:
-        os._exit(EXIT_ERROR)
 
 
 def _wait(pid: int, seconds: float | None) -> tuple[int | None, int]:

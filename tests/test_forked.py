@@ -1,0 +1,79 @@
+"""symrot.forked: a function run in a forked child, its value or exception taken back."""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import pytest
+
+from symrot.errors import InvalidGeneratingFunction
+from symrot.forked import ForkedChildError, in_child
+
+
+def test_the_value_comes_from_another_process() -> None:
+    with in_child(lambda: (os.getpid(), [1.5, "x"])) as wait:
+        child, value = wait()
+    assert child != os.getpid() and value == [1.5, "x"]
+
+
+def test_the_parent_works_while_the_child_computes() -> None:
+    start = time.monotonic()
+    with in_child(lambda: time.sleep(0.6) or "slept") as wait:
+        time.sleep(0.6)
+        assert wait() == "slept"
+    assert time.monotonic() - start < 1.1
+
+
+def test_an_exception_of_the_child_is_raised_in_the_parent() -> None:
+    def fail() -> None:
+        raise InvalidGeneratingFunction("p(0) must be 0")
+
+    with in_child(fail) as wait, pytest.raises(InvalidGeneratingFunction, match="p\\(0\\) must be 0"):
+        wait()
+
+
+def test_an_exception_that_does_not_pickle_is_named() -> None:
+    class Local(Exception):
+        pass
+
+    def fail() -> None:
+        raise Local("not at module level")
+
+    with in_child(fail) as wait, pytest.raises(ForkedChildError, match="Local: not at module level"):
+        wait()
+
+
+def test_an_exception_that_does_not_unpickle_is_named() -> None:
+    def fail() -> None:
+        raise _TwoArguments(3.0, "validation")
+
+    with in_child(fail) as wait, pytest.raises(ForkedChildError, match=r"_TwoArguments: 3\.0 s in"):
+        wait()
+
+
+class _TwoArguments(Exception):
+    """Like symrot.budget.BudgetExceeded: its args (the message) do not rebuild it."""
+
+    def __init__(self, seconds: float, stage: str) -> None:
+        super().__init__(f"{seconds} s in {stage}")
+
+
+def test_a_child_whose_value_is_not_taken_is_killed(tmp_path: Path) -> None:
+    marker = tmp_path / "pid"
+
+    def sleep() -> None:
+        marker.write_text(str(os.getpid()))
+        time.sleep(60)
+
+    with in_child(sleep):
+        while not marker.exists() or not marker.read_text():
+            time.sleep(0.01)
+    with pytest.raises(ProcessLookupError):
+        os.kill(int(marker.read_text()), 0)
+
+
+def test_a_child_that_dies_without_a_result_is_an_error() -> None:
+    with in_child(lambda: os._exit(3)) as wait, pytest.raises(ForkedChildError, match="without a result"):
+        wait()
