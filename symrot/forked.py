@@ -11,8 +11,8 @@ The result comes back pickled through a pipe, and so does an exception (re-raise
 one that cannot be pickled becomes a :class:`ForkedChildError` naming it). The child dies with its
 parent (Linux ``PR_SET_PDEATHSIG``), so a command killed at its time budget leaves no process
 behind, and a parent that stops waiting (an exception of its own, an expired budget) kills it.
-Where ``os.fork`` does not exist the function runs in the calling process, before the caller's
-own work.
+Where ``os.fork`` does not exist or fails (no process or memory left for a child) the function
+runs in the calling process, before the caller's own work.
 """
 
 from __future__ import annotations
@@ -59,7 +59,12 @@ class _Child(Generic[T]):
         sys.stderr.flush()
         read, write = os.pipe()
         parent = os.getpid()
-        pid = os.fork()
+        try:
+            pid = os.fork()
+        except OSError:
+            os.close(read)
+            os.close(write)
+            raise
         if pid == 0:  # pragma: no cover - the child's work is the parent's result
             os.close(read)
             status = 1
@@ -137,7 +142,12 @@ class _Done(Generic[T]):
 def in_child(function: Callable[[], T]) -> Iterator[Callable[[], T]]:
     """``function()`` in a forked child; the body gets a callable that waits for its value (or
     raises its exception). The child is killed if the body leaves without taking the value."""
-    child: _Child[T] | _Done[T] = _Child(function) if hasattr(os, "fork") else _Done(function)
+    child: _Child[T] | _Done[T] | None = None
+    if hasattr(os, "fork"):
+        with suppress(OSError):  # no process or memory left for a child (EAGAIN, ENOMEM)
+            child = _Child(function)
+    if child is None:
+        child = _Done(function)
     try:
         yield child.result
     finally:

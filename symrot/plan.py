@@ -609,8 +609,9 @@ def _algebraic_forms(derivation: Derivation, inverse: sp.Expr | None,
     if inverse is None:
         return forms
     work = 0
+    planned = derivation.planned_expressions()
     for coefficient in _searched(derivation):
-        closed = derivation.planned_expressions()[coefficient]
+        closed = planned[coefficient]
         found = None
         for form in dict.fromkeys((derivation.simplified_form(coefficient), closed)):
             size = reduction_size(form, inverse)

@@ -77,3 +77,12 @@ def test_a_child_whose_value_is_not_taken_is_killed(tmp_path: Path) -> None:
 def test_a_child_that_dies_without_a_result_is_an_error() -> None:
     with in_child(lambda: os._exit(3)) as wait, pytest.raises(ForkedChildError, match="without a result"):
         wait()
+
+
+def test_without_a_child_the_function_runs_here(monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_fork() -> int:
+        raise BlockingIOError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(os, "fork", no_fork)
+    with in_child(os.getpid) as wait:
+        assert wait() == os.getpid()
