@@ -72,9 +72,9 @@ def test_analysis_is_fast() -> None:
     for name in ("cayley_gibbs_rodrigues", "det_h_one", "tangent_m5", "sine_m3"):
         d = derive_expression(family_member("tangent", 5).expression if name == "tangent_m5"
                               else lookup(name).expression)
-        started = time.monotonic()
+        started = time.process_time()  # CPU time: the wall time of a loaded CI run measures the load
         validity(d)
-        assert time.monotonic() - started < 1.5
+        assert time.process_time() - started < 1.5
 
 
 def test_symbolic_candidates_find_poles_inside_tan_and_zeros_of_p_prime() -> None:

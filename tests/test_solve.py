@@ -30,9 +30,9 @@ PAPER = {
 
 @pytest.mark.parametrize("prop", sorted(PAPER))
 def test_paper_properties_give_eqs_31_to_35(prop: str) -> None:
-    started = time.monotonic()
+    started = time.process_time()  # CPU time: the wall time of a loaded CI run measures the load
     solution = solve_property(prop)
-    assert time.monotonic() - started < 10
+    assert time.process_time() - started < 10
     expected, constant = PAPER[prop]
     assert solution.expression is not None
     assert sp.expand(solution.expression) == sp.expand(expected)
@@ -45,9 +45,9 @@ def test_registry_entries_are_derived_from_their_property(name: str) -> None:
     match = re.fullmatch(r"(sine|tangent)_m(\d)", name)
     entry = family_member(match.group(1), int(match.group(2))) if match else lookup(name)
     assert entry.defining_property is not None
-    started = time.monotonic()
+    started = time.process_time()
     solution = solve_property(entry.defining_property)
-    assert time.monotonic() - started < 10
+    assert time.process_time() - started < 10
     assert solution.expression is not None
     assert sp.expand(solution.expression) == sp.expand(entry.expression)
 
