@@ -13,12 +13,17 @@ issue 19); this module assembles them into the header and writes it.
 from __future__ import annotations
 
 import re
+from contextlib import ExitStack
+from functools import partial
 from pathlib import Path
+from typing import Any
 
 import sympy as sp
 
 from ..core import Derivation, derive_expression
+from ..derivatives import rate_vector, tensor_derivative
 from ..errors import SymrotError
+from ..forked import in_child
 from ..plan import evaluation_plan
 from ..plan_ir import ClosedAngle, EvaluationPlan
 from ..registry import NAMED, find_by_expression, lookup
@@ -26,7 +31,7 @@ from .c_batch import DEFAULT_BLOCK, BatchWriter
 from .c_derivatives import DerivativeWriter
 from .c_functions import FUNCTIONS, CFunction
 from .c_operations import OperationWriter
-from .c_printer import PRECISIONS
+from .c_printer import PRECISIONS, Precision
 from .c_writer import FunctionWriter
 from .templating import render
 
@@ -38,24 +43,20 @@ class InvalidHeaderName(SymrotError):
 
 
 def header_source(plan: EvaluationPlan, name: str, expression: str | None = None) -> str:
-    """The text of ``symrot_NAME.h`` for ``plan``."""
+    """The text of ``symrot_NAME.h`` for ``plan``: the float functions are printed in a forked
+    child while this process prints the double ones (:mod:`symrot.forked`), after the derivative
+    algebra both read (:func:`symrot.derivatives.tensor_derivative`, :func:`rate_vector`)."""
     if not HEADER_NAME.fullmatch(name):
         raise InvalidHeaderName(f"--name {name[:40]!r} is not a C identifier")
-    functions = []
-    for precision in PRECISIONS:
-        writer = FunctionWriter(plan, name, precision)
-        batch = BatchWriter(writer)
-        if plan.complement is not None:
-            functions.append(writer.complement_function())
-        functions.append(writer.angle_function())
-        functions += writer.angle_low_functions
-        public = [writer.function(spec) for spec in FUNCTIONS]
-        for spec, function in zip(FUNCTIONS, public, strict=True):
-            if function["batch_signature"]:
-                function["batch_statements"], function["batch_notes"] = batch.kernel(spec)
-        functions += public
-        functions += OperationWriter(plan, name, precision).all()
-        functions += DerivativeWriter(plan, name, precision).all()
+    tensor_derivative()
+    rate_vector()
+    first, *others = PRECISIONS
+    with ExitStack() as children:
+        waits = [children.enter_context(in_child(partial(_precision_functions, plan, name, precision)))
+                 for precision in others]
+        functions = _precision_functions(plan, name, first)
+        for wait in waits:
+            functions += wait()
     identifier = registry_title(plan.p)
     text = expression or sp.sstr(plan.p)
     return render(
@@ -65,6 +66,26 @@ def header_source(plan: EvaluationPlan, name: str, expression: str | None = None
         plan_note=f"the float64 and float32 plans of symrot.plan, {angle_kind(plan)} for phi",
         guard=f"SYMROT_{name.upper()}_H", functions=functions, block=DEFAULT_BLOCK,
     )
+
+
+def _precision_functions(plan: EvaluationPlan, name: str, precision: Precision) -> list[dict[str, Any]]:
+    """The functions of one precision, in header order: angle, public functions with their batch
+    kernels, operations, derivatives."""
+    writer = FunctionWriter(plan, name, precision)
+    batch = BatchWriter(writer)
+    functions = []
+    if plan.complement is not None:
+        functions.append(writer.complement_function())
+    functions.append(writer.angle_function())
+    functions += writer.angle_low_functions
+    public = [writer.function(spec) for spec in FUNCTIONS]
+    for spec, function in zip(FUNCTIONS, public, strict=True):
+        if function["batch_signature"]:
+            function["batch_statements"], function["batch_notes"] = batch.kernel(spec)
+    functions += public
+    functions += OperationWriter(plan, name, precision).all()
+    functions += DerivativeWriter(plan, name, precision).all()
+    return functions
 
 
 def angle_kind(plan: EvaluationPlan) -> str:
