@@ -13,11 +13,12 @@ import argparse
 import difflib
 import sys
 from collections.abc import Callable, Iterable
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 
 from . import strict_json
 from .api import derive
+from .forked import in_child
 from .registry import NAMED
 from .timeouts import deterministic
 
@@ -195,25 +196,28 @@ def selected_prefixes(only: str | None) -> list[str]:
 
 
 def render(only: str | None = None, jobs: int = 1, name: str | None = None) -> dict[str, Content]:
-    """Every selected file; with ``jobs`` > 1 the work runs in that many forked processes (the
-    result does not depend on how it is split: every task is deterministic). With ``name``, only
+    """Every selected file; with ``jobs`` > 1 the work runs in that many processes at once. Each
+    task runs in a process of its own, forked from this one, so that what it prints cannot depend on
+    which tasks ran before it in the same process (SymPy's caches, remembered derivations whose
+    tensors another task simplified in another order) nor on how the work is split: the result is
+    the one ``--name NAME`` gives in a fresh process (tests/test_generated.py). With ``name``, only
     that parameterization's files of the per-name producers (one task)."""
+    import multiprocessing
+
     from .cli.progress import each
 
     files: dict[str, Content] = {}
     selected = selected_prefixes(only)
     work = [("names", name)] if name is not None else tasks(selected)
+    run = partial(_run_task, selected=tuple(selected))
     if jobs <= 1:
         for task in each(work, "symrot.generate"):
-            files.update(_run_task(task, tuple(selected)))
+            with in_child(partial(run, task)) as wait:
+                files.update(wait())
         return dict(sorted(files.items()))
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("fork")) as pool:
-        futures = [pool.submit(_run_task, task, tuple(selected)) for task in work]
-        for future in each(as_completed(futures), "symrot.generate", total=len(futures)):
-            files.update(future.result())
+    with multiprocessing.get_context("fork").Pool(processes=jobs, maxtasksperchild=1) as pool:
+        for made in each(pool.imap_unordered(run, work), "symrot.generate", total=len(work)):
+            files.update(made)
     return dict(sorted(files.items()))
 
 
