@@ -97,6 +97,7 @@ from .quaternion_plan import (
 )
 from .series import coefficient_list, taylor_series
 from .timeouts import bounded
+from .two_processes import computed_in_two_processes, simplify_tensors
 
 MAX_TERMS = 24
 CHEAP_TERMS = 8
@@ -556,6 +557,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     from .singularities import validity
 
     derivation = derive_expression(p)
+    simplify_tensors(derivation, beside=lambda: validity(derivation))
     _check_scale(derivation)
     limits = validity(derivation)
     phi_max = float(limits.phi_max_float) if np.isfinite(limits.phi_max_float) else 4 * float(np.pi)
@@ -604,13 +606,29 @@ def _algebraic_forms(derivation: Derivation, inverse: sp.Expr | None,
     simplest form and then the raw one are tried (:func:`symrot.algebraic.algebraic_in_x`). The search
     of one plan is capped by the size of what it simplifies (a few seconds for every named
     parameterization; expressions whose forms never simplify would otherwise spend minutes): past
-    ALGEBRAIC_WORK, coefficients get branches. Both precisions use the result."""
+    ALGEBRAIC_WORK, coefficients get branches. Both precisions use the result.
+
+    The simplest forms that the cap admits if every earlier one succeeds are reduced first, half of
+    them in a forked child (:func:`symrot.two_processes.computed_in_two_processes`); the search then
+    runs in order on those values, reducing here what it needs beyond them (raw forms)."""
     forms: dict[str, sp.Expr | None] = {}
     if inverse is None:
         return forms
-    work = 0
     planned = derivation.planned_expressions()
-    for coefficient in _searched(derivation):
+    searched = _searched(derivation)
+    ahead: list[sp.Expr] = []
+    sizes: list[int] = []
+    work = 0
+    for coefficient in searched:
+        form = derivation.simplified_form(coefficient)
+        size = reduction_size(form, inverse)
+        if size <= REDUCTION_OPS and work + size <= ALGEBRAIC_WORK and form not in ahead:
+            work += size
+            ahead.append(form)
+            sizes.append(size)
+    reduced = computed_in_two_processes(lambda form: algebraic_in_x(form, inverse, p_max), ahead, sizes)
+    work = 0
+    for coefficient in searched:
         closed = planned[coefficient]
         found = None
         for form in dict.fromkeys((derivation.simplified_form(coefficient), closed)):
@@ -618,7 +636,7 @@ def _algebraic_forms(derivation: Derivation, inverse: sp.Expr | None,
             if found is not None or size > REDUCTION_OPS or work + size > ALGEBRAIC_WORK:
                 continue
             work += size
-            found = algebraic_in_x(form, inverse, p_max)
+            found = reduced[form] if form in reduced else algebraic_in_x(form, inverse, p_max)
         forms[coefficient] = found
     return forms
 

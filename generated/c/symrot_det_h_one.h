@@ -406,10 +406,10 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
 
 /* symrot_det_h_one_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 12 in x below x = 0.764824, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 0.110312, else s*sin(phi)/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 597 */
+ * ops: 595 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -426,20 +426,20 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
         return;
     }
     double c_H_inverse_across, c_H_inverse_2;
-    if (x < 0.764824235244299) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.847696164362506e-14)*x - 2.227352392712e-13) - 2.7052088947240463e-12) - 3.316097701005811e-11) - 4.112699899093853e-10) - 11192989.0/2161295136000000.0) - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
+    if (x < 0.1103124080629894) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-11192989.0/2161295136000000.0)*x - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = sin(phi);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = (w2*w2);
-        const double w4 = 1.0/w3;
-        const double w5 = 6*phi;
-        const double w6 = w2*cos(w1);
-        c_H_inverse_across = (1.0/4.0)*w0*w4*cbrt(6*phi - 6*w0);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w4*(-8*w3 + w5*w6 + pow(1 - 2*w3, 2) - 1)/pow(cbrt(w5 - 12*w6), 4);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/w2;
+        const double w4 = 6*phi;
+        const double w5 = w1*cos(w0);
+        c_H_inverse_across = (1.0/4.0)*s*w3*sin(phi);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w3*(-8*w2 + w4*w5 + pow(1 - 2*w2, 2) - 1)/pow(cbrt(w4 - 12*w5), 4);
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -456,12 +456,12 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: s, phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -469,32 +469,31 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
+            if (!(x <= 11.243134665607636) || x < 3.327466624075446e-08) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*(phi - sin(phi)));
-                const double u1 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
+                const double u0 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -519,9 +518,9 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = (sin0*sin0);
             const double w1 = 1.0/w0;
-            c_H_inverse_across_lanes[k] = (1.0/4.0)*sin1*u0*w1;
-            poly_H_inverse_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.847696164362506e-14)*x - 2.227352392712e-13) - 2.7052088947240463e-12) - 3.316097701005811e-11) - 4.112699899093853e-10) - 11192989.0/2161295136000000.0) - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
-            c_H_inverse_2_lanes[k] = -1.0/2.0*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u1*u1*u1*u1);
+            c_H_inverse_across_lanes[k] = (1.0/4.0)*s*sin1*w1;
+            poly_H_inverse_across_lanes[k] = 1 + (-1.0/10.0)*x;
+            c_H_inverse_2_lanes[k] = -1.0/2.0*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u0*u0*u0*u0);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -529,7 +528,7 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
             const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const double v_H_inverse_across = x < 0.764824235244299 ? poly_H_inverse_across : closed_H_inverse_across;
+            const double v_H_inverse_across = x < 3.327466624075446e-08 ? poly_H_inverse_across : closed_H_inverse_across;
             c_H_inverse_across_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
@@ -704,10 +703,10 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
 
 /* symrot_det_h_one_root_tangent: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_across: Horner degree 12 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * K_1: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
- * K_2: Horner degree 21 in x below x = 2.63022, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 643 */
+ * K_across: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
+ * K_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
+ * K_2: Horner degree 17 in x below x = 1.43428, else (x/(8*sin(phi/2)**2) - sin(phi/2)/s)/x
+ * ops: 581 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -724,20 +723,19 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
         return;
     }
     double c_K_across, c_K_1, c_K_2;
-    if (x < 0.764824235244299) {
-        c_K_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
-        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
+    if (x < 0.1103124080629894) {
+        c_K_across = x*(x*(x*(x*(x*(x*((-4.517630699305304e-10)*x - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
+        c_K_1 = x*(x*(x*(x*(x*(x*((5.844969408074523e-11)*x + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
+        c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.3462827495637501e-20)*x + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = cbrt(6*(phi - sin(phi)));
-        const double w3 = cbrt(6*phi - 12*w1*cos(w0));
-        const double w4 = (w3*w3);
-        c_K_across = w1/w2;
-        c_K_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w2*w2);
-        c_K_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0 : (-w1/w3 + (1.0/8.0)*w4/(w1*w1))/w4;
+        const double s = sqrt(x);
+        const double w0 = sin((1.0/2.0)*phi);
+        const double w1 = w0/s;
+        const double w2 = 1.0/x;
+        c_K_across = w1;
+        c_K_1 = 2*w2*pow(sin((1.0/4.0)*phi), 2);
+        c_K_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.3462827495637501e-20)*x + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0 : w2*(-w1 + (1.0/8.0)*x/(w0*w0));
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -754,12 +752,12 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -767,32 +765,26 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
+            if (!(x <= 11.243134665607636) || x < 1.9211893090849666e-14) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*(phi - sin(phi)));
-                const double u1 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -813,28 +805,29 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = (u1*u1);
-            c_K_across_lanes[k] = sin0/u0;
-            poly_K_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/(u0*u0);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (-sin0/u1 + (1.0/8.0)*w0/(sin0*sin0))/w0;
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.837904569910299e-25)*x + 8.960375161004176e-24) + 1.0252484904999445e-22) + 1.1742209353136828e-21) + 1.3462827495637501e-20) + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
+            const double w0 = sin0/s;
+            const double w1 = 1.0/x;
+            c_K_across_lanes[k] = w0;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-1.0/80.0)*x;
+            c_K_1_lanes[k] = 2*(sin1*sin1)*w1;
+            poly_K_1_lanes[k] = x*(x*(x*((150653.0/794787840000.0)*x + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
+            c_K_2_lanes[k] = w1*(-w0 + (1.0/8.0)*x/(sin0*sin0));
+            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.3462827495637501e-20)*x + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double closed_K_across = c_K_across_lanes[k];
             const double poly_K_across = poly_K_across_lanes[k];
-            const double v_K_across = x < 0.764824235244299 ? poly_K_across : closed_K_across;
+            const double v_K_across = x < 1.9211893090849666e-14 ? poly_K_across : closed_K_across;
             c_K_across_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_K_across;
             const double closed_K_1 = c_K_1_lanes[k];
             const double poly_K_1 = poly_K_1_lanes[k];
-            const double v_K_1 = x < 1.4342812090283275 ? poly_K_1 : closed_K_1;
+            const double v_K_1 = x < 0.004229756532686548 ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_K_1;
             const double closed_K_2 = c_K_2_lanes[k];
             const double poly_K_2 = poly_K_2_lanes[k];
-            const double v_K_2 = x < 2.6302227241416043 ? poly_K_2 : closed_K_2;
+            const double v_K_2 = x < 1.4342812090283275 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_K_2;
         }
         for (k = 0; k < m; ++k) {
@@ -855,10 +848,10 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
 
 /* symrot_det_h_one_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 12 in x below x = 0.764824, else sin(phi)*cbrt(6*(phi - sin(phi)))/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 0.110312, else s*sin(phi)/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 596 */
+ * ops: 594 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -869,20 +862,20 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
         return;
     }
     double c_H_inverse_across, c_H_inverse_2;
-    if (x < 0.764824235244299) {
-        c_H_inverse_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.847696164362506e-14)*x - 2.227352392712e-13) - 2.7052088947240463e-12) - 3.316097701005811e-11) - 4.112699899093853e-10) - 11192989.0/2161295136000000.0) - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
+    if (x < 0.1103124080629894) {
+        c_H_inverse_across = x*(x*(x*(x*(x*(x*((-11192989.0/2161295136000000.0)*x - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = sin(phi);
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = (w2*w2);
-        const double w4 = 1.0/w3;
-        const double w5 = 6*phi;
-        const double w6 = w2*cos(w1);
-        c_H_inverse_across = (1.0/4.0)*w0*w4*cbrt(6*phi - 6*w0);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w4*(-8*w3 + w5*w6 + pow(1 - 2*w3, 2) - 1)/pow(cbrt(w5 - 12*w6), 4);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/w2;
+        const double w4 = 6*phi;
+        const double w5 = w1*cos(w0);
+        c_H_inverse_across = (1.0/4.0)*s*w3*sin(phi);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w3*(-8*w2 + w4*w5 + pow(1 - 2*w2, 2) - 1)/pow(cbrt(w4 - 12*w5), 4);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -2114,10 +2107,10 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
 
 /* symrot_det_h_one_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*phi - 6*sin(phi))/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else s*sin(phi)/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 489 */
+ * ops: 487 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2139,15 +2132,15 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = sinf(phi);
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = (w2*w2);
-        const float w4 = 1.0F/w3;
-        const float w5 = 6*phi;
-        const float w6 = w2*cosf(w1);
-        c_H_inverse_across = -1.0F/4.0F*w0*w4*cbrtf(6*w0 - w5);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 1.0F/w2;
+        const float w4 = 6*phi;
+        const float w5 = w1*cosf(w0);
+        c_H_inverse_across = (1.0F/4.0F)*s*w3*sinf(phi);
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w3*(-8*w2 + w4*w5 + powf(1 - 2*w2, 2) - 1)/powf(cbrtf(w4 - 12*w5), 4);
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -2164,12 +2157,12 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: s, phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2177,32 +2170,31 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 0.21121144F) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 6*sinf(phi));
-                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                const float u0 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -2227,9 +2219,9 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = (sin0*sin0);
             const float w1 = 1.0F/w0;
-            c_H_inverse_across_lanes[k] = (1.0F/4.0F)*sin1*u0*w1;
-            poly_H_inverse_across_lanes[k] = x*(x*(x*(x*((-8.811724e-07F)*x - 1.2201092e-05F) - 23.0F/126000.0F) - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
-            c_H_inverse_2_lanes[k] = -1.0F/2.0F*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u1*u1*u1*u1);
+            c_H_inverse_across_lanes[k] = (1.0F/4.0F)*s*sin1*w1;
+            poly_H_inverse_across_lanes[k] = x*(x*((-23.0F/126000.0F)*x - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
+            c_H_inverse_2_lanes[k] = -1.0F/2.0F*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u0*u0*u0*u0);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2237,7 +2229,7 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float x = x_lanes[k];
             const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
             const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const float v_H_inverse_across = x < 0.7648242F ? poly_H_inverse_across : closed_H_inverse_across;
+            const float v_H_inverse_across = x < 0.21121144F ? poly_H_inverse_across : closed_H_inverse_across;
             c_H_inverse_across_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x <= 11.2431345F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
@@ -2405,10 +2397,10 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
 
 /* symrot_det_h_one_root_tangent_f: tangent K of the square root, gamma = K pdot (82) (eq 83).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*phi - 6*sin(phi))
- * K_1: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*phi - 6*sin(phi))**2
+ * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
+ * K_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 518 */
+ * ops: 494 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2427,20 +2419,18 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
     float c_K_across, c_K_1, c_K_2;
     if (x < 1.4342812F) {
         c_K_across = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-        c_K_1 = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+        c_K_1 = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         c_K_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
-        const float w2 = 6*phi;
-        const float w3 = cbrtf(w2 - 6*sinf(phi));
-        const float w4 = cosf(w0);
-        const float w5 = -cbrtf(12*w1*w4 - w2);
-        const float w6 = (w5*w5);
-        c_K_across = w1/w3;
-        c_K_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - w4)/(w3*w3);
-        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w5 + (1.0F/8.0F)*w6/(w1*w1))/w6;
+        const float w2 = cbrtf(6*phi - 12*w1*cosf(w0));
+        const float w3 = (w2*w2);
+        c_K_across = w1/s;
+        c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
+        c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w2 + (1.0F/8.0F)*w3/(w1*w1))/w3;
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2457,12 +2447,12 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
  * K[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: s, phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2470,32 +2460,31 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 1.9211895e-14F) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 6*sinf(phi));
-                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                const float u0 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
             u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -2506,14 +2495,22 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = (u1*u1);
-            c_K_across_lanes[k] = sin0/u0;
-            poly_K_across_lanes[k] = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-            c_K_1_lanes[k] = (1 - cos0)/(u0*u0);
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (-sin0/u1 + (1.0F/8.0F)*w0/(sin0*sin0))/w0;
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float w0 = (u0*u0);
+            c_K_across_lanes[k] = sin0/s;
+            poly_K_across_lanes[k] = 1.0F/2.0F;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
+            poly_K_1_lanes[k] = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (-sin0/u0 + (1.0F/8.0F)*w0/(sin0*sin0))/w0;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2521,11 +2518,11 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float x = x_lanes[k];
             const float closed_K_across = c_K_across_lanes[k];
             const float poly_K_across = poly_K_across_lanes[k];
-            const float v_K_across = x < 0.7648242F ? poly_K_across : closed_K_across;
+            const float v_K_across = x < 1.9211895e-14F ? poly_K_across : closed_K_across;
             c_K_across_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_across;
             const float closed_K_1 = c_K_1_lanes[k];
             const float poly_K_1 = poly_K_1_lanes[k];
-            const float v_K_1 = x < 2.6302226F ? poly_K_1 : closed_K_1;
+            const float v_K_1 = x < 0.7648242F ? poly_K_1 : closed_K_1;
             c_K_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_K_1;
             const float closed_K_2 = c_K_2_lanes[k];
             const float poly_K_2 = poly_K_2_lanes[k];
@@ -2550,10 +2547,10 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
 
 /* symrot_det_h_one_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)*cbrt(6*phi - 6*sin(phi))/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else s*sin(phi)/(4*sin(phi/2)**2)
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 488 */
+ * ops: 486 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2569,15 +2566,15 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
         c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = sinf(phi);
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = (w2*w2);
-        const float w4 = 1.0F/w3;
-        const float w5 = 6*phi;
-        const float w6 = w2*cosf(w1);
-        c_H_inverse_across = -1.0F/4.0F*w0*w4*cbrtf(6*w0 - w5);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w4*(-8*w3 + w5*w6 + powf(1 - 2*w3, 2) - 1)/powf(cbrtf(w5 - 12*w6), 4);
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 1.0F/w2;
+        const float w4 = 6*phi;
+        const float w5 = w1*cosf(w0);
+        c_H_inverse_across = (1.0F/4.0F)*s*w3*sinf(phi);
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w3*(-8*w2 + w4*w5 + powf(1 - 2*w2, 2) - 1)/powf(cbrtf(w4 - 12*w5), 4);
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];

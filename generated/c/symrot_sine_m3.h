@@ -100,7 +100,7 @@ static inline double symrot_sine_m3_angle(const double p[3])
 /* symrot_sine_m3_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1 = -(4*x - 27)/27 (algebraic in x)
+ * R_1 = 1 - 4*x/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * ops: 88 */
 static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9])
@@ -217,7 +217,7 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
 
 /* symrot_sine_m3_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_across = -(4*x - 27)/27 (algebraic in x)
+ * H_across = 1 - 4*x/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
  * ops: 111 */
@@ -804,7 +804,7 @@ static inline void symrot_sine_m3_pdot(const double p[3], const double omega[3],
 
 /* symrot_sine_m3_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * H_across = -(4*x - 27)/27 (algebraic in x)
+ * H_across = 1 - 4*x/27 (algebraic in x)
  * H_1: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 8 in x below x = 0.129471, else (4*sin(phi/6)**2 + 2*sin(phi/2)**2)/(sqrt(d)*x)
  * ops: 110 */
@@ -1004,7 +1004,7 @@ static inline int symrot_sine_m3_rescale(const double p[3], double q[3])
 /* symrot_sine_m3_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * R_1 = -(4*x - 27)/27 (algebraic in x)
+ * R_1 = 1 - 4*x/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)
@@ -1078,7 +1078,7 @@ static inline void symrot_sine_m3_rotation_derivative(const double p[3], const d
 /* symrot_sine_m3_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
- * R_1 = -(4*x - 27)/27 (algebraic in x)
+ * R_1 = 1 - 4*x/27 (algebraic in x)
  * R_2: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x = -4/27 (constant)

@@ -731,7 +731,7 @@ static inline void symrot_sine_m6_omega(const double p[3], const double pdot[3],
 /* symrot_sine_m6_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 5.196152422706632 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0 = -sqrt(36 - x)*(x - 9)/54 (algebraic in x)
- * nu = -(x - 27)/27 (algebraic in x)
+ * nu = 1 - x/27 (algebraic in x)
  * ops: 19 */
 static inline void symrot_sine_m6_to_quaternion(const double p[3], double e[4])
 {

@@ -471,42 +471,22 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.015605974459691814:  # every lane on the polynomial
         t = x
-        series = -6.816125240403192e-19
-        series = -8.626941850237128e-18 + t * series
-        series = -1.1016217975387359e-16 + t * series
-        series = -1.4213047418173123e-15 + t * series
-        series = -1.8561269939266666e-14 + t * series
-        series = -2.4592808133854967e-13 + t * series
-        series = -3.3160977010058107e-12 + t * series
-        series = -4.569666554548725e-11 + t * series
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
+        series = -1.4686206650492366e-07
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.015605974459691814:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.015605974459691814
     if small.any():
         t = x[small]
-        series = -6.816125240403192e-19
-        series = -8.626941850237128e-18 + t * series
-        series = -1.1016217975387359e-16 + t * series
-        series = -1.4213047418173123e-15 + t * series
-        series = -1.8561269939266666e-14 + t * series
-        series = -2.4592808133854967e-13 + t * series
-        series = -3.3160977010058107e-12 + t * series
-        series = -4.569666554548725e-11 + t * series
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
+        series = -1.4686206650492366e-07
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
@@ -672,47 +652,21 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.0022017832983058567:  # every lane on the polynomial
         t = x
-        series = 1.5019995445864313e-19
-        series = 1.7235273973410984e-18 + t * series
-        series = 1.9803468699690516e-17 + t * series
-        series = 2.2788644458698284e-16 + t * series
-        series = 2.626920959275406e-15 + t * series
-        series = 3.034221310416404e-14 + t * series
-        series = 3.512942948038655e-13 + t * series
-        series = 4.078624601653741e-12 + t * series
-        series = 4.7515127524272383e-11 + t * series
-        series = 5.558692794351005e-10 + t * series
-        series = 6.5376456526666615e-09 + t * series
-        series = 7.742584166903895e-08 + t * series
-        series = 9.256715506715507e-07 + t * series
-        series = 1.1218692022263451e-05 + t * series
+        series = 1.1218692022263451e-05
         series = 0.0001388888888888889 + t * series
         series = 0.0017857142857142857 + t * series
         series = 0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.125)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.0022017832983058567:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.0022017832983058567
     if small.any():
         t = x[small]
-        series = 1.5019995445864313e-19
-        series = 1.7235273973410984e-18 + t * series
-        series = 1.9803468699690516e-17 + t * series
-        series = 2.2788644458698284e-16 + t * series
-        series = 2.626920959275406e-15 + t * series
-        series = 3.034221310416404e-14 + t * series
-        series = 3.512942948038655e-13 + t * series
-        series = 4.078624601653741e-12 + t * series
-        series = 4.7515127524272383e-11 + t * series
-        series = 5.558692794351005e-10 + t * series
-        series = 6.5376456526666615e-09 + t * series
-        series = 7.742584166903895e-08 + t * series
-        series = 9.256715506715507e-07 + t * series
-        series = 1.1218692022263451e-05 + t * series
+        series = 1.1218692022263451e-05
         series = 0.0001388888888888889 + t * series
         series = 0.0017857142857142857 + t * series
         series = 0.025 + t * series
@@ -722,43 +676,21 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.004229756532686548:  # every lane on the polynomial
         t = x
-        series = 7.005500832060205e-20
-        series = 8.78575012329886e-19 + t * series
-        series = 1.1103729250660078e-17 + t * series
-        series = 1.415858727786663e-16 + t * series
-        series = 1.8241874371141333e-15 + t * series
-        series = 2.3791812685232493e-14 + t * series
-        series = 3.1488034564609846e-13 + t * series
-        series = 4.242513271852192e-12 + t * series
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.004229756532686548:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.004229756532686548
     if small.any():
         t = x[small]
-        series = 7.005500832060205e-20
-        series = 8.78575012329886e-19 + t * series
-        series = 1.1103729250660078e-17 + t * series
-        series = 1.415858727786663e-16 + t * series
-        series = 1.8241874371141333e-15 + t * series
-        series = 2.3791812685232493e-14 + t * series
-        series = 3.1488034564609846e-13 + t * series
-        series = 4.242513271852192e-12 + t * series
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -768,13 +700,9 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
         t = x
-        series = 7.837904569910299e-25
-        series = 8.960375161004176e-24 + t * series
-        series = 1.0252484904999445e-22 + t * series
-        series = 1.1742209353136828e-21 + t * series
-        series = 1.3462827495637501e-20 + t * series
+        series = 1.3462827495637501e-20
         series = 1.5454156215361094e-19 + t * series
         series = 1.7764157194142527e-18 + t * series
         series = 2.0451064003372294e-17 + t * series
@@ -793,19 +721,13 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.0022098214285714286 + t * series
         series = 0.0375 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
-    w1 = w0**2
-    out = numpy.asarray((sin_half/w0 + (0.125)*w1/sin_half**2)/w1, dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+    out = numpy.asarray(((0.125)*x/sin_half**2 - sin_half/s)/x, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
-    small = x < 2.6302227241416043
+    small = x < 1.4342812090283275
     if small.any():
         t = x[small]
-        series = 7.837904569910299e-25
-        series = 8.960375161004176e-24 + t * series
-        series = 1.0252484904999445e-22 + t * series
-        series = 1.1742209353136828e-21 + t * series
-        series = 1.3462827495637501e-20 + t * series
+        series = 1.3462827495637501e-20
         series = 1.5454156215361094e-19 + t * series
         series = 1.7764157194142527e-18 + t * series
         series = 2.0451064003372294e-17 + t * series
@@ -869,81 +791,36 @@ def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 3.327466624075446e-08:  # every lane on the polynomial
         t = x
-        series = -1.847696164362506e-14
-        series = -2.227352392712e-13 + t * series
-        series = -2.7052088947240463e-12 + t * series
-        series = -3.316097701005811e-11 + t * series
-        series = -4.112699899093853e-10 + t * series
-        series = -5.178834122911754e-09 + t * series
-        series = -6.656956359337311e-08 + t * series
-        series = -8.811723990295419e-07 + t * series
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
+        series = -0.1
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sin(phi)
-    out = numpy.asarray((0.25)*w0*numpy.cbrt(6*phi - 6*w0)/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray((0.25)*s*numpy.sin(phi)/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 3.327466624075446e-08:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 3.327466624075446e-08
     if small.any():
         t = x[small]
-        series = -1.847696164362506e-14
-        series = -2.227352392712e-13 + t * series
-        series = -2.7052088947240463e-12 + t * series
-        series = -3.316097701005811e-11 + t * series
-        series = -4.112699899093853e-10 + t * series
-        series = -5.178834122911754e-09 + t * series
-        series = -6.656956359337311e-08 + t * series
-        series = -8.811723990295419e-07 + t * series
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
+        series = -0.1
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _K_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
         t = x
-        series = -1.2358884471431072e-15
-        series = -1.5586041391956483e-14 + t * series
-        series = -1.9870905217627718e-13 + t * series
-        series = -2.5669594363297223e-12 + t * series
-        series = -3.370441278711113e-11 + t * series
-        series = -4.517630699305304e-10 + t * series
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
+        series = -0.0125
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray(sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.9211893090849666e-14
     if small.any():
         t = x[small]
-        series = -1.2358884471431072e-15
-        series = -1.5586041391956483e-14 + t * series
-        series = -1.9870905217627718e-13 + t * series
-        series = -2.5669594363297223e-12 + t * series
-        series = -3.370441278711113e-11 + t * series
-        series = -4.517630699305304e-10 + t * series
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
+        series = -0.0125
         series = 0.5 + t * series
         out[small] = series
     return out
@@ -1871,38 +1748,22 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
         t = x
-        series = -1.1016217975387359e-16
-        series = -1.4213047418173123e-15 + t * series
-        series = -1.8561269939266666e-14 + t * series
-        series = -2.4592808133854967e-13 + t * series
-        series = -3.3160977010058107e-12 + t * series
-        series = -4.569666554548725e-11 + t * series
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
+        series = -1.4686206650492366e-07
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+    out = numpy.asarray(2*(1 - numpy.cos(phi))/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 4.619481091176478
+    small = x < 0.7648242161335777
     if small.any():
         t = x[small]
-        series = -1.1016217975387359e-16
-        series = -1.4213047418173123e-15 + t * series
-        series = -1.8561269939266666e-14 + t * series
-        series = -2.4592808133854967e-13 + t * series
-        series = -3.3160977010058107e-12 + t * series
-        series = -4.569666554548725e-11 + t * series
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
+        series = -1.4686206650492366e-07
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
@@ -2032,21 +1893,9 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
         t = x
-        series = 1.3104795857796848e-20
-        series = 1.5019995445864313e-19 + t * series
-        series = 1.7235273973410984e-18 + t * series
-        series = 1.9803468699690516e-17 + t * series
-        series = 2.2788644458698284e-16 + t * series
-        series = 2.626920959275406e-15 + t * series
-        series = 3.034221310416404e-14 + t * series
-        series = 3.512942948038655e-13 + t * series
-        series = 4.078624601653741e-12 + t * series
-        series = 4.7515127524272383e-11 + t * series
-        series = 5.558692794351005e-10 + t * series
-        series = 6.5376456526666615e-09 + t * series
-        series = 7.742584166903895e-08 + t * series
+        series = 7.742584166903895e-08
         series = 9.256715506715507e-07 + t * series
         series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
@@ -2054,25 +1903,13 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.125)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+    out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 4.619481091176478
+    small = x < 0.7648242161335777
     if small.any():
         t = x[small]
-        series = 1.3104795857796848e-20
-        series = 1.5019995445864313e-19 + t * series
-        series = 1.7235273973410984e-18 + t * series
-        series = 1.9803468699690516e-17 + t * series
-        series = 2.2788644458698284e-16 + t * series
-        series = 2.626920959275406e-15 + t * series
-        series = 3.034221310416404e-14 + t * series
-        series = 3.512942948038655e-13 + t * series
-        series = 4.078624601653741e-12 + t * series
-        series = 4.7515127524272383e-11 + t * series
-        series = 5.558692794351005e-10 + t * series
-        series = 6.5376456526666615e-09 + t * series
-        series = 7.742584166903895e-08 + t * series
+        series = 7.742584166903895e-08
         series = 9.256715506715507e-07 + t * series
         series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
@@ -2084,29 +1921,21 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
         t = x
-        series = 4.242513271852192e-12
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 2.630222574480542
+    small = x < 0.7648242161335777
     if small.any():
         t = x[small]
-        series = 4.242513271852192e-12
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -2197,25 +2026,20 @@ def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 0.2112114357353433:  # every lane on the polynomial
         t = x
-        series = -8.811723990295419e-07
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
+        series = -0.00018253968253968255
         series = -0.0032142857142857142 + t * series
         series = -0.1 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sin(phi)
-    out = numpy.asarray((0.25)*w0*numpy.cbrt(6*phi - 6*w0)/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    out = numpy.asarray((0.25)*s*numpy.sin(phi)/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.2112114357353433:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 0.2112114357353433
     if small.any():
         t = x[small]
-        series = -8.811723990295419e-07
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
+        series = -0.00018253968253968255
         series = -0.0032142857142857142 + t * series
         series = -0.1 + t * series
         series = 1.0 + t * series
@@ -2224,27 +2048,14 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
-        t = x
-        series = -8.889107582955239e-08
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 0.5)
+    out = numpy.asarray(sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.921189444436213e-14
     if small.any():
-        t = x[small]
-        series = -8.889107582955239e-08
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
+        series = 0.5
         out[small] = series
     return out
 
@@ -2847,8 +2658,8 @@ _USES_PHI = {
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 1.4342812090283275, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 1.4342812090283275, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 1.4342812090283275, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 1.4342812090283275, 'K_1': 1.4342812090283275, 'K_2': 2.6302227241416043, 'H_across': 0.764824235244299, 'H_inverse_across': 0.764824235244299, 'K_across': 0.764824235244299, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
-    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 4.619481091176478, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 4.619481091176478, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 4.619481091176478, 'K_1': 2.630222574480542, 'K_2': 4.619481091176478, 'H_across': 0.7648242161335777, 'H_inverse_across': 0.7648242161335777, 'K_across': 0.7648242161335777, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
+    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 1.4342812090283275, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 1.4342812090283275, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 0.764824235244299, 'H_inverse_across': 3.327466624075446e-08, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
+    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 4.619481091176478, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 0.7648242161335777, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 0.7648242161335777, 'K_1': 0.7648242161335777, 'K_2': 4.619481091176478, 'H_across': 0.7648242161335777, 'H_inverse_across': 0.2112114357353433, 'K_across': 1.921189444436213e-14, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)

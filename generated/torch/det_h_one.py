@@ -419,17 +419,9 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -6.816125240403192e-19 + 0.0 * x
-    series = -8.626941850237128e-18 + t * series
-    series = -1.1016217975387359e-16 + t * series
-    series = -1.4213047418173123e-15 + t * series
-    series = -1.8561269939266666e-14 + t * series
-    series = -2.4592808133854967e-13 + t * series
-    series = -3.3160977010058107e-12 + t * series
-    series = -4.569666554548725e-11 + t * series
-    series = -6.473542653639692e-10 + t * series
+    series = -6.473542653639692e-10 + 0.0 * x
     series = -9.50993765619616e-09 + t * series
     series = -1.4686206650492366e-07 + t * series
     series = -2.440218511647083e-06 + t * series
@@ -437,8 +429,9 @@ def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0010714285714285715 + t * series
     series = -0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    closed = 2*(1 - _xp.cos(phi))/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    x = _where(small, 0.1103124080629894, x)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = 4*sin_half**2/x
     return _where(small, series, closed)
 
 
@@ -532,19 +525,9 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 1.5019995445864313e-19 + 0.0 * x
-    series = 1.7235273973410984e-18 + t * series
-    series = 1.9803468699690516e-17 + t * series
-    series = 2.2788644458698284e-16 + t * series
-    series = 2.626920959275406e-15 + t * series
-    series = 3.034221310416404e-14 + t * series
-    series = 3.512942948038655e-13 + t * series
-    series = 4.078624601653741e-12 + t * series
-    series = 4.7515127524272383e-11 + t * series
-    series = 5.558692794351005e-10 + t * series
-    series = 6.5376456526666615e-09 + t * series
+    series = 6.5376456526666615e-09 + 0.0 * x
     series = 7.742584166903895e-08 + t * series
     series = 9.256715506715507e-07 + t * series
     series = 1.1218692022263451e-05 + t * series
@@ -552,25 +535,16 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0017857142857142857 + t * series
     series = 0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    sin_half = _where(small, 0.5762057860563947, sin_half)
-    cos_half = _where(small, 0.8173046507362676, cos_half)
-    closed = (0.125)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
+    x = _where(small, 0.1103124080629894, x)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = (0.125)*x/sin_half**2
     return _where(small, series, closed)
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 7.005500832060205e-20 + 0.0 * x
-    series = 8.78575012329886e-19 + t * series
-    series = 1.1103729250660078e-17 + t * series
-    series = 1.415858727786663e-16 + t * series
-    series = 1.8241874371141333e-15 + t * series
-    series = 2.3791812685232493e-14 + t * series
-    series = 3.1488034564609846e-13 + t * series
-    series = 4.242513271852192e-12 + t * series
-    series = 5.844969408074523e-11 + t * series
+    series = 5.844969408074523e-11 + 0.0 * x
     series = 8.286380574805527e-10 + t * series
     series = 1.2203463534465907e-08 + t * series
     series = 1.8955121406990826e-07 + t * series
@@ -578,19 +552,16 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
     series = 6.138392857142858e-05 + t * series
     series = 0.0015625 + t * series
     series = 0.125 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    closed = 2*_xp.sin((0.25)*phi)**2/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    phi = _where(small, 0.33274666277661247, phi)
+    x = _where(small, 0.1103124080629894, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.6302227241416043
+    small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 7.837904569910299e-25 + 0.0 * x
-    series = 8.960375161004176e-24 + t * series
-    series = 1.0252484904999445e-22 + t * series
-    series = 1.1742209353136828e-21 + t * series
-    series = 1.3462827495637501e-20 + t * series
+    series = 1.3462827495637501e-20 + 0.0 * x
     series = 1.5454156215361094e-19 + t * series
     series = 1.7764157194142527e-18 + t * series
     series = 2.0451064003372294e-17 + t * series
@@ -608,12 +579,10 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0001609002976190476 + t * series
     series = 0.0022098214285714286 + t * series
     series = 0.0375 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    w0 = _cbrt(12*cos_half*sin_half - 6*phi)
-    w1 = w0**2
-    closed = (sin_half/w0 + (0.125)*w1/sin_half**2)/w1
+    s = _where(small, 1.197614799937078, s)
+    x = _where(small, 1.4342812090283275, x)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = ((0.125)*x/sin_half**2 - sin_half/s)/x
     return _where(small, series, closed)
 
 
@@ -640,14 +609,9 @@ def _H_across_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -1.847696164362506e-14 + 0.0 * x
-    series = -2.227352392712e-13 + t * series
-    series = -2.7052088947240463e-12 + t * series
-    series = -3.316097701005811e-11 + t * series
-    series = -4.112699899093853e-10 + t * series
-    series = -5.178834122911754e-09 + t * series
+    series = -5.178834122911754e-09 + 0.0 * x
     series = -6.656956359337311e-08 + t * series
     series = -8.811723990295419e-07 + t * series
     series = -1.2201092558235416e-05 + t * series
@@ -655,22 +619,17 @@ def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0032142857142857142 + t * series
     series = -0.1 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    w0 = _xp.sin(phi)
-    closed = (0.25)*w0*_cbrt(6*phi - 6*w0)/sin_half**2
+    phi = _where(small, 0.33274666277661247, phi)
+    s = _where(small, 0.33213311798583023, s)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = (0.25)*s*_xp.sin(phi)/sin_half**2
     return _where(small, series, closed)
 
 
 def _K_across_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -1.2358884471431072e-15 + 0.0 * x
-    series = -1.5586041391956483e-14 + t * series
-    series = -1.9870905217627718e-13 + t * series
-    series = -2.5669594363297223e-12 + t * series
-    series = -3.370441278711113e-11 + t * series
-    series = -4.517630699305304e-10 + t * series
+    series = -4.517630699305304e-10 + 0.0 * x
     series = -6.22104590536751e-09 + t * series
     series = -8.889107582955239e-08 + t * series
     series = -1.340206714788188e-06 + t * series
@@ -678,9 +637,9 @@ def _K_across_64(x, phi, s, d, sin_half, cos_half):
     series = -0.00042410714285714285 + t * series
     series = -0.0125 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    closed = sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
+    s = _where(small, 0.33213311798583023, s)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = sin_half/s
     return _where(small, series, closed)
 
 
@@ -1267,26 +1226,18 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 4.619481091176478
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -1.1016217975387359e-16 + 0.0 * x
-    series = -1.4213047418173123e-15 + t * series
-    series = -1.8561269939266666e-14 + t * series
-    series = -2.4592808133854967e-13 + t * series
-    series = -3.3160977010058107e-12 + t * series
-    series = -4.569666554548725e-11 + t * series
-    series = -6.473542653639692e-10 + t * series
-    series = -9.50993765619616e-09 + t * series
+    series = -9.50993765619616e-09 + 0.0 * x
     series = -1.4686206650492366e-07 + t * series
     series = -2.440218511647083e-06 + t * series
     series = -4.563492063492064e-05 + t * series
     series = -0.0010714285714285715 + t * series
     series = -0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = 4*sin_half**2/_cbrt(12*cos_half*sin_half - 6*phi)**2
+    phi = _where(small, 1.2281574046507382, phi)
+    x = _where(small, 1.4342812011199078, x)
+    closed = 2*(1 - _xp.cos(phi))/x
     return _where(small, series, closed)
 
 
@@ -1364,20 +1315,9 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 4.619481091176478
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 1.3104795857796848e-20 + 0.0 * x
-    series = 1.5019995445864313e-19 + t * series
-    series = 1.7235273973410984e-18 + t * series
-    series = 1.9803468699690516e-17 + t * series
-    series = 2.2788644458698284e-16 + t * series
-    series = 2.626920959275406e-15 + t * series
-    series = 3.034221310416404e-14 + t * series
-    series = 3.512942948038655e-13 + t * series
-    series = 4.078624601653741e-12 + t * series
-    series = 4.7515127524272383e-11 + t * series
-    series = 5.558692794351005e-10 + t * series
-    series = 6.5376456526666615e-09 + t * series
+    series = 6.5376456526666615e-09 + 0.0 * x
     series = 7.742584166903895e-08 + t * series
     series = 9.256715506715507e-07 + t * series
     series = 1.1218692022263451e-05 + t * series
@@ -1385,28 +1325,25 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0017857142857142857 + t * series
     series = 0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = (0.125)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
+    x = _where(small, 1.4342812011199078, x)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = (0.125)*x/sin_half**2
     return _where(small, series, closed)
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222574480542
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 4.242513271852192e-12 + 0.0 * x
-    series = 5.844969408074523e-11 + t * series
-    series = 8.286380574805527e-10 + t * series
+    series = 8.286380574805527e-10 + 0.0 * x
     series = 1.2203463534465907e-08 + t * series
     series = 1.8955121406990826e-07 + t * series
     series = 3.189329117063492e-06 + t * series
     series = 6.138392857142858e-05 + t * series
     series = 0.0015625 + t * series
     series = 0.125 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    closed = (1 - cos_half)/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    phi = _where(small, 1.2281574046507382, phi)
+    x = _where(small, 1.4342812011199078, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
@@ -1469,9 +1406,9 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     series = -0.1 + t * series
     series = 1.0 + t * series
     phi = _where(small, 1.2281574046507382, phi)
+    s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    w0 = _xp.sin(phi)
-    closed = (0.25)*w0*_cbrt(6*phi - 6*w0)/sin_half**2
+    closed = (0.25)*s*_xp.sin(phi)/sin_half**2
     return _where(small, series, closed)
 
 
@@ -1485,9 +1422,9 @@ def _K_across_32(x, phi, s, d, sin_half, cos_half):
     series = -0.00042410714285714285 + t * series
     series = -0.0125 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
+    s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    closed = sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
+    closed = sin_half/s
     return _where(small, series, closed)
 
 

@@ -11,7 +11,6 @@ from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
 from ..budget import stage
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
 from ..errors import SymrotError
-from ..forked import in_child
 from .output import output_directory, write_file
 
 SCALAR_LABELS = {
@@ -23,10 +22,6 @@ SCALAR_LABELS = {
 }
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 TENSOR_LABELS = {"R": "R", "H": "H", "H_inverse": "H^-1", "G": "G", "K": "K"}
-CHILD_TENSORS = ("H_inverse", "K")
-"""Tensors simplified in a forked child by :func:`simplify_for_display`: the two costliest (for
-tan(φ/3) + 8 tan(3φ/4)/9, 2.6 and 1.8 s of the 8.1 s for all five; the parent's three and the
-validity analysis took 3.7 s)."""
 
 
 def register(subparsers: Any) -> None:
@@ -88,35 +83,17 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
     return 0
 
 
-def simplify_for_display(derivation: Any) -> None:
-    """Simplify the five tensors (eqs 14, 22, 26, 81, 83) and analyse the validity range, on the
-    machine's two cores: :data:`CHILD_TENSORS` in a forked child while this process does the
-    others and the validity analysis, then the child's forms fill the tensors' cached properties.
-    Both processes start from the same state, so the printed forms are the same on every run."""
-    from ..singularities import validity
-
-    def child_forms() -> dict[str, tuple[Any, Any]]:
-        return {name: (derivation.tensors[name].simplified, derivation.tensors[name].canonical)
-                for name in CHILD_TENSORS}
-
-    with in_child(child_forms) as wait:
-        for name in TENSOR_NAMES:
-            if name not in CHILD_TENSORS:
-                derivation.tensors[name].simplified  # noqa: B018 (fills the cached property)
-                derivation.tensors[name].canonical  # noqa: B018
-        validity(derivation)
-        forms = wait()
-    for name, (simplified, canonical) in forms.items():
-        derivation.tensors[name].__dict__.update(simplified=simplified, canonical=canonical)
-
-
 def run(args: argparse.Namespace) -> int:
     if getattr(args, "emit", None):
         _check_emit_options(args)
     result = derive(args.expression, normalize=args.normalize)
     if getattr(args, "emit", None):
         return emit_code(result, args)
-    simplify_for_display(result.derivation)
+    from ..singularities import validity
+    from ..two_processes import simplify_tensors
+
+    derivation = result.derivation
+    simplify_tensors(derivation, beside=lambda: validity(derivation))
     if args.json:
         text = strict_json.dumps(result.to_dict(series_terms=args.terms), indent=2)
     else:
