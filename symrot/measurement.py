@@ -131,6 +131,7 @@ def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
     which the backends have as rounded input: 4 atanh(φ/4) recomputed from φ̂ cancels near φ = 4."""
     if argument == PHI:
         return expr
+    expr = _with_same_calls(expr, argument)
     coefficient, rest = argument.as_coeff_Mul()
     if argument.is_Add:  # sin(φ)/2 + sinh(φ)/2 = (sin φ + sinh φ)/2
         coefficient, rest = argument.as_content_primitive()
@@ -146,6 +147,22 @@ def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
     if argument.is_Add and written.has(*argument.atoms(sp.Function)):
         written = _with_equal_sums(written, argument)
     return written
+
+
+def _with_same_calls(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
+    """``expr`` with every call of p's outer function on an argument that expands to p's own,
+    written as p itself: the simplified tensors of eq 35 hold cbrt(6(φ − sin φ)) where p is
+    cbrt(6φ − 6 sin φ), which no structural match finds (H⁻¹₀ = 2(1 − cos φ)/p² stayed a form in φ
+    with a 16-term polynomial where 4 sin²(φ/2)/x needs 5)."""
+    if not (isinstance(argument, sp.Function) and len(argument.args) == 1):
+        return expr
+    inner = sp.expand(argument.args[0])
+
+    def same_call(node: sp.Expr) -> bool:
+        return (node.func == argument.func and node != argument and len(node.args) == 1
+                and sp.expand(node.args[0]) == inner)
+
+    return expr.replace(same_call, lambda node: argument)
 
 
 def _with_equal_sums(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:

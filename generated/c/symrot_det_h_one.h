@@ -118,9 +118,9 @@ static inline double symrot_det_h_one_angle(const double p[3])
 /* symrot_det_h_one_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
- * ops: 573 */
+ * R_1: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
+ * R_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
+ * ops: 528 */
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -137,15 +137,14 @@ static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[
         return;
     }
     double c_R_1, c_R_2;
-    if (x < 0.764824235244299) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_R_1 = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = sin(phi);
-        const double w1 = cbrt(6*phi - 6*w0);
-        c_R_1 = w0/w1;
-        c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
+        const double s = sqrt(x);
+        c_R_1 = sin(phi)/s;
+        c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -163,12 +162,12 @@ static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -176,27 +175,26 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
+            if (!(x <= 11.243134665607636) || x < 1.9211893090849666e-14) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*(phi - sin(phi)));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
             const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -207,12 +205,20 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_R_1_lanes[k] = sin0/u0;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-            c_R_2_lanes[k] = (1 - cos0)/(u0*u0);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+            const double a1_a = (1.0/2.0)*phi;
+            const double a1_q = rint(a1_a*0.6366197723675814);
+            const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
+            const double a1_z = a1_r*a1_r;
+            const double a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/355687428096000.0)*a1_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*(a1_z*((1.0/20922789888000.0)*a1_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a1_j = a1_q - 4*rint(0.25*a1_q - 0.375);
+            const double a1_h = rint(0.5*a1_j - 0.25);
+            const double a1_odd = a1_j - 2*a1_h;
+            const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_R_1_lanes[k] = sin0/s;
+            poly_R_1_lanes[k] = 1 + (-3.0/20.0)*x;
+            c_R_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_R_2_lanes[k] = x*(x*((-23.0/1008000.0)*x - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -220,11 +226,11 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
             c_R_0_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : 1;
             const double closed_R_1 = c_R_1_lanes[k];
             const double poly_R_1 = poly_R_1_lanes[k];
-            const double v_R_1 = x < 0.764824235244299 ? poly_R_1 : closed_R_1;
+            const double v_R_1 = x < 1.9211893090849666e-14 ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_R_1;
             const double closed_R_2 = c_R_2_lanes[k];
             const double poly_R_2 = poly_R_2_lanes[k];
-            const double v_R_2 = x < 1.4342812090283275 ? poly_R_2 : closed_R_2;
+            const double v_R_2 = x < 0.00016163055520154135 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -246,10 +252,10 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
 
 /* symrot_det_h_one_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
+ * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 640 */
+ * ops: 593 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -266,20 +272,20 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
         return;
     }
     double c_H_across, c_H_1, c_H_2;
-    if (x < 0.764824235244299) {
-        c_H_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_H_across = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+        c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = sin(phi);
-        const double w1 = cbrt(6*phi - 6*w0);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = w3*cos(w2);
-        c_H_across = w0/w1;
-        c_H_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w4 + (1.0/2.0)*sin(2*phi))/((w3*w3)*(phi - 2*w4));
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = w1*cos(w0);
+        c_H_across = sin(phi)/s;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w3 + (1.0/2.0)*sin(2*phi))/(w2*(phi - 2*w3));
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -296,12 +302,12 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -309,27 +315,26 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
+            if (!(x <= 11.243134665607636) || x < 1.9211893090849666e-14) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*(phi - sin(phi)));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
             const double a0_a = phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -340,8 +345,6 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double a1_a = (1.0/2.0)*phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
@@ -364,12 +367,13 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double a2_h = rint(0.5*a2_j - 0.25);
             const double a2_odd = a2_j - 2*a2_h;
             const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const double w0 = cos1*sin1;
-            c_H_across_lanes[k] = sin0/u0;
-            poly_H_across_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-            c_H_1_lanes[k] = (1 - cos0)/(u0*u0);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-            c_H_2_lanes[k] = (1.0/12.0)*(3*phi + (1.0/2.0)*sin2 - 8*w0)/((sin1*sin1)*(phi - 2*w0));
+            const double w0 = (sin1*sin1);
+            const double w1 = cos1*sin1;
+            c_H_across_lanes[k] = sin0/s;
+            poly_H_across_lanes[k] = 1 + (-3.0/20.0)*x;
+            c_H_1_lanes[k] = 2*w0/x;
+            poly_H_1_lanes[k] = x*(x*((-23.0/1008000.0)*x - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+            c_H_2_lanes[k] = (1.0/12.0)*(3*phi + (1.0/2.0)*sin2 - 8*w1)/(w0*(phi - 2*w1));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -377,11 +381,11 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double x = x_lanes[k];
             const double closed_H_across = c_H_across_lanes[k];
             const double poly_H_across = poly_H_across_lanes[k];
-            const double v_H_across = x < 0.764824235244299 ? poly_H_across : closed_H_across;
+            const double v_H_across = x < 1.9211893090849666e-14 ? poly_H_across : closed_H_across;
             c_H_across_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_across;
             const double closed_H_1 = c_H_1_lanes[k];
             const double poly_H_1 = poly_H_1_lanes[k];
-            const double v_H_1 = x < 1.4342812090283275 ? poly_H_1 : closed_H_1;
+            const double v_H_1 = x < 0.00016163055520154135 ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
@@ -568,9 +572,9 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
 /* symrot_det_h_one_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 12 in x below x = 0.764824, else sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * G_2: Horner degree 15 in x below x = 1.43428, else 2*sin(phi/4)**2/cbrt(6*(phi - sin(phi)))**2
- * ops: 573 */
+ * G_1: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
+ * G_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
+ * ops: 529 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -587,14 +591,14 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
         return;
     }
     double c_G_1, c_G_2;
-    if (x < 0.764824235244299) {
-        c_G_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
+    if (x < 0.1103124080629894) {
+        c_G_1 = x*(x*(x*(x*(x*(x*((-4.517630699305304e-10)*x - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
+        c_G_2 = x*(x*(x*(x*(x*(x*((5.844969408074523e-11)*x + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = cbrt(6*(phi - sin(phi)));
-        c_G_1 = sin((1.0/2.0)*phi)/w0;
-        c_G_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(w0*w0);
+        const double s = sqrt(x);
+        c_G_1 = sin((1.0/2.0)*phi)/s;
+        c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
     G[0] = c_G_2*(p[0]*p[0]) + t;
@@ -612,12 +616,12 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*(phi - sin(phi))).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -625,27 +629,26 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 0.764824235244299) {
+            if (!(x <= 11.243134665607636) || x < 1.9211893090849666e-14) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*(phi - sin(phi)));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -666,10 +669,10 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_G_1_lanes[k] = sin0/u0;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2358884471431072e-15)*x - 1.5586041391956483e-14) - 1.9870905217627718e-13) - 2.5669594363297223e-12) - 3.370441278711113e-11) - 4.517630699305304e-10) - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/(u0*u0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.005500832060205e-20)*x + 8.78575012329886e-19) + 1.1103729250660078e-17) + 1.415858727786663e-16) + 1.8241874371141333e-15) + 2.3791812685232493e-14) + 3.1488034564609846e-13) + 4.242513271852192e-12) + 5.844969408074523e-11) + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
+            c_G_1_lanes[k] = sin0/s;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-1.0/80.0)*x;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*(x*(x*((150653.0/794787840000.0)*x + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -677,11 +680,11 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             c_G_0_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : 1;
             const double closed_G_1 = c_G_1_lanes[k];
             const double poly_G_1 = poly_G_1_lanes[k];
-            const double v_G_1 = x < 0.764824235244299 ? poly_G_1 : closed_G_1;
+            const double v_G_1 = x < 1.9211893090849666e-14 ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_G_1;
             const double closed_G_2 = c_G_2_lanes[k];
             const double poly_G_2 = poly_G_2_lanes[k];
-            const double v_G_2 = x < 1.4342812090283275 ? poly_G_2 : closed_G_2;
+            const double v_G_2 = x < 0.004229756532686548 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -888,10 +891,10 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
 
 /* symrot_det_h_one_omega: omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
+ * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 639 */
+ * ops: 592 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -902,20 +905,20 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
         return;
     }
     double c_H_across, c_H_1, c_H_2;
-    if (x < 0.764824235244299) {
-        c_H_across = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_H_across = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+        c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = sin(phi);
-        const double w1 = cbrt(6*phi - 6*w0);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = w3*cos(w2);
-        c_H_across = w0/w1;
-        c_H_1 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w4 + (1.0/2.0)*sin(2*phi))/((w3*w3)*(phi - 2*w4));
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = w1*cos(w0);
+        c_H_across = sin(phi)/s;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w3 + (1.0/2.0)*sin(2*phi))/(w2*(phi - 2*w3));
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -929,8 +932,8 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
 /* symrot_det_h_one_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
- * nu: Horner degree 12 in x below x = 0.764824, else 2*sin(phi/2)/cbrt(6*(phi - sin(phi)))
- * ops: 528 */
+ * nu: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)/s
+ * ops: 495 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -944,12 +947,13 @@ static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4]
     double c_e_0, c_nu;
     if (x < 0.1103124080629894) {
         c_e_0 = x*(x*(x*(x*(x*(x*((-8.286380574805527e-10)*x - 3362377.0/275526451200000.0) - 150653.0/794787840000.0) - 823.0/258048000.0) - 11.0/179200.0) - 1.0/640.0) - 1.0/8.0) + 1;
-        c_nu = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.4717768942862145e-15)*x - 3.1172082783912966e-14) - 3.9741810435255436e-13) - 5.1339188726594446e-12) - 6.740882557422226e-11) - 9.035261398610608e-10) - 1.244209181073502e-08) - 1312063.0/7380172800000.0) - 17753.0/6623232000.0) - 71.0/1612800.0) - 19.0/22400.0) - 1.0/40.0) + 1;
+        c_nu = x*(x*(x*(x*(x*(x*((-9.035261398610608e-10)*x - 1.244209181073502e-08) - 1312063.0/7380172800000.0) - 17753.0/6623232000.0) - 71.0/1612800.0) - 19.0/22400.0) - 1.0/40.0) + 1;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         c_e_0 = cos(w0);
-        c_nu = x < 0.764824235244299 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-2.4717768942862145e-15)*x - 3.1172082783912966e-14) - 3.9741810435255436e-13) - 5.1339188726594446e-12) - 6.740882557422226e-11) - 9.035261398610608e-10) - 1.244209181073502e-08) - 1312063.0/7380172800000.0) - 17753.0/6623232000.0) - 71.0/1612800.0) - 19.0/22400.0) - 1.0/40.0) + 1 : 2*sin(w0)/cbrt(6*(phi - sin(phi)));
+        c_nu = 2*sin(w0)/s;
     }
     const double half_nu = (1.0/2.0)*c_nu;
     e[0] = c_e_0;
@@ -1091,12 +1095,12 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
 /* symrot_det_h_one_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * R_1: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
+ * R_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (-2*sin(phi/2)**2 + 1 - 4*sin(phi/2)**3*cos(phi/2)/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 784 */
+ * ops: 736 */
 static inline void symrot_det_h_one_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1113,27 +1117,27 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
-    if (x < 0.764824235244299) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_R_1 = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = sin(phi);
-        const double w1 = cbrt(6*phi - 6*w0);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = (w3*w3);
-        const double w5 = cos(w2);
-        const double w6 = w3*w5;
-        const double w7 = 2*w6;
-        const double w8 = 1.0/(phi - w7);
-        const double w9 = (1.0/8.0)/w4;
-        c_R_1 = w0/w1;
-        c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w9*(-4.0/3.0*(w3*w3*w3)*w5*w8 - 2*w4 + 1);
-        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w9*(-8.0/3.0*(w3*w3*w3*w3)*w8 + w7)/cbrt(6*phi - 12*w6);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 2*w2;
+        const double w4 = cos(w0);
+        const double w5 = w1*w4;
+        const double w6 = 2*w5;
+        const double w7 = 1.0/(phi - w6);
+        const double w8 = (1.0/8.0)/w2;
+        c_R_1 = sin(phi)/s;
+        c_R_2 = w3/x;
+        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w8*(-4.0/3.0*(w1*w1*w1)*w4*w7 - w3 + 1);
+        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w8*(-8.0/3.0*(w1*w1*w1*w1)*w7 + w6)/cbrt(6*phi - 12*w5);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1175,12 +1179,12 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
 /* symrot_det_h_one_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 12 in x below x = 0.764824, else sin(phi)/cbrt(6*(phi - sin(phi)))
- * R_2: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * R_1: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
+ * R_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (-2*sin(phi/2)**2 + 1 - 4*sin(phi/2)**3*cos(phi/2)/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 785 */
+ * ops: 737 */
 static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1197,27 +1201,27 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
-    if (x < 0.764824235244299) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.4273770483331233e-15)*x + 3.054732998294483e-14) + 3.8844043825273724e-13) + 5.001592370976041e-12) + 6.539638581589419e-11) + 33227.0/38118080000000.0) + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_R_1 = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = sin(phi);
-        const double w1 = cbrt(6*phi - 6*w0);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = sin(w2);
-        const double w4 = (w3*w3);
-        const double w5 = cos(w2);
-        const double w6 = w3*w5;
-        const double w7 = 2*w6;
-        const double w8 = 1.0/(phi - w7);
-        const double w9 = (1.0/8.0)/w4;
-        c_R_1 = w0/w1;
-        c_R_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0 : (1 - cos(phi))/(w1*w1);
-        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w9*(-4.0/3.0*(w3*w3*w3)*w5*w8 - 2*w4 + 1);
-        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w9*(-8.0/3.0*(w3*w3*w3*w3)*w8 + w7)/cbrt(6*phi - 12*w6);
+        const double s = sqrt(x);
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 2*w2;
+        const double w4 = cos(w0);
+        const double w5 = w1*w4;
+        const double w6 = 2*w5;
+        const double w7 = 1.0/(phi - w6);
+        const double w8 = (1.0/8.0)/w2;
+        c_R_1 = sin(phi)/s;
+        c_R_2 = w3/x;
+        c_R_1_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.4590852718839616e-19)*x + 1.6712992943913682e-18) + 1.9164647128732757e-17) + 2.2002829132536273e-16) + 2.5296275904133537e-15) + 2.912852457999748e-14) + 3.360206298123931e-13) + 3.884404382527373e-12) + 4.5014331338784364e-11) + 5.231710865271535e-10) + 33227.0/5445440000000.0) + 151439.0/2118916800000.0) + 1213.0/1441440000.0) + 43.0/4312000.0) + 1.0/8400.0) + 1.0/700.0) - 3.0/20.0 : w8*(-4.0/3.0*(w1*w1*w1)*w4*w7 - w3 + 1);
+        c_R_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : w8*(-8.0/3.0*(w1*w1*w1*w1)*w7 + w6)/cbrt(6*phi - 12*w5);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1257,12 +1261,12 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
 /* symrot_det_h_one_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 850 */
+ * ops: 896 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1279,35 +1283,35 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
         return;
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
-    if (x < 1.4342812090283275) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = 2*phi;
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = cos(w2);
-        const double w4 = sin(w2);
-        const double w5 = w3*w4;
-        const double w6 = 2*w5;
-        const double w7 = 1.0/(phi - w6);
-        const double w8 = (w4*w4);
-        const double w9 = 1.0/w8;
-        const double w10 = w7*w9;
+        const double w2 = (w1*w1);
+        const double w3 = 2*phi;
+        const double w4 = sin(w3);
+        const double w5 = cos(w0);
+        const double w6 = w1*w5;
+        const double w7 = 2*w6;
+        const double w8 = 1.0/(phi - w7);
+        const double w9 = 1.0/w2;
+        const double w10 = w8*w9;
         const double w11 = 6*phi;
-        const double w12 = w11 - 12*w5;
-        const double w13 = w3/(w4*w4*w4);
+        const double w12 = w11 - 12*w6;
+        const double w13 = w5/(w1*w1*w1);
         const double w14 = cbrt(w12);
-        const double w15 = w1 + w11 - 16*w5;
-        c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w1 - 8*w5);
-        c_H_0_x = (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w7);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w4*w4*w4*w4)*w7 + w6)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w7 - 1.0/2.0*w9*(8*w8 + cos(w0) - 1));
+        const double w15 = w11 + w4 - 16*w6;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w4 - 8*w6);
+        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w8);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w1*w1*w1*w1)*w8 + w7)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(8*w2 + cos(w3) - 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1352,12 +1356,12 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
 /* symrot_det_h_one_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 856 */
+ * ops: 902 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1374,35 +1378,35 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
         return;
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
-    if (x < 1.4342812090283275) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = 2*phi;
+        const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
-        const double w2 = (1.0/2.0)*phi;
-        const double w3 = cos(w2);
-        const double w4 = sin(w2);
-        const double w5 = w3*w4;
-        const double w6 = 2*w5;
-        const double w7 = 1.0/(phi - w6);
-        const double w8 = (w4*w4);
-        const double w9 = 1.0/w8;
-        const double w10 = w7*w9;
+        const double w2 = (w1*w1);
+        const double w3 = 2*phi;
+        const double w4 = sin(w3);
+        const double w5 = cos(w0);
+        const double w6 = w1*w5;
+        const double w7 = 2*w6;
+        const double w8 = 1.0/(phi - w7);
+        const double w9 = 1.0/w2;
+        const double w10 = w8*w9;
         const double w11 = 6*phi;
-        const double w12 = w11 - 12*w5;
-        const double w13 = w3/(w4*w4*w4);
+        const double w12 = w11 - 12*w6;
+        const double w13 = w5/(w1*w1*w1);
         const double w14 = cbrt(w12);
-        const double w15 = w1 + w11 - 16*w5;
-        c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w1 - 8*w5);
-        c_H_0_x = (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w7);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w4*w4*w4*w4)*w7 + w6)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w7 - 1.0/2.0*w9*(8*w8 + cos(w0) - 1));
+        const double w15 = w11 + w4 - 16*w6;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w4 - 8*w6);
+        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w8);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w1*w1*w1*w1)*w8 + w7)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(8*w2 + cos(w3) - 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1534,13 +1538,13 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
 /* symrot_det_h_one_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 17 in x below x = 1.43428, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(4*sin(phi/2)**2)
- * H_1: Horner degree 15 in x below x = 1.43428, else (1 - cos(phi))/cbrt(6*(phi - sin(phi)))**2
+ * H_0: Horner degree 7 in x below x = 0.110312, else x/(4*sin(phi/2)**2)
+ * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 814 */
+ * ops: 859 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1551,9 +1555,9 @@ static inline void symrot_det_h_one_angular_acceleration(const double p[3], cons
         return;
     }
     double c_H_0, c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
-    if (x < 1.4342812090283275) {
-        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.0039990891728625e-19)*x + 3.447054794682197e-18) + 3.960693739938103e-17) + 4.557728891739657e-16) + 5.253841918550812e-15) + 6.068442620832808e-14) + 7.02588589607731e-13) + 8.157249203307483e-12) + 9.503025504854477e-11) + 1.111738558870201e-09) + 99681.0/7623616000000.0) + 151439.0/977961600000.0) + 1213.0/655200000.0) + 387.0/17248000.0) + 1.0/3600.0) + 1.0/280.0) + 1.0/20.0) + 1;
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.408062620201596e-19)*x - 4.313470925118564e-18) - 5.5081089876936793e-17) - 7.106523709086561e-16) - 9.280634969633333e-15) - 1.2296404066927484e-13) - 1.6580488505029053e-12) - 2.2848332772743624e-11) - 3.236771326819846e-10) - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+    if (x < 0.1103124080629894) {
+        c_H_0 = x*(x*(x*(x*(x*(x*((99681.0/7623616000000.0)*x + 151439.0/977961600000.0) + 1213.0/655200000.0) + 387.0/17248000.0) + 1.0/3600.0) + 1.0/280.0) + 1.0/20.0) + 1;
+        c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
@@ -1564,24 +1568,24 @@ static inline void symrot_det_h_one_angular_acceleration(const double p[3], cons
         const double w1 = sin(w0);
         const double w2 = (w1*w1);
         const double w3 = 1.0/w2;
-        const double w4 = 6*phi;
-        const double w5 = cos(w0);
-        const double w6 = w1*w5;
-        const double w7 = w4 - 12*w6;
-        const double w8 = cbrt(w7);
-        const double w9 = 2*phi;
-        const double w10 = sin(w9);
-        const double w11 = 2*w6;
-        const double w12 = 1.0/(phi - w11);
-        const double w13 = w12*w3;
-        const double w14 = w5/(w1*w1*w1);
-        const double w15 = w10 + w4 - 16*w6;
-        c_H_0 = (1.0/4.0)*w3*(w8*w8);
-        c_H_1 = (1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w13*(3*phi + (1.0/2.0)*w10 - 8*w6);
-        c_H_0_x = (1.0/48.0)*w3*w7*(2*w12 - 3.0/2.0*w14);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w3*(-8.0/3.0*(w1*w1*w1*w1)*w12 + w11)/w8;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w13*w8*((1.0/2.0)*w12*w15 + (1.0/4.0)*w14*w15 - 1.0/2.0*w3*(8*w2 + cos(w9) - 1));
+        const double w4 = 2*phi;
+        const double w5 = sin(w4);
+        const double w6 = cos(w0);
+        const double w7 = w1*w6;
+        const double w8 = 2*w7;
+        const double w9 = 1.0/(phi - w8);
+        const double w10 = w3*w9;
+        const double w11 = 6*phi;
+        const double w12 = w11 - 12*w7;
+        const double w13 = w6/(w1*w1*w1);
+        const double w14 = cbrt(w12);
+        const double w15 = w11 + w5 - 16*w7;
+        c_H_0 = (1.0/4.0)*w3*x;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w5 - 8*w7);
+        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w3*(-3.0/2.0*w13 + 2*w9);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w3*(-8.0/3.0*(w1*w1*w1*w1)*w9 + w8)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w9 - 1.0/2.0*w3*(8*w2 + cos(w4) - 1));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1799,9 +1803,9 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
 /* symrot_det_h_one_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
- * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
- * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 474 */
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
+ * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/x
+ * ops: 430 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1820,15 +1824,12 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
     float c_R_1, c_R_2;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = sinf(phi);
-        const float w1 = 6*phi;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        c_R_1 = -w0/cbrtf(6*w0 - w1);
-        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*(w3*w3)/powf(cbrtf(w1 - 12*w3*cosf(w2)), 2);
+        const float s = sqrtf(x);
+        c_R_1 = sinf(phi)/s;
+        c_R_2 = (1 - cosf(phi))/x;
     }
     const float t = -c_R_2*x + 1;
     R[0] = c_R_2*(p[0]*p[0]) + t;
@@ -1846,12 +1847,12 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
  * R[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -1859,32 +1860,26 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 1.9211895e-14F) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 6*sinf(phi));
-                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
             const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -1895,20 +1890,12 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
-            const float a1_q = rintf(a1_a*0.63661975F);
-            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
-            const float a1_z = a1_r*a1_r;
-            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
-            const float a1_h = rintf(0.5F*a1_j - 0.25F);
-            const float a1_odd = a1_j - 2*a1_h;
-            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            c_R_1_lanes[k] = sin0/u0;
-            poly_R_1_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-            c_R_2_lanes[k] = 2*(sin1*sin1)/(u1*u1);
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
+            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
+            c_R_1_lanes[k] = sin0/s;
+            poly_R_1_lanes[k] = 1;
+            c_R_2_lanes[k] = (1 - cos0)/x;
+            poly_R_2_lanes[k] = x*(x*(x*(x*((-7.343103e-08F)*x - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1916,11 +1903,11 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             c_R_0_lanes[k] = !(x <= 11.2431345F) ? NAN : 1;
             const float closed_R_1 = c_R_1_lanes[k];
             const float poly_R_1 = poly_R_1_lanes[k];
-            const float v_R_1 = x < 0.7648242F ? poly_R_1 : closed_R_1;
+            const float v_R_1 = x < 1.9211895e-14F ? poly_R_1 : closed_R_1;
             c_R_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_1;
             const float closed_R_2 = c_R_2_lanes[k];
             const float poly_R_2 = poly_R_2_lanes[k];
-            const float v_R_2 = x < 4.619481F ? poly_R_2 : closed_R_2;
+            const float v_R_2 = x < 0.7648242F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 11.2431345F) ? NAN : v_R_2;
         }
         for (k = 0; k < m; ++k) {
@@ -1942,10 +1929,10 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
 
 /* symrot_det_h_one_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
- * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
+ * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 513 */
+ * ops: 485 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1964,19 +1951,18 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
     float c_H_across, c_H_1, c_H_2;
     if (x < 1.4342812F) {
         c_H_across = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_H_1 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = sinf(phi);
-        const float w1 = 6*phi;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = (w3*w3);
-        const float w5 = w3*cosf(w2);
-        c_H_across = -w0/cbrtf(6*w0 - w1);
-        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w4/powf(cbrtf(w1 - 12*w5), 2);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w5 + (1.0F/2.0F)*sinf(2*phi))/(w4*(phi - 2*w5));
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = w1*cosf(w0);
+        c_H_across = sinf(phi)/s;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w3 + (1.0F/2.0F)*sinf(2*phi))/(w2*(phi - 2*w3));
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -1993,12 +1979,12 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
  * H[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)), u1 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2006,32 +1992,26 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 1.9211895e-14F) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 6*sinf(phi));
-                const float u1 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
             const float a0_a = phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -2066,10 +2046,10 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             const float w0 = (sin1*sin1);
             const float w1 = cos1*sin1;
-            c_H_across_lanes[k] = sin0/u0;
-            poly_H_across_lanes[k] = x*(x*(x*(x*((1.6830391e-07F)*x + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-            c_H_1_lanes[k] = 2*w0/(u1*u1);
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+            c_H_across_lanes[k] = sin0/s;
+            poly_H_across_lanes[k] = 1;
+            c_H_1_lanes[k] = 2*w0/x;
+            poly_H_1_lanes[k] = x*((-3.0F/5600.0F)*x - 1.0F/40.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = (1.0F/12.0F)*(3*phi + (1.0F/2.0F)*sin2 - 8*w1)/(w0*(phi - 2*w1));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         }
@@ -2078,11 +2058,11 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float x = x_lanes[k];
             const float closed_H_across = c_H_across_lanes[k];
             const float poly_H_across = poly_H_across_lanes[k];
-            const float v_H_across = x < 0.7648242F ? poly_H_across : closed_H_across;
+            const float v_H_across = x < 1.9211895e-14F ? poly_H_across : closed_H_across;
             c_H_across_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_across;
             const float closed_H_1 = c_H_1_lanes[k];
             const float poly_H_1 = poly_H_1_lanes[k];
-            const float v_H_1 = x < 2.6302226F ? poly_H_1 : closed_H_1;
+            const float v_H_1 = x < 0.008125107F ? poly_H_1 : closed_H_1;
             c_H_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_1;
             const float closed_H_2 = c_H_2_lanes[k];
             const float poly_H_2 = poly_H_2_lanes[k];
@@ -2269,9 +2249,9 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
 /* symrot_det_h_one_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
- * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/cbrt(6*phi - 6*sin(phi))
- * G_2: Horner degree 8 in x below x = 2.63022, else (1 - cos(phi/2))/cbrt(6*phi - 6*sin(phi))**2
- * ops: 457 */
+ * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
+ * G_2: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
+ * ops: 433 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2290,13 +2270,12 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
     float c_G_1, c_G_2;
     if (x < 1.4342812F) {
         c_G_1 = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-        c_G_2 = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+        c_G_2 = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = cbrtf(6*phi - 6*sinf(phi));
-        c_G_1 = sinf(w0)/w1;
-        c_G_2 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F : (1 - cosf(w0))/(w1*w1);
+        const float s = sqrtf(x);
+        c_G_1 = sinf((1.0F/2.0F)*phi)/s;
+        c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
     G[0] = c_G_2*(p[0]*p[0]) + t;
@@ -2314,12 +2293,12 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
  * G[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: phi, u0 = cbrt(6*phi - 6*sin(phi)).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -2327,27 +2306,26 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.7648242F) {
+            if (!(x <= 11.2431345F) || x < 1.9211895e-14F) {
+                s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
-                const float u0 = cbrtf(6*phi - 6*sinf(phi));
+                s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
+            s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float s = s_lanes[k];
             const float phi = phi_lanes[k];
-            const float u0 = u0_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = rintf(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
@@ -2358,12 +2336,20 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float a0_h = rintf(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
-            const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            c_G_1_lanes[k] = sin0/u0;
-            poly_G_1_lanes[k] = x*(x*(x*(x*((-8.889108e-08F)*x - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-            c_G_2_lanes[k] = (1 - cos0)/(u0*u0);
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((4.2425135e-12F)*x + 5.8449696e-11F) + 8.2863805e-10F) + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            const float a1_a = (1.0F/4.0F)*phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            c_G_1_lanes[k] = sin0/s;
+            poly_G_1_lanes[k] = 1.0F/2.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
+            poly_G_2_lanes[k] = x*(x*(x*((1.8955122e-07F)*x + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2371,11 +2357,11 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             c_G_0_lanes[k] = !(x <= 11.2431345F) ? NAN : 1;
             const float closed_G_1 = c_G_1_lanes[k];
             const float poly_G_1 = poly_G_1_lanes[k];
-            const float v_G_1 = x < 0.7648242F ? poly_G_1 : closed_G_1;
+            const float v_G_1 = x < 1.9211895e-14F ? poly_G_1 : closed_G_1;
             c_G_1_lanes[k] = !(x <= 11.2431345F) ? NAN : v_G_1;
             const float closed_G_2 = c_G_2_lanes[k];
             const float poly_G_2 = poly_G_2_lanes[k];
-            const float v_G_2 = x < 2.6302226F ? poly_G_2 : closed_G_2;
+            const float v_G_2 = x < 0.7648242F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 11.2431345F) ? NAN : v_G_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2587,10 +2573,10 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
 
 /* symrot_det_h_one_omega_f: omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
- * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
+ * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 512 */
+ * ops: 484 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2603,19 +2589,18 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
     float c_H_across, c_H_1, c_H_2;
     if (x < 1.4342812F) {
         c_H_across = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_H_1 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = sinf(phi);
-        const float w1 = 6*phi;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = (w3*w3);
-        const float w5 = w3*cosf(w2);
-        c_H_across = -w0/cbrtf(6*w0 - w1);
-        c_H_1 = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : 2*w4/powf(cbrtf(w1 - 12*w5), 2);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w5 + (1.0F/2.0F)*sinf(2*phi))/(w4*(phi - 2*w5));
+        const float s = sqrtf(x);
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = w1*cosf(w0);
+        c_H_across = sinf(phi)/s;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w3 + (1.0F/2.0F)*sinf(2*phi))/(w2*(phi - 2*w3));
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2629,8 +2614,8 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
 /* symrot_det_h_one_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
- * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/cbrt(6*phi - 6*sin(phi))
- * ops: 402 */
+ * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/s
+ * ops: 399 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2647,9 +2632,10 @@ static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4]
         c_nu = x*(x*(x*(x*(x*((-1.2442092e-08F)*x - 1.7778216e-07F) - 2.6804134e-06F) - 71.0F/1612800.0F) - 19.0F/22400.0F) - 1.0F/40.0F) + 1;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
         c_e_0 = cosf(w0);
-        c_nu = 2*sinf(w0)/cbrtf(6*phi - 6*sinf(phi));
+        c_nu = 2*sinf(w0)/s;
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
     e[0] = c_e_0;
@@ -2789,12 +2775,12 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
 /* symrot_det_h_one_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
- * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
+ * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 655 */
+ * ops: 609 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2813,25 +2799,23 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = sinf(phi);
-        const float w1 = 6*phi;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = w3*cosf(w2);
-        const float w5 = cbrtf(w1 - 12*w4);
-        const float w6 = (w3*w3);
-        const float w7 = 2*w6;
-        const float w8 = (1.0F/8.0F)/w6;
-        const float w9 = 2*w4;
-        c_R_1 = -w0/cbrtf(6*w0 - w1);
-        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/(phi - w0) - w7 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = (1.0F/8.0F)/w3;
+        const float w5 = w2*cosf(w1);
+        const float w6 = 2*w5;
+        c_R_1 = w0/s;
+        c_R_2 = (1 - cosf(phi))/x;
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w4*(-2.0F/3.0F*w0*w3/(phi - w0) - 2*w3 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w4*(-8.0F/3.0F*(w2*w2*w2*w2)/(phi - w6) + w6)/cbrtf(6*phi - 12*w5);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2873,12 +2857,12 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
 /* symrot_det_h_one_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/cbrt(6*phi - 6*sin(phi))
- * R_2: Horner degree 13 in x below x = 4.61948, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
+ * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/x
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 656 */
+ * ops: 610 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2897,25 +2881,23 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     if (x < 1.4342812F) {
         c_R_1 = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+        c_R_2 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_R_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F;
         c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = sinf(phi);
-        const float w1 = 6*phi;
-        const float w2 = (1.0F/2.0F)*phi;
-        const float w3 = sinf(w2);
-        const float w4 = w3*cosf(w2);
-        const float w5 = cbrtf(w1 - 12*w4);
-        const float w6 = (w3*w3);
-        const float w7 = 2*w6;
-        const float w8 = (1.0F/8.0F)/w6;
-        const float w9 = 2*w4;
-        c_R_1 = -w0/cbrtf(6*w0 - w1);
-        c_R_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-5.508109e-17F)*x - 7.106524e-16F) - 9.280635e-15F) - 1.2296404e-13F) - 1.6580488e-12F) - 2.2848333e-11F) - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F : w7/(w5*w5);
-        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w8*(-2.0F/3.0F*w0*w6/(phi - w0) - w7 + 1);
-        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w8*(-8.0F/3.0F*(w3*w3*w3*w3)/(phi - w9) + w9)/w5;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = (1.0F/8.0F)/w3;
+        const float w5 = w2*cosf(w1);
+        const float w6 = 2*w5;
+        c_R_1 = w0/s;
+        c_R_2 = (1 - cosf(phi))/x;
+        c_R_1_x = x < 2.6302226F ? x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3602063e-13F)*x + 3.8844045e-12F) + 4.5014333e-11F) + 5.2317106e-10F) + 6.1018026e-09F) + 7.1470005e-08F) + 8.415196e-07F) + 43.0F/4312000.0F) + 1.0F/8400.0F) + 1.0F/700.0F) - 3.0F/20.0F : w4*(-2.0F/3.0F*w0*w3/(phi - w0) - 2*w3 + 1);
+        c_R_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : w4*(-8.0F/3.0F*(w2*w2*w2*w2)/(phi - w6) + w6)/cbrtf(6*phi - 12*w5);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2955,12 +2937,12 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
 /* symrot_det_h_one_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 783 */
+ * ops: 782 */
 static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2977,8 +2959,8 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
         return;
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
-    if (x < 2.6302226F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+    if (x < 1.4342812F) {
+        c_H_1 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
@@ -2988,24 +2970,24 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
         const float w2 = (w1*w1);
-        const float w3 = 6*phi;
-        const float w4 = cosf(w0);
-        const float w5 = w1*w4;
-        const float w6 = w3 - 12*w5;
-        const float w7 = cbrtf(w6);
-        const float w8 = 2*phi;
-        const float w9 = sinf(w8);
-        const float w10 = 2*w5;
-        const float w11 = 1.0F/(phi - w10);
-        const float w12 = 1.0F/w2;
-        const float w13 = w11*w12;
-        const float w14 = w4/(w1*w1*w1);
-        const float w15 = w3 - 16*w5 + w9;
-        c_H_1 = 2*w2/(w7*w7);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w13*(3*phi - 8*w5 + (1.0F/2.0F)*w9);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w6*(2*w11 - 3.0F/2.0F*w14);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w12*(-8.0F/3.0F*(w1*w1*w1*w1)*w11 + w10)/w7;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w13*w7*((1.0F/2.0F)*w11*w15 - 1.0F/2.0F*w12*(8*w2 + cosf(w8) - 1) + (1.0F/4.0F)*w14*w15);
+        const float w3 = 2*phi;
+        const float w4 = sinf(w3);
+        const float w5 = cosf(w0);
+        const float w6 = w1*w5;
+        const float w7 = 2*w6;
+        const float w8 = 1.0F/(phi - w7);
+        const float w9 = 1.0F/w2;
+        const float w10 = w8*w9;
+        const float w11 = 6*phi;
+        const float w12 = w11 - 12*w6;
+        const float w13 = w5/(w1*w1*w1);
+        const float w14 = cbrtf(w12);
+        const float w15 = w11 + w4 - 16*w6;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w10*(3*phi + (1.0F/2.0F)*w4 - 8*w6);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w9*(-3.0F/2.0F*w13 + 2*w8);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w9*(-8.0F/3.0F*(w1*w1*w1*w1)*w8 + w7)/w14;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(8*w2 + cosf(w3) - 1));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3050,12 +3032,12 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
 /* symrot_det_h_one_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 789 */
+ * ops: 788 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3072,8 +3054,8 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
         return;
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
-    if (x < 2.6302226F) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+    if (x < 1.4342812F) {
+        c_H_1 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
@@ -3083,24 +3065,24 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
         const float w2 = (w1*w1);
-        const float w3 = 6*phi;
-        const float w4 = cosf(w0);
-        const float w5 = w1*w4;
-        const float w6 = w3 - 12*w5;
-        const float w7 = cbrtf(w6);
-        const float w8 = 2*phi;
-        const float w9 = sinf(w8);
-        const float w10 = 2*w5;
-        const float w11 = 1.0F/(phi - w10);
-        const float w12 = 1.0F/w2;
-        const float w13 = w11*w12;
-        const float w14 = w4/(w1*w1*w1);
-        const float w15 = w3 - 16*w5 + w9;
-        c_H_1 = 2*w2/(w7*w7);
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w13*(3*phi - 8*w5 + (1.0F/2.0F)*w9);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w6*(2*w11 - 3.0F/2.0F*w14);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w12*(-8.0F/3.0F*(w1*w1*w1*w1)*w11 + w10)/w7;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w13*w7*((1.0F/2.0F)*w11*w15 - 1.0F/2.0F*w12*(8*w2 + cosf(w8) - 1) + (1.0F/4.0F)*w14*w15);
+        const float w3 = 2*phi;
+        const float w4 = sinf(w3);
+        const float w5 = cosf(w0);
+        const float w6 = w1*w5;
+        const float w7 = 2*w6;
+        const float w8 = 1.0F/(phi - w7);
+        const float w9 = 1.0F/w2;
+        const float w10 = w8*w9;
+        const float w11 = 6*phi;
+        const float w12 = w11 - 12*w6;
+        const float w13 = w5/(w1*w1*w1);
+        const float w14 = cbrtf(w12);
+        const float w15 = w11 + w4 - 16*w6;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w10*(3*phi + (1.0F/2.0F)*w4 - 8*w6);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w9*(-3.0F/2.0F*w13 + 2*w8);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w9*(-8.0F/3.0F*(w1*w1*w1*w1)*w8 + w7)/w14;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(8*w2 + cosf(w3) - 1));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3232,13 +3214,13 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
 /* symrot_det_h_one_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
  * alpha = d omega/dt = H pddot + Hdot pdot for omega = H pdot (eq 20).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_0: Horner degree 18 in x below x = 4.61948, else cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(4*sin(phi/2)**2)
- * H_1: Horner degree 8 in x below x = 2.63022, else 2*sin(phi/2)**2/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
+ * H_0: Horner degree 7 in x below x = 1.43428, else x/(4*sin(phi/2)**2)
+ * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 799 */
+ * ops: 745 */
 static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3249,9 +3231,9 @@ static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], con
         return;
     }
     float c_H_0, c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
-    if (x < 2.6302226F) {
-        c_H_0 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
-        c_H_1 = x*(x*(x*(x*(x*(x*(x*((-2.2848333e-11F)*x - 3.2367714e-10F) - 4.754969e-09F) - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+    if (x < 1.4342812F) {
+        c_H_0 = x*(x*(x*(x*(x*(x*((1.3075291e-08F)*x + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1;
+        c_H_1 = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F;
@@ -3262,25 +3244,24 @@ static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], con
         const float w1 = sinf(w0);
         const float w2 = (w1*w1);
         const float w3 = 1.0F/w2;
-        const float w4 = 6*phi;
-        const float w5 = cosf(w0);
-        const float w6 = w1*w5;
-        const float w7 = w4 - 12*w6;
-        const float w8 = cbrtf(w7);
-        const float w9 = (w8*w8);
-        const float w10 = 2*phi;
-        const float w11 = sinf(w10);
-        const float w12 = 2*w6;
-        const float w13 = 1.0F/(phi - w12);
-        const float w14 = w13*w3;
-        const float w15 = w5/(w1*w1*w1);
-        const float w16 = w11 + w4 - 16*w6;
-        c_H_0 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6209591e-20F)*x + 3.0039992e-19F) + 3.4470548e-18F) + 3.9606936e-17F) + 4.5577286e-16F) + 5.2538417e-15F) + 6.068443e-14F) + 7.025886e-13F) + 8.157249e-12F) + 9.5030254e-11F) + 1.1117386e-09F) + 1.3075291e-08F) + 1.5485168e-07F) + 1.8513431e-06F) + 2.2437383e-05F) + 1.0F/3600.0F) + 1.0F/280.0F) + 1.0F/20.0F) + 1 : (1.0F/4.0F)*w3*w9;
-        c_H_1 = 2*w2/w9;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w14*(3*phi + (1.0F/2.0F)*w11 - 8*w6);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w3*w7*(2*w13 - 3.0F/2.0F*w15);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w3*(-8.0F/3.0F*(w1*w1*w1*w1)*w13 + w12)/w8;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w14*w8*((1.0F/2.0F)*w13*w16 + (1.0F/4.0F)*w15*w16 - 1.0F/2.0F*w3*(8*w2 + cosf(w10) - 1));
+        const float w4 = 2*phi;
+        const float w5 = sinf(w4);
+        const float w6 = cosf(w0);
+        const float w7 = w1*w6;
+        const float w8 = 2*w7;
+        const float w9 = 1.0F/(phi - w8);
+        const float w10 = w3*w9;
+        const float w11 = 6*phi;
+        const float w12 = w11 - 12*w7;
+        const float w13 = w6/(w1*w1*w1);
+        const float w14 = cbrtf(w12);
+        const float w15 = w11 + w5 - 16*w7;
+        c_H_0 = (1.0F/4.0F)*w3*x;
+        c_H_1 = 2*w2/x;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w10*(3*phi + (1.0F/2.0F)*w5 - 8*w7);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w3*(-3.0F/2.0F*w13 + 2*w9);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w3*(-8.0F/3.0F*(w1*w1*w1*w1)*w9 + w8)/w14;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w9 - 1.0F/2.0F*w3*(8*w2 + cosf(w4) - 1));
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

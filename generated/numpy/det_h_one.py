@@ -37,44 +37,20 @@ P_MAX_SQUARED = 11.243134665607636  # fl(p_max^2); inside the range: x = |p|^2 <
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
         t = x
-        series = -6.816125240403192e-19
-        series = -8.626941850237128e-18 + t * series
-        series = -1.1016217975387359e-16 + t * series
-        series = -1.4213047418173123e-15 + t * series
-        series = -1.8561269939266666e-14 + t * series
-        series = -2.4592808133854967e-13 + t * series
-        series = -3.3160977010058107e-12 + t * series
-        series = -4.569666554548725e-11 + t * series
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
+        series = -4.563492063492064e-05
         series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*(1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.00016163055520154135
     if small.any():
         t = x[small]
-        series = -6.816125240403192e-19
-        series = -8.626941850237128e-18 + t * series
-        series = -1.1016217975387359e-16 + t * series
-        series = -1.4213047418173123e-15 + t * series
-        series = -1.8561269939266666e-14 + t * series
-        series = -2.4592808133854967e-13 + t * series
-        series = -3.3160977010058107e-12 + t * series
-        series = -4.569666554548725e-11 + t * series
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
+        series = -4.563492063492064e-05
         series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
@@ -83,135 +59,57 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
         t = x
-        series = -2.4717768942862145e-15
-        series = -3.1172082783912966e-14 + t * series
-        series = -3.9741810435255436e-13 + t * series
-        series = -5.1339188726594446e-12 + t * series
-        series = -6.740882557422226e-11 + t * series
-        series = -9.035261398610608e-10 + t * series
-        series = -1.244209181073502e-08 + t * series
-        series = -1.7778215165910478e-07 + t * series
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
+        series = -0.025
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.9211893090849666e-14
     if small.any():
         t = x[small]
-        series = -2.4717768942862145e-15
-        series = -3.1172082783912966e-14 + t * series
-        series = -3.9741810435255436e-13 + t * series
-        series = -5.1339188726594446e-12 + t * series
-        series = -6.740882557422226e-11 + t * series
-        series = -9.035261398610608e-10 + t * series
-        series = -1.244209181073502e-08 + t * series
-        series = -1.7778215165910478e-07 + t * series
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
+        series = -0.025
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 9.999999999999995e-15:  # every lane on the polynomial
         t = x
-        series = 1.5905201294923517e-14
-        series = 1.1265276036398177e-13 + t * series
-        series = 7.978953359858307e-13 + t * series
-        series = 5.651354180596242e-12 + t * series
-        series = 4.0027973542176834e-11 + t * series
-        series = 2.8351938089872594e-10 + t * series
-        series = 2.0082446735268566e-09 + t * series
-        series = 1.4225834946840515e-08 + t * series
-        series = 1.0078371181814193e-07 + t * series
-        series = 7.141710355470859e-07 + t * series
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
+        series = 0.1
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
+    if span is not None and span[0] >= 9.999999999999995e-15:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 9.999999999999995e-15
     if small.any():
         t = x[small]
-        series = 1.5905201294923517e-14
-        series = 1.1265276036398177e-13 + t * series
-        series = 7.978953359858307e-13 + t * series
-        series = 5.651354180596242e-12 + t * series
-        series = 4.0027973542176834e-11 + t * series
-        series = 2.8351938089872594e-10 + t * series
-        series = 2.0082446735268566e-09 + t * series
-        series = 1.4225834946840515e-08 + t * series
-        series = 1.0078371181814193e-07 + t * series
-        series = 7.141710355470859e-07 + t * series
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
+        series = 0.1
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.0022017832983058567:  # every lane on the polynomial
         t = x
-        series = 3.0039990891728625e-19
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
+        series = 2.2437384044526902e-05
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.0022017832983058567:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.0022017832983058567
     if small.any():
         t = x[small]
-        series = 3.0039990891728625e-19
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
+        series = 2.2437384044526902e-05
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
@@ -229,85 +127,38 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
         t = x
-        series = 2.4273770483331233e-15
-        series = 3.054732998294483e-14 + t * series
-        series = 3.8844043825273724e-13 + t * series
-        series = 5.001592370976041e-12 + t * series
-        series = 6.539638581589419e-11 + t * series
-        series = 8.716860870222215e-10 + t * series
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
+        series = -0.15
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sin(phi)
-    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.9211893090849666e-14
     if small.any():
         t = x[small]
-        series = 2.4273770483331233e-15
-        series = 3.054732998294483e-14 + t * series
-        series = 3.8844043825273724e-13 + t * series
-        series = 5.001592370976041e-12 + t * series
-        series = 6.539638581589419e-11 + t * series
-        series = 8.716860870222215e-10 + t * series
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
+        series = -0.15
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
         t = x
-        series = -3.408062620201596e-19
-        series = -4.313470925118564e-18 + t * series
-        series = -5.5081089876936793e-17 + t * series
-        series = -7.106523709086561e-16 + t * series
-        series = -9.280634969633333e-15 + t * series
-        series = -1.2296404066927484e-13 + t * series
-        series = -1.6580488505029053e-12 + t * series
-        series = -2.2848332772743624e-11 + t * series
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
+        series = -2.281746031746032e-05
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.00016163055520154135
     if small.any():
         t = x[small]
-        series = -3.408062620201596e-19
-        series = -4.313470925118564e-18 + t * series
-        series = -5.5081089876936793e-17 + t * series
-        series = -7.106523709086561e-16 + t * series
-        series = -9.280634969633333e-15 + t * series
-        series = -1.2296404066927484e-13 + t * series
-        series = -1.6580488505029053e-12 + t * series
-        series = -2.2848332772743624e-11 + t * series
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
+        series = -2.281746031746032e-05
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
@@ -316,47 +167,21 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.0022017832983058567:  # every lane on the polynomial
         t = x
-        series = 3.0039990891728625e-19
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
+        series = 2.2437384044526902e-05
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.0022017832983058567:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.0022017832983058567
     if small.any():
         t = x[small]
-        series = 3.0039990891728625e-19
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
+        series = 2.2437384044526902e-05
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
@@ -366,44 +191,20 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
         t = x
-        series = -3.408062620201596e-19
-        series = -4.313470925118564e-18 + t * series
-        series = -5.5081089876936793e-17 + t * series
-        series = -7.106523709086561e-16 + t * series
-        series = -9.280634969633333e-15 + t * series
-        series = -1.2296404066927484e-13 + t * series
-        series = -1.6580488505029053e-12 + t * series
-        series = -2.2848332772743624e-11 + t * series
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
+        series = -2.281746031746032e-05
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((1 - numpy.cos(phi))/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.00016163055520154135
     if small.any():
         t = x[small]
-        series = -3.408062620201596e-19
-        series = -4.313470925118564e-18 + t * series
-        series = -5.5081089876936793e-17 + t * series
-        series = -7.106523709086561e-16 + t * series
-        series = -9.280634969633333e-15 + t * series
-        series = -1.2296404066927484e-13 + t * series
-        series = -1.6580488505029053e-12 + t * series
-        series = -2.2848332772743624e-11 + t * series
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
+        series = -2.281746031746032e-05
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
@@ -566,83 +367,39 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
         t = x
-        series = -1.2358884471431072e-15
-        series = -1.5586041391956483e-14 + t * series
-        series = -1.9870905217627718e-13 + t * series
-        series = -2.5669594363297223e-12 + t * series
-        series = -3.370441278711113e-11 + t * series
-        series = -4.517630699305304e-10 + t * series
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
+        series = -0.0125
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray(sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.9211893090849666e-14
     if small.any():
         t = x[small]
-        series = -1.2358884471431072e-15
-        series = -1.5586041391956483e-14 + t * series
-        series = -1.9870905217627718e-13 + t * series
-        series = -2.5669594363297223e-12 + t * series
-        series = -3.370441278711113e-11 + t * series
-        series = -4.517630699305304e-10 + t * series
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
+        series = -0.0125
         series = 0.5 + t * series
         out[small] = series
     return out
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    if span is not None and span[1] < 0.004229756532686548:  # every lane on the polynomial
         t = x
-        series = 7.005500832060205e-20
-        series = 8.78575012329886e-19 + t * series
-        series = 1.1103729250660078e-17 + t * series
-        series = 1.415858727786663e-16 + t * series
-        series = 1.8241874371141333e-15 + t * series
-        series = 2.3791812685232493e-14 + t * series
-        series = 3.1488034564609846e-13 + t * series
-        series = 4.242513271852192e-12 + t * series
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.004229756532686548:  # every lane on the closed form
         return out
-    small = x < 1.4342812090283275
+    small = x < 0.004229756532686548
     if small.any():
         t = x[small]
-        series = 7.005500832060205e-20
-        series = 8.78575012329886e-19 + t * series
-        series = 1.1103729250660078e-17 + t * series
-        series = 1.415858727786663e-16 + t * series
-        series = 1.8241874371141333e-15 + t * series
-        series = 2.3791812685232493e-14 + t * series
-        series = 3.1488034564609846e-13 + t * series
-        series = 4.242513271852192e-12 + t * series
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -750,41 +507,18 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.764824235244299:  # every lane on the polynomial
+    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
         t = x
-        series = 2.4273770483331233e-15
-        series = 3.054732998294483e-14 + t * series
-        series = 3.8844043825273724e-13 + t * series
-        series = 5.001592370976041e-12 + t * series
-        series = 6.539638581589419e-11 + t * series
-        series = 8.716860870222215e-10 + t * series
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
+        series = -0.15
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sin(phi)
-    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
-    if span is not None and span[0] >= 0.764824235244299:  # every lane on the closed form
+    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
         return out
-    small = x < 0.764824235244299
+    small = x < 1.9211893090849666e-14
     if small.any():
         t = x[small]
-        series = 2.4273770483331233e-15
-        series = 3.054732998294483e-14 + t * series
-        series = 3.8844043825273724e-13 + t * series
-        series = 5.001592370976041e-12 + t * series
-        series = 6.539638581589419e-11 + t * series
-        series = 8.716860870222215e-10 + t * series
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
+        series = -0.15
         series = 1.0 + t * series
         out[small] = series
     return out
@@ -1396,31 +1130,19 @@ def _scale_64(e0, e_norm):
 
 
 def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+    if span is not None and span[1] < 0.008125106898670383:  # every lane on the polynomial
         t = x
-        series = -4.569666554548725e-11
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
+        series = -0.0010714285714285715
         series = -0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(4*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
-    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+    out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.008125106898670383:  # every lane on the closed form
         return out
-    small = x < 2.630222574480542
+    small = x < 0.008125106898670383
     if small.any():
         t = x[small]
-        series = -4.569666554548725e-11
-        series = -6.473542653639692e-10 + t * series
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
+        series = -0.0010714285714285715
         series = -0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
@@ -1428,77 +1150,35 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
-        t = x
-        series = -1.7778215165910478e-07
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 1.0)
+    out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.921189444436213e-14
     if small.any():
-        t = x[small]
-        series = -1.7778215165910478e-07
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     return out
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
-        t = x
-        series = 7.141710355470859e-07
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.tan((0.5)*phi)/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[1] < 1.0000000233721947e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 1.0)
+    out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.0000000233721947e-14:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.0000000233721947e-14
     if small.any():
-        t = x[small]
-        series = 7.141710355470859e-07
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     return out
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
         t = x
-        series = 2.6209591715593697e-20
-        series = 3.0039990891728625e-19 + t * series
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
+        series = 1.548516833380779e-07
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1506,25 +1186,13 @@ def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 4.619481091176478
+    small = x < 0.7648242161335777
     if small.any():
         t = x[small]
-        series = 2.6209591715593697e-20
-        series = 3.0039990891728625e-19 + t * series
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
+        series = 1.548516833380779e-07
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1544,65 +1212,35 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
-        t = x
-        series = 1.683039183039183e-07
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sin(phi)
-    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 1.0)
+    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.921189444436213e-14
     if small.any():
-        t = x[small]
-        series = 1.683039183039183e-07
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     return out
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
         t = x
-        series = -5.5081089876936793e-17
-        series = -7.106523709086561e-16 + t * series
-        series = -9.280634969633333e-15 + t * series
-        series = -1.2296404066927484e-13 + t * series
-        series = -1.6580488505029053e-12 + t * series
-        series = -2.2848332772743624e-11 + t * series
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
+        series = -7.343103325246183e-08
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+    out = numpy.asarray((1 - numpy.cos(phi))/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 4.619481091176478
+    small = x < 0.7648242161335777
     if small.any():
         t = x[small]
-        series = -5.5081089876936793e-17
-        series = -7.106523709086561e-16 + t * series
-        series = -9.280634969633333e-15 + t * series
-        series = -1.2296404066927484e-13 + t * series
-        series = -1.6580488505029053e-12 + t * series
-        series = -2.2848332772743624e-11 + t * series
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
+        series = -7.343103325246183e-08
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
@@ -1613,21 +1251,9 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
         t = x
-        series = 2.6209591715593697e-20
-        series = 3.0039990891728625e-19 + t * series
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
+        series = 1.548516833380779e-07
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1635,25 +1261,13 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*numpy.cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 4.619481091176478
+    small = x < 0.7648242161335777
     if small.any():
         t = x[small]
-        series = 2.6209591715593697e-20
-        series = 3.0039990891728625e-19 + t * series
-        series = 3.447054794682197e-18 + t * series
-        series = 3.960693739938103e-17 + t * series
-        series = 4.557728891739657e-16 + t * series
-        series = 5.253841918550812e-15 + t * series
-        series = 6.068442620832808e-14 + t * series
-        series = 7.02588589607731e-13 + t * series
-        series = 8.157249203307483e-12 + t * series
-        series = 9.503025504854477e-11 + t * series
-        series = 1.111738558870201e-09 + t * series
-        series = 1.3075291305333323e-08 + t * series
-        series = 1.548516833380779e-07 + t * series
+        series = 1.548516833380779e-07
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1665,31 +1279,19 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+    if span is not None and span[1] < 0.008125106898670383:  # every lane on the polynomial
         t = x
-        series = -2.2848332772743624e-11
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
+        series = -0.0005357142857142857
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/numpy.cbrt(12*cos_half*sin_half - 6*phi)**2, dtype=x.dtype)
-    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+    out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.008125106898670383:  # every lane on the closed form
         return out
-    small = x < 2.630222574480542
+    small = x < 0.008125106898670383
     if small.any():
         t = x[small]
-        series = -2.2848332772743624e-11
-        series = -3.236771326819846e-10 + t * series
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
+        series = -0.0005357142857142857
         series = -0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
@@ -1835,55 +1437,34 @@ def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
-        t = x
-        series = -8.889107582955239e-08
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/numpy.cbrt(6*phi - 6*numpy.sin(phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 0.5)
+    out = numpy.asarray(sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.921189444436213e-14
     if small.any():
-        t = x[small]
-        series = -8.889107582955239e-08
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
+        series = 0.5
         out[small] = series
     return out
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
         t = x
-        series = 4.242513271852192e-12
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((1 - cos_half)/numpy.cbrt(6*phi - 6*numpy.sin(phi))**2, dtype=x.dtype)
-    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 2.630222574480542
+    small = x < 0.7648242161335777
     if small.any():
         t = x[small]
-        series = 4.242513271852192e-12
-        series = 5.844969408074523e-11 + t * series
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
+        series = 1.8955121406990826e-07
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -1999,28 +1580,14 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
-        t = x
-        series = 1.683039183039183e-07
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sin(phi)
-    out = numpy.asarray(w0/numpy.cbrt(6*phi - 6*w0), dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 1.0)
+    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.921189444436213e-14
     if small.any():
-        t = x[small]
-        series = 1.683039183039183e-07
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     return out
 
@@ -2658,8 +2225,8 @@ _USES_PHI = {
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'p_prime': 1.4342812090283275, 'nu': 0.764824235244299, 'epsilon': 0.764824235244299, 'mu': 1.4342812090283275, 'R_1': 0.764824235244299, 'R_2': 1.4342812090283275, 'H_0': 1.4342812090283275, 'H_1': 1.4342812090283275, 'H_2': 2.6302227241416043, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.764824235244299, 'G_2': 1.4342812090283275, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 0.764824235244299, 'H_inverse_across': 3.327466624075446e-08, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
-    "32": {'p_prime': 2.630222574480542, 'nu': 0.7648242161335777, 'epsilon': 0.7648242161335777, 'mu': 4.619481091176478, 'R_1': 0.7648242161335777, 'R_2': 4.619481091176478, 'H_0': 4.619481091176478, 'H_1': 2.630222574480542, 'H_2': 4.619481091176478, 'H_inverse_0': 0.7648242161335777, 'H_inverse_2': 4.619481091176478, 'G_1': 0.7648242161335777, 'G_2': 2.630222574480542, 'K_0': 0.7648242161335777, 'K_1': 0.7648242161335777, 'K_2': 4.619481091176478, 'H_across': 0.7648242161335777, 'H_inverse_across': 0.2112114357353433, 'K_across': 1.921189444436213e-14, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
+    "64": {'p_prime': 0.00016163055520154135, 'nu': 1.9211893090849666e-14, 'epsilon': 9.999999999999995e-15, 'mu': 0.0022017832983058567, 'R_1': 1.9211893090849666e-14, 'R_2': 0.00016163055520154135, 'H_0': 0.0022017832983058567, 'H_1': 0.00016163055520154135, 'H_2': 2.6302227241416043, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 1.9211893090849666e-14, 'G_2': 0.004229756532686548, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 1.9211893090849666e-14, 'H_inverse_across': 3.327466624075446e-08, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
+    "32": {'p_prime': 0.008125106898670383, 'nu': 1.921189444436213e-14, 'epsilon': 1.0000000233721947e-14, 'mu': 0.7648242161335777, 'R_1': 1.921189444436213e-14, 'R_2': 0.7648242161335777, 'H_0': 0.7648242161335777, 'H_1': 0.008125106898670383, 'H_2': 4.619481091176478, 'H_inverse_0': 0.7648242161335777, 'H_inverse_2': 4.619481091176478, 'G_1': 1.921189444436213e-14, 'G_2': 0.7648242161335777, 'K_0': 0.7648242161335777, 'K_1': 0.7648242161335777, 'K_2': 4.619481091176478, 'H_across': 1.921189444436213e-14, 'H_inverse_across': 0.2112114357353433, 'K_across': 1.921189444436213e-14, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)

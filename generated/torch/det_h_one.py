@@ -181,17 +181,9 @@ P_MAX_SQUARED = 11.243134665607636  # fl(p_max^2); inside the range: x = |p|^2 <
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -6.816125240403192e-19 + 0.0 * x
-    series = -8.626941850237128e-18 + t * series
-    series = -1.1016217975387359e-16 + t * series
-    series = -1.4213047418173123e-15 + t * series
-    series = -1.8561269939266666e-14 + t * series
-    series = -2.4592808133854967e-13 + t * series
-    series = -3.3160977010058107e-12 + t * series
-    series = -4.569666554548725e-11 + t * series
-    series = -6.473542653639692e-10 + t * series
+    series = -6.473542653639692e-10 + 0.0 * x
     series = -9.50993765619616e-09 + t * series
     series = -1.4686206650492366e-07 + t * series
     series = -2.440218511647083e-06 + t * series
@@ -199,20 +191,16 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0010714285714285715 + t * series
     series = -0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    closed = 2*(1 - _xp.cos(phi))/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    x = _where(small, 0.1103124080629894, x)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = 4*sin_half**2/x
     return _where(small, series, closed)
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -2.4717768942862145e-15 + 0.0 * x
-    series = -3.1172082783912966e-14 + t * series
-    series = -3.9741810435255436e-13 + t * series
-    series = -5.1339188726594446e-12 + t * series
-    series = -6.740882557422226e-11 + t * series
-    series = -9.035261398610608e-10 + t * series
+    series = -9.035261398610608e-10 + 0.0 * x
     series = -1.244209181073502e-08 + t * series
     series = -1.7778215165910478e-07 + t * series
     series = -2.680413429576376e-06 + t * series
@@ -220,25 +208,16 @@ def _nu_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0008482142857142857 + t * series
     series = -0.025 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    closed = 2*sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
+    s = _where(small, 0.33213311798583023, s)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = 2*sin_half/s
     return _where(small, series, closed)
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 0.05752053308030299
     t = _where(small, x, 0.0)
-    series = 1.5905201294923517e-14 + 0.0 * x
-    series = 1.1265276036398177e-13 + t * series
-    series = 7.978953359858307e-13 + t * series
-    series = 5.651354180596242e-12 + t * series
-    series = 4.0027973542176834e-11 + t * series
-    series = 2.8351938089872594e-10 + t * series
-    series = 2.0082446735268566e-09 + t * series
-    series = 1.4225834946840515e-08 + t * series
-    series = 1.0078371181814193e-07 + t * series
-    series = 7.141710355470859e-07 + t * series
+    series = 7.141710355470859e-07 + 0.0 * x
     series = 5.063042332919034e-06 + t * series
     series = 3.592768342768343e-05 + t * series
     series = 0.0002554692331478046 + t * series
@@ -246,25 +225,16 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
     series = 0.013214285714285715 + t * series
     series = 0.1 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    closed = 2*_xp.tan((0.5)*phi)/_cbrt(6*phi - 6*_xp.sin(phi))
+    phi = _where(small, 0.24006487875616042, phi)
+    s = _where(small, 0.2398343867761731, s)
+    closed = 2*_xp.tan((0.5)*phi)/s
     return _where(small, series, closed)
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 3.0039990891728625e-19 + 0.0 * x
-    series = 3.447054794682197e-18 + t * series
-    series = 3.960693739938103e-17 + t * series
-    series = 4.557728891739657e-16 + t * series
-    series = 5.253841918550812e-15 + t * series
-    series = 6.068442620832808e-14 + t * series
-    series = 7.02588589607731e-13 + t * series
-    series = 8.157249203307483e-12 + t * series
-    series = 9.503025504854477e-11 + t * series
-    series = 1.111738558870201e-09 + t * series
-    series = 1.3075291305333323e-08 + t * series
+    series = 1.3075291305333323e-08 + 0.0 * x
     series = 1.548516833380779e-07 + t * series
     series = 1.8513431013431014e-06 + t * series
     series = 2.2437384044526902e-05 + t * series
@@ -272,10 +242,9 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0035714285714285713 + t * series
     series = 0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    sin_half = _where(small, 0.5762057860563947, sin_half)
-    cos_half = _where(small, 0.8173046507362676, cos_half)
-    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
+    x = _where(small, 0.1103124080629894, x)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = (0.25)*x/sin_half**2
     return _where(small, series, closed)
 
 
@@ -288,14 +257,9 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 2.4273770483331233e-15 + 0.0 * x
-    series = 3.054732998294483e-14 + t * series
-    series = 3.8844043825273724e-13 + t * series
-    series = 5.001592370976041e-12 + t * series
-    series = 6.539638581589419e-11 + t * series
-    series = 8.716860870222215e-10 + t * series
+    series = 8.716860870222215e-10 + 0.0 * x
     series = 1.1911667949082915e-08 + t * series
     series = 1.683039183039183e-07 + t * series
     series = 2.4930426716141e-06 + t * series
@@ -303,24 +267,16 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0007142857142857143 + t * series
     series = -0.15 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    w0 = _xp.sin(phi)
-    closed = w0/_cbrt(6*phi - 6*w0)
+    phi = _where(small, 0.33274666277661247, phi)
+    s = _where(small, 0.33213311798583023, s)
+    closed = _xp.sin(phi)/s
     return _where(small, series, closed)
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -3.408062620201596e-19 + 0.0 * x
-    series = -4.313470925118564e-18 + t * series
-    series = -5.5081089876936793e-17 + t * series
-    series = -7.106523709086561e-16 + t * series
-    series = -9.280634969633333e-15 + t * series
-    series = -1.2296404066927484e-13 + t * series
-    series = -1.6580488505029053e-12 + t * series
-    series = -2.2848332772743624e-11 + t * series
-    series = -3.236771326819846e-10 + t * series
+    series = -3.236771326819846e-10 + 0.0 * x
     series = -4.75496882809808e-09 + t * series
     series = -7.343103325246183e-08 + t * series
     series = -1.2201092558235415e-06 + t * series
@@ -328,25 +284,16 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0005357142857142857 + t * series
     series = -0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    closed = (1 - _xp.cos(phi))/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    x = _where(small, 0.1103124080629894, x)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = 2*sin_half**2/x
     return _where(small, series, closed)
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 3.0039990891728625e-19 + 0.0 * x
-    series = 3.447054794682197e-18 + t * series
-    series = 3.960693739938103e-17 + t * series
-    series = 4.557728891739657e-16 + t * series
-    series = 5.253841918550812e-15 + t * series
-    series = 6.068442620832808e-14 + t * series
-    series = 7.02588589607731e-13 + t * series
-    series = 8.157249203307483e-12 + t * series
-    series = 9.503025504854477e-11 + t * series
-    series = 1.111738558870201e-09 + t * series
-    series = 1.3075291305333323e-08 + t * series
+    series = 1.3075291305333323e-08 + 0.0 * x
     series = 1.548516833380779e-07 + t * series
     series = 1.8513431013431014e-06 + t * series
     series = 2.2437384044526902e-05 + t * series
@@ -354,25 +301,16 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0035714285714285713 + t * series
     series = 0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    sin_half = _where(small, 0.5762057860563947, sin_half)
-    cos_half = _where(small, 0.8173046507362676, cos_half)
-    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
+    x = _where(small, 0.1103124080629894, x)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = (0.25)*x/sin_half**2
     return _where(small, series, closed)
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -3.408062620201596e-19 + 0.0 * x
-    series = -4.313470925118564e-18 + t * series
-    series = -5.5081089876936793e-17 + t * series
-    series = -7.106523709086561e-16 + t * series
-    series = -9.280634969633333e-15 + t * series
-    series = -1.2296404066927484e-13 + t * series
-    series = -1.6580488505029053e-12 + t * series
-    series = -2.2848332772743624e-11 + t * series
-    series = -3.236771326819846e-10 + t * series
+    series = -3.236771326819846e-10 + 0.0 * x
     series = -4.75496882809808e-09 + t * series
     series = -7.343103325246183e-08 + t * series
     series = -1.2201092558235415e-06 + t * series
@@ -380,8 +318,9 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0005357142857142857 + t * series
     series = -0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    closed = (1 - _xp.cos(phi))/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    x = _where(small, 0.1103124080629894, x)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = 2*sin_half**2/x
     return _where(small, series, closed)
 
 
@@ -479,14 +418,9 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -1.2358884471431072e-15 + 0.0 * x
-    series = -1.5586041391956483e-14 + t * series
-    series = -1.9870905217627718e-13 + t * series
-    series = -2.5669594363297223e-12 + t * series
-    series = -3.370441278711113e-11 + t * series
-    series = -4.517630699305304e-10 + t * series
+    series = -4.517630699305304e-10 + 0.0 * x
     series = -6.22104590536751e-09 + t * series
     series = -8.889107582955239e-08 + t * series
     series = -1.340206714788188e-06 + t * series
@@ -494,24 +428,16 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
     series = -0.00042410714285714285 + t * series
     series = -0.0125 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    closed = sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
+    s = _where(small, 0.33213311798583023, s)
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    closed = sin_half/s
     return _where(small, series, closed)
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812090283275
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 7.005500832060205e-20 + 0.0 * x
-    series = 8.78575012329886e-19 + t * series
-    series = 1.1103729250660078e-17 + t * series
-    series = 1.415858727786663e-16 + t * series
-    series = 1.8241874371141333e-15 + t * series
-    series = 2.3791812685232493e-14 + t * series
-    series = 3.1488034564609846e-13 + t * series
-    series = 4.242513271852192e-12 + t * series
-    series = 5.844969408074523e-11 + t * series
+    series = 5.844969408074523e-11 + 0.0 * x
     series = 8.286380574805527e-10 + t * series
     series = 1.2203463534465907e-08 + t * series
     series = 1.8955121406990826e-07 + t * series
@@ -519,8 +445,9 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
     series = 6.138392857142858e-05 + t * series
     series = 0.0015625 + t * series
     series = 0.125 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    closed = 2*_xp.sin((0.25)*phi)**2/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    phi = _where(small, 0.33274666277661247, phi)
+    x = _where(small, 0.1103124080629894, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
@@ -587,14 +514,9 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.764824235244299
+    small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 2.4273770483331233e-15 + 0.0 * x
-    series = 3.054732998294483e-14 + t * series
-    series = 3.8844043825273724e-13 + t * series
-    series = 5.001592370976041e-12 + t * series
-    series = 6.539638581589419e-11 + t * series
-    series = 8.716860870222215e-10 + t * series
+    series = 8.716860870222215e-10 + 0.0 * x
     series = 1.1911667949082915e-08 + t * series
     series = 1.683039183039183e-07 + t * series
     series = 2.4930426716141e-06 + t * series
@@ -602,9 +524,9 @@ def _H_across_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0007142857142857143 + t * series
     series = -0.15 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    w0 = _xp.sin(phi)
-    closed = w0/_cbrt(6*phi - 6*w0)
+    phi = _where(small, 0.33274666277661247, phi)
+    s = _where(small, 0.33213311798583023, s)
+    closed = _xp.sin(phi)/s
     return _where(small, series, closed)
 
 
@@ -1021,21 +943,18 @@ def _scale_64(e0, e_norm):
 
 
 def _p_prime_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222574480542
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -4.569666554548725e-11 + 0.0 * x
-    series = -6.473542653639692e-10 + t * series
-    series = -9.50993765619616e-09 + t * series
+    series = -9.50993765619616e-09 + 0.0 * x
     series = -1.4686206650492366e-07 + t * series
     series = -2.440218511647083e-06 + t * series
     series = -4.563492063492064e-05 + t * series
     series = -0.0010714285714285715 + t * series
     series = -0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    closed = 4*sin_half**2/_cbrt(12*cos_half*sin_half - 6*phi)**2
+    x = _where(small, 1.4342812011199078, x)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = 4*sin_half**2/x
     return _where(small, series, closed)
 
 
@@ -1049,9 +968,9 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
     series = -0.0008482142857142857 + t * series
     series = -0.025 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
+    s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    closed = 2*sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
+    closed = 2*sin_half/s
     return _where(small, series, closed)
 
 
@@ -1067,25 +986,15 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     series = 0.1 + t * series
     series = 1.0 + t * series
     phi = _where(small, 0.886071872158482, phi)
-    closed = 2*_xp.tan((0.5)*phi)/_cbrt(6*phi - 6*_xp.sin(phi))
+    s = _where(small, 0.8745422895055319, s)
+    closed = 2*_xp.tan((0.5)*phi)/s
     return _where(small, series, closed)
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 4.619481091176478
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 2.6209591715593697e-20 + 0.0 * x
-    series = 3.0039990891728625e-19 + t * series
-    series = 3.447054794682197e-18 + t * series
-    series = 3.960693739938103e-17 + t * series
-    series = 4.557728891739657e-16 + t * series
-    series = 5.253841918550812e-15 + t * series
-    series = 6.068442620832808e-14 + t * series
-    series = 7.02588589607731e-13 + t * series
-    series = 8.157249203307483e-12 + t * series
-    series = 9.503025504854477e-11 + t * series
-    series = 1.111738558870201e-09 + t * series
-    series = 1.3075291305333323e-08 + t * series
+    series = 1.3075291305333323e-08 + 0.0 * x
     series = 1.548516833380779e-07 + t * series
     series = 1.8513431013431014e-06 + t * series
     series = 2.2437384044526902e-05 + t * series
@@ -1093,10 +1002,9 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0035714285714285713 + t * series
     series = 0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
+    x = _where(small, 1.4342812011199078, x)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = (0.25)*x/sin_half**2
     return _where(small, series, closed)
 
 
@@ -1119,50 +1027,31 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
     series = -0.15 + t * series
     series = 1.0 + t * series
     phi = _where(small, 1.2281574046507382, phi)
-    w0 = _xp.sin(phi)
-    closed = w0/_cbrt(6*phi - 6*w0)
+    s = _where(small, 1.1976147966353403, s)
+    closed = _xp.sin(phi)/s
     return _where(small, series, closed)
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 4.619481091176478
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -5.5081089876936793e-17 + 0.0 * x
-    series = -7.106523709086561e-16 + t * series
-    series = -9.280634969633333e-15 + t * series
-    series = -1.2296404066927484e-13 + t * series
-    series = -1.6580488505029053e-12 + t * series
-    series = -2.2848332772743624e-11 + t * series
-    series = -3.236771326819846e-10 + t * series
-    series = -4.75496882809808e-09 + t * series
+    series = -4.75496882809808e-09 + 0.0 * x
     series = -7.343103325246183e-08 + t * series
     series = -1.2201092558235415e-06 + t * series
     series = -2.281746031746032e-05 + t * series
     series = -0.0005357142857142857 + t * series
     series = -0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = 2*sin_half**2/_cbrt(12*cos_half*sin_half - 6*phi)**2
+    phi = _where(small, 1.2281574046507382, phi)
+    x = _where(small, 1.4342812011199078, x)
+    closed = (1 - _xp.cos(phi))/x
     return _where(small, series, closed)
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 4.619481091176478
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 2.6209591715593697e-20 + 0.0 * x
-    series = 3.0039990891728625e-19 + t * series
-    series = 3.447054794682197e-18 + t * series
-    series = 3.960693739938103e-17 + t * series
-    series = 4.557728891739657e-16 + t * series
-    series = 5.253841918550812e-15 + t * series
-    series = 6.068442620832808e-14 + t * series
-    series = 7.02588589607731e-13 + t * series
-    series = 8.157249203307483e-12 + t * series
-    series = 9.503025504854477e-11 + t * series
-    series = 1.111738558870201e-09 + t * series
-    series = 1.3075291305333323e-08 + t * series
+    series = 1.3075291305333323e-08 + 0.0 * x
     series = 1.548516833380779e-07 + t * series
     series = 1.8513431013431014e-06 + t * series
     series = 2.2437384044526902e-05 + t * series
@@ -1170,29 +1059,25 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0035714285714285713 + t * series
     series = 0.05 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = (0.25)*_cbrt(12*cos_half*sin_half - 6*phi)**2/sin_half**2
+    x = _where(small, 1.4342812011199078, x)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = (0.25)*x/sin_half**2
     return _where(small, series, closed)
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222574480542
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -2.2848332772743624e-11 + 0.0 * x
-    series = -3.236771326819846e-10 + t * series
-    series = -4.75496882809808e-09 + t * series
+    series = -4.75496882809808e-09 + 0.0 * x
     series = -7.343103325246183e-08 + t * series
     series = -1.2201092558235415e-06 + t * series
     series = -2.281746031746032e-05 + t * series
     series = -0.0005357142857142857 + t * series
     series = -0.025 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    closed = 2*sin_half**2/_cbrt(12*cos_half*sin_half - 6*phi)**2
+    x = _where(small, 1.4342812011199078, x)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = 2*sin_half**2/x
     return _where(small, series, closed)
 
 
@@ -1290,27 +1175,25 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
     series = -0.00042410714285714285 + t * series
     series = -0.0125 + t * series
     series = 0.5 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
+    s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    closed = sin_half/_cbrt(6*phi - 6*_xp.sin(phi))
+    closed = sin_half/s
     return _where(small, series, closed)
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.630222574480542
+    small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 4.242513271852192e-12 + 0.0 * x
-    series = 5.844969408074523e-11 + t * series
-    series = 8.286380574805527e-10 + t * series
+    series = 8.286380574805527e-10 + 0.0 * x
     series = 1.2203463534465907e-08 + t * series
     series = 1.8955121406990826e-07 + t * series
     series = 3.189329117063492e-06 + t * series
     series = 6.138392857142858e-05 + t * series
     series = 0.0015625 + t * series
     series = 0.125 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    closed = (1 - cos_half)/_cbrt(6*phi - 6*_xp.sin(phi))**2
+    phi = _where(small, 1.2281574046507382, phi)
+    x = _where(small, 1.4342812011199078, x)
+    closed = 2*_xp.sin((0.25)*phi)**2/x
     return _where(small, series, closed)
 
 
@@ -1389,8 +1272,8 @@ def _H_across_32(x, phi, s, d, sin_half, cos_half):
     series = -0.15 + t * series
     series = 1.0 + t * series
     phi = _where(small, 1.2281574046507382, phi)
-    w0 = _xp.sin(phi)
-    closed = w0/_cbrt(6*phi - 6*w0)
+    s = _where(small, 1.1976147966353403, s)
+    closed = _xp.sin(phi)/s
     return _where(small, series, closed)
 
 
