@@ -2,8 +2,7 @@
 
 Issue 16 asks for ≤ 10 s wall per emit of a user function (≤ 5 s for the paper's families); the
 derivation summary alone (backend ``derive``: ``symrot derive EXPR``, no emit) has a target of 5 s
-for any function. Each
-emit runs as a user would run it, as its own ``python -m symrot derive … --emit BACKEND`` process
+for any function. Each run is what a user runs, its own ``python -m symrot derive …`` process
 (with ``--timeout 600``, so that a slow emit is measured rather than cut at the CLI's 60 s default),
 one at a time. Reported: wall seconds and the CPU seconds of the process and its children (the
 CLI's worker), which the load of a shared machine inflates less than wall time; and the machine's
