@@ -21,8 +21,8 @@ import os
 import pickle
 import signal
 import sys
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager, suppress
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import ExitStack, contextmanager, suppress
 from typing import Generic, TypeVar
 
 from .errors import SymrotError
@@ -152,3 +152,14 @@ def in_child(function: Callable[[], T]) -> Iterator[Callable[[], T]]:
         yield child.result
     finally:
         child.close()
+
+
+def first_here_others_in_children(functions: Sequence[Callable[[], T]]) -> list[T]:
+    """The values of ``functions``, in order: the first computed in this process while each other
+    one runs in a forked child of its own (started first, all from this process's state)."""
+    first, *others = functions
+    with ExitStack() as children:
+        waits = [children.enter_context(in_child(function)) for function in others]
+        values = [first()]
+        values += [wait() for wait in waits]
+    return values

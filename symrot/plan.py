@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from contextlib import ExitStack, suppress
+from contextlib import suppress
 from dataclasses import replace
 from functools import lru_cache, partial
 from typing import Any, NamedTuple
@@ -60,7 +60,7 @@ from .core import Derivation, derive_expression
 from .domain import FIRST_POWER, domain_limit
 from .errors import SymrotError
 from .evaluation import log_grid, model_function
-from .forked import in_child
+from .forked import first_here_others_in_children
 from .functions import RealCbrt, mpmath_namespace
 from .measurement import (
     EDGE_POINTS,
@@ -576,12 +576,9 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     _prepare_shared_work(derivation, algebraic_forms, inverse)
     shared = _SharedWork(derivation, limits, phi_max, p_max, inverse, complement, unbounded, det_h_own_scale,
                          algebraic_forms)
-    (first, first_dtype), *others = PRECISIONS.items()
-    with ExitStack() as children:
-        waits = {label: children.enter_context(in_child(partial(_precision_plan, shared, label, dtype)))
-                 for label, dtype in others}
-        precisions = {first: _precision_plan(shared, first, first_dtype)}
-        precisions.update({label: wait() for label, wait in waits.items()})
+    plans = first_here_others_in_children([partial(_precision_plan, shared, label, dtype)
+                                           for label, dtype in PRECISIONS.items()])
+    precisions = dict(zip(PRECISIONS, plans, strict=True))
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
                           _p_max_squared(p, limits.phi_max, p_max))
 

@@ -18,7 +18,7 @@ from collections.abc import Callable, Hashable, Sequence
 from typing import Any, TypeVar
 
 from .core import TENSOR_NAMES, Derivation
-from .forked import in_child
+from .forked import first_here_others_in_children, in_child
 
 CHILD_TENSORS = ("H_inverse", "K")
 """Tensors simplified in the child: the two costliest (for tan(φ/3) + 8 tan(3φ/4)/9, 2.6 and 1.8 s
@@ -63,7 +63,6 @@ def computed_in_two_processes(function: Callable[[K], V], jobs: Sequence[K],
     theirs = [jobs[i] for i in order[1::2]]
     if not theirs:
         return {job: function(job) for job in mine}
-    with in_child(lambda: {job: function(job) for job in theirs}) as wait:
-        values = {job: function(job) for job in mine}
-        values.update(wait())
-    return values
+    here, there = first_here_others_in_children([lambda: {job: function(job) for job in mine},
+                                                 lambda: {job: function(job) for job in theirs}])
+    return {**here, **there}

@@ -13,7 +13,6 @@ issue 19); this module assembles them into the header and writes it.
 from __future__ import annotations
 
 import re
-from contextlib import ExitStack
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -23,7 +22,7 @@ import sympy as sp
 from ..core import Derivation, derive_expression
 from ..derivatives import rate_vector, tensor_derivative
 from ..errors import SymrotError
-from ..forked import in_child
+from ..forked import first_here_others_in_children
 from ..plan import evaluation_plan
 from ..plan_ir import ClosedAngle, EvaluationPlan
 from ..registry import NAMED, find_by_expression, lookup
@@ -50,13 +49,9 @@ def header_source(plan: EvaluationPlan, name: str, expression: str | None = None
         raise InvalidHeaderName(f"--name {name[:40]!r} is not a C identifier")
     tensor_derivative()
     rate_vector()
-    first, *others = PRECISIONS
-    with ExitStack() as children:
-        waits = [children.enter_context(in_child(partial(_precision_functions, plan, name, precision)))
-                 for precision in others]
-        functions = _precision_functions(plan, name, first)
-        for wait in waits:
-            functions += wait()
+    functions = [function for functions_of_one in first_here_others_in_children(
+        [partial(_precision_functions, plan, name, precision) for precision in PRECISIONS])
+        for function in functions_of_one]
     identifier = registry_title(plan.p)
     text = expression or sp.sstr(plan.p)
     return render(
