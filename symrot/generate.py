@@ -195,6 +195,30 @@ def selected_prefixes(only: str | None) -> list[str]:
     return [prefix for prefix, _ in producers() if any(prefix.startswith(start) for start in starts)]
 
 
+BACKEND_MODULES = ("numpy_backend", "array_backend", "c_backend", "latex", "typeset", "figures")
+"""The backend modules the tasks import (matplotlib with the figures)."""
+
+
+def warm_shared_state() -> None:
+    """Do once, before the tasks fork, the work every task would repeat that depends on no
+    parameterization: import the backends, compile every template, and derive the p-free algebra of
+    :mod:`symrot.derivatives` (∂(T a)/∂p and Ṫ ṗ on their bases). Each task inherits it. The state is
+    the same in every run and for every split of the work (``--name`` too), so what a task prints
+    still depends only on its own work."""
+    import importlib
+
+    from .backends.templating import environment
+    from .derivatives import rate_vector, tensor_derivative
+
+    for module in BACKEND_MODULES:
+        importlib.import_module(f".backends.{module}", __package__)
+    templates = environment()
+    for template in templates.list_templates(extensions=["j2"]):
+        templates.get_template(template)
+    tensor_derivative()
+    rate_vector()
+
+
 def render(only: str | None = None, jobs: int = 1, name: str | None = None) -> dict[str, Content]:
     """Every selected file; with ``jobs`` > 1 the work runs in that many processes at once. Each
     task runs in a process of its own, forked from this one, so that what it prints cannot depend on
@@ -210,6 +234,7 @@ def render(only: str | None = None, jobs: int = 1, name: str | None = None) -> d
     selected = selected_prefixes(only)
     work = [("names", name)] if name is not None else tasks(selected)
     run = partial(_run_task, selected=tuple(selected))
+    warm_shared_state()
     if jobs <= 1:
         for task in each(work, "symrot.generate"):
             with in_child(partial(run, task)) as wait:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import io
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 import mpmath
@@ -34,6 +35,8 @@ from ..registry import family_member, lookup
 from .latex import QUANTITY_SYMBOLS, latex
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
@@ -133,9 +136,12 @@ def _singularities(derivation: Derivation, quantity: str) -> tuple[float | None,
     return bound, poles
 
 
-def curves(family: str, quantity: str, extra: tuple[sp.Expr, ...] = ()) -> list[Curve]:
-    """The family members m = 1…5, the rotation vector (dotted) and ``extra`` curves."""
+@lru_cache(maxsize=32)
+def curves(family: str, quantity: str, extra: tuple[sp.Expr, ...] = ()) -> tuple[Curve, ...]:
+    """The family members m = 1…5, the rotation vector (dotted) and ``extra`` curves. Remembered
+    (the curves are read, never changed), so a figure's PDF and PNG evaluate them once."""
     phi = np.linspace(*ANGLE_RANGE, SAMPLES)
+    phi.flags.writeable = False
     members: list[tuple[str, str | None, bool, sp.Expr]] = [
         (f"$m = {m}$", MARKERS[m], False, family_member(family, m).expression)
         for m in FAMILY_ORDERS
@@ -146,11 +152,13 @@ def curves(family: str, quantity: str, extra: tuple[sp.Expr, ...] = ()) -> list[
     for label, marker, dotted, expr in members:
         d = derive_expression(expr)
         bound, poles = _singularities(d, quantity)
-        out.append(Curve(label, marker, dotted, phi, evaluate(d, quantity, phi), bound, poles))
-    return out
+        values = evaluate(d, quantity, phi)
+        values.flags.writeable = False
+        out.append(Curve(label, marker, dotted, phi, values, bound, poles))
+    return tuple(out)
 
 
-def data_limits(shown: list[Curve]) -> tuple[float, float]:
+def data_limits(shown: Sequence[Curve]) -> tuple[float, float]:
     """The 2–98 % range of every curve's values away from its poles (window ±π/6), widened to
     the whole reference curve (the rotation vector, dotted) and padded by 5 %."""
     kept = []
@@ -204,7 +212,7 @@ def pi_label(k: int) -> str:
     return f"${numerator}\\pi$" if value.q == 1 else f"${numerator}\\pi/{value.q}$"
 
 
-def _draw_panel(ax: Axes, shown: list[Curve], quantity: str, font_size: float) -> None:
+def _draw_panel(ax: Axes, shown: Sequence[Curve], quantity: str, font_size: float) -> None:
     limits = data_limits(shown)
     low, high = limits
     for curve in shown:
