@@ -291,21 +291,34 @@ class UnplannableCoefficient(SymrotError):
     too large for it)."""
 
 
-def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
-                dtype: type, argument: sp.Expr = PHI, inverse: sp.Expr | None = None,
-                complement: sp.Rational | None = None, part: TensorPart | None = None,
-                extra_forms: tuple[sp.Expr, ...] = ()) -> Branch:
-    """Choose the form, the switch t₀ and the Horner degree for one coefficient in one precision.
+FormsKey = tuple[sp.Expr, sp.Expr, float, sp.Expr | None, sp.Rational | None]
+"""(closed form, argument s(φ), φ_max, closed inverse, fold complement): what :func:`candidate_forms`
+depends on (not the precision)."""
+_CANDIDATES: dict[FormsKey, tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]] = {}
+CANDIDATES_KEPT = 4096
+"""Most entries :func:`candidate_forms` remembers (then it starts again)."""
 
-    The coefficient is evaluated from s = ``argument``(φ) (p for the coefficients of x, φ itself
-    for Newton's ratio and slope). Besides the forms in φ, the same with p written as s
-    (:func:`with_length`) and, given the closed ``inverse`` φ(s), with their algebraic parts written
-    through it (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of
-    the tangent family, fold complement d of the sine family), measured on the inputs of
-    :func:`measured_inputs` against one reference at REFERENCE_DIGITS. A coefficient of a tensor
-    (``part``) is measured as it enters the tensor: relative to ‖T‖/|p|^k where that is below c(0)
-    (:func:`_branch_for`). ``extra_forms``: more candidates, already in the backends' variables
-    (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part)."""
+
+def candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse: sp.Expr | None,
+                    complement: sp.Rational | None) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]:
+    """(the forms in φ that the reference evaluates, every candidate form :func:`plan_branch`
+    measures) for one coefficient; the same for both precisions, so remembered, and computed for
+    all coefficients before the precisions part (:func:`_prepare_shared_work`)."""
+    key: FormsKey = (closed, argument, phi_max, inverse, complement)
+    if key not in _CANDIDATES:
+        if len(_CANDIDATES) >= CANDIDATES_KEPT:
+            _CANDIDATES.clear()
+        _CANDIDATES[key] = _candidate_forms(*key)
+    return _CANDIDATES[key]
+
+
+def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse: sp.Expr | None,
+                     complement: sp.Rational | None) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]:
+    """Besides the forms in φ (half angles, cancellation-free rewrites), the same with p written as
+    s (:func:`with_length`), with a pole's vanishing factor through s, and, given the closed
+    ``inverse`` φ(s), with their algebraic parts written through it
+    (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of the
+    tangent family, fold complement d of the sine family)."""
     forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
     forms += [well_conditioned(closed), near_half_turn(closed)] if closed.has(sp.cos) else []
     forms.append(closed)
@@ -321,7 +334,26 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         forms = [closed_with_base_angle(form, inverse) for form in forms]
         if complement is not None:
             forms = [closed_with_complement(form, inverse, complement) for form in forms]
-    forms += extra_forms
+    return plain, tuple(forms)
+
+
+def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
+                dtype: type, argument: sp.Expr = PHI, inverse: sp.Expr | None = None,
+                complement: sp.Rational | None = None, part: TensorPart | None = None,
+                extra_forms: tuple[sp.Expr, ...] = ()) -> Branch:
+    """Choose the form, the switch t₀ and the Horner degree for one coefficient in one precision.
+
+    The coefficient is evaluated from s = ``argument``(φ) (p for the coefficients of x, φ itself
+    for Newton's ratio and slope). Besides the forms in φ, the same with p written as s
+    (:func:`with_length`) and, given the closed ``inverse`` φ(s), with their algebraic parts written
+    through it (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of
+    the tangent family, fold complement d of the sine family), measured on the inputs of
+    :func:`measured_inputs` against one reference at REFERENCE_DIGITS. A coefficient of a tensor
+    (``part``) is measured as it enters the tensor: relative to ‖T‖/|p|^k where that is below c(0)
+    (:func:`_branch_for`). ``extra_forms``: more candidates, already in the backends' variables
+    (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part)."""
+    plain, candidates = candidate_forms(closed, argument, phi_max, inverse, complement)
+    forms = [*candidates, *extra_forms]
     inputs = measured_inputs(argument, phi_max, dtype, complement)
     reference = reference_values(plain, argument, phi_max, dtype, complement)
     floors = None if part is None else tensor_floors(part, argument, phi_max, dtype, complement)
@@ -381,7 +413,8 @@ def tensor_part(derivation: Derivation, coefficient: str, det_h_own_scale: bool 
         names = (*tensor.coefficient_names(), tensor.across_name)
         if coefficient in names:
             u = tensor.u_basis
-            norm = sp.Max(sp.Abs(u.a), sp.Abs(u.a - u.c), sp.Abs(u.b))
+            # unevaluated: only evaluated numerically, and Max's pairwise comparisons cost 40 ms
+            norm = sp.Max(sp.Abs(u.a), sp.Abs(u.a - u.c), sp.Abs(u.b), evaluate=False)
             return TensorPart(norm, 0 if coefficient == tensor.across_name else names.index(coefficient))
     return None
 
@@ -573,9 +606,9 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
     det_h_own_scale = unbounded or {("det_H", "0"), ("p_prime", "oo")} <= at_edge
     complement = fold_complement(inverse, p_max)
     algebraic_forms = _algebraic_forms(derivation, inverse, p_max)
-    _prepare_shared_work(derivation, algebraic_forms, inverse)
     shared = _SharedWork(derivation, limits, phi_max, p_max, inverse, complement, unbounded, det_h_own_scale,
                          algebraic_forms)
+    _prepare_shared_work(shared)
     plans = first_here_others_in_children([partial(_precision_plan, shared, label, dtype)
                                            for label, dtype in PRECISIONS.items()])
     precisions = dict(zip(PRECISIONS, plans, strict=True))
@@ -638,12 +671,13 @@ def _algebraic_forms(derivation: Derivation, inverse: sp.Expr | None,
     return forms
 
 
-def _prepare_shared_work(derivation: Derivation, algebraic_forms: dict[str, sp.Expr | None],
-                         inverse: sp.Expr | None) -> None:
+def _prepare_shared_work(shared: _SharedWork) -> None:
     """Compute once, before the precisions part, the symbolic work that both plans read: the
     simplified forms and series of the coefficients without an algebraic form and of their slopes,
-    the quaternion's scalar series and scale, and Newton's forms without a closed inverse (a step
-    that fails is left to the plan, which meets the same failure in its place)."""
+    the quaternion's scalar series, scale and algebraic form, Newton's forms without a closed
+    inverse (a step that fails is left to the plan, which meets the same failure in its place), and
+    the candidate forms of every branch (:func:`candidate_forms`), half of them in a forked child."""
+    derivation, algebraic_forms, inverse = shared.derivation, shared.algebraic_forms, shared.inverse
     for coefficient in _searched(derivation):
         if algebraic_forms.get(coefficient) is None:
             _prepare(derivation, coefficient)
@@ -654,9 +688,39 @@ def _prepare_shared_work(derivation: Derivation, algebraic_forms: dict[str, sp.E
                                         lambda: _quaternion_scalar_series(derivation.p)]
     if inverse is None:
         warm.append(lambda: _newton_forms(derivation.p))
+    if inverse is not None:
+        warm.append(lambda: algebraic_in_x(quaternion_scalar(), inverse, shared.p_max))
     for step in warm:
         with suppress(SymrotError):
             step()
+    keys = _branch_keys(shared)
+    computed = computed_in_two_processes(_forms_or_failure, keys, [int(sp.count_ops(k[0])) for k in keys])
+    _CANDIDATES.update({key: forms for key, forms in computed.items() if forms is not None})
+
+
+def _branch_keys(shared: _SharedWork) -> list[FormsKey]:
+    """The :func:`candidate_forms` keys of the branches both precisions plan: the coefficients
+    without an algebraic form, the slopes of such parents, and e₀."""
+    derivation, p = shared.derivation, shared.derivation.p
+    names = [n for n in _searched(derivation) if shared.algebraic_forms.get(n) is None]
+    names += [slope for slope, (parent, _) in derivation.slopes.items()
+              if derivation.constant_value(slope) is None and shared.algebraic_forms.get(parent) is None]
+    closed: list[sp.Expr] = []
+    for name in names:
+        with suppress(SymrotError):
+            closed.append(derivation.simplified_form(name))
+    closed.append(quaternion_scalar())
+    return list(dict.fromkeys((form, p, shared.phi_max, shared.inverse, shared.complement)
+                              for form in closed))
+
+
+def _forms_or_failure(key: FormsKey) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]] | None:
+    """:func:`_candidate_forms`, or None where a step fails in any way: the plan then computes them
+    again in its place and meets the failure there, as it did before they were computed ahead."""
+    try:
+        return _candidate_forms(*key)
+    except Exception:  # re-raised where the plan needs the forms
+        return None
 
 
 def _prepare(derivation: Derivation, coefficient: str) -> None:

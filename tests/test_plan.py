@@ -235,3 +235,38 @@ def test_one_plus_cosine_is_written_through_the_half_angle_next_to_a_half_turn()
         exact = 1 / (1 + mpmath.cos(mpmath.mpf(near_pi)))
     assert not np.isfinite(plain) or abs(plain / float(exact) - 1) > 1e-3
     assert abs(half / float(exact) - 1) < 1e-13
+
+
+def test_every_branch_measures_candidate_forms_computed_before_the_precisions(monkeypatch) -> None:
+    """The candidate forms of every branch in x are computed once, half in a forked child, before
+    the precisions part (plan._prepare_shared_work), and equal those computed in place."""
+    import symrot.plan as plan
+    from symrot.core import derive_expression
+    from symrot.parsing import parse_expression
+
+    original_forms, original_precision = plan._candidate_forms, plan._precision_plan
+    late: list[sp.Expr] = []
+    in_precision = False
+
+    def forms(*key):
+        if in_precision and key[1] != PHI:
+            late.append(key[0])
+        return original_forms(*key)
+
+    def precision(shared, label, dtype):
+        nonlocal in_precision
+        in_precision = True
+        try:
+            return original_precision(shared, label, dtype)
+        finally:
+            in_precision = False
+
+    monkeypatch.setattr(plan, "_candidate_forms", forms)
+    monkeypatch.setattr(plan, "_precision_plan", precision)
+    derivation = derive_expression(parse_expression("2*asinh(phi/2)"))  # a p no other test plans
+    result = plan.evaluation_plan(derivation, "two_asinh_half")
+    assert late == []  # float64, planned in this process, computed none of them itself
+    keys = [key for key in plan._CANDIDATES if key[1] == derivation.p]
+    assert keys and any(isinstance(c, Branch) for c in result.precisions["float64"].coefficients.values())
+    for key in keys:
+        assert plan._CANDIDATES[key] == original_forms(*key), key[0]
