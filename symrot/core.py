@@ -23,7 +23,7 @@ import sympy as sp
 
 from .axial import AxialTensor
 from .budget import stage
-from .derivatives import slope_definitions, slope_series
+from .derivatives import ROOT_DIFFERENTIATED, SLOPES, VALUES, slope_definitions, slope_name, slope_series
 from .errors import InvalidGeneratingFunction
 from .parsing import PHI
 from .series import Series, coefficient_list, compose_even_in_x, revert, taylor_series
@@ -109,6 +109,9 @@ class Derivation:
     tensors: dict[str, Tensor]
     slopes: dict[str, tuple[str, sp.Expr]] = field(default_factory=dict)
     """Slopes dc/dx of R, H, H⁻¹'s coefficients (:mod:`symrot.derivatives`): name → (parent, raw)."""
+    root_slopes: dict[str, tuple[str, sp.Expr]] = field(default_factory=dict)
+    """Slopes of G's and K's coefficients, the same way: derived (series, closed forms,
+    :func:`symrot.derivatives.derivative_values`) but not among :meth:`planned_expressions`."""
     _series_cache: dict[tuple[str, int], list[sp.Expr]] = field(default_factory=dict, repr=False)
     _constants: dict[str, sp.Expr | None] = field(default_factory=dict, repr=False)
     _slopes_simplified: dict[str, sp.Expr] = field(default_factory=dict, repr=False)
@@ -144,6 +147,28 @@ class Derivation:
         return {**self.coefficient_expressions(), **self.across_expressions(),
                 **{n: raw for n, (_, raw) in self.slopes.items()}}
 
+    def expression(self, name: str) -> sp.Expr:
+        """The raw expression of a planned quantity or of a slope of G or K."""
+        if name in self.root_slopes:
+            return self.root_slopes[name][1]
+        return self.planned_expressions()[name]
+
+    def slope_parent(self, name: str) -> str | None:
+        """The coefficient whose slope ``name`` is, None when it is not a slope."""
+        found = self.slopes.get(name) or self.root_slopes.get(name)
+        return None if found is None else found[0]
+
+    def derivative_values(self, tensor: str) -> dict[sp.Symbol, sp.Expr]:
+        """The scalars of :meth:`symrot.derivatives.TensorDerivative.matrix` for one of the five
+        tensors (R, H, H⁻¹, G or K): its coefficients c_k and their slopes c_k′ = dc_k/dx as
+        simplified closed forms in φ = φ(|p|); ``tensor_derivative().matrix(p, a,
+        d.derivative_values("G"))`` is ∂(G a)/∂p (eqs 81, 83)."""
+        values: dict[sp.Symbol, sp.Expr] = {}
+        for k, name in enumerate(self.tensors[tensor].coefficient_names()):
+            values[VALUES[k]] = self.simplified_form(name)
+            values[SLOPES[k]] = self.simplified_form(slope_name(name))
+        return values
+
     def simplified_planned(self) -> dict[str, sp.Expr]:
         """Simplified forms of :meth:`planned_expressions` (see :meth:`simplified_form`)."""
         return {name: self.simplified_form(name) for name in self.planned_expressions()}
@@ -155,13 +180,14 @@ class Derivation:
         across = {t.across_name: t for t in self.tensors.values()}
         if name in across:
             return across[name].canonical[1, 1]
-        if name not in self.slopes:
+        parent_name = self.slope_parent(name)
+        if parent_name is None:
             for tensor in self.tensors.values():  # simplify only the tensor that holds it
                 if name in tensor.coefficient_names():
                     return tensor.simplified[tensor.coefficient_names().index(name)]
             return self.scalars[name]
         if name not in self._slopes_simplified:
-            parent = self.simplified_coefficients()[self.slopes[name][0]]
+            parent = self.simplified_coefficients()[parent_name]
             quotient = sp.diff(parent, PHI) / (2 * self.p * self.scalars["p_prime"])
             self._slopes_simplified[name] = sp.factor_terms(quotient)
         return self._slopes_simplified[name]
@@ -169,7 +195,7 @@ class Derivation:
     # -- series -----------------------------------------------------------------------------
     def taylor_in_phi(self, name: str, order: int) -> list[sp.Expr]:
         """Exact Taylor coefficients of coefficient ``name`` in φ (index k ↔ φ^k)."""
-        series: Series = taylor_series(self.planned_expressions()[name], order)
+        series: Series = taylor_series(self.expression(name), order)
         if not series.is_zero and series.shift < 0:
             raise InvalidGeneratingFunction(f"coefficient {name} has a pole at phi = 0")
         return coefficient_list(series, 0, order)
@@ -191,8 +217,9 @@ class Derivation:
         return self._series_cache[key]
 
     def _series_in_x(self, name: str, n_terms: int) -> list[sp.Expr]:
-        if name in self.slopes:  # exact, term by term from the parent's series
-            return slope_series(self.series_in_x(self.slopes[name][0], n_terms + 1), n_terms)
+        parent = self.slope_parent(name)
+        if parent is not None:  # exact, term by term from the parent's series
+            return slope_series(self.series_in_x(parent, n_terms + 1), n_terms)
         order = 2 * n_terms
         in_phi = self.taylor_in_phi(name, order)
         odd = [k for k in range(1, order, 2) if in_phi[k] != 0]
@@ -213,7 +240,8 @@ class Derivation:
         return self._constants[name]
 
     def _find_constant(self, name: str) -> sp.Expr | None:
-        if name in self.slopes and self.constant_value(self.slopes[name][0]) is not None:
+        parent = self.slope_parent(name)
+        if parent is not None and self.constant_value(parent) is not None:
             return sp.S.Zero
         simplified = self.simplified_form(name)
         if simplified.is_Number:
@@ -232,7 +260,7 @@ class Derivation:
     # -- numeric evaluation -------------------------------------------------------------------
     def evaluate(self, name: str, angle: mpmath.mpf | str, digits: int = 50) -> mpmath.mpf:
         """Coefficient ``name`` at φ = angle to ``digits`` digits (raw closed form)."""
-        return evaluate(self.planned_expressions()[name], angle, digits)
+        return evaluate(self.expression(name), angle, digits)
 
 
 def scalar_definitions(p: sp.Expr) -> dict[str, sp.Expr]:
@@ -270,7 +298,8 @@ def derive_function(function: ValidatedFunction) -> Derivation:
     }
     coefficients = {n: c for t in tensors.values() for n, c in zip(t.coefficient_names(), t.coefficients,
                                                                   strict=True)}
-    return Derivation(function, raw, scalars, tensors, slope_definitions(coefficients, p))
+    return Derivation(function, raw, scalars, tensors, slope_definitions(coefficients, p),
+                      slope_definitions(coefficients, p, ROOT_DIFFERENTIATED))
 
 
 def derive_expression(expr: sp.Expr, normalize: bool = False) -> Derivation:

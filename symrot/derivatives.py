@@ -29,7 +29,11 @@ import sympy as sp
 from .parsing import PHI
 
 DIFFERENTIATED = ("R", "H", "H_inverse")
-"""Tensors whose coefficient slopes are derived (Rᵀ and Hᵀ share R's and H's)."""
+"""Tensors whose coefficient slopes are derived and planned: the emitted derivative functions read
+them (Rᵀ and Hᵀ share R's and H's)."""
+ROOT_DIFFERENTIATED = ("G", "K")
+"""Tensors of Appendix B whose slopes are derived too (∂(G a)/∂p, ∂(K a)/∂p by the same
+:func:`tensor_derivative`, eqs 81, 83) but not planned: no emitted function reads them."""
 SLOPE_SUFFIX = "_x"
 
 _P = sp.Matrix(sp.symbols("p_1:4", real=True))
@@ -45,11 +49,13 @@ def slope_name(coefficient: str) -> str:
     return coefficient + SLOPE_SUFFIX
 
 
-def slope_definitions(coefficients: dict[str, sp.Expr], p: sp.Expr) -> dict[str, tuple[str, sp.Expr]]:
-    """{slope name: (parent coefficient, dc/dx = (dc/dφ) / (2 p p′))} for R, H, H⁻¹'s coefficients."""
+def slope_definitions(coefficients: dict[str, sp.Expr], p: sp.Expr,
+                      tensors: tuple[str, ...] = DIFFERENTIATED) -> dict[str, tuple[str, sp.Expr]]:
+    """{slope name: (parent coefficient, dc/dx = (dc/dφ) / (2 p p′))} for the coefficients of
+    ``tensors`` (R, H, H⁻¹ unless told)."""
     denominator = 2 * p * sp.diff(p, PHI)
     out = {}
-    for tensor in DIFFERENTIATED:
+    for tensor in tensors:
         for k in range(3):
             parent = f"{tensor}_{k}"
             out[slope_name(parent)] = (parent, sp.diff(coefficients[parent], PHI) / denominator)

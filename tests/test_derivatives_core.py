@@ -56,7 +56,7 @@ def test_basis_is_independent() -> None:
 def test_slope_series_is_the_derivative_of_the_closed_form(expression: str) -> None:
     """The series of H_2′ (from the parent's series) against the 50-digit closed form dc/dφ / (2 p p′)."""
     derivation = derive(expression).derivation
-    for name in ("H_2", "R_1", "H_inverse_2"):
+    for name in ("H_2", "R_1", "H_inverse_2", "G_1", "K_2"):
         series = derivation.series_in_x(slope_name(name), 12)
         with mpmath.workdps(60):
             phi = mpmath.mpf("0.05")
@@ -73,12 +73,14 @@ def _mp(expr: sp.Expr, phi: mpmath.mpf) -> mpmath.mpf:
 @pytest.mark.parametrize("expression", ["2*sin(phi/2)", "sinh(phi)"])
 def test_core_derivative_is_the_directional_derivative(expression: str) -> None:
     """∂(T a)/∂p δp from the core's coefficients and slopes equals d/dt T(p + t δp) a at t = 0 (60
-    digits, mpmath.diff), T in R, H, H⁻¹ with the core's closed forms at φ = p⁻¹(|p|)."""
+    digits, mpmath.diff), T in R, H, H⁻¹ (planned) and G, K (derived only) with the core's closed
+    forms at φ = p⁻¹(|p|)."""
     derivation = derive(expression).derivation
     function = GeneratingFunction(expression)
     rng = random.Random(19)
-    closed = {n: sp.lambdify(PHI, e, modules=[mpmath_namespace(), "mpmath"])
-              for n, e in derivation.planned_expressions().items()}
+    expressions = {**derivation.planned_expressions(),
+                   **{name: raw for name, (_, raw) in derivation.root_slopes.items()}}
+    closed = {n: sp.lambdify(PHI, e, modules=[mpmath_namespace(), "mpmath"]) for n, e in expressions.items()}
     with mpmath.workdps(60):
         def tensor(q: list[Any], name: str, slopes: bool = False) -> Any:
             s = mpmath.sqrt(sum(v * v for v in q))
@@ -89,7 +91,7 @@ def test_core_derivative_is_the_directional_derivative(expression: str) -> None:
         p = [mpmath.mpf(rng.uniform(-0.6, 0.6)) for _ in range(3)]
         a = [mpmath.mpf(rng.uniform(-1, 1)) for _ in range(3)]
         direction = [mpmath.mpf(rng.uniform(-1, 1)) for _ in range(3)]
-        for name in ("R", "H", "H_inverse"):
+        for name in ("R", "H", "H_inverse", "G", "K"):
             def image(t: Any, name: str = name) -> Any:
                 q = [p[i] + t * direction[i] for i in range(3)]
                 c = tensor(q, name)
@@ -111,3 +113,25 @@ def test_rate_vector_is_the_derivative_applied_to_pdot() -> None:
     d0, d1, d2 = SLOPES
     assert rate_vector() == {d0: {"a (p.a)": 2}, d1: {"(p x a) (p.a)": 2}, d2: {"(p x (p x a)) (p.a)": 2},
                              c2: {"(p x a) x a": -1}}
+
+
+def test_slopes_of_g_and_k_are_derived_but_not_planned() -> None:
+    """G's and K's slopes (Appendix B) exist with their parents and exact series, are not among the
+    planned expressions (no emitted function reads them), and Derivation.derivative_values gives ∂(G a)/∂p:
+    for the rotation vector, G = R(p/2) (eq 76), so ∂(G a)/∂p = ½ ∂(R a)/∂p at p/2, checked at a
+    rational point at 40 digits."""
+    derivation = derive("rotation_vector").derivation
+    assert set(derivation.root_slopes) == {slope_name(f"{t}_{k}") for t in ("G", "K") for k in range(3)}
+    assert not set(derivation.root_slopes) & set(derivation.planned_expressions())
+    assert derivation.slope_parent("K_2_x") == "K_2" and derivation.slope_parent("K_2") is None
+    assert derivation.series_in_x("G_1_x", 2) == [sp.Rational(-1, 48), sp.Rational(1, 1920)]
+    p = sp.Matrix([sp.Rational(3, 10), sp.Rational(-1, 5), sp.Rational(2, 5)])
+    a = sp.Matrix([1, sp.Rational(1, 3), -2])
+    angle = sp.sqrt((p.T * p)[0, 0])
+
+    def at(values: dict[sp.Symbol, sp.Expr], phi: sp.Expr) -> dict[sp.Symbol, sp.Expr]:
+        return {symbol: value.subs(PHI, phi) for symbol, value in values.items()}
+
+    root = tensor_derivative().matrix(p, a, at(derivation.derivative_values("G"), angle))
+    half = tensor_derivative().matrix(p / 2, a, at(derivation.derivative_values("R"), angle / 2)) / 2
+    assert max(abs(sp.N(v, 40)) for v in root - half) < 1e-35

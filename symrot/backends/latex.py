@@ -21,7 +21,15 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES, Derivation
-from ..derivatives import DIFFERENTIATED, SLOPES, VALUES, rate_vector, slope_name, tensor_derivative
+from ..derivatives import (
+    DIFFERENTIATED,
+    ROOT_DIFFERENTIATED,
+    SLOPES,
+    VALUES,
+    rate_vector,
+    slope_name,
+    tensor_derivative,
+)
 from ..functions import RealCbrt
 from ..parsing import PHI
 from ..registry import NamedParameterization
@@ -341,7 +349,7 @@ def sheet(result: NamedDerivation, series_terms: int = 4) -> str:
     # the slopes as exact series (their closed forms dc/dφ / (2 p p′) can be wider than the page)
     slopes = [(TENSOR_SYMBOLS[name], [series_latex(d.series_in_x(slope_name(f"{name}_{k}"), series_terms))
                                       for k in range(3)])
-              for name in DIFFERENTIATED]
+              for name in (*DIFFERENTIATED, *ROOT_DIFFERENTIATED)]
     return render(
         "latex/sheet.tex.j2",
         title=title_of(result),
