@@ -395,8 +395,11 @@ OWN_SCALE = TensorPart(sp.Integer(0), 0)
 """Where p → ∞ at φ_max, det H (``tangent_det``) and the slopes dc/dx are measured relative to
 themselves, as the domain sweep counts them: s then resolves the distance to the edge, and every
 coefficient of s is well conditioned up to it (det H = μν² ~ 1/x² next to a pole, where a form in
-φ̂ loses every digit). With p finite at the edge (ν → 0 at 2π, a fold) det H(s) is ill conditioned
-there, and they keep the floor max(|c|, |c(0)|)."""
+φ̂ loses every digit). The same where det H → 0 at φ_max because p′ → ∞ there (a logarithmic pole
+such as asinh(tan φ), an arcsine edge): H₀ = cos φ of asinh(tan φ) and its slope vanish at π/2, and
+measured against a fixed floor, their forms in φ̂ looked as good as those through s (1/cosh s) while
+float32 ∂(H a)/∂p was 5·10⁵ ulp off at π/2 − 10⁻⁶. With p finite at the edge otherwise (ν → 0 at 2π, a
+fold) det H(s) is ill conditioned there, and they keep the floor max(|c|, |c(0)|)."""
 
 
 def tensor_part(derivation: Derivation, coefficient: str, det_h_own_scale: bool = False) -> TensorPart | None:
@@ -748,7 +751,7 @@ def _precision_plan(shared: _SharedWork, label: str, dtype: type[np.floating]) -
         if coefficient in derivation.slopes:  # after every parent: its parent's plan is known
             try:
                 coefficients[coefficient] = _plan_slope(derivation, coefficient, coefficients, phi_max,
-                                                        dtype, inverse, complement, unbounded)
+                                                        dtype, inverse, complement, shared.det_h_own_scale)
             except UnplannableCoefficient:  # e.g. 1e-8*phi in float32: dc/dx ~ 1/kappa^4 overflows
                 coefficients[coefficient] = Constant(sp.Integer(0))  # never used: see slope_limit
                 slopes_unrepresentable = True
@@ -822,16 +825,17 @@ def _algebraic_value(coefficient: Coefficient) -> sp.Expr | None:
 
 def _plan_slope(derivation: Derivation, name: str, coefficients: dict[str, Coefficient], phi_max: float,
                 dtype: type, inverse: sp.Expr | None, complement: sp.Rational | None,
-                unbounded: bool) -> Coefficient:
+                own_scale: bool) -> Coefficient:
     """A slope dc/dx (:mod:`symrot.derivatives`): the derivative in x of its parent's algebraic form when
-    the parent has one (d(D)/dx = −1), else a Branch of its closed form and exact series. Never a search
-    of its own under the algebraic time budget, so that the plan is the same on a loaded machine."""
+    the parent has one (d(D)/dx = −1), else a Branch of its closed form and exact series, measured
+    relative to itself with ``own_scale`` (:data:`OWN_SCALE`). Never a search of its own under the
+    algebraic time budget, so that the plan is the same on a loaded machine."""
     parent = coefficients[derivation.slopes[name][0]]
     if isinstance(parent, Algebraic):
         return Algebraic(sp.diff(parent.expression, X) - sp.diff(parent.expression, D))
     series = derivation.series_in_x(name, MAX_TERMS)
     return plan_branch(derivation.simplified_form(name), series, derivation.p ** 2, phi_max, dtype,
-                       derivation.p, inverse, complement, OWN_SCALE if unbounded else None)
+                       derivation.p, inverse, complement, OWN_SCALE if own_scale else None)
 
 
 def _check_scale(derivation: Derivation) -> None:

@@ -180,6 +180,18 @@ def test_emitted_derivatives_within_8_ulp(name: str) -> None:
     assert not failures, failures
 
 
+def test_derivatives_next_to_a_logarithmic_pole() -> None:
+    """asinh(tan φ) (tests/corpus.py, 46): p′ → ∞ and det H → 0 at π/2 while |p| is still finite
+    10⁻¹² from it. The slopes of H, R and H⁻¹ are measured relative to themselves there (plan.OWN_SCALE),
+    so that the factor that vanishes at the edge, cos φ, is taken through s (1/cosh s) and not from
+    the rounded angle: float32 ∂(H a)/∂p was 5·10⁵ ulp off at π/2 − 10⁻⁶ before."""
+    function, _ = _function("asinh(tan(phi))")
+    angles = [0.5, float(np.pi / 2) - 1e-4, float(np.pi / 2) - 1e-5, float(np.pi / 2) - 1e-6]
+    worst = check_sweep(module_of("asinh(tan(phi))"), function, angles, FUNCTIONS)
+    failures = {k: v for k, v in worst.items() if v > TARGET_ULP}
+    assert not failures, failures
+
+
 @pytest.mark.parametrize("name", ["rotation_vector", "euler_rodrigues", "sinh(phi)"])
 def test_rates_along_a_trajectory(name: str) -> None:
     """Ḣ ṗ = [∂(H a)/∂p]_(a=ṗ) ṗ against d/dt H(p(t)) ṗ, and α = angular_acceleration against
