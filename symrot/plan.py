@@ -156,6 +156,26 @@ def gudermannian(expr: sp.Expr) -> sp.Expr:
                         lambda e: sp.atan(sp.sinh(e.args[0].args[0])))
 
 
+def hyperbolic_complement(expr: sp.Expr) -> sp.Expr:
+    """Replace k − k tanh²(u) in a sum by k/cosh²(u), the same function, accurate for large u where
+    tanh u rounds next to 1: the forms through the inverse φ = 4 tanh(s/4) of p = 4 atanh(φ/4) read
+    1 − φ²/16 as 1 − tanh²(s/4), which loses its digits next to the pole at 4 (float64 H₂ 9.6 ulp
+    at the edge of the plan's grid, 1.9 with it)."""
+    def complement(sum_: sp.Expr) -> sp.Expr | None:
+        constant, _ = sum_.as_coeff_Add()
+        if constant == 0:
+            return None
+        for term in sum_.args:
+            factor, rest = term.as_coeff_Mul()
+            if factor == -constant and rest.is_Pow and rest.exp == 2 and isinstance(rest.base, sp.tanh):
+                others = [a for a in sum_.args if a is not term and a != constant]
+                return sp.Add(*others, constant * sp.cosh(rest.base.args[0]) ** -2)
+        return None
+
+    return expr.replace(lambda e: isinstance(e, sp.Add) and complement(e) is not None,
+                        lambda e: complement(e))
+
+
 def half_angle(expr: sp.Expr) -> sp.Expr:
     """sin φ → 2 sin(φ/2) cos(φ/2), cos φ → 1 − 2 sin²(φ/2): every call on the one argument φ/2, so
     that a compiler can evaluate them with a single sincos (and 1 − cos φ stays accurate)."""
@@ -331,6 +351,7 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
         forms += [with_pole_factor(form, pole) for form in forms]
     if inverse is not None and argument != PHI:
         forms += [with_inverse(form, inverse) for form in forms]
+        forms += [hyperbolic_complement(form) for form in forms if form.has(sp.tanh)]
         forms = [closed_with_base_angle(form, inverse) for form in forms]
         if complement is not None:
             forms = [closed_with_complement(form, inverse, complement) for form in forms]

@@ -270,3 +270,19 @@ def test_every_branch_measures_candidate_forms_computed_before_the_precisions(mo
     assert keys and any(isinstance(c, Branch) for c in result.precisions["float64"].coefficients.values())
     for key in keys:
         assert plan._CANDIDATES[key] == original_forms(*key), key[0]
+
+
+def test_hyperbolic_complement_is_the_same_function_without_cancellation() -> None:
+    """k − k tanh²(u) in a sum becomes k/cosh²(u) (the forms through φ = 4 tanh(s/4) of 4 atanh(φ/4));
+    other sums are left alone; the value is unchanged (40 digits at a large u, where the old form
+    has lost every digit in float64)."""
+    from symrot.measurement import S
+    from symrot.plan import hyperbolic_complement
+
+    form = 16 - 16 * sp.tanh(S / 4) ** 2 + PHI
+    rewritten = hyperbolic_complement(form)
+    assert rewritten == PHI + 16 / sp.cosh(S / 4) ** 2
+    assert hyperbolic_complement(2 - sp.tanh(S) ** 2) == 2 - sp.tanh(S) ** 2
+    point = {S: sp.Integer(160), PHI: sp.Rational(1, 3)}
+    assert abs(sp.N((form - rewritten).subs(point), 40)) < sp.Float("1e-60")
+    assert float(16 - 16 * np.tanh(40.0) ** 2) == 0.0 != float(16 / np.cosh(40.0) ** 2)
