@@ -111,7 +111,7 @@ class Derivation:
     """Slopes dc/dx of R, H, H⁻¹'s coefficients (:mod:`symrot.derivatives`): name → (parent, raw)."""
     root_slopes: dict[str, tuple[str, sp.Expr]] = field(default_factory=dict)
     """Slopes of G's and K's coefficients, the same way: derived (series, closed forms,
-    :func:`symrot.derivatives.derivative_values`) but not among :meth:`planned_expressions`."""
+    :meth:`derivative_values`) but not among :meth:`planned_expressions`."""
     _series_cache: dict[tuple[str, int], list[sp.Expr]] = field(default_factory=dict, repr=False)
     _constants: dict[str, sp.Expr | None] = field(default_factory=dict, repr=False)
     _slopes_simplified: dict[str, sp.Expr] = field(default_factory=dict, repr=False)

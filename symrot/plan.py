@@ -368,8 +368,8 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     for Newton's ratio and slope). Besides the forms in φ, the same with p written as s
     (:func:`with_length`) and, given the closed ``inverse`` φ(s), with their algebraic parts written
     through it (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of
-    the tangent family, fold complement d of the sine family), measured on the inputs of
-    :func:`measured_inputs` against one reference at REFERENCE_DIGITS. A coefficient of a tensor
+    the tangent family, fold complement d of the sine family) (:func:`candidate_forms`), measured on
+    the inputs of :func:`measured_inputs` against one reference at REFERENCE_DIGITS. A coefficient of a tensor
     (``part``) is measured as it enters the tensor: relative to ‖T‖/|p|^k where that is below c(0)
     (:func:`_branch_for`). ``extra_forms``: more candidates, already in the backends' variables
     (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part)."""
