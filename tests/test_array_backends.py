@@ -145,6 +145,14 @@ def _sample(dtype: type) -> np.ndarray:
     return (axes * sizes[:, None]).astype(dtype)
 
 
+AGREEMENT_ULP = 2.0
+"""Forward values against the NumPy module (issue 20), in ulp of each point's largest entry."""
+NEWTON_AGREEMENT_ULP = 4.0
+"""The same for eq 35, whose Newton angle takes sin and cbrt from the framework's own kernels: a
+one-ulp difference of the residual moves φ by about one ulp, which R, H⁻¹ and K amplify (3.4 ulp
+measured in float64, 2.7 in float32, JAX and PyTorch alike)."""
+
+
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_values_equal_the_numpy_module(adapter: Adapter, dtype: type) -> None:
     p = _sample(dtype)
@@ -166,7 +174,38 @@ def test_values_equal_the_numpy_module(adapter: Adapter, dtype: type) -> None:
             scale = np.maximum(np.nan_to_num(scale), np.finfo(dtype).tiny)
             error = np.nan_to_num(np.abs(value.astype(np.float64) - expected) / (scale * np.finfo(dtype).eps))
             worst[name, function] = float(np.max(error))
-    assert max(worst.values()) <= 6.0, {k: v for k, v in worst.items() if v > 6.0}
+    bound = {name: NEWTON_AGREEMENT_ULP if name == "det_h_one" else AGREEMENT_ULP for name in names}
+    over = {k: v for k, v in worst.items() if v > bound[k[0]]}
+    assert not over, over
+
+
+def _straddling_the_edge(p_max_squared: float, dtype: type, count: int = 64) -> np.ndarray:
+    """p next to |p|² = p_max² whose x summed as (p0² + p1²) + p2² and as (p0² + p2²) + p1² fall on
+    different sides of p_max²: the validity test gives NaN or a value depending on the order."""
+    rng = np.random.default_rng(7)
+    found: list[np.ndarray] = []
+    while len(found) < count:
+        axes = rng.normal(size=(4096, 3))
+        axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+        p = (axes * np.sqrt(p_max_squared)).astype(dtype)
+        square = p * p
+        one = (square[:, 0] + square[:, 1]) + square[:, 2]
+        other = (square[:, 0] + square[:, 2]) + square[:, 1]
+        found += list(p[(one < p_max_squared) != (other < p_max_squared)])
+    return np.array(found[:count], dtype=dtype)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_the_edge_of_the_range_is_where_the_numpy_module_has_it(adapter: Adapter, dtype: type) -> None:
+    """x = |p|² is summed in the NumPy module's order, so the same p is inside or outside."""
+    module, reference = generated(adapter.kind, "euler_rodrigues"), generated("numpy", "euler_rodrigues")
+    p = _straddling_the_edge(4.0, dtype)  # |p| < 2
+    for function in ("angle", "rotation_matrix"):
+        expected = np.isnan(getattr(reference, function)(p).reshape(len(p), -1)).any(axis=1)
+        value = adapter.numpy(getattr(module, function)(adapter.array(p))).reshape(len(p), -1)
+        assert 0 < expected.sum() < len(p), "the sample does not straddle the edge"
+        assert np.array_equal(np.isnan(value).any(axis=1), expected), function
+        assert np.isfinite(value[~expected]).all(), function
 
 
 def test_outside_the_range_is_nan(adapter: Adapter) -> None:

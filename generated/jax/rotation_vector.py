@@ -967,6 +967,12 @@ def _dot(a, b):
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
+def _squared_norm(p):
+    """x = |p|^2 = (p0^2 + p2^2) + p1^2, summed in the NumPy module's order: the same x, hence the
+    same validity test at the edge of the range and the same coefficients, as the NumPy module."""
+    return (p[..., 0] * p[..., 0] + p[..., 2] * p[..., 2]) + p[..., 1] * p[..., 1]
+
+
 def _cross(a, b):
     return _xp.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
                       a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
@@ -1022,9 +1028,9 @@ def _prepare(p, names):
     """p, (x, phi, s, d, sin(phi/2), cos(phi/2)), valid, suffix for the coefficient functions
     ``names``; p is replaced by 0 outside the validity range (safe for every derivative)."""
     suffix = _suffix(p)
-    valid = _inside(_dot(p, p), suffix)
+    valid = _inside(_squared_norm(p), suffix)
     p = _where(valid[..., None], p, 0.0)
-    x = _dot(p, p)
+    x = _squared_norm(p)
     s = _length(p, x, suffix)
     d = None
     if any(_USES_PHI[suffix][name] for name in names):
@@ -1241,7 +1247,7 @@ def _from_quaternion(e0, e, valid, suffix):
     e_norm = _where(valid, e_norm, 0.0)
     e = _where(valid[..., None], e, 0.0)
     p = _SCALE[suffix](e0, e_norm)[..., None] * e
-    valid = valid & _inside(_dot(p, p), suffix)
+    valid = valid & _inside(_squared_norm(p), suffix)
     return _where(valid[..., None], p, math.nan)
 
 
