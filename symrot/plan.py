@@ -40,6 +40,7 @@ from typing import Any, NamedTuple
 import mpmath
 import numpy as np
 import sympy as sp
+from sympy.core.traversal import bottom_up
 
 from .algebraic import (
     REDUCTION_OPS,
@@ -172,8 +173,11 @@ def hyperbolic_complement(expr: sp.Expr) -> sp.Expr:
                 return sp.Add(*others, constant * sp.cosh(rest.base.args[0]) ** -2)
         return None
 
-    return expr.replace(lambda e: isinstance(e, sp.Add) and complement(e) is not None,
-                        lambda e: complement(e))
+    def rewrite(e: sp.Expr) -> sp.Expr:
+        found = complement(e) if isinstance(e, sp.Add) else None
+        return e if found is None else found
+
+    return bottom_up(expr, rewrite)  # inner sums first, each matched once
 
 
 def half_angle(expr: sp.Expr) -> sp.Expr:
