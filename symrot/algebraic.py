@@ -86,6 +86,11 @@ def _whole_multiples(expr: sp.Expr, angle: sp.Symbol) -> bool:
     return True
 
 
+def has_radical(expr: sp.Expr) -> bool:
+    """Whether ``expr`` has a power with a non-integer exponent (a square or cube root of s, …)."""
+    return any(isinstance(e, sp.Pow) and not e.exp.is_Integer for e in sp.preorder_traversal(expr))
+
+
 @lru_cache(maxsize=1024)
 def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     """c(φ(s)) with multiple and half angles of the base angle expanded, before simplification;
@@ -96,6 +101,8 @@ def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     base = base_angle(inverse)
     if base is None and not inverse.has(*INVERSE_FUNCTIONS):
         return None
+    if any(has_radical(call.args[0]) for call in inverse.atoms(*INVERSE_FUNCTIONS)):
+        return None  # atan of Cardano's root (tan φ + tan³φ/3): 6 s per coefficient, never simpler
     eta = sp.Symbol("eta", positive=True)
     if base is not None and expands_beyond_the_cap(closed.subs(PHI, 2 * base[0] * eta), eta,
                                                    REDUCTION_MULTIPLE):

@@ -190,6 +190,22 @@ def test_the_reduction_to_x_is_sized_by_the_largest_multiple_angle() -> None:
     assert expanded_in_s(within, 6 * sp.atan(s / 6)) is not None
 
 
+def test_an_inverse_of_a_radical_is_not_reduced_to_x() -> None:
+    """The closed inverse of tan φ + tan³φ/3 is the atan of Cardano's root of a cubic: SymPy's
+    simplify ran into its 6 s bound on each coefficient expanded through it, and ``--emit`` ran out
+    of its 60 s budget during planning. No reduction is attempted (the coefficients get branches);
+    one whose inverse is an atan of s/k still is."""
+    from symrot.algebraic import S, expanded_in_s
+    from symrot.plan import closed_inverse
+
+    p = sp.tan(PHI) ** 3 / 3 + sp.tan(PHI)
+    inverse = closed_inverse(p, sp.Integer(1))
+    assert inverse is not None and inverse.has(sp.atan)
+    closed = sp.sin(PHI) / p
+    assert expanded_in_s(closed, inverse) is None
+    assert expanded_in_s(sp.sin(PHI) / (4 * sp.tan(PHI / 4)), 4 * sp.atan(S / 4)) is not None
+
+
 def test_whole_multiples_of_the_base_angle_reduce_without_half_angle_radicals() -> None:
     """sin φ/(5 tan(φ/5)) of 5 tan(φ/5) has only whole multiples of θ = atan(s/5): expanded in θ it
     is algebraic in x. Through the half angle η = θ/2 (radicals √((1 ± cos θ)/2)) SymPy's simplify
