@@ -31,7 +31,7 @@ import mpmath
 import sympy as sp
 
 from .algebraic import S
-from .functions import BoundedPower, mpmath_namespace
+from .functions import BoundedPower, RealCbrt, mpmath_namespace
 from .parsing import PHI
 from .timeouts import bounded
 
@@ -41,6 +41,8 @@ ROOT_DISTANCE = 1e-9
 """A factor's root found from the float φ_max must lie this close to it (relative)."""
 MAX_DIVISIONS = 4
 """Largest multiplicity of f divided out of one sum ((φ² − 10)² = φ⁴ − 20φ² + 100 needs 2)."""
+MAX_POLE_ORDER = 3
+"""Largest order m of the pole, p = N/(D·f^m), whose f is written through s as (N/(D·s))^(1/m)."""
 MAX_MULTIPLE = 4
 """Largest multiple n of the factor's angle whose sin(naφ), cos(naφ) are expanded."""
 DIVISION_OPS = 120
@@ -99,13 +101,26 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
         vanishing = [(f, root, m) for f, (root, m) in roots.items() if root is not None]
         if not vanishing:
             return _logarithmic_pole(p, phi_max) or _arcsine_edge(p, phi_max)
-        if len(vanishing) != 1 or vanishing[0][2] != 1:
+        if len(vanishing) != 1 or vanishing[0][2] > MAX_POLE_ORDER:
             return None
-        factor, root, _ = vanishing[0]
+        factor, root, order = vanishing[0]
         rest = constant * sp.Mul(*(f**m for f, m in factors if f != factor))
         if _value(numerator / rest, root) in (None, 0):
             return None  # 0/0 at φ_max: not a pole of this factor
-    return PoleFactor(factor, numerator / (rest * S), root)
+        slope = _value(sp.diff(factor, PHI), root)
+        if slope in (None, 0):
+            return None
+    return PoleFactor(factor, _root_of_order(numerator / (rest * S), order, slope), root)
+
+
+def _root_of_order(power: sp.Expr, order: int, slope: mpmath.mpf) -> sp.Expr:
+    """f from f^order = ``power`` (= N/(D·s)) below the pole, where f has the sign opposite to its
+    ``slope`` f′(φ_max): p = tan φ + tan³φ/3 = N/(D cos³φ) has f = cos φ = ∛(N/(D·s))."""
+    if order == 1:
+        return power
+    if order == 3:
+        return RealCbrt(power)
+    return (-1 if slope > 0 else 1) * sp.sqrt(power)
 
 
 class _LinearCall(NamedTuple):

@@ -46,11 +46,30 @@ def test_the_factor_vanishes_at_the_pole_and_its_s_form_is_p_s_identity(text: st
 
 
 @pytest.mark.parametrize("text, phi_max", [("sin(phi)", "pi"), ("phi + phi**3/6", "2*pi"),
-                                           ("phi/(1 - phi**2/10)**2", "sqrt(10)"),
+                                           ("phi/(1 - phi**2/10)**4", "sqrt(10)"),
                                            ("sin(phi)*cosh(phi/3)", "pi/2")])
-def test_no_factor_without_a_simple_pole(text: str, phi_max: str) -> None:
-    """No pole (sin, a polynomial, a fold), a double pole: nothing to rewrite."""
+def test_no_factor_without_a_pole_of_order_at_most_three(text: str, phi_max: str) -> None:
+    """No pole (sin, a polynomial, a fold), a pole of order 4: nothing to rewrite."""
     assert pole_factor(_p(text), float(sp.sympify(phi_max))) is None
+
+
+@pytest.mark.parametrize("text, phi_max", [("phi/(1 - phi**2/10)**2", "sqrt(10)"),
+                                           ("tan(phi)**3/3 + tan(phi)", "pi/2"),
+                                           ("phi/cos(phi)**2", "pi/2")])
+def test_a_pole_of_order_two_or_three_writes_its_factor_as_a_root_through_s(text: str, phi_max: str) -> None:
+    """p = N/(D·f^m): f = (N/(D·s))^(1/m) with f's sign below the pole. Without it, every form of
+    tan φ + tan³φ/3 kept cos φ from the rounded angle and the domain ended at |p|² = 2³² (NaN from
+    φ = 1.56 on, of π/2)."""
+    p, edge = _p(text), sp.sympify(phi_max)
+    pole = pole_factor(p, float(edge))
+    assert pole is not None
+    assert abs(sp.N(pole.factor.subs(PHI, edge), 40)) < 1e-35
+    through = sp.lambdify((PHI, S), pole.through_s, modules=[mpmath_namespace(), "mpmath"])
+    factor, p_of = (sp.lambdify(PHI, e, modules=[mpmath_namespace(), "mpmath"]) for e in (pole.factor, p))
+    with mpmath.workdps(50):
+        for distance in ("1e-1", "1e-4", "1e-9"):
+            angle = mpmath.mpf(sp.N(edge, 50)) - mpmath.mpf(distance)
+            assert abs(through(angle, p_of(angle)) / factor(angle) - 1) < mpmath.mpf(10) ** -40, distance
 
 
 def _relative_error(form: sp.Expr, p: sp.Expr, theta: mpmath.mpf) -> float:
