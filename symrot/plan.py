@@ -509,7 +509,7 @@ def _magnitude(coefficient: sp.Expr) -> float:
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...],
                 floors: tuple[np.ndarray, ...] | None = None) -> Branch:
-    epsilon = float(np.finfo(dtype).eps)
+    epsilon, tiny = float(np.finfo(dtype).eps), float(np.finfo(dtype).tiny)
     model_closed = model_function(closed, [PHI, S, X, D])
     angles = angle_grid(phi_max)
     t_values = _switch_values(variable_of_phi, phi_max, dtype)
@@ -531,7 +531,11 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         with np.errstate(all="ignore"):
             floor = scale0 if floors is None else np.fmin(scale0, floors[k])
             errors = np.abs(values - exact) / (np.maximum(np.abs(exact), floor) * epsilon)
-        errors = np.where(np.isfinite(values), np.where(np.isnan(exact), 0.0, errors), np.inf)
+        # a value below the format's normal range has no digits to lose: every finite form ties
+        # there (det H ~ 1/x² of tan φ + tan³φ/3 underflows float32 next to its pole, and that tie
+        # chose the form in φ̂ over the one through s, which is right up to the underflow)
+        unmeasured = np.isnan(exact) | ((exact != 0) & (np.abs(exact) < tiny))
+        errors = np.where(np.isfinite(values), np.where(unmeasured, 0.0, errors), np.inf)
         closed_error[k] = float(np.max(errors))
     floats = [_magnitude(c) for c in series]
     # every Horner coefficient must be finite in the format (e.g. 1000 tan(φ/1000) has a

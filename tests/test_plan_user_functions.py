@@ -71,6 +71,16 @@ def test_a_pole_where_p_grows_exponentially_ends_the_domain_instead_of_failing()
         assert 2.0**32 <= precision.x_limit <= 2.0**600
 
 
+def test_a_triple_pole_keeps_its_domain_up_to_where_det_h_underflows() -> None:
+    """tan φ + tan³φ/3 = N/(D cos³φ): cos φ through s as ∛(N/(D·s)) (symrot.pole), and in float32,
+    where det H ~ 1/x² underflows next to the pole, forms are compared only where the value is a
+    normal number. Without both, every form kept cos φ from the rounded angle and the domain ended
+    at |p|² = 2³² in both precisions (NaN from φ = 1.56 of π/2)."""
+    plan = evaluation_plan(derive("tan(phi)**3/3 + tan(phi)").derivation, "triple_pole")
+    assert plan.precisions["float64"].x_limit >= 2.0**300
+    assert plan.precisions["float32"].x_limit >= 2.0**80
+
+
 def test_a_p_too_small_for_a_format_is_refused_before_any_planning() -> None:
     """'1e-20*phi' --emit c took 34 s to fail on its first float32 coefficient (issue 17): the
     scale check refuses it at once, naming the format and the coefficient that overflows."""
