@@ -6,7 +6,8 @@ Sources of singularity, for 0 < φ ≤ 4π:
 * ``nu``: ν → 0 or ∞, the kinematic inversion through Euler–Rodrigues parameters (eq 75) fails;
 * ``p_prime``: p′ → 0 or ∞ (μ → ∞ or 0), H (22) or H⁻¹ (26) is singular;
 * ``det_H``: det H (24) → 0 or ∞;
-* ``monotonicity``: p′ changes sign, so |p| no longer determines φ.
+* ``monotonicity``: p′ changes sign, so |p| no longer determines φ: through a zero, or by a jump
+  where p has a kink (asin(sin φ) at π/2, found by :func:`_first_sign_jump`).
 
 Method (bounded, numeric-first): each scalar function is scanned in double precision on a fine
 grid; sign changes, near-touching zeros (local minima of |f|) and poles (local maxima of |f|)
@@ -56,6 +57,7 @@ CAUSES = {
     ("det_H", "oo"): "det H -> oo: H^-1 is singular",
     ("monotonicity", "0"): "p' changes sign: |p| no longer determines phi",
     ("p", "edge"): "p is not real beyond this angle (the edge of its real domain)",
+    ("monotonicity", "jump"): "p' jumps across 0 (p has a kink): |p| no longer determines phi",
 }
 MAX_CANDIDATES = 48
 """Brackets polished per function, smallest angles first (the validity range is the smallest). Each
@@ -63,6 +65,10 @@ costs a 50-digit root search of ~10 ms; functions with zeros in infinite familie
 in (0, 4π]: with 400, the validity analysis of sin(sinh φ) polished 1600 and took 15 s (1143 listed
 singularities), with 48 it takes 1 s (185 listed, the same edge 1.2334); 2 sin(tan(φ/2)) 5.0 → 2.6 s.
 The named parameterizations and the other corpus functions have at most 16 per function."""
+JUMP_STEPS = 100
+"""Bisection steps that locate a jump of p′, at twice DIGITS (to ~10⁻³² of the grid step, enough
+to match a multiple of π to the 25 digits of :func:`_exact_angle`; p′ such as cos φ/√(1 − sin²φ)
+is resolved there)."""
 EDGE_STEPS = 200
 """Bisection steps that locate the edge of the real domain to 50 digits."""
 
@@ -121,6 +127,12 @@ def _validity_of(p: sp.Expr) -> Validity:
             if quantity == "p_prime" and limit == "0" and sign_change:
                 found.append(Singularity(phi, float(angle), CAUSES[("monotonicity", "0")],
                                          "monotonicity", "0"))
+    jump = _first_sign_jump(derivation.scalars_raw["p_prime"])
+    if jump is not None:  # asin(sin φ): p′ = cos φ/√(1 − sin²φ) is ±1, never 0 nor ∞
+        exact = _exact_angle(jump, candidates)
+        numeric_only |= exact is None
+        phi = exact if exact is not None else sp.Float(mpmath.nstr(jump, 30), 30)
+        found.append(Singularity(phi, float(jump), CAUSES[("monotonicity", "jump")], "monotonicity", "jump"))
     found.sort(key=lambda s: (s.phi_float, QUANTITIES.index(s.quantity)
                               if s.quantity in QUANTITIES else len(QUANTITIES)))
     if not found:
@@ -130,6 +142,39 @@ def _validity_of(p: sp.Expr) -> Validity:
                                     and abs(s.phi_float - edge.phi_float) < 1e-9
                                     for s in found) else _magnitude_at(p, edge)
     return Validity(edge.phi, edge.phi_float, p_at_edge, tuple(found), numeric_only)
+
+
+def _first_sign_jump(p_prime: sp.Expr) -> mpmath.mpf | None:
+    """The first angle in (0, 4π] where p′ changes sign without passing through 0 or ∞ (a jump, as
+    where p has |g| or sign(g) in it), bisected at 50 digits; None when p′ keeps its sign or every
+    sign change is a zero or a pole (which :func:`_events` finds and classifies)."""
+    grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
+    numeric = sp.lambdify(PHI, p_prime, modules=[{"RealCbrt": np.cbrt}, "numpy"])
+    with np.errstate(all="ignore"):
+        values = np.asarray(numeric(grid), dtype=float) * np.ones_like(grid)
+    exact = _safe(_mp(p_prime))
+    finite = np.flatnonzero(np.isfinite(values))  # 0/0 on a grid point next to the jump is skipped
+    change = np.flatnonzero(np.sign(values[finite[:-1]]) * np.sign(values[finite[1:]]) < 0)
+    if not change.size:
+        return None
+    before, after = finite[change[0]], finite[change[0] + 1]
+    with mpmath.workdps(2 * DIGITS):
+        low, high = mpmath.mpf(grid[before]), mpmath.mpf(grid[after])
+        sign = mpmath.sign(exact(low))
+        for _ in range(JUMP_STEPS):
+            middle = (low + high) / 2
+            value = exact(middle)
+            if not mpmath.isfinite(value) or value == 0:
+                break
+            low, high = (middle, high) if mpmath.sign(value) == sign else (low, middle)
+        step = mpmath.mpf(10) ** -15 * high
+        left, right = exact(low - step), exact(high + step)
+        size = max(abs(values[before]), abs(values[after]))
+        if not (mpmath.isfinite(left) and mpmath.isfinite(right)):
+            return None
+        if min(abs(left), abs(right)) < 1e-6 * size or max(abs(left), abs(right)) > 1e6 * size:
+            return None  # a zero or a pole of p′ (found by _events), not a jump
+        return low
 
 
 def _magnitude_at(p: sp.Expr, edge: Singularity) -> float:

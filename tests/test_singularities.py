@@ -147,3 +147,25 @@ def test_the_scale_of_a_base_angle_is_read_without_simplify() -> None:
     assert linear_scale(S / 4) == 4 and linear_scale(3 * S / 2) == sp.Rational(2, 3)
     assert linear_scale(sp.sinh(S)) is None and linear_scale(-S) is None
     assert linear_scale(sp.sqrt(2) * S) is None
+
+
+def test_a_jump_of_p_prime_across_zero_ends_the_range() -> None:
+    """asin(sin φ) rises to π/2 and falls back: p′ = cos φ/√(1 − sin²φ) jumps from 1 to −1 at π/2,
+    never 0 nor ∞, so no zero or pole marked it. The range ran to π with |p| < 0, and every
+    ``--emit`` ended in an internal error (ZeroDivisionError)."""
+    found = validity(derive_expression(parse_expression("asin(sin(phi))")))
+    assert found.phi_max == sp.pi / 2
+    assert abs(found.p_max_float - 1.5707963267948966) < 1e-12
+    assert found.singularities[0].quantity == "monotonicity" and found.singularities[0].limit == "jump"
+    # zeros and poles of p′ that change its sign are not jumps
+    for text in ("sin(phi)", "phi/(1 - phi**2/10)"):
+        listed = validity(derive_expression(parse_expression(text))).singularities
+        assert all(s.limit != "jump" for s in listed)
+
+
+def test_every_cause_has_its_latex_meaning() -> None:
+    """A cause without a meaning made ``symrot sheet`` fail on the functions that have it."""
+    from symrot.backends.latex import CAUSE_MEANINGS
+    from symrot.singularities import CAUSES
+
+    assert set(CAUSES) == set(CAUSE_MEANINGS)

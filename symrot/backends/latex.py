@@ -157,6 +157,8 @@ CAUSE_MEANINGS = {
     ("monotonicity", "0"): r"$p'$ changes sign, so $\|\mathbf{p}\|$ no longer determines"
                            r" $\varphi$",
     ("p", "edge"): r"$p$ is not real beyond this angle (the edge of its real domain)",
+    ("monotonicity", "jump"): r"$p'$ jumps across 0 ($p$ has a kink), so $\|\mathbf{p}\|$ no longer"
+                              r" determines $\varphi$",
 }
 """What each kind of singularity of :data:`symrot.singularities.CAUSES` means, as LaTeX."""
 SERIES = (("nu", r"\nu"), ("mu", r"\mu"), ("det_H", r"\det\mathbf{H}"),
