@@ -199,7 +199,7 @@ def _symbolic_candidates(p: sp.Expr, p_prime: sp.Expr) -> tuple[tuple[sp.Expr, .
 
     def zeros() -> sp.Set | None:
         if not (_periodic_in_phi(p_prime) and _one_frequency_or_polynomial(p_prime)
-                and _plain_hyperbolic(p_prime)):
+                and _plain_hyperbolic(p_prime) and _low_degree_in_calls(p_prime)):
             return None  # solveset runs past any bound (cos(sinh φ) cosh φ: > 20 s); numeric scan only
         return sp.solveset(p_prime, PHI, SCAN_INTERVAL)
 
@@ -243,6 +243,25 @@ def _one_frequency_or_polynomial(expr: sp.Expr) -> bool:
     return len({call.args[0] for call in calls}) <= 1 or all(isinstance(call, (sp.sin, sp.cos))
                                                                 for call in calls)
 
+
+def _low_degree_in_calls(expr: sp.Expr) -> bool:
+    """Whether ``expr``, where it is a polynomial in its trigonometric and hyperbolic calls, has
+    total degree at most :data:`MAX_CALL_DEGREE` in them: p′ = 1 + 3 sin²φ cos φ of φ + sin³φ is a
+    cubic in cos φ, and ``solveset`` ran past its 15 s safety bound on it (Cardano's roots inside
+    acos), which ended ``derive`` with exit 2. A shape, not a time, decides."""
+    calls = expr.atoms(*_HYPERBOLIC, *_PERIODIC)
+    if not calls:
+        return True
+    opaque = {call: sp.Dummy() for call in calls}
+    replaced = expr.xreplace(opaque)
+    generators = list(opaque.values())
+    if not replaced.is_polynomial(*generators):
+        return True
+    return bool(sp.Poly(replaced, *generators).total_degree() <= MAX_CALL_DEGREE)
+
+
+MAX_CALL_DEGREE = 2
+"""Largest total degree of p′ in its trigonometric and hyperbolic calls on which ``solveset`` runs."""
 
 _HYPERBOLIC = (sp.sinh, sp.cosh, sp.tanh, sp.coth, sp.sech, sp.csch)
 

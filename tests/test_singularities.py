@@ -169,3 +169,17 @@ def test_every_cause_has_its_latex_meaning() -> None:
     from symrot.singularities import CAUSES
 
     assert set(CAUSES) == set(CAUSE_MEANINGS)
+
+
+def test_a_cubic_in_the_cosine_is_left_to_the_numeric_scan() -> None:
+    """p′ = 1 + 3 sin²φ cos φ of φ + sin³φ is a cubic in cos φ: solveset ran past its 15 s safety
+    bound on it and ``derive`` exited 2. It is not attempted (shape, not time); the scan finds the
+    zero of p′ at 1.97679 (3c³ − 3c − 1 = 0 in c = cos φ)."""
+    from symrot.parsing import PHI
+    from symrot.singularities import _low_degree_in_calls
+
+    assert not _low_degree_in_calls(1 + 3 * sp.sin(PHI) ** 2 * sp.cos(PHI))
+    assert _low_degree_in_calls(sp.cos(PHI / 4)) and _low_degree_in_calls(1 / sp.cos(PHI) ** 2)
+    found = validity(derive_expression(parse_expression("phi + sin(phi)**3")))
+    assert abs(found.phi_max_float - 1.9767889011924048) < 1e-12
+    assert found.singularities[0].quantity == "p_prime" and found.numeric_only
