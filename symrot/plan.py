@@ -909,7 +909,9 @@ def _p_max_squared(p: sp.Expr, phi_max: sp.Expr, p_max: float) -> sp.Float | Non
     if not np.isfinite(p_max):
         return None
     exact = sp.N(p.subs(PHI, phi_max) ** 2, 50)
-    return exact if exact.is_real and exact.is_finite else sp.Float(p_max * p_max, 50)
+    # at a jump of p (2 atan(tan(φ/2)) at π) the value there is not p_max, nor a number
+    jump = exact.is_Float and abs(float(exact) - p_max * p_max) > 1e-9 * p_max * p_max
+    return exact if exact.is_Float and exact.is_finite and not jump else sp.Float(p_max * p_max, 50)
 
 
 def _use_complement(coefficient: Coefficient, inverse: sp.Expr, complement: sp.Rational) -> Coefficient:

@@ -58,6 +58,7 @@ CAUSES = {
     ("monotonicity", "0"): "p' changes sign: |p| no longer determines phi",
     ("p", "edge"): "p is not real beyond this angle (the edge of its real domain)",
     ("monotonicity", "jump"): "p' jumps across 0 (p has a kink): |p| no longer determines phi",
+    ("p", "jump"): "p jumps (is discontinuous): |p| no longer determines phi",
 }
 MAX_CANDIDATES = 48
 """Brackets polished per function, smallest angles first (the validity range is the smallest). Each
@@ -133,6 +134,14 @@ def _validity_of(p: sp.Expr) -> Validity:
         numeric_only |= exact is None
         phi = exact if exact is not None else sp.Float(mpmath.nstr(jump, 30), 30)
         found.append(Singularity(phi, float(jump), CAUSES[("monotonicity", "jump")], "monotonicity", "jump"))
+    drop = _first_drop(p)
+    if drop is not None and any(abs(s.phi_float - float(drop)) < 1e-9 * float(drop) for s in found):
+        drop = None  # p falls across a pole or a logarithm (asinh(tan φ) at π/2): already listed
+    if drop is not None:  # 2 atan(tan(φ/2)) falls from π to −π at π; p′ = 1 says nothing
+        exact = _exact_angle(drop, candidates)
+        numeric_only |= exact is None
+        phi = exact if exact is not None else sp.Float(mpmath.nstr(drop, 30), 30)
+        found.append(Singularity(phi, float(drop), CAUSES[("p", "jump")], "p", "jump"))
     found.sort(key=lambda s: (s.phi_float, QUANTITIES.index(s.quantity)
                               if s.quantity in QUANTITIES else len(QUANTITIES)))
     if not found:
@@ -177,13 +186,53 @@ def _first_sign_jump(p_prime: sp.Expr) -> mpmath.mpf | None:
         return low
 
 
+def _first_drop(p: sp.Expr) -> mpmath.mpf | None:
+    """The first angle in (0, 4π] where p falls by a jump (a discontinuity), bisected at twice
+    DIGITS; None where p only decreases continuously (after a zero of p′, which :func:`_events`
+    finds) or never decreases."""
+    grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
+    numeric = sp.lambdify(PHI, p, modules=[{"RealCbrt": np.cbrt}, "numpy"])
+    with np.errstate(all="ignore"):
+        values = np.asarray(numeric(grid), dtype=float) * np.ones_like(grid)
+    finite = np.flatnonzero(np.isfinite(values))
+    falls = np.flatnonzero(values[finite[1:]] < values[finite[:-1]])
+    if not falls.size:
+        return None
+    before, after = finite[falls[0]], finite[falls[0] + 1]
+    exact = _safe(_mp(p))
+    with mpmath.workdps(2 * DIGITS):
+        low, high = mpmath.mpf(grid[before]), mpmath.mpf(grid[after])
+        start = exact(low)
+        for _ in range(JUMP_STEPS):
+            middle = (low + high) / 2
+            value = exact(middle)
+            if not mpmath.isfinite(value):
+                break
+            low, high = (middle, high) if value >= start else (low, middle)
+        step = mpmath.mpf(10) ** -15 * high
+        left, right = exact(low - step), exact(high + step)
+        if not (mpmath.isfinite(left) and mpmath.isfinite(right)):
+            return None
+        scale = max(abs(values[before]), abs(values[after]), 1.0)
+        if left - right < 1e-6 * scale:
+            return None  # a continuous decrease: p′ < 0 there, a sign change _events reports
+        if max(abs(left), abs(right)) > 1e6 * scale:
+            return None  # a pole (tan φ from +∞ to −∞), which _events reports
+        return low
+
+
 def _magnitude_at(p: sp.Expr, edge: Singularity) -> float:
-    """|p| at the edge of the validity range: exact when SymPy can, else from the left side."""
-    value = p.subs(PHI, edge.phi).evalf(30)
-    if value.is_real and value.is_finite:
+    """|p| at the edge of the validity range: exact when SymPy can, else from the left side (always
+    at a jump of p, whose value there is not the limit from the left)."""
+    value = p.subs(PHI, edge.phi).evalf(30) if edge.limit != "jump" else sp.nan
+    if value.is_Number and value.is_real and value.is_finite:
         return abs(float(value))
     with mpmath.workdps(DIGITS):
-        left = _safe(_mp(p))(mpmath.mpf(edge.phi_float) * (1 - mpmath.mpf(10) ** -12))
+        if edge.limit == "jump":  # p stays finite up to a jump: its limit from the left, to 30 digits
+            angle = mpmath.mpf(sp.N(edge.phi, DIGITS)) * (1 - mpmath.mpf(10) ** -30)
+        else:
+            angle = mpmath.mpf(edge.phi_float) * (1 - mpmath.mpf(10) ** -12)
+        left = _safe(_mp(p))(angle)
     return float(abs(left)) if mpmath.isfinite(left) else float("inf")
 
 

@@ -183,3 +183,15 @@ def test_a_cubic_in_the_cosine_is_left_to_the_numeric_scan() -> None:
     found = validity(derive_expression(parse_expression("phi + sin(phi)**3")))
     assert abs(found.phi_max_float - 1.9767889011924048) < 1e-12
     assert found.singularities[0].quantity == "p_prime" and found.numeric_only
+
+
+def test_a_jump_of_p_itself_ends_the_range() -> None:
+    """2 atan(tan(φ/2)) is φ up to π and falls to −π there, while SymPy's p′ is 1 everywhere: the
+    analysis reported no singular angle in (0, 4π] and the emitted code an unbounded range. A fall
+    of p across a pole or a logarithm (tan φ, asinh(tan φ) at π/2) is not a jump."""
+    found = validity(derive_expression(parse_expression("2*atan(tan(phi/2))")))
+    assert found.phi_max == sp.pi and abs(found.p_max_float - 3.141592653589793) < 1e-15
+    assert (found.singularities[0].quantity, found.singularities[0].limit) == ("p", "jump")
+    for text in ("tan(phi)", "asinh(tan(phi))"):
+        listed = validity(derive_expression(parse_expression(text))).singularities
+        assert all(s.limit != "jump" for s in listed), text

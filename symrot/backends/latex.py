@@ -159,6 +159,7 @@ CAUSE_MEANINGS = {
     ("p", "edge"): r"$p$ is not real beyond this angle (the edge of its real domain)",
     ("monotonicity", "jump"): r"$p'$ jumps across 0 ($p$ has a kink), so $\|\mathbf{p}\|$ no longer"
                               r" determines $\varphi$",
+    ("p", "jump"): r"$p$ jumps (is discontinuous), so $\|\mathbf{p}\|$ no longer determines $\varphi$",
 }
 """What each kind of singularity of :data:`symrot.singularities.CAUSES` means, as LaTeX."""
 SERIES = (("nu", r"\nu"), ("mu", r"\mu"), ("det_H", r"\det\mathbf{H}"),
@@ -185,6 +186,8 @@ def cause_latex(quantity: str, limit: str) -> str:
         return r"p' \gtrless 0"
     if limit == "edge":
         return r"p \notin \mathbb{R}\ \text{beyond}"
+    if limit == "jump":
+        return r"p\ \text{jumps}"
     return rf"{QUANTITY_SYMBOLS[quantity]} \to {LIMITS[limit]}"
 
 
