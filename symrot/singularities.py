@@ -67,7 +67,7 @@ in (0, 4π]: with 400, the validity analysis of sin(sinh φ) polished 1600 and t
 singularities), with 48 it takes 1 s (185 listed, the same edge 1.2334); 2 sin(tan(φ/2)) 5.0 → 2.6 s.
 The named parameterizations and the other corpus functions have at most 16 per function."""
 JUMP_STEPS = 100
-"""Bisection steps that locate a jump of p′, at twice DIGITS (to ~10⁻³² of the grid step, enough
+"""Bisection steps that locate a jump of p′ or of p, at twice DIGITS (to ~10⁻³² of the grid step, enough
 to match a multiple of π to the 25 digits of :func:`_exact_angle`; p′ such as cos φ/√(1 − sin²φ)
 is resolved there)."""
 EDGE_STEPS = 200
@@ -155,7 +155,7 @@ def _validity_of(p: sp.Expr) -> Validity:
 
 def _first_sign_jump(p_prime: sp.Expr) -> mpmath.mpf | None:
     """The first angle in (0, 4π] where p′ changes sign without passing through 0 or ∞ (a jump, as
-    where p has |g| or sign(g) in it), bisected at 50 digits; None when p′ keeps its sign or every
+    where p has |g| or sign(g) in it), bisected at twice DIGITS; None when p′ keeps its sign or every
     sign change is a zero or a pole (which :func:`_events` finds and classifies)."""
     grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
     numeric = sp.lambdify(PHI, p_prime, modules=[{"RealCbrt": np.cbrt}, "numpy"])
