@@ -257,7 +257,17 @@ def _solvable_shape(p: sp.Expr) -> bool:
         return True
     if len(outermost) > 1:
         return False
-    return not p.xreplace({outermost[0]: sp.Dummy()}).has(PHI)
+    level = sp.Dummy()
+    outer = p.xreplace({outermost[0]: level})
+    if outer.has(PHI):
+        return False
+    # a cubic in the call (asinh³φ + asinh φ): Cardano's root inside sinh, which solve spent its
+    # whole bound on and the emit its 60 s budget; tan³φ/3 + tan φ got atan of it, never printed
+    return not (outer.is_polynomial(level) and sp.degree(outer, level) > MAX_SOLVED_DEGREE)
+
+
+MAX_SOLVED_DEGREE = 2
+"""Largest degree of p as a polynomial in its one function application for which ``solve`` runs."""
 
 
 def _exact_angle(p_of: Callable[[mpmath.mpf], mpmath.mpf], slope_of: Callable[[mpmath.mpf], mpmath.mpf],

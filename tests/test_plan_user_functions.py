@@ -71,6 +71,18 @@ def test_a_pole_where_p_grows_exponentially_ends_the_domain_instead_of_failing()
         assert 2.0**32 <= precision.x_limit <= 2.0**600
 
 
+def test_p_cubic_in_its_one_function_is_not_solved() -> None:
+    """asinh³φ + asinh φ = s: sp.solve wrote sinh of Cardano's root and spent its whole bound on it,
+    and ``--emit`` ran out of its 60 s budget (61.8 s). A cubic or higher in the one call is not
+    handed to the solver (the Newton angle serves it); a quadratic or linear one still is."""
+    from symrot.plan import _solvable_shape
+
+    assert not _solvable_shape(sp.asinh(PHI) ** 3 + sp.asinh(PHI))
+    assert not _solvable_shape(sp.tan(PHI) ** 3 / 3 + sp.tan(PHI))
+    assert _solvable_shape(2 * sp.asinh(PHI / 2)) and _solvable_shape(sp.atan(sp.sin(PHI)))
+    assert closed_inverse(sp.asinh(PHI) ** 3 + sp.asinh(PHI), sp.Integer(1)) is None
+
+
 def test_a_triple_pole_keeps_its_domain_up_to_where_det_h_underflows() -> None:
     """tan φ + tan³φ/3 = N/(D cos³φ): cos φ through s as ∛(N/(D·s)) (symrot.pole), and in float32,
     where det H ~ 1/x² underflows next to the pole, forms are compared only where the value is a
