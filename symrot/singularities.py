@@ -153,14 +153,20 @@ def _validity_of(p: sp.Expr) -> Validity:
     return Validity(edge.phi, edge.phi_float, p_at_edge, tuple(found), numeric_only)
 
 
+def _scan(expr: sp.Expr) -> tuple[np.ndarray, np.ndarray]:
+    """(grid, values): ``expr`` in double precision on SCAN_POINTS angles up to SCAN_END."""
+    grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
+    numeric = sp.lambdify(PHI, expr, modules=[{"RealCbrt": np.cbrt}, "numpy"])
+    with np.errstate(all="ignore"):
+        values = np.asarray(numeric(grid), dtype=float) * np.ones_like(grid)
+    return grid, values
+
+
 def _first_sign_jump(p_prime: sp.Expr) -> mpmath.mpf | None:
     """The first angle in (0, 4π] where p′ changes sign without passing through 0 or ∞ (a jump, as
     where p has |g| or sign(g) in it), bisected at twice DIGITS; None when p′ keeps its sign or every
     sign change is a zero or a pole (which :func:`_events` finds and classifies)."""
-    grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
-    numeric = sp.lambdify(PHI, p_prime, modules=[{"RealCbrt": np.cbrt}, "numpy"])
-    with np.errstate(all="ignore"):
-        values = np.asarray(numeric(grid), dtype=float) * np.ones_like(grid)
+    grid, values = _scan(p_prime)
     exact = _safe(_mp(p_prime))
     finite = np.flatnonzero(np.isfinite(values))  # 0/0 on a grid point next to the jump is skipped
     change = np.flatnonzero(np.sign(values[finite[:-1]]) * np.sign(values[finite[1:]]) < 0)
@@ -190,10 +196,7 @@ def _first_drop(p: sp.Expr) -> mpmath.mpf | None:
     """The first angle in (0, 4π] where p falls by a jump (a discontinuity), bisected at twice
     DIGITS; None where p only decreases continuously (after a zero of p′, which :func:`_events`
     finds) or never decreases."""
-    grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
-    numeric = sp.lambdify(PHI, p, modules=[{"RealCbrt": np.cbrt}, "numpy"])
-    with np.errstate(all="ignore"):
-        values = np.asarray(numeric(grid), dtype=float) * np.ones_like(grid)
+    grid, values = _scan(p)
     finite = np.flatnonzero(np.isfinite(values))
     falls = np.flatnonzero(values[finite[1:]] < values[finite[:-1]])
     if not falls.size:
@@ -340,10 +343,7 @@ def _events(expr: sp.Expr, extra: tuple[float, ...] = ()) -> list[tuple[mpmath.m
 
     ``extra`` are candidate angles from the symbolic analysis, bracketed in addition to the scan.
     """
-    grid = np.linspace(SCAN_END / SCAN_POINTS, SCAN_END, SCAN_POINTS)
-    numeric = sp.lambdify(PHI, expr, modules=[{"RealCbrt": np.cbrt}, "numpy"])
-    with np.errstate(all="ignore"):
-        values = np.asarray(numeric(grid), dtype=float) * np.ones_like(grid)
+    grid, values = _scan(expr)
     exact = _mp(expr)
     events: list[tuple[mpmath.mpf, str, bool]] = []
     with mpmath.workdps(DIGITS):
