@@ -29,6 +29,7 @@ from typing import NamedTuple
 
 import mpmath
 import sympy as sp
+from sympy.polys.polyerrors import BasePolynomialError
 
 from .algebraic import S
 from .functions import BoundedPower, RealCbrt, mpmath_namespace
@@ -92,7 +93,10 @@ def pole_factor(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     numerator, denominator = sp.fraction(quotient)
     if not denominator.has(PHI):
         return _logarithmic_pole(p, phi_max) or _log_pole(p, phi_max) or _arcsine_edge(p, phi_max)
-    factored = bounded(2.0, None, sp.factor_list, denominator)
+    try:  # a denominator that is not a polynomial in its calls: √(1 + φ²) of φ/√(1 + φ²)
+        factored = bounded(2.0, None, sp.factor_list, denominator)
+    except BasePolynomialError:
+        return None
     if factored is None:
         return None
     constant, factors = factored
