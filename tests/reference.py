@@ -104,13 +104,38 @@ def validity_edge(p: Callable[[Any], Any], dp: Callable[[Any], Any], grid: int =
         return top
 
 
+SMALL_ANGLES = (mpmath.mpf("3e-31"), mpmath.mpf("7e-13"))
+"""Where :func:`loses_digits_at_small_angles` looks (not powers of two: the roundings of exp(φ) and
+exp(−φ) at 2⁻¹³³ drop the same φ²/2 and their difference is exact by symmetry)."""
+
+
+def loses_digits_at_small_angles(function: Callable[[Any], Any]) -> bool:
+    """Whether ``function`` loses more than its guard digits at one of SMALL_ANGLES: its values at
+    DIGITS + 10 digits and at twice as many plus 80 differ by more than 10^−DIGITS relative (the
+    cancellation of 1 − cos φ or exp(φ) − exp(−φ)), or it cannot be evaluated there."""
+    for angle in SMALL_ANGLES:
+        values = []
+        for digits in (DIGITS + 10, 2 * (DIGITS + 10) + 80):
+            with mpmath.workdps(digits):
+                try:
+                    values.append(+function(+angle))
+                except (ZeroDivisionError, ValueError):
+                    return True
+        coarse, fine = values
+        if fine == 0 or abs(coarse - fine) > abs(fine) * mpmath.mpf(10) ** -DIGITS:
+            return True
+    return False
+
+
 @dataclass
 class GeneratingFunction:
     """p(φ) with its derivative, as mpmath functions, and its validity range."""
 
     expression: str
     cancels: bool = False
-    """True when evaluating p(φ) loses digits at small φ (e.g. exp(φ) − exp(−φ)): extra digits."""
+    """True when evaluating p(φ) loses digits at small φ (e.g. exp(φ) − exp(−φ)): extra digits. Set
+    here too when p or p′ measurably loses them (:func:`loses_digits_at_small_angles`), so that a
+    function typed without the flag (2(1 − cos φ)/φ) is not measured against a cancelled reference."""
     phi_max_text: str | None = None
     """φ_max as a SymPy expression; None: :func:`validity_edge`."""
     expr: sp.Expr = field(init=False)
@@ -127,6 +152,7 @@ class GeneratingFunction:
                 self.phi_max = validity_edge(self.p, self.dp)
             else:
                 self.phi_max = mpmath.mpf(sp.N(parse(self.phi_max_text), DIGITS + 10))
+        self.cancels = self.cancels or any(loses_digits_at_small_angles(f) for f in (self.p, self.dp))
 
     def guard(self, s: Any) -> int:
         """Extra digits for |p| = s: the cancellation of p(φ) at small φ, when flagged."""
