@@ -152,9 +152,16 @@ def gudermannian(expr: sp.Expr) -> sp.Expr:
     """Replace asin(tanh a) by atan(sinh a), the same function (the Gudermannian), accurate for large
     a, where tanh a rounds next to 1 and asin's slope 1/√(1 − u²) = cosh a multiplies its rounding:
     asin(tanh φ) (corpus entry 28) was 80 ulp off at φ = 6.27, beyond the Newton angle's residual
-    tolerance, so the float64 range ended at |p| = 1.56686 < p_max = 1.56706 (NaN up to 2π)."""
-    return expr.replace(lambda e: isinstance(e, sp.asin) and isinstance(e.args[0], sp.tanh),
+    tolerance, so the float64 range ended at |p| = 1.56686 < p_max = 1.56706 (NaN up to 2π).
+
+    Likewise atanh(sin a) by asinh(tan a), its inverse, equal for |a| < π/2 (a form is only taken
+    where it measures right): next to a = π/2, sin a rounds next to 1 and 1 − sin a keeps none of
+    its digits; from_quaternion of atanh(sin φ) was 1.4·10¹⁰ ulp off at π/2 − 10⁻⁶ (tan a keeps the
+    relative accuracy of π/2 − a)."""
+    expr = expr.replace(lambda e: isinstance(e, sp.asin) and isinstance(e.args[0], sp.tanh),
                         lambda e: sp.atan(sp.sinh(e.args[0].args[0])))
+    return expr.replace(lambda e: isinstance(e, sp.atanh) and isinstance(e.args[0], sp.sin),
+                        lambda e: sp.asinh(sp.tan(e.args[0].args[0])))
 
 
 def hyperbolic_complement(expr: sp.Expr) -> sp.Expr:
@@ -234,15 +241,18 @@ RATIONALIZED_OPS = 40
 
 
 def angle_forms(inverse: sp.Expr) -> tuple[sp.Expr, ...]:
-    """The closed inverse φ(s) as solved and with its square roots moved into the denominator
-    (``radsimp`` of 1/φ): for p = φ/(1 − φ²/10), (√(10s² + 25) − 5)/s cancels for small s and was
-    never printed (the Newton angle was 416 float32 ulp off next to the pole), while
-    10s/(√(10s² + 25) + 5) is accurate everywhere. The plan prints the first that measures within
-    :data:`ANGLE_TOLERANCE_ULP`."""
+    """The closed inverse φ(s) as solved, with asin(tanh u) as atan(sinh u) (:func:`gudermannian`),
+    and with its square roots moved into the denominator (``radsimp`` of 1/φ): for
+    p = φ/(1 − φ²/10), (√(10s² + 25) − 5)/s cancels for small s and was never printed (the Newton
+    angle was 416 float32 ulp off next to the pole), while 10s/(√(10s² + 25) + 5) is accurate
+    everywhere. For p = atanh(sin φ), asin(tanh s) loses the digits of π/2 − φ as tanh s rounds next
+    to 1, and the Newton angle that replaced it converged only below |p| = 5.02 (φ = 1.5576 of π/2),
+    where the range ended. The plan prints the first that measures within :data:`ANGLE_TOLERANCE_ULP`."""
+    forms = (inverse, gudermannian(inverse))
     radicals = [a for a in inverse.atoms(sp.Pow) if a.exp.is_Rational and not a.exp.is_Integer]
     if not radicals or sp.count_ops(inverse) > RATIONALIZED_OPS:
-        return (inverse,)
-    return tuple(dict.fromkeys((inverse, 1 / sp.radsimp(1 / inverse))))
+        return tuple(dict.fromkeys(forms))
+    return tuple(dict.fromkeys((*forms, 1 / sp.radsimp(1 / inverse))))
 
 
 def _solvable_shape(p: sp.Expr) -> bool:
@@ -356,7 +366,7 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
     forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
     forms += [well_conditioned(closed), near_half_turn(closed)] if closed.has(sp.cos) else []
     forms.append(closed)
-    if closed.has(sp.asin):
+    if closed.has(sp.asin, sp.atanh):
         forms.append(gudermannian(closed))
     plain = tuple(dict.fromkeys([closed, *forms]))
     forms += [with_length(form, argument) for form in forms]

@@ -195,8 +195,13 @@ def _gudermannian_pole(p: sp.Expr, phi_max: float) -> PoleFactor | None:
     a logarithm, corpus entry 46): f = cos(aφ), the factor of p′ = A′ + B′ asinh(tan aφ) + aB/cos(aφ).
     Through s, tan(aφ) = sinh((s − A)/B), so f = 1/cosh((s − A)/B), whose relative error is that of
     (s − A)/B times tanh of it, a few ε; from the rounded φ̂, f loses ε φ_max/(φ_max − φ) (the
-    derivatives of asinh(tan φ) were 6·10⁵ ulp off at π/2 − 10⁻⁶). The call itself is (s − A)/B."""
-    calls = [call for call in p.atoms(sp.asinh) if isinstance(call.args[0], sp.tan) and call.has(PHI)]
+    derivatives of asinh(tan φ) were 6·10⁵ ulp off at π/2 − 10⁻⁶). The call itself is (s − A)/B.
+
+    atanh(sin(aφ)) is the same function on |aφ| < π/2 and is taken the same way: as a logarithmic
+    pole (f = 1 − sin²(aφ)) it left cos(aφ) = 1/p′ of the coefficients in the rounded φ̂, and the
+    domain of atanh(sin φ) ended at |p| = 5.02 (φ = 1.5576 of π/2) in both precisions."""
+    calls = [call for call in p.atoms(sp.asinh, sp.atanh) if call.has(PHI)
+             and isinstance(call.args[0], sp.tan if isinstance(call, sp.asinh) else sp.sin)]
     with mpmath.workdps(ZERO_DIGITS):
         roots = [(call, _root_near(sp.cos(call.args[0].args[0]), phi_max)) for call in calls]
         edges = [(call, root) for call, root in roots if root is not None]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import mpmath
 import numpy as np
+import pytest
 import sympy as sp
 
 from symrot.api import derive
@@ -222,6 +223,36 @@ def test_newton_next_to_a_pole_steps_on_the_reciprocal_below_the_pole() -> None:
             with np.errstate(all="ignore"):  # the modules' functions are wrapped so; p overflows at the top
                 got = float(namespace["_angle"](np.array([size], dtype=dtype))[0])  # type: ignore[operator]
             assert abs(got - exact) <= 4 * float(np.finfo(dtype).eps) * exact, (dtype, gap, got, exact)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_an_arcsine_of_tanh_inverse_is_offered_as_the_arctangent_of_sinh(dtype: type) -> None:
+    """p = atanh(sin φ) (the inverse Gudermannian function, as asinh(tan φ)): SymPy solves it as
+    asin(tanh s), which loses the digits of π/2 − φ where tanh s rounds next to 1; the Newton angle
+    that replaced it converged below |p| = 5.02 only, and the range ended there (φ = 1.5576 of π/2).
+    atan(sinh s), the same function, is offered next and measures within the tolerance."""
+    from symrot.plan import ANGLE_TOLERANCE_ULP, angle_forms
+
+    p = sp.atanh(sp.sin(PHI))
+    inverse = closed_inverse(p, sp.Integer(1))
+    assert inverse == sp.asin(sp.tanh(S))
+    forms = angle_forms(inverse)
+    assert forms[:2] == (inverse, sp.atan(sp.sinh(S)))
+    half_pi = float(np.pi) / 2
+    assert closed_angle_error(forms[0], p, half_pi, dtype) > ANGLE_TOLERANCE_ULP
+    assert closed_angle_error(forms[1], p, half_pi, dtype) <= ANGLE_TOLERANCE_ULP
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_the_quaternion_scale_of_atanh_sin_is_measured_as_asinh_tan(dtype: type) -> None:
+    """σ = p(φ)/sin(φ/2) of p = atanh(sin φ): 1 − sin φ from the rounded φ keeps none of its digits
+    next to π/2, and from_quaternion was 1.4·10¹⁰ (float64) and 3.4·10⁶ (float32) ulp off at
+    π/2 − 10⁻⁶; asinh(tan φ), the same function there, is a candidate and the plan takes it."""
+    from symrot.plan import _quaternion_scale
+
+    scale = _quaternion_scale(sp.atanh(sp.sin(PHI)), float(np.pi) / 2, dtype)
+    assert scale.algebraic is None and scale.branch is not None
+    assert scale.branch.closed.has(sp.asinh(sp.tan(PHI))) and not scale.branch.closed.has(sp.atanh)
 
 
 def test_a_closed_inverse_that_cancels_is_rejected_not_crashed() -> None:
