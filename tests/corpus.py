@@ -120,6 +120,9 @@ CORPUS: tuple[Entry, ...] = (
     # 3 sin φ/(2 cos(φ/4) atanh(3φ/2)), and atanh from the rounded angle next to 2/3 cost float64
     # rotation_matrix 102 ulp and omega 195 ulp before atanh(3φ/2) was written as 3s/(2 cos(φ/4))
     Entry("2*cos(phi/4)*atanh(3*phi/2)/3", "inverse hyperbolic", "pole", False, "2/3"),
+    # typed at the CLI (stop 44): a radical denominator that factor_list cannot take ended --emit in
+    # an internal error
+    Entry("phi/sqrt(1 + phi**2)", "algebraic", "nu", True, TWO_PI),
 )
 
 
