@@ -472,13 +472,21 @@ def _safe(f: Callable[[mpmath.mpf], mpmath.mpf]) -> Callable[[mpmath.mpf], mpmat
     return safe
 
 
+NEAR = mpmath.mpf(10) ** -4
+"""How far from a zero :func:`_classify` compares its one-sided values with."""
+
+
 def _classify(safe: Callable[[mpmath.mpf], mpmath.mpf], angle: mpmath.mpf
               ) -> tuple[mpmath.mpf, str, bool] | None:
-    """Zero ('0') or pole ('oo') of ``safe`` at ``angle`` from one-sided values at ± 10⁻²⁰."""
+    """Zero ('0') or pole ('oo') of ``safe`` at ``angle`` from one-sided values at ± 10⁻²⁰. A zero is
+    small both absolutely and next to the values at ± :data:`NEAR` (f ~ f′·10⁻²⁰ against f′·10⁻⁴ at a
+    simple zero): det H ~ cos¹⁰(φ/2) of 2 sin(φ/2)/cos³(φ/2) is 10⁻²⁸ at 3.1377 and below 10⁻¹² all
+    around there; read as a zero, it ended the range at |p| = 2.6·10⁸ short of the pole at π."""
     delta = mpmath.mpf(10) ** -20
     left, right = safe(angle - delta), safe(angle + delta)
     tiny, huge = mpmath.mpf(10) ** -12, mpmath.mpf(10) ** 12
-    if abs(left) < tiny and abs(right) < tiny:
+    around = max(abs(safe(angle - NEAR)), abs(safe(angle + NEAR)))
+    if abs(left) < tiny and abs(right) < tiny and max(abs(left), abs(right)) < tiny * around:
         crosses = mpmath.sign(safe(angle - 10 * delta)) != mpmath.sign(safe(angle + 10 * delta))
         return angle, "0", bool(crosses)
     if abs(left) > huge or abs(right) > huge:

@@ -130,6 +130,18 @@ def test_sums_of_tangents_have_their_pole_as_the_edge(text: str, edge: sp.Expr) 
     assert abs(found.phi_max_float - float(edge)) < 1e-12
 
 
+@pytest.mark.parametrize(("text", "edge"), [("2*sin(phi/2)/cos(phi/2)**3", sp.pi),
+                                            ("tan(phi)**3/3 + tan(phi)", sp.pi / 2)])
+def test_a_quantity_that_is_merely_small_next_to_a_pole_is_not_a_zero(text: str, edge: sp.Expr) -> None:
+    """det H ~ cos¹⁰(φ/2) of 2 sin(φ/2)/cos³(φ/2) is 10⁻²⁸ at φ = 3.1377 and below the absolute
+    threshold of a zero all around there: it was read as a zero of det H, which ended the range at
+    |p| = 2.6·10⁸ (NaN from φ = 3.1377 in every emitted function). A zero is small relative to the
+    values next to it too; the edge is the pole at π, and p is unbounded."""
+    found = validity(derive_expression(parse_expression(text)))
+    assert abs(found.phi_max_float - float(edge)) < 1e-12
+    assert found.p_max_float == float("inf")
+
+
 def test_infinitely_many_zeros_are_polished_only_near_the_smallest_angles() -> None:
     """p′ = cos(sinh φ) cosh φ of sin(sinh φ) vanishes wherever sinh φ = π/2 + kπ: ~10⁵ zeros in
     (0, 4π]. At most MAX_CANDIDATES brackets per quantity are polished (smallest angles first); the
