@@ -257,8 +257,12 @@ def newton_lanes(p: sp.Expr, slope: sp.Expr, angles: np.ndarray, phi_max: float,
             printed: np.ndarray = np.asarray(rounded * ratio, dtype=dtype)
         residual_error = [abs(float(value) - f(mpmath.mpf(float(angle)))) if np.isfinite(value) else 0.0
                           for value, angle in zip(printed, rounded, strict=True)]
-    tolerance = [2 * epsilon * (theta + spread * (1 + min(float(error) / (epsilon * s), RESIDUAL_ULPS)))
-                 for theta, spread, error, s in zip(exact, spreads, residual_error, sizes, strict=True)]
+    # in Python floats: epsilon * s of a float32 s is a float32, and a large residual divided by it
+    # overflowed in the cast (a RuntimeWarning from the Python API, for sin φ + sin(3φ)/9)
+    tolerance = []
+    for theta, spread, error, s in zip(exact, spreads, residual_error, sizes, strict=True):
+        residual_ulps = min(float(error) / (epsilon * float(s)), RESIDUAL_ULPS)
+        tolerance.append(2 * epsilon * (theta + spread * (1 + residual_ulps)))
     return NewtonLanes(np.asarray(sizes, dtype=dtype), np.asarray(exact), np.asarray(tolerance))
 
 

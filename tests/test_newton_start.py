@@ -125,3 +125,16 @@ def test_newton_in_w_needs_fewer_steps_from_the_far_start() -> None:
     edge = measured_iterations(lanes, series, far, models, False, 1.0, sp.Rational(1, 2))
     assert plain.unconverged == edge.unconverged == math.inf
     assert edge.steps < plain.steps
+
+
+def test_lanes_of_a_residual_far_off_in_float32_stay_finite_without_warnings() -> None:
+    """The tolerance divides the residual's error by ε s; with s a float32, ε s was a float32 and
+    the quotient overflowed in the cast (a RuntimeWarning through the Python API while planning
+    sin φ + sin(3φ)/9). The residual's share is capped at RESIDUAL_ULPS, so the tolerance is finite."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lanes = newton_lanes(PHI, sp.Integer(1), np.array([0.5, 1.0]), 2 * math.pi, np.float32,
+                             lambda t: np.full_like(t, 1e35))
+    assert np.all(np.isfinite(lanes.tolerance)) and np.all(lanes.tolerance > 0)
