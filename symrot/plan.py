@@ -154,10 +154,10 @@ def gudermannian(expr: sp.Expr) -> sp.Expr:
     asin(tanh φ) (corpus entry 28) was 80 ulp off at φ = 6.27, beyond the Newton angle's residual
     tolerance, so the float64 range ended at |p| = 1.56686 < p_max = 1.56706 (NaN up to 2π).
 
-    Likewise atanh(sin a) by asinh(tan a), its inverse, equal for |a| < π/2 (a form is only taken
-    where it measures right): next to a = π/2, sin a rounds next to 1 and 1 − sin a keeps none of
-    its digits; from_quaternion of atanh(sin φ) was 1.4·10¹⁰ ulp off at π/2 − 10⁻⁶ (tan a keeps the
-    relative accuracy of π/2 − a)."""
+    Likewise atanh(sin a) by asinh(tan a), the same function (the inverse Gudermannian) for
+    |a| < π/2 (a form is only taken where it measures right): next to a = π/2, sin a rounds next
+    to 1 and 1 − sin a keeps none of its digits; from_quaternion of atanh(sin φ) was 1.4·10¹⁰ ulp
+    off at π/2 − 10⁻⁶ (tan a keeps the relative accuracy of π/2 − a)."""
     expr = expr.replace(lambda e: isinstance(e, sp.asin) and isinstance(e.args[0], sp.tanh),
                         lambda e: sp.atan(sp.sinh(e.args[0].args[0])))
     return expr.replace(lambda e: isinstance(e, sp.atanh) and isinstance(e.args[0], sp.sin),
