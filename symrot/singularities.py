@@ -128,20 +128,17 @@ def _validity_of(p: sp.Expr) -> Validity:
             if quantity == "p_prime" and limit == "0" and sign_change:
                 found.append(Singularity(phi, float(angle), CAUSES[("monotonicity", "0")],
                                          "monotonicity", "0"))
-    jump = _first_sign_jump(derivation.scalars_raw["p_prime"])
-    if jump is not None:  # asin(sin φ): p′ = cos φ/√(1 − sin²φ) is ±1, never 0 nor ∞
-        exact = _exact_angle(jump, candidates)
+    # asin(sin φ): p′ = cos φ/√(1 − sin²φ) is ±1, never 0 nor ∞; 2 atan(tan(φ/2)) falls from π to −π
+    # at π while p′ = 1 says nothing
+    for quantity in ("monotonicity", "p"):
+        angle = _first_sign_jump(derivation.scalars_raw["p_prime"]) if quantity == "monotonicity" \
+            else _first_drop(p)
+        if angle is None or any(abs(s.phi_float - float(angle)) < 1e-9 * float(angle) for s in found):
+            continue  # p falls across a pole or a logarithm (asinh(tan φ) at π/2): already listed
+        exact = _exact_angle(angle, candidates)
         numeric_only |= exact is None
-        phi = exact if exact is not None else sp.Float(mpmath.nstr(jump, 30), 30)
-        found.append(Singularity(phi, float(jump), CAUSES[("monotonicity", "jump")], "monotonicity", "jump"))
-    drop = _first_drop(p)
-    if drop is not None and any(abs(s.phi_float - float(drop)) < 1e-9 * float(drop) for s in found):
-        drop = None  # p falls across a pole or a logarithm (asinh(tan φ) at π/2): already listed
-    if drop is not None:  # 2 atan(tan(φ/2)) falls from π to −π at π; p′ = 1 says nothing
-        exact = _exact_angle(drop, candidates)
-        numeric_only |= exact is None
-        phi = exact if exact is not None else sp.Float(mpmath.nstr(drop, 30), 30)
-        found.append(Singularity(phi, float(drop), CAUSES[("p", "jump")], "p", "jump"))
+        phi = exact if exact is not None else sp.Float(mpmath.nstr(angle, 30), 30)
+        found.append(Singularity(phi, float(angle), CAUSES[(quantity, "jump")], quantity, "jump"))
     found.sort(key=lambda s: (s.phi_float, QUANTITIES.index(s.quantity)
                               if s.quantity in QUANTITIES else len(QUANTITIES)))
     if not found:
@@ -167,26 +164,20 @@ def _first_sign_jump(p_prime: sp.Expr) -> mpmath.mpf | None:
     where p has |g| or sign(g) in it), bisected at twice DIGITS; None when p′ keeps its sign or every
     sign change is a zero or a pole (which :func:`_events` finds and classifies)."""
     grid, values = _scan(p_prime)
-    exact = _safe(_mp(p_prime))
     finite = np.flatnonzero(np.isfinite(values))  # 0/0 on a grid point next to the jump is skipped
     change = np.flatnonzero(np.sign(values[finite[:-1]]) * np.sign(values[finite[1:]]) < 0)
     if not change.size:
         return None
     before, after = finite[change[0]], finite[change[0] + 1]
+    exact = _safe(_mp(p_prime))
     with mpmath.workdps(2 * DIGITS):
-        low, high = mpmath.mpf(grid[before]), mpmath.mpf(grid[after])
-        sign = mpmath.sign(exact(low))
-        for _ in range(JUMP_STEPS):
-            middle = (low + high) / 2
-            value = exact(middle)
-            if not mpmath.isfinite(value) or value == 0:
-                break
-            low, high = (middle, high) if mpmath.sign(value) == sign else (low, middle)
-        step = mpmath.mpf(10) ** -15 * high
-        left, right = exact(low - step), exact(high + step)
-        size = max(abs(values[before]), abs(values[after]))
-        if not (mpmath.isfinite(left) and mpmath.isfinite(right)):
+        sign = mpmath.sign(exact(mpmath.mpf(grid[before])))
+        found = _bisected(exact, grid[before], grid[after], lambda value: mpmath.sign(value) == sign,
+                          stop=lambda value: value == 0)
+        if found is None:
             return None
+        low, left, right = found
+        size = max(abs(values[before]), abs(values[after]))
         if min(abs(left), abs(right)) < 1e-6 * size or max(abs(left), abs(right)) > 1e6 * size:
             return None  # a zero or a pole of p′ (found by _events), not a jump
         return low
@@ -204,24 +195,38 @@ def _first_drop(p: sp.Expr) -> mpmath.mpf | None:
     before, after = finite[falls[0]], finite[falls[0] + 1]
     exact = _safe(_mp(p))
     with mpmath.workdps(2 * DIGITS):
-        low, high = mpmath.mpf(grid[before]), mpmath.mpf(grid[after])
-        start = exact(low)
-        for _ in range(JUMP_STEPS):
-            middle = (low + high) / 2
-            value = exact(middle)
-            if not mpmath.isfinite(value):
-                break
-            low, high = (middle, high) if value >= start else (low, middle)
-        step = mpmath.mpf(10) ** -15 * high
-        left, right = exact(low - step), exact(high + step)
-        if not (mpmath.isfinite(left) and mpmath.isfinite(right)):
+        start = exact(mpmath.mpf(grid[before]))
+        found = _bisected(exact, grid[before], grid[after], lambda value: value >= start)
+        if found is None:
             return None
+        low, left, right = found
         scale = max(abs(values[before]), abs(values[after]), 1.0)
         if left - right < 1e-6 * scale:
             return None  # a continuous decrease: p′ < 0 there, a sign change _events reports
         if max(abs(left), abs(right)) > 1e6 * scale:
             return None  # a pole (tan φ from +∞ to −∞), which _events reports
         return low
+
+
+def _bisected(exact: Callable[[mpmath.mpf], mpmath.mpf], low: float, high: float,
+              keeps_left: Callable[[mpmath.mpf], bool],
+              stop: Callable[[mpmath.mpf], bool] = lambda value: False,
+              ) -> tuple[mpmath.mpf, mpmath.mpf, mpmath.mpf] | None:
+    """(low, f(low − δ), f(high + δ)) after JUMP_STEPS bisections of [low, high] that keep the left
+    end where ``keeps_left``(f) holds (stopping early at a value that is not finite or ``stop``s),
+    with δ = 10⁻¹⁵ high: the two sides of a jump of f; None when a side is not finite."""
+    left_end, right_end = mpmath.mpf(low), mpmath.mpf(high)
+    for _ in range(JUMP_STEPS):
+        middle = (left_end + right_end) / 2
+        value = exact(middle)
+        if not mpmath.isfinite(value) or stop(value):
+            break
+        left_end, right_end = (middle, right_end) if keeps_left(value) else (left_end, middle)
+    step = mpmath.mpf(10) ** -15 * right_end
+    left, right = exact(left_end - step), exact(right_end + step)
+    if not (mpmath.isfinite(left) and mpmath.isfinite(right)):
+        return None
+    return left_end, left, right
 
 
 def _magnitude_at(p: sp.Expr, edge: Singularity) -> float:
