@@ -358,18 +358,48 @@ def _divided(total: sp.Expr, pole: PoleFactor) -> sp.Expr:
         value = _value(total, pole.phi_max)
     if value is None or abs(value) > mpmath.mpf(10) ** (10 - ZERO_DIGITS):
         return total
+    quotient, power = _repeatedly_divided(total, pole.factor)
+    if power == 0:
+        divided = _divided_through_base_angle(total, pole)
+        return divided if divided != total else _divided_through_cofunction(total, pole)
+    return quotient * BoundedPower(pole.through_s, power)
+
+
+def _divided_through_cofunction(total: sp.Expr, pole: PoleFactor) -> sp.Expr:
+    """A vanishing sum that is a polynomial in the cofunction g of f = cos(a) (g = sin a; for
+    f = sin(a), g = cos a), which is σ = ±1 at φ_max, written through f²: P(g) = (g − σ)^k·Q(g) and
+    g − σ = −f²/(g + σ) (g² + f² = 1), so P = Q·(−1/(g + σ))^k·(N/(D·s))^(2k). SymPy writes
+    1 − sin²(φ/4) as (sin(φ/4) − 1)(sin(φ/4) + 1), and the first factor, of size (2π − φ)²/32 next
+    to the pole at 2π, lost every digit from the rounded angle in H⁻¹'s across-axis part of
+    hypothesis row 1 (2 tan(φ/4) cosh(3φ/4) + …: 1.2·10⁴ ulp at |p|² = 2³², where the range ended)."""
+    if not isinstance(pole.factor, (sp.sin, sp.cos)):
+        return total
+    argument = pole.factor.args[0]
+    cofunction = sp.sin(argument) if isinstance(pole.factor, sp.cos) else sp.cos(argument)
+    with mpmath.workdps(ZERO_DIGITS):
+        value = _value(cofunction, pole.phi_max)
+    if value is None or abs(abs(value) - 1) > mpmath.mpf(10) ** (10 - ZERO_DIGITS):
+        return total
+    sigma = sp.Integer(1 if value > 0 else -1)
+    quotient, power = _repeatedly_divided(total, cofunction - sigma, cofunction)
+    if power == 0:
+        return total
+    return quotient * (-1 / (cofunction + sigma)) ** power * BoundedPower(pole.through_s, 2 * power)
+
+
+def _repeatedly_divided(total: sp.Expr, divisor: sp.Expr, *generators: sp.Expr) -> tuple[sp.Expr, int]:
+    """(total/divisor^k, k) for the largest k ≤ :data:`MAX_DIVISIONS` that leaves no remainder, as
+    polynomials in ``generators`` (SymPy's choice when none are given)."""
     quotient, power = total, 0
     while power < MAX_DIVISIONS:
         try:
-            divided, remainder = sp.div(quotient, pole.factor)
+            divided, remainder = sp.div(quotient, divisor, *generators)
         except (sp.PolynomialError, sp.GeneratorsNeeded, sp.CoercionFailed):
             break
         if remainder != 0 or divided == 0:
             break
         quotient, power = divided, power + 1
-    if power == 0:
-        return _divided_through_base_angle(total, pole)
-    return quotient * BoundedPower(pole.through_s, power)
+    return quotient, power
 
 
 def _divided_through_base_angle(total: sp.Expr, pole: PoleFactor) -> sp.Expr:

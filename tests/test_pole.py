@@ -148,6 +148,29 @@ def test_a_vanishing_sum_of_other_multiples_of_the_base_angle_is_divided_by_the_
         assert _relative_error(det_h, p, theta) > 1e4
 
 
+def test_a_vanishing_sum_of_the_cofunction_is_written_through_the_factor_squared() -> None:
+    """Hypothesis row 1, p = A + 2 tan(φ/4) cosh(3φ/4), a pole at 2π: SymPy writes H⁻¹'s
+    across-axis part with (sin(φ/4) − 1)(sin(φ/4) + 1) = −cos²(φ/4), whose first factor is of size
+    (2π − φ)²/32 and has no generator cos(φ/4) to divide by. As −f²/(sin(φ/4) + 1), with f through
+    s, it keeps its digits (it was 1.2·10⁴ ulp off at |p|² = 2³², where the range ended)."""
+    p = _p("phi**3*sqrt(phi**2/2 + 1)/4 + 2*sqrt(phi**2 + 1)*asinh(phi/4) + 2*tan(phi/4)*cosh(3*phi/4)")
+    pole = pole_factor(p, 2 * math.pi)
+    assert pole is not None and pole.factor == sp.cos(PHI / 4)
+    sine = sp.sin(PHI / 4)
+    form = (-sp.cos(PHI / 2) * (PHI**3 * sp.cos(PHI / 4) + 8 * sine * sp.cosh(3 * PHI / 4))
+            / (16 * sine * (sine - 1) * (sine + 1)))
+    rewritten = with_pole_factor(form, pole)
+    assert rewritten.has(S) and not rewritten.has(sine - 1)
+    identity = sp.lambdify(PHI, rewritten.subs(S, p) - form, modules=[mpmath_namespace(), "mpmath"])
+    with mpmath.workdps(60):
+        for angle in ("0.5", "3.0", "6.0"):
+            assert abs(identity(mpmath.mpf(angle))) < mpmath.mpf(10) ** -35 * abs(
+                sp.lambdify(PHI, form, modules=[mpmath_namespace(), "mpmath"])(mpmath.mpf(angle)))
+        theta = 2 * mpmath.pi - mpmath.mpf("1.37e-6")
+        assert _relative_error(rewritten, p, theta) <= 8
+        assert _relative_error(form, p, theta) > 1e4
+
+
 def test_a_tangent_beside_other_terms_writes_its_cosine_through_s_minus_the_rest() -> None:
     """p = A + B tan(2φ/3), a pole at 3π/4 (hypothesis row 94): cos(2φ/3) = B sin(2φ/3)/(s − A),
     with no A·cos(2φ/3) from the rounded angle inside (det H was 291 ulp off at |p|² = 2³² through
