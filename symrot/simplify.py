@@ -6,7 +6,10 @@
    written as n·θ with θ = φ/L (L the lcm of the denominators), expanded to polynomials in
    s = sin θ, c = cos θ, and numerator and denominator are reduced modulo s² + c² − 1 before
    cancelling. Non-trigonometric functions (e.g. the real cube root of eq 35) become opaque
-   symbols so that powers of them cancel. This is plain polynomial algebra.
+   symbols so that powers of them cancel, each with a name of its own (SymPy orders polynomial
+   generators by name, so shared names made the result depend on the string hash seed). This is
+   plain polynomial algebra; only square-free factors that are not plainly irreducible are
+   factored.
 2. A time-bounded ``trigsimp`` of the candidates, which contracts 2cos²θ − 1 into cos 2θ.
 
 The shortest candidate (by operation count, then by printed length) wins. Which inputs a step
@@ -96,16 +99,26 @@ def expands_beyond_the_cap(expr: sp.Expr, angle: sp.Expr, cap: int = BASE_ANGLE_
     return False
 
 
+def _numbered_dummy(name: str, number: int) -> sp.Dummy:
+    """A Dummy named ``name`` + ``number``: opaque symbols that share one name tie in the order
+    SymPy's polynomial code gives its generators (``_sort_gens`` sorts by the printed name), and the
+    tie fell to the iteration order of a set, i.e. to Python's string hash seed. The reduction of
+    R₂ = (1 − cos φ)/p² of hypothesis row 1 then factored over another generator order: its sign
+    arrangement differed between hash seeds, and once Wang's factorization ran past its 15 s safety
+    bound (0.2 s otherwise), which stopped the plan."""
+    return sp.Dummy(f"{name}{number}")
+
+
 def base_angle_reduction(expr: sp.Expr) -> sp.Expr | None:
     """Reduce a rational function of φ and trig(kφ) modulo sin² + cos² = 1 (see module doc)."""
     opaque: dict[sp.Expr, sp.Symbol] = {}
     for function in sorted(expr.atoms(sp.Function), key=sp.default_sort_key):
         if not isinstance(function, _TRIG) and function.has(PHI):
-            opaque[function] = sp.Dummy("f")
+            opaque[function] = _numbered_dummy("f", len(opaque))
     # Powers with symbolic bases and fractional exponents are opaque too (e.g. sqrt(1 - p^2)).
     for power in sorted(expr.atoms(sp.Pow), key=sp.default_sort_key):
         if power.has(PHI) and not power.exp.is_Integer and power not in opaque:
-            opaque[power] = sp.Dummy("r")
+            opaque[power] = _numbered_dummy("r", len(opaque))
     hidden = expr.xreplace(opaque)
     multiples = _trig_multiples(hidden)
     if multiples is None:
@@ -140,13 +153,42 @@ def base_angle_reduction(expr: sp.Expr) -> sp.Expr | None:
         num_r, den_r = (_reduced_modulo(part, relation, gens) for part in (numerator, denom))
         if any(_beyond_the_factoring_cap(part, gens) for part in (num_r, den_r)):
             return None
-        candidate = sp.factor(sp.cancel(num_r / den_r))
+        candidate = _factored(sp.cancel(num_r / den_r))
         if best is None or complexity(candidate) < complexity(best):
             best = candidate
     assert best is not None
     back = {s: sp.sin(PHI / denominator), c: sp.cos(PHI / denominator)}
     result = best.xreplace(back).xreplace({v: k for k, v in opaque.items()})
     return result
+
+
+def _factored(quotient: sp.Expr) -> sp.Expr:
+    """``sp.factor(quotient)``, without asking SymPy to factor what is already irreducible: the
+    numerator and the denominator are split into square-free factors, and only those that are not
+    plainly irreducible (:func:`_plainly_irreducible`) go to ``sp.factor``. Wang's multivariate
+    algorithm, which ``factor`` runs on every factor, depends on the generator order and its random
+    evaluation points: on the square of p·cos(φ/4) of hypothesis row 1 (7 generators, degree one
+    in several) it ran past a minute in one order and took 0.2 s in the others."""
+    numerator, denominator = sp.fraction(quotient)
+    return _factored_polynomial(numerator) / _factored_polynomial(denominator)
+
+
+def _factored_polynomial(polynomial: sp.Expr) -> sp.Expr:
+    if not polynomial.free_symbols:
+        return polynomial
+    coefficient, factors = sp.sqf_list(polynomial)
+    return sp.Mul(coefficient, *((factor if _plainly_irreducible(factor) else sp.factor(factor))**k
+                                 for factor, k in factors))
+
+
+def _plainly_irreducible(factor: sp.Expr) -> bool:
+    """Whether ``factor`` has degree one in one of its symbols with coprime coefficients there (then
+    it has no factor of positive degree: one of degree zero in that symbol would divide both)."""
+    for symbol in sorted(factor.free_symbols, key=sp.default_sort_key):
+        poly = sp.Poly(factor, symbol)
+        if poly.degree() == 1 and not sp.gcd(*poly.all_coeffs()).free_symbols:
+            return True
+    return False
 
 
 def _beyond_the_factoring_cap(polynomial: sp.Expr, gens: list[sp.Expr]) -> bool:
@@ -210,7 +252,7 @@ def _trigsimp(base: sp.Expr) -> sp.Expr:
     127 calls had 27 distinct arguments, and the repeats were 5.9 of the 8.5 s spent in
     ``trigsimp``. An interrupted call (the time bound's exception) is not remembered."""
     hyperbolic = sorted(base.atoms(HyperbolicFunction), key=sp.default_sort_key)
-    opaque = {function: sp.Dummy("h") for function in hyperbolic}
+    opaque = {function: _numbered_dummy("h", k) for k, function in enumerate(hyperbolic)}
     contracted: sp.Expr = sp.trigsimp(base.xreplace(opaque))
     return contracted.xreplace({symbol: function for function, symbol in opaque.items()})
 

@@ -78,3 +78,51 @@ def test_trigsimp_sees_hyperbolic_functions_as_symbols(monkeypatch: pytest.Monke
     assert len(seen) == 1 and not seen[0].has(sp.cosh, sp.sinh)
     assert contracted == (6 * sp.cosh(PHI / 3) / sp.cos(2 * PHI) ** 2 + sp.tan(2 * PHI) * sp.sinh(PHI / 3)
                           + 6 * sp.cos(2 * PHI / 3) / (PHI**2 + 1))
+
+
+_ROW_1_REDUCTION = """
+import sympy as sp
+from symrot.parsing import PHI
+from symrot.simplify import base_angle_reduction
+p = (PHI**3 * sp.sqrt(PHI**2 / 2 + 1) / 4 + 2 * sp.sqrt(PHI**2 + 1) * sp.asinh(PHI / 4)
+     + 2 * sp.tan(PHI / 4) * sp.cosh(3 * PHI / 4))
+print(sp.srepr(base_angle_reduction((1 - sp.cos(PHI)) / p**2)))
+"""
+
+
+def test_the_reduction_is_the_same_under_every_string_hash_seed() -> None:
+    """R₂ = (1 − cos φ)/p² of hypothesis row 1: the opaque symbols (asinh, cosh and two roots)
+    once shared the names "f" and "r", and SymPy's polynomial code orders generators by name, so
+    their order was that of a set: the factored form's signs differed between hash seeds, and in
+    one order Wang's factorization of the denominator ran past a minute (the plan's 15 s safety
+    bound). Now every seed gives one form, within the subprocess timeout."""
+    import os
+    import subprocess
+    import sys
+
+    forms = set()
+    for seed in ("0", "2", "5"):
+        environment = {**os.environ, "PYTHONHASHSEED": seed}
+        done = subprocess.run([sys.executable, "-c", _ROW_1_REDUCTION], capture_output=True, text=True,
+                              env=environment, timeout=120, check=True)
+        forms.add(done.stdout)
+    assert len(forms) == 1 and "cosh" in forms.pop()
+
+
+def test_factoring_skips_factors_that_are_plainly_irreducible(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A square-free factor of degree one in some symbol with coprime coefficients there is not
+    handed to ``sp.factor`` (Wang's algorithm); the others are, and the product is unchanged."""
+    from symrot import simplify
+
+    a, b, c = sp.symbols("a b c")
+    linear = a * b + c**3 + 2  # degree one in a, coefficients b and c^3 + 2 coprime
+    assert simplify._plainly_irreducible(linear)
+    assert not simplify._plainly_irreducible(c**2 - 1)
+    assert not simplify._plainly_irreducible(a * b + a * c)  # a (b + c): a divides every split
+    factored_calls = []
+    original = sp.factor
+    monkeypatch.setattr(simplify.sp, "factor", lambda e: factored_calls.append(e) or original(e))
+    quotient = (c**2 - 1) * linear**2 / (linear * (c + 2)) ** 3
+    result = simplify._factored(sp.cancel(quotient))
+    assert sp.cancel(result - quotient) == 0
+    assert factored_calls == [c**2 - 1]

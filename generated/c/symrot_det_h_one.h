@@ -254,8 +254,8 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 593 */
+ * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 592 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -282,10 +282,10 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
         const double w2 = (w1*w1);
-        const double w3 = w1*cos(w0);
+        const double w3 = cos(w0);
         c_H_across = sin(phi)/s;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w3 + (1.0/2.0)*sin(2*phi))/(w2*(phi - 2*w3));
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*(-3*phi + 8*w1*w3 - 1.0/2.0*sin(2*phi))/(w2*(phi - 2*w1*w3));
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -368,12 +368,11 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double a2_odd = a2_j - 2*a2_h;
             const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             const double w0 = (sin1*sin1);
-            const double w1 = cos1*sin1;
             c_H_across_lanes[k] = sin0/s;
             poly_H_across_lanes[k] = 1 + (-3.0/20.0)*x;
             c_H_1_lanes[k] = 2*w0/x;
             poly_H_1_lanes[k] = x*(x*((-23.0/1008000.0)*x - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-            c_H_2_lanes[k] = (1.0/12.0)*(3*phi + (1.0/2.0)*sin2 - 8*w1)/(w0*(phi - 2*w1));
+            c_H_2_lanes[k] = -1.0/12.0*(8*cos1*sin1 - 3*phi - 1.0/2.0*sin2)/(w0*(-2*cos1*sin1 + phi));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -893,8 +892,8 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 592 */
+ * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 591 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -915,10 +914,10 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
         const double w2 = (w1*w1);
-        const double w3 = w1*cos(w0);
+        const double w3 = cos(w0);
         c_H_across = sin(phi)/s;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*(3*phi - 8*w3 + (1.0/2.0)*sin(2*phi))/(w2*(phi - 2*w3));
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*(-3*phi + 8*w1*w3 - 1.0/2.0*sin(2*phi))/(w2*(phi - 2*w1*w3));
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -1262,11 +1261,11 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 896 */
+ * H_2_x: Horner degree 21 in x below x = 2.63022, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 897 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1306,12 +1305,12 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
         const double w12 = w11 - 12*w6;
         const double w13 = w5/(w1*w1*w1);
         const double w14 = cbrt(w12);
-        const double w15 = w11 + w4 - 16*w6;
+        const double w15 = 16*w1*w5 - w11 - w4;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w4 - 8*w6);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*w10*(-3*phi + 8*w1*w5 - 1.0/2.0*w4);
         c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w8);
         c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(8*w2 + cos(w3) - 1));
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : (1.0/48.0)*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(-8*w2 - cos(w3) + 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1357,11 +1356,11 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 902 */
+ * H_2_x: Horner degree 21 in x below x = 2.63022, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 903 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1401,12 +1400,12 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
         const double w12 = w11 - 12*w6;
         const double w13 = w5/(w1*w1*w1);
         const double w14 = cbrt(w12);
-        const double w15 = w11 + w4 - 16*w6;
+        const double w15 = 16*w1*w5 - w11 - w4;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w4 - 8*w6);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*w10*(-3*phi + 8*w1*w5 - 1.0/2.0*w4);
         c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w8);
         c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(8*w2 + cos(w3) - 1));
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : (1.0/48.0)*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(-8*w2 - cos(w3) + 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1540,11 +1539,11 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0: Horner degree 7 in x below x = 0.110312, else x/(4*sin(phi/2)**2)
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * H_2_x: Horner degree 21 in x below x = 2.63022, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 859 */
+ * H_2_x: Horner degree 21 in x below x = 2.63022, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 860 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1579,13 +1578,13 @@ static inline void symrot_det_h_one_angular_acceleration(const double p[3], cons
         const double w12 = w11 - 12*w7;
         const double w13 = w6/(w1*w1*w1);
         const double w14 = cbrt(w12);
-        const double w15 = w11 + w5 - 16*w7;
+        const double w15 = 16*w1*w6 - w11 - w5;
         c_H_0 = (1.0/4.0)*w3*x;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : (1.0/12.0)*w10*(3*phi + (1.0/2.0)*w5 - 8*w7);
+        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*w10*(-3*phi + 8*w1*w6 - 1.0/2.0*w5);
         c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w3*(-3.0/2.0*w13 + 2*w9);
         c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w3*(-8.0/3.0*(w1*w1*w1*w1)*w9 + w8)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : -1.0/48.0*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w9 - 1.0/2.0*w3*(8*w2 + cos(w4) - 1));
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : (1.0/48.0)*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w9 - 1.0/2.0*w3*(-8*w2 - cos(w4) + 1));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1931,8 +1930,8 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 485 */
+ * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 484 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1959,10 +1958,10 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
         const float w2 = (w1*w1);
-        const float w3 = w1*cosf(w0);
+        const float w3 = cosf(w0);
         c_H_across = sinf(phi)/s;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w3 + (1.0F/2.0F)*sinf(2*phi))/(w2*(phi - 2*w3));
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*(-3*phi + 8*w1*w3 - 1.0F/2.0F*sinf(2*phi))/(w2*(phi - 2*w1*w3));
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -2045,12 +2044,11 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float a2_odd = a2_j - 2*a2_h;
             const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             const float w0 = (sin1*sin1);
-            const float w1 = cos1*sin1;
             c_H_across_lanes[k] = sin0/s;
             poly_H_across_lanes[k] = 1;
             c_H_1_lanes[k] = 2*w0/x;
             poly_H_1_lanes[k] = x*((-3.0F/5600.0F)*x - 1.0F/40.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = (1.0F/12.0F)*(3*phi + (1.0F/2.0F)*sin2 - 8*w1)/(w0*(phi - 2*w1));
+            c_H_2_lanes[k] = -1.0F/12.0F*(8*cos1*sin1 - 3*phi - 1.0F/2.0F*sin2)/(w0*(-2*cos1*sin1 + phi));
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2575,8 +2573,8 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 484 */
+ * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 483 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2597,10 +2595,10 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
         const float w2 = (w1*w1);
-        const float w3 = w1*cosf(w0);
+        const float w3 = cosf(w0);
         c_H_across = sinf(phi)/s;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*(3*phi - 8*w3 + (1.0F/2.0F)*sinf(2*phi))/(w2*(phi - 2*w3));
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*(-3*phi + 8*w1*w3 - 1.0F/2.0F*sinf(2*phi))/(w2*(phi - 2*w1*w3));
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2938,11 +2936,11 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 782 */
+ * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 783 */
 static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2982,12 +2980,12 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
         const float w12 = w11 - 12*w6;
         const float w13 = w5/(w1*w1*w1);
         const float w14 = cbrtf(w12);
-        const float w15 = w11 + w4 - 16*w6;
+        const float w15 = 16*w1*w5 - w11 - w4;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w10*(3*phi + (1.0F/2.0F)*w4 - 8*w6);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*w10*(-3*phi + 8*w1*w5 - 1.0F/2.0F*w4);
         c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w9*(-3.0F/2.0F*w13 + 2*w8);
         c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w9*(-8.0F/3.0F*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(8*w2 + cosf(w3) - 1));
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : (1.0F/48.0F)*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(-8*w2 - cosf(w3) + 1));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3033,11 +3031,11 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 788 */
+ * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 789 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3077,12 +3075,12 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
         const float w12 = w11 - 12*w6;
         const float w13 = w5/(w1*w1*w1);
         const float w14 = cbrtf(w12);
-        const float w15 = w11 + w4 - 16*w6;
+        const float w15 = 16*w1*w5 - w11 - w4;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w10*(3*phi + (1.0F/2.0F)*w4 - 8*w6);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*w10*(-3*phi + 8*w1*w5 - 1.0F/2.0F*w4);
         c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w9*(-3.0F/2.0F*w13 + 2*w8);
         c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w9*(-8.0F/3.0F*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(8*w2 + cosf(w3) - 1));
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : (1.0F/48.0F)*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(-8*w2 - cosf(w3) + 1));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3216,11 +3214,11 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0: Horner degree 7 in x below x = 1.43428, else x/(4*sin(phi/2)**2)
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else (3*phi - 8*sin(phi/2)*cos(phi/2) + sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * H_2_x: Horner degree 21 in x below x = 4.61948, else -((6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (8*sin(phi/2)**2 + cos(2*phi) - 1)/(2*sin(phi/2)**2) + (6*phi - 16*sin(phi/2)*cos(phi/2) + sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 745 */
+ * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * ops: 746 */
 static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3255,13 +3253,13 @@ static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], con
         const float w12 = w11 - 12*w7;
         const float w13 = w6/(w1*w1*w1);
         const float w14 = cbrtf(w12);
-        const float w15 = w11 + w5 - 16*w7;
+        const float w15 = 16*w1*w6 - w11 - w5;
         c_H_0 = (1.0F/4.0F)*w3*x;
         c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : (1.0F/12.0F)*w10*(3*phi + (1.0F/2.0F)*w5 - 8*w7);
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*w10*(-3*phi + 8*w1*w6 - 1.0F/2.0F*w5);
         c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w3*(-3.0F/2.0F*w13 + 2*w9);
         c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w3*(-8.0F/3.0F*(w1*w1*w1*w1)*w9 + w8)/w14;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : -1.0F/48.0F*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w9 - 1.0F/2.0F*w3*(8*w2 + cosf(w4) - 1));
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : (1.0F/48.0F)*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w9 - 1.0F/2.0F*w3*(-8*w2 - cosf(w4) + 1));
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

@@ -200,7 +200,7 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 7 in x below x = 0.785123, else (phi - sin(phi))/phi**3
  * ops: 86 */
 static inline void symrot_rotation_vector_tangent(const double p[3], double H[9])
 {
@@ -224,7 +224,7 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
-        c_H_2 = -(-phi + sin(phi))/(phi*phi*phi);
+        c_H_2 = (phi - sin(phi))/(phi*phi*phi);
     }
     const double t = -c_H_2*x + 1;
     H[0] = c_H_2*(p[0]*p[0]) + t;
@@ -293,7 +293,7 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
             poly_H_1_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
-            c_H_2_lanes[k] = -(-phi + sin1)/(phi*phi*phi);
+            c_H_2_lanes[k] = (phi - sin1)/(phi*phi*phi);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -596,7 +596,7 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
  * K_1: Horner degree 7 in x below x = 2.89787, else 2*sin(phi/4)**2/phi**2
- * K_2: Horner degree 8 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
+ * K_2: Horner degree 8 in x below x = 5.56735, else (phi - 2*sin(phi/2))/(2*phi**3)
  * ops: 89 */
 static inline void symrot_rotation_vector_root_tangent(const double p[3], double K[9])
 {
@@ -620,7 +620,7 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
-        c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : -1.0/2.0*(-phi + 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
+        c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : (1.0/2.0)*(phi - 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
     }
     const double t = -c_K_2*x + 1.0/2.0;
     K[0] = c_K_2*(p[0]*p[0]) + t;
@@ -689,7 +689,7 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
             poly_K_1_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
-            c_K_2_lanes[k] = -1.0/2.0*(-phi + 2*sin1)/(phi*phi*phi);
+            c_K_2_lanes[k] = (1.0/2.0)*(phi - 2*sin1)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -759,7 +759,7 @@ static inline void symrot_rotation_vector_pdot(const double p[3], const double o
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 7 in x below x = 0.785123, else (phi - sin(phi))/phi**3
  * ops: 85 */
 static inline void symrot_rotation_vector_omega(const double p[3], const double pdot[3], double omega[3])
 {
@@ -777,7 +777,7 @@ static inline void symrot_rotation_vector_omega(const double p[3], const double 
     } else {
         const double phi = symrot_rotation_vector__phi(sqrt(x));
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/(phi*phi);
-        c_H_2 = -(-phi + sin(phi))/(phi*phi*phi);
+        c_H_2 = (phi - sin(phi))/(phi*phi*phi);
     }
     const double t = -c_H_2*x + 1;
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
@@ -1111,10 +1111,10 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative(const do
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 7 in x below x = 0.785123, else (phi - sin(phi))/phi**3
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 + 3*(-phi + sin(phi))/phi)/(2*phi**4)
+ * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 - 3*(phi - sin(phi))/phi)/(2*phi**4)
  * ops: 235 */
 static inline void symrot_rotation_vector_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
@@ -1143,12 +1143,12 @@ static inline void symrot_rotation_vector_tangent_derivative(const double p[3], 
         const double w1 = sin(w0);
         const double w2 = (w1*w1);
         const double w3 = 1.0/(phi*phi*phi);
-        const double w4 = -phi + sin(phi);
+        const double w4 = phi - sin(phi);
         const double w5 = 1.0/phi;
         c_H_1 = 2*w2/(phi*phi);
-        c_H_2 = -w3*w4;
+        c_H_2 = w3*w4;
         c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
-        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
+        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(-3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1191,10 +1191,10 @@ static inline void symrot_rotation_vector_tangent_derivative(const double p[3], 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 7 in x below x = 0.785123, else (phi - sin(phi))/phi**3
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 + 3*(-phi + sin(phi))/phi)/(2*phi**4)
+ * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 - 3*(phi - sin(phi))/phi)/(2*phi**4)
  * ops: 236 */
 static inline void symrot_rotation_vector_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
@@ -1223,12 +1223,12 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative(const dou
         const double w1 = sin(w0);
         const double w2 = (w1*w1);
         const double w3 = 1.0/(phi*phi*phi);
-        const double w4 = -phi + sin(phi);
+        const double w4 = phi - sin(phi);
         const double w5 = 1.0/phi;
         c_H_1 = 2*w2/(phi*phi);
-        c_H_2 = -w3*w4;
+        c_H_2 = w3*w4;
         c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
-        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
+        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(-3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
     }
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
@@ -1337,10 +1337,10 @@ static inline void symrot_rotation_vector_tangent_inverse_derivative(const doubl
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 7 in x below x = 0.785123, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 7 in x below x = 0.785123, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 7 in x below x = 0.785123, else (phi - sin(phi))/phi**3
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 + 3*(-phi + sin(phi))/phi)/(2*phi**4)
+ * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 - 3*(phi - sin(phi))/phi)/(2*phi**4)
  * ops: 200 */
 static inline void symrot_rotation_vector_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
@@ -1363,12 +1363,12 @@ static inline void symrot_rotation_vector_angular_acceleration(const double p[3]
         const double w1 = sin(w0);
         const double w2 = (w1*w1);
         const double w3 = 1.0/(phi*phi*phi);
-        const double w4 = -phi + sin(phi);
+        const double w4 = phi - sin(phi);
         const double w5 = 1.0/phi;
         c_H_1 = 2*w2/(phi*phi);
-        c_H_2 = -w3*w4;
+        c_H_2 = w3*w4;
         c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
-        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
+        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(-3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1663,7 +1663,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 6 in x below x = 5.56735, else (phi - sin(phi))/phi**3
  * ops: 78 */
 static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9])
 {
@@ -1687,7 +1687,7 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
-        c_H_2 = -(-phi + sinf(phi))/(phi*phi*phi);
+        c_H_2 = (phi - sinf(phi))/(phi*phi*phi);
     }
     const float t = -c_H_2*x + 1;
     H[0] = c_H_2*(p[0]*p[0]) + t;
@@ -1756,7 +1756,7 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
             poly_H_1_lanes[k] = 1.0F/2.0F;
-            c_H_2_lanes[k] = -(-phi + sin1)/(phi*phi*phi);
+            c_H_2_lanes[k] = (phi - sin1)/(phi*phi*phi);
             poly_H_2_lanes[k] = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2058,7 +2058,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_0 = 1/2 (constant)
  * K_1: Horner degree 4 in x below x = 5.56735, else 2*sin(phi/4)**2/phi**2
- * K_2: Horner degree 4 in x below x = 5.56735, else -(-phi + 2*sin(phi/2))/(2*phi**3)
+ * K_2: Horner degree 4 in x below x = 5.56735, else (phi - 2*sin(phi/2))/(2*phi**3)
  * ops: 67 */
 static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float K[9])
 {
@@ -2082,7 +2082,7 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
-        c_K_2 = -1.0F/2.0F*(-phi + 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
+        c_K_2 = (1.0F/2.0F)*(phi - 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
     }
     const float t = -c_K_2*x + 1.0F/2.0F;
     K[0] = c_K_2*(p[0]*p[0]) + t;
@@ -2151,7 +2151,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
             poly_K_1_lanes[k] = 1.0F/8.0F;
-            c_K_2_lanes[k] = -1.0F/2.0F*(-phi + 2*sin1)/(phi*phi*phi);
+            c_K_2_lanes[k] = (1.0F/2.0F)*(phi - 2*sin1)/(phi*phi*phi);
             poly_K_2_lanes[k] = x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2221,7 +2221,7 @@ static inline void symrot_rotation_vector_pdot_f(const float p[3], const float o
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 6 in x below x = 5.56735, else (phi - sin(phi))/phi**3
  * ops: 77 */
 static inline void symrot_rotation_vector_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
@@ -2239,7 +2239,7 @@ static inline void symrot_rotation_vector_omega_f(const float p[3], const float 
     } else {
         const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
         c_H_1 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/(phi*phi);
-        c_H_2 = -(-phi + sinf(phi))/(phi*phi*phi);
+        c_H_2 = (phi - sinf(phi))/(phi*phi*phi);
     }
     const float t = -c_H_2*x + 1;
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
@@ -2577,10 +2577,10 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative_f(const 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 6 in x below x = 5.56735, else (phi - sin(phi))/phi**3
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 + 3*(-phi + 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
+ * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 - 3*(phi - 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
  * ops: 201 */
 static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
@@ -2610,12 +2610,12 @@ static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3],
         const float w2 = (w1*w1);
         const float w3 = 2*w2;
         const float w4 = 1.0F/(phi*phi*phi);
-        const float w5 = cosf(w0);
+        const float w5 = 2*w1*cosf(w0);
         const float w6 = 1.0F/phi;
         c_H_1 = w3/(phi*phi);
-        c_H_2 = -w4*(-phi + sinf(phi));
-        c_H_1_x = (1.0F/2.0F)*w4*(2*w1*w5 - 4*w2*w6);
-        c_H_2_x = (1.0F/2.0F)*(w3 + 3*w6*(-phi + 2*w1*w5))/(phi*phi*phi*phi);
+        c_H_2 = w4*(phi - sinf(phi));
+        c_H_1_x = (1.0F/2.0F)*w4*(-4*w2*w6 + w5);
+        c_H_2_x = (1.0F/2.0F)*(w3 - 3*w6*(phi - w5))/(phi*phi*phi*phi);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2658,10 +2658,10 @@ static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3],
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 6 in x below x = 5.56735, else (phi - sin(phi))/phi**3
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 + 3*(-phi + 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
+ * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 - 3*(phi - 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
  * ops: 202 */
 static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
@@ -2691,12 +2691,12 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const f
         const float w2 = (w1*w1);
         const float w3 = 2*w2;
         const float w4 = 1.0F/(phi*phi*phi);
-        const float w5 = cosf(w0);
+        const float w5 = 2*w1*cosf(w0);
         const float w6 = 1.0F/phi;
         c_H_1 = w3/(phi*phi);
-        c_H_2 = -w4*(-phi + sinf(phi));
-        c_H_1_x = (1.0F/2.0F)*w4*(2*w1*w5 - 4*w2*w6);
-        c_H_2_x = (1.0F/2.0F)*(w3 + 3*w6*(-phi + 2*w1*w5))/(phi*phi*phi*phi);
+        c_H_2 = w4*(phi - sinf(phi));
+        c_H_1_x = (1.0F/2.0F)*w4*(-4*w2*w6 + w5);
+        c_H_2_x = (1.0F/2.0F)*(w3 - 3*w6*(phi - w5))/(phi*phi*phi*phi);
     }
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
@@ -2805,10 +2805,10 @@ static inline void symrot_rotation_vector_tangent_inverse_derivative_f(const flo
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0 = 1 (constant)
  * H_1: Horner degree 6 in x below x = 5.56735, else 2*sin(phi/2)**2/phi**2
- * H_2: Horner degree 6 in x below x = 5.56735, else -(-phi + sin(phi))/phi**3
+ * H_2: Horner degree 6 in x below x = 5.56735, else (phi - sin(phi))/phi**3
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 + 3*(-phi + 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
+ * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 - 3*(phi - 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
  * ops: 166 */
 static inline void symrot_rotation_vector_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
@@ -2832,12 +2832,12 @@ static inline void symrot_rotation_vector_angular_acceleration_f(const float p[3
         const float w2 = (w1*w1);
         const float w3 = 2*w2;
         const float w4 = 1.0F/(phi*phi*phi);
-        const float w5 = cosf(w0);
+        const float w5 = 2*w1*cosf(w0);
         const float w6 = 1.0F/phi;
         c_H_1 = w3/(phi*phi);
-        c_H_2 = -w4*(-phi + sinf(phi));
-        c_H_1_x = (1.0F/2.0F)*w4*(2*w1*w5 - 4*w2*w6);
-        c_H_2_x = (1.0F/2.0F)*(w3 + 3*w6*(-phi + 2*w1*w5))/(phi*phi*phi*phi);
+        c_H_2 = w4*(phi - sinf(phi));
+        c_H_1_x = (1.0F/2.0F)*w4*(-4*w2*w6 + w5);
+        c_H_2_x = (1.0F/2.0F)*(w3 - 3*w6*(phi - w5))/(phi*phi*phi*phi);
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

@@ -842,7 +842,7 @@ static inline void symrot_sine_m3_omega(const double p[3], const double pdot[3],
 /* symrot_sine_m3_to_quaternion: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.129471, else cos(phi/2)
- * nu: Horner degree 7 in x below x = 0.129471, else 2*sin(phi/2)/s
+ * nu: Horner degree 7 in x below x = 0.129471, else (2*sqrt(d)/3 + 1)/(3*cos(phi/6))
  * ops: 75 */
 static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
 {
@@ -861,10 +861,8 @@ static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
         c_nu = x*(x*(x*(x*(x*(x*((-1077205.0/481469424205824.0)*x - 56525.0/2229025112064.0) - 1547.0/5159780352.0) - 2431.0/644972544.0) - 13.0/248832.0) - 1.0/1152.0) - 5.0/216.0) + 1;
     } else {
         const double phi = symrot_sine_m3__phi(sqrt(x), d);
-        const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        c_e_0 = cos(w0);
-        c_nu = 2*sin(w0)/s;
+        c_e_0 = cos((1.0/2.0)*phi);
+        c_nu = (1.0/3.0)*((2.0/3.0)*sqrt(d) + 1)/cos((1.0/6.0)*phi);
     }
     const double half_nu = (1.0/2.0)*c_nu;
     e[0] = c_e_0;
@@ -2379,7 +2377,7 @@ static inline void symrot_sine_m3_omega_f(const float p[3], const float pdot[3],
 /* symrot_sine_m3_to_quaternion_f: Euler-Rodrigues parameters e = (e0, e1, e2, e3), e0 = cos(phi/2) = nu/epsilon, (e1, e2, e3) = (nu/2) p (eq 74-75).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 1.59536, else cos(phi/2)
- * nu: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/2)/s
+ * nu: Horner degree 7 in x below x = 1.59536, else (2*sqrt(d)/3 + 1)/(3*cos(phi/6))
  * ops: 75 */
 static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
 {
@@ -2398,10 +2396,8 @@ static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
         c_nu = x*(x*(x*(x*(x*(x*((-2.2373279e-09F)*x - 2.535862e-08F) - 2.9981896e-07F) - 3.7691527e-06F) - 13.0F/248832.0F) - 1.0F/1152.0F) - 5.0F/216.0F) + 1;
     } else {
         const float phi = symrot_sine_m3__phi_f(sqrtf(x), d);
-        const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        c_e_0 = cosf(w0);
-        c_nu = 2*sinf(w0)/s;
+        c_e_0 = cosf((1.0F/2.0F)*phi);
+        c_nu = (1.0F/3.0F)*((2.0F/3.0F)*sqrtf(d) + 1)/cosf((1.0F/6.0F)*phi);
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
     e[0] = c_e_0;

@@ -238,8 +238,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    out = numpy.asarray((0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0)), dtype=x.dtype)
+    out = numpy.asarray(-0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*numpy.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi)), dtype=x.dtype)
     if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
         return out
     small = x < 2.6302227241416043
@@ -820,8 +819,8 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     w3 = (phi - 2*w2)**(-1.0)
     w4 = 6*phi
     w5 = 2*phi
-    w6 = -16*w2 + w4 + numpy.sin(w5)
-    out = numpy.asarray((0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
+    w6 = 16*cos_half*sin_half - w4 - numpy.sin(w5)
+    out = numpy.asarray(-0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - numpy.cos(w5) + 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
     if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
         return out
     small = x < 2.6302227241416043
@@ -1320,8 +1319,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    out = numpy.asarray((0.08333333333333333)*(3*phi - 8*w0 + (0.5)*numpy.sin(2*phi))/(sin_half**2*(phi - 2*w0)), dtype=x.dtype)
+    out = numpy.asarray(-0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*numpy.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi)), dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478
@@ -1864,8 +1862,8 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     w3 = (phi - 2*w2)**(-1.0)
     w4 = 6*phi
     w5 = 2*phi
-    w6 = -16*w2 + w4 + numpy.sin(w5)
-    out = numpy.asarray((0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + numpy.cos(w5) - 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
+    w6 = 16*cos_half*sin_half - w4 - numpy.sin(w5)
+    out = numpy.asarray(-0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - numpy.cos(w5) + 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478

@@ -172,7 +172,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.008333333333333333 + t * series
         series = 0.16666666666666666 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-(-phi + numpy.sin(phi))/phi**3, dtype=x.dtype)
+    out = numpy.asarray((phi - numpy.sin(phi))/phi**3, dtype=x.dtype)
     if span is not None and span[0] >= 0.7851233626304374:  # every lane on the closed form
         return out
     small = x < 0.7851233626304374
@@ -325,7 +325,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.00026041666666666666 + t * series
         series = 0.020833333333333332 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-0.5*(-phi + 2*sin_half)/phi**3, dtype=x.dtype)
+    out = numpy.asarray((0.5)*(phi - 2*sin_half)/phi**3, dtype=x.dtype)
     if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
         return out
     small = x < 5.5673482008975155
@@ -475,7 +475,7 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.0003968253968253968 + t * series
         series = -0.008333333333333333 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(-numpy.cos(phi) + 1 + 3*(-phi + numpy.sin(phi))/phi)/phi**4, dtype=x.dtype)
+    out = numpy.asarray((0.5)*(-numpy.cos(phi) + 1 - 3*(phi - numpy.sin(phi))/phi)/phi**4, dtype=x.dtype)
     if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
         return out
     small = x < 5.5673482008975155
@@ -703,7 +703,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.008333333333333333 + t * series
         series = 0.16666666666666666 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-(-phi + numpy.sin(phi))/phi**3, dtype=x.dtype)
+    out = numpy.asarray((phi - numpy.sin(phi))/phi**3, dtype=x.dtype)
     if span is not None and span[0] >= 1.5083706018396157:  # every lane on the closed form
         return out
     small = x < 1.5083706018396157
@@ -814,7 +814,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.00026041666666666666 + t * series
         series = 0.020833333333333332 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-0.5*(-phi + 2*sin_half)/phi**3, dtype=x.dtype)
+    out = numpy.asarray((0.5)*(phi - 2*sin_half)/phi**3, dtype=x.dtype)
     if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
         return out
     small = x < 5.567347935831094
@@ -930,7 +930,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.0003968253968253968 + t * series
         series = -0.008333333333333333 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(2*sin_half**2 + 3*(2*cos_half*sin_half - phi)/phi)/phi**4, dtype=x.dtype)
+    out = numpy.asarray((0.5)*(2*sin_half**2 - 3*(-2*cos_half*sin_half + phi)/phi)/phi**4, dtype=x.dtype)
     if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
         return out
     small = x < 5.567347935831094

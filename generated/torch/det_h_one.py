@@ -352,8 +352,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
     phi = _where(small, 1.7023118078717785, phi)
     sin_half = _where(small, 0.7520427801883164, sin_half)
     cos_half = _where(small, 0.6591142971948246, cos_half)
-    w0 = cos_half*sin_half
-    closed = (0.08333333333333333)*(3*phi - 8*w0 + (0.5)*_xp.sin(2*phi))/(sin_half**2*(phi - 2*w0))
+    closed = -0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*_xp.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi))
     return _where(small, series, closed)
 
 
@@ -730,8 +729,8 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     w3 = (phi - 2*w2)**(-1.0)
     w4 = 6*phi
     w5 = 2*phi
-    w6 = -16*w2 + w4 + _xp.sin(w5)
-    closed = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + _xp.cos(w5) - 1) + (0.5)*w3*w6)*_cbrt(12*w2 - w4)
+    w6 = 16*cos_half*sin_half - w4 - _xp.sin(w5)
+    closed = -0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - _xp.cos(w5) + 1) + (0.5)*w3*w6)*_cbrt(12*w2 - w4)
     return _where(small, series, closed)
 
 
@@ -1105,8 +1104,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
-    w0 = cos_half*sin_half
-    closed = (0.08333333333333333)*(3*phi - 8*w0 + (0.5)*_xp.sin(2*phi))/(sin_half**2*(phi - 2*w0))
+    closed = -0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*_xp.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi))
     return _where(small, series, closed)
 
 
@@ -1464,8 +1462,8 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     w3 = (phi - 2*w2)**(-1.0)
     w4 = 6*phi
     w5 = 2*phi
-    w6 = -16*w2 + w4 + _xp.sin(w5)
-    closed = (0.020833333333333332)*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(8*w0 + _xp.cos(w5) - 1) + (0.5)*w3*w6)*_cbrt(12*w2 - w4)
+    w6 = 16*cos_half*sin_half - w4 - _xp.sin(w5)
+    closed = -0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - _xp.cos(w5) + 1) + (0.5)*w3*w6)*_cbrt(12*w2 - w4)
     return _where(small, series, closed)
 
 

@@ -248,7 +248,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
     series = -0.008333333333333333 + t * series
     series = 0.16666666666666666 + t * series
     phi = _where(small, 0.886071872158482, phi)
-    closed = -(-phi + _xp.sin(phi))/phi**3
+    closed = (phi - _xp.sin(phi))/phi**3
     return _where(small, series, closed)
 
 
@@ -360,7 +360,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.020833333333333332 + t * series
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
-    closed = -0.5*(-phi + 2*sin_half)/phi**3
+    closed = (0.5)*(phi - 2*sin_half)/phi**3
     return _where(small, series, closed)
 
 
@@ -448,7 +448,7 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0003968253968253968 + t * series
     series = -0.008333333333333333 + t * series
     phi = _where(small, 2.3595228756885396, phi)
-    closed = (0.5)*(-_xp.cos(phi) + 1 + 3*(-phi + _xp.sin(phi))/phi)/phi**4
+    closed = (0.5)*(-_xp.cos(phi) + 1 - 3*(phi - _xp.sin(phi))/phi)/phi**4
     return _where(small, series, closed)
 
 
@@ -649,7 +649,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     series = -0.008333333333333333 + t * series
     series = 0.16666666666666666 + t * series
     phi = _where(small, 2.3595228756885396, phi)
-    closed = -(-phi + _xp.sin(phi))/phi**3
+    closed = (phi - _xp.sin(phi))/phi**3
     return _where(small, series, closed)
 
 
@@ -739,7 +739,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.020833333333333332 + t * series
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
-    closed = -0.5*(-phi + 2*sin_half)/phi**3
+    closed = (0.5)*(phi - 2*sin_half)/phi**3
     return _where(small, series, closed)
 
 
@@ -815,7 +815,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = (0.5)*(2*sin_half**2 + 3*(2*cos_half*sin_half - phi)/phi)/phi**4
+    closed = (0.5)*(2*sin_half**2 - 3*(-2*cos_half*sin_half + phi)/phi)/phi**4
     return _where(small, series, closed)
 
 
