@@ -174,6 +174,7 @@ def _factored(quotient: sp.Expr) -> sp.Expr:
 
 
 def _factored_polynomial(polynomial: sp.Expr) -> sp.Expr:
+    """``polynomial`` as its square-free factors, each factored by SymPy unless plainly irreducible."""
     if not polynomial.free_symbols:
         return polynomial
     coefficient, factors = sp.sqf_list(polynomial)

@@ -118,7 +118,7 @@ def test_factoring_skips_factors_that_are_plainly_irreducible(monkeypatch: pytes
     linear = a * b + c**3 + 2  # degree one in a, coefficients b and c^3 + 2 coprime
     assert simplify._plainly_irreducible(linear)
     assert not simplify._plainly_irreducible(c**2 - 1)
-    assert not simplify._plainly_irreducible(a * b + a * c)  # a (b + c): a divides every split
+    assert not simplify._plainly_irreducible(a * b + a * c)  # a·(b + c): coefficients share a
     factored_calls = []
     original = sp.factor
     monkeypatch.setattr(simplify.sp, "factor", lambda e: factored_calls.append(e) or original(e))
