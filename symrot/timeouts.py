@@ -53,7 +53,9 @@ SAFETY_FACTOR = 30.0
 steps well inside their size caps met it on a loaded machine: a sum factor's trigsimp of 1.5 s
 alone took 3.7 s beside a CI run, and once a base-angle reduction that took at most 0.3 s in four
 other runs (hypothesis row 1) stopped a plan at its 5 s safety bound while a benchmark shared the
-machine (cause not found: garbage collection paused the process for at most 0.14 s).
+machine. The cause was found later, and it was not the load: the reduction's opaque symbols shared
+names, so SymPy's generator order followed the string hash seed, and in one order its factoring ran
+past a minute (see :func:`symrot.simplify._numbered_dummy`).
 The bound only stops hangs; the size caps decide what is attempted."""
 SYMPY_SEED = 0
 """The state of SymPy's random generator at the start of every :func:`bounded` step."""
