@@ -130,9 +130,8 @@ def _validity_of(p: sp.Expr) -> Validity:
                                          "monotonicity", "0"))
     # asin(sin φ): p′ = cos φ/√(1 − sin²φ) is ±1, never 0 nor ∞; 2 atan(tan(φ/2)) falls from π to −π
     # at π while p′ = 1 says nothing
-    for quantity in ("monotonicity", "p"):
-        angle = _first_sign_jump(derivation.scalars_raw["p_prime"]) if quantity == "monotonicity" \
-            else _first_drop(p)
+    jumps = (("monotonicity", _first_sign_jump(derivation.scalars_raw["p_prime"])), ("p", _first_drop(p)))
+    for quantity, angle in jumps:
         if angle is None or any(abs(s.phi_float - float(angle)) < 1e-9 * float(angle) for s in found):
             continue  # p falls across a pole or a logarithm (asinh(tan φ) at π/2): already listed
         exact = _exact_angle(angle, candidates)
