@@ -146,6 +146,9 @@ def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         written = _with_product_length(written, argument)
     if argument.is_Add and written.has(*argument.atoms(sp.Function)):
         written = _with_equal_sums(written, argument)
+        factored = sp.factor_terms(argument)  # 13φ³cosh(φ/2)/3 + φ cosh(φ/2) = φ(13φ²/3 + 1) cosh(φ/2)
+        if factored.is_Mul:
+            written = _with_product_length(written, factored)
     return written
 
 
@@ -206,9 +209,13 @@ def _with_product_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         return expr
 
     def holds_a_power(term: sp.Expr) -> bool:
-        return isinstance(term, sp.Mul) and all(base in term.as_powers_dict() for base in factors)
+        if not isinstance(term, sp.Mul):
+            return False
+        powers = _with_bases_of(term.as_powers_dict(), factors)
+        return all(base in powers for base in factors)
 
     def factor_out(term: sp.Expr) -> sp.Expr:
+        term = _rescaled_bases(term, factors)
         powers = term.as_powers_dict()
         ratios = [powers[base] / exponent for base, exponent in factors.items()]
         if not all(r.is_Rational and r * ratios[0] > 0 for r in ratios):
@@ -220,6 +227,35 @@ def _with_product_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         return term * rest ** -k * length
 
     return expr.replace(holds_a_power, factor_out)
+
+
+def _primitive(base: sp.Expr) -> tuple[sp.Rational, sp.Expr]:
+    """(c, b) with base = c·b, c a positive rational and b a sum with coprime integer coefficients
+    (φ²/2 + 1 = ½ (φ² + 2)); (1, base) for anything else."""
+    content, primitive = base.as_content_primitive() if base.is_Add else (sp.S.One, base)
+    return (content, primitive) if content.is_Rational and content > 0 else (sp.S.One, base)
+
+
+def _with_bases_of(powers: dict[sp.Expr, sp.Expr], factors: dict[sp.Expr, sp.Expr]) -> dict[sp.Expr, sp.Expr]:
+    """``powers`` with every base that is a positive multiple of a base of ``factors`` keyed by that
+    base (the exponents only; see :func:`_rescaled_bases` for the term itself)."""
+    by_primitive = {_primitive(base)[1]: base for base in factors}
+    return {by_primitive.get(_primitive(base)[1], base): exponent for base, exponent in powers.items()}
+
+
+def _rescaled_bases(term: sp.Expr, factors: dict[sp.Expr, sp.Expr]) -> sp.Expr:
+    """``term`` with each power g^e of a base g = (c_g/c_f)·f, a positive multiple of a base f of p,
+    written (c_g/c_f)^e f^e: simplification writes p = √(φ²/2 + 1) sinh(2φ)/2 squared as
+    (φ² + 2) sinh²(2φ)/8, whose sum is no base of p (hypothesis row 53: G₂ recomputed sinh(2φ̂)²,
+    12 ulp of G in float32 next to 2π)."""
+    by_primitive = {_primitive(base)[1]: base for base in factors}
+    replaced = {}
+    for base, exponent in term.as_powers_dict().items():
+        content, primitive = _primitive(base)
+        own = by_primitive.get(primitive)
+        if own is not None and own != base:
+            replaced[base**exponent] = (content / _primitive(own)[0]) ** exponent * own**exponent
+    return term.xreplace(replaced) if replaced else term
 
 
 @lru_cache(maxsize=8)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from symrot.algebraic import S
 from symrot.api import derive
 from symrot.parsing import PHI
 from symrot.plan import (
@@ -156,6 +157,31 @@ def test_forms_in_s_and_x_are_found_inside_products_and_sums() -> None:
     assert with_length(sp.sin(PHI / 2) * other, total) == 2 * S * sp.sin(PHI / 2)
     unrelated = PHI * sp.cosh(3 * PHI / 2) + sp.atan(PHI / 4)
     assert with_length(1 / unrelated, total) == 1 / unrelated
+
+
+@pytest.mark.parametrize(("argument", "form", "expected"), [
+    # p² simplified to (φ² + 2) sinh²(2φ)/8: the sum φ²/2 + 1 of p appears doubled (hypothesis row
+    # 53: G_2 recomputed sinh(2φ̂)², 17.7 ulp of G in float32 at 2π − 10⁻⁶)
+    ("sqrt(phi**2/2 + 1)*sinh(2*phi)/2", 16 * sp.sin(PHI / 4) ** 2 / ((PHI**2 + 2) * sp.sinh(2 * PHI) ** 2),
+     2 * sp.sin(PHI / 4) ** 2 / X),
+    ("sqrt(phi**2/2 + 1)*sinh(2*phi)/2", 2 * sp.sin(PHI / 2) / (sp.sqrt(PHI**2 + 2) * sp.sinh(2 * PHI)),
+     sp.sqrt(2) * sp.sin(PHI / 2) / (2 * S)),
+    # a sum p whose terms share factors: its factored form is a product (hypothesis row 80)
+    ("13*phi**3*cosh(phi/2)/3 + phi*cosh(phi/2)",
+     18 * sp.sin(PHI / 4) ** 2 / (PHI**2 * (13 * PHI**2 + 3) ** 2 * sp.cosh(PHI / 2) ** 2),
+     2 * sp.sin(PHI / 4) ** 2 / X),
+])
+def test_forms_in_s_and_x_are_found_when_a_factor_of_p_is_rescaled(argument: str, form: sp.Expr,
+                                                                   expected: sp.Expr) -> None:
+    from symrot.measurement import with_length
+    from symrot.parsing import parse_expression
+
+    p = parse_expression(argument)
+    written = with_length(form, p)
+    assert written == expected
+    back = written.xreplace({X: p**2, S: p})
+    angles = (sp.Rational(3, 10), sp.Rational(11, 10), sp.Rational(59, 10))
+    assert all(abs(sp.N((back - form).subs(PHI, angle), 30)) < 1e-25 for angle in angles)
 
 
 def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
