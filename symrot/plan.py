@@ -369,7 +369,14 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
     if closed.has(sp.asin, sp.atanh):
         forms.append(gudermannian(closed))
     plain = tuple(dict.fromkeys([closed, *forms]))
-    forms += [with_length(form, argument) for form in forms]
+    written = [with_length(form, argument) for form in forms]
+    forms += written
+    # cos a → 1 − 2 sin²(a/2) after p is written as s: before, it changes the sums that
+    # with_length recognizes as p (cos(φ/3) in 3φ cos(φ/3)/5 + …), and (1 − cos(φ/2))/x cancels
+    # at small φ (hypothesis row 120: G₂ recomputed p from φ̂, 9 ulp of G in float32 at 6.18)
+    forms += [conditioned for conditioned in dict.fromkeys(well_conditioned(form) for form in written
+                                                           if form.has(sp.cos) and form.has(S, X))
+              if conditioned not in forms]
     pole = pole_factor(argument, phi_max) if argument != PHI else None
     if pole is not None:  # p → ∞ at φ_max: its vanishing factor through s (symrot.pole)
         forms += [with_pole_factor(form, pole) for form in forms]

@@ -184,6 +184,21 @@ def test_forms_in_s_and_x_are_found_when_a_factor_of_p_is_rescaled(argument: str
     assert all(abs(sp.N((back - form).subs(PHI, angle), 30)) < 1e-25 for angle in angles)
 
 
+def test_the_half_angle_form_through_x_is_a_candidate_when_p_is_a_sum_of_cosines() -> None:
+    """Hypothesis row 120: G_2 = 25 (1 - cos(phi/2))/(5 p)^2. Its half-angle form rewrites cos(phi/3)
+    inside p, so p is no longer recognized in it; written through x first, (1 - cos(phi/2))/x
+    cancels at small phi. The planned form recomputed p from the rounded angle (9 ulp of G in
+    float32 at 6.18); 2 sin^2(phi/4)/x must be measured."""
+    from symrot.parsing import parse_expression
+    from symrot.plan import candidate_forms
+
+    p = parse_expression("3*phi*cos(phi/3)/5 + 2*sqrt(2*phi**2 + 1)*sinh(phi)/5")
+    closed = 25 * (1 - sp.cos(PHI / 2)) / (3 * PHI * sp.cos(PHI / 3)
+                                           + 2 * sp.sqrt(2 * PHI**2 + 1) * sp.sinh(PHI)) ** 2
+    _, forms = candidate_forms(closed, p, 2 * np.pi, None, None)
+    assert 2 * sp.sin(PHI / 4) ** 2 / X in forms
+
+
 def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
     """G_2 of sinh(phi) cosh(phi) next to 2 pi is ~ 2/x, far below G_2(0) = 1/8: measured relative
     to 1/8 its form in phi (sinh amplifies the float32 angle's rounding 4 times, 6 ulp of G_2 x)
