@@ -672,7 +672,7 @@ def _plan_for(p: sp.Expr, name: str) -> EvaluationPlan:
                                            for label, dtype in PRECISIONS.items()])
     precisions = dict(zip(PRECISIONS, plans, strict=True))
     return EvaluationPlan(name, p, p_max, phi_max, precisions, e0_min(limits.phi_max), complement,
-                          _p_max_squared(p, limits.phi_max, p_max))
+                          _p_max_squared(p, limits.phi_max, p_max, ("p", "jump") in at_edge))
 
 
 def _searched(derivation: Derivation) -> list[str]:
@@ -931,14 +931,14 @@ def _domain_limit(derivation: Derivation, coefficients: dict[str, Coefficient],
     return domain_limit(printed, references, derivation.p, inverse, phi_max, p_max, dtype)
 
 
-def _p_max_squared(p: sp.Expr, phi_max: sp.Expr, p_max: float) -> sp.Float | None:
-    """p(φ_max)² at 50 digits, or None when p is unbounded."""
+def _p_max_squared(p: sp.Expr, phi_max: sp.Expr, p_max: float, at_jump: bool) -> sp.Float | None:
+    """p(φ_max)² at 50 digits, or None when p is unbounded. Where the range ends at a jump of p
+    (``at_jump``: 2 atan(tan(φ/2)) at π, see :mod:`symrot.singularities`) the value there is not the
+    limit from the left, so p_max (that limit, from the validity analysis) is squared instead."""
     if not np.isfinite(p_max):
         return None
-    exact = sp.N(p.subs(PHI, phi_max) ** 2, 50)
-    # at a jump of p (2 atan(tan(φ/2)) at π) the value there is not p_max, nor a number
-    jump = exact.is_Float and abs(float(exact) - p_max * p_max) > 1e-9 * p_max * p_max
-    return exact if exact.is_Float and exact.is_finite and not jump else sp.Float(p_max * p_max, 50)
+    exact = None if at_jump else sp.N(p.subs(PHI, phi_max) ** 2, 50)
+    return exact if exact is not None and exact.is_Float and exact.is_finite else sp.Float(p_max * p_max, 50)
 
 
 def _use_complement(coefficient: Coefficient, inverse: sp.Expr, complement: sp.Rational) -> Coefficient:
