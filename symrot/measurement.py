@@ -208,14 +208,14 @@ def _with_product_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         # `compose` then missed 4 κ, 1.9·10⁶ ulp at 2π − 10⁻⁶; they met it before)
         return expr
 
+    by_primitive = {_primitive(base)[1]: base for base in factors}
+
     def holds_a_power(term: sp.Expr) -> bool:
-        if not isinstance(term, sp.Mul):
-            return False
-        powers = _with_bases_of(term.as_powers_dict(), factors)
-        return all(base in powers for base in factors)
+        return isinstance(term, sp.Mul) and all(base in _rescaled_bases(term, by_primitive).as_powers_dict()
+                                                 for base in factors)
 
     def factor_out(term: sp.Expr) -> sp.Expr:
-        term = _rescaled_bases(term, factors)
+        term = _rescaled_bases(term, by_primitive)
         powers = term.as_powers_dict()
         ratios = [powers[base] / exponent for base, exponent in factors.items()]
         if not all(r.is_Rational and r * ratios[0] > 0 for r in ratios):
@@ -236,19 +236,11 @@ def _primitive(base: sp.Expr) -> tuple[sp.Rational, sp.Expr]:
     return (content, primitive) if content.is_Rational and content > 0 else (sp.S.One, base)
 
 
-def _with_bases_of(powers: dict[sp.Expr, sp.Expr], factors: dict[sp.Expr, sp.Expr]) -> dict[sp.Expr, sp.Expr]:
-    """``powers`` with every base that is a positive multiple of a base of ``factors`` keyed by that
-    base (the exponents only; see :func:`_rescaled_bases` for the term itself)."""
-    by_primitive = {_primitive(base)[1]: base for base in factors}
-    return {by_primitive.get(_primitive(base)[1], base): exponent for base, exponent in powers.items()}
-
-
-def _rescaled_bases(term: sp.Expr, factors: dict[sp.Expr, sp.Expr]) -> sp.Expr:
+def _rescaled_bases(term: sp.Expr, by_primitive: dict[sp.Expr, sp.Expr]) -> sp.Expr:
     """``term`` with each power g^e of a base g = (c_g/c_f)·f, a positive multiple of a base f of p,
-    written (c_g/c_f)^e f^e: simplification writes p = √(φ²/2 + 1) sinh(2φ)/2 squared as
-    (φ² + 2) sinh²(2φ)/8, whose sum is no base of p (hypothesis row 53: G₂ recomputed sinh(2φ̂)²,
-    12 ulp of G in float32 next to 2π)."""
-    by_primitive = {_primitive(base)[1]: base for base in factors}
+    written (c_g/c_f)^e f^e (``by_primitive``: p's bases f by their primitive parts): simplification
+    writes p = √(φ²/2 + 1) sinh(2φ)/2 squared as (φ² + 2) sinh²(2φ)/8, whose sum is no base of p
+    (hypothesis row 53: G₂ recomputed sinh(2φ̂)², 12 ulp of G in float32 next to 2π)."""
     replaced = {}
     for base, exponent in term.as_powers_dict().items():
         content, primitive = _primitive(base)

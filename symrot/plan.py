@@ -374,9 +374,10 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
     # cos a → 1 − 2 sin²(a/2) after p is written as s: before, it changes the sums that
     # with_length recognizes as p (cos(φ/3) in 3φ cos(φ/3)/5 + …), and (1 − cos(φ/2))/x cancels
     # at small φ (hypothesis row 120: G₂ recomputed p from φ̂, 9 ulp of G in float32 at 6.18)
-    forms += [conditioned for conditioned in dict.fromkeys(well_conditioned(form) for form in written
-                                                           if form.has(sp.cos) and form.has(S, X))
-              if conditioned not in forms]
+    for form in written:
+        conditioned = well_conditioned(form)
+        if form.has(S, X) and conditioned not in forms:
+            forms.append(conditioned)
     pole = pole_factor(argument, phi_max) if argument != PHI else None
     if pole is not None:  # p → ∞ at φ_max: its vanishing factor through s (symrot.pole)
         forms += [with_pole_factor(form, pole) for form in forms]
