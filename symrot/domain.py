@@ -45,6 +45,9 @@ form that underflows (the tangent's H₂ = (16/(x + 16))²/8 of Wiener–Milenko
 x = 2^514 in float64)."""
 WRONG_ULP = 64.0
 """A relative error beyond this many ulp is a wrong result, not an imprecise one."""
+CHUNK = 16
+"""Points of the sweep whose forms are evaluated in one call of each model: most ranges end within
+the first few octaves, and the references of a chunk's points past the first wrong one are wasted."""
 
 
 def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mapping[str, sp.Expr],
@@ -64,12 +67,16 @@ def domain_limit(coefficients: Mapping[str, tuple[str, Any]], references: Mappin
     angle_of = _angle_function(p, inverse, phi_max)
     complement = p_max * p_max if math.isfinite(p_max) else math.inf
     floors = _floors(exact, references, math.isfinite(p_max))
-    for k in range(FIRST_POWER, top + 1):
-        for x, edge in ((2.0**k, 2.0 ** (k - 1)), (2.0**k * OFF_POWER, 2.0**k)):
-            if x >= complement:
-                return 2.0**top
-            if not _right_at(x, k, models, exact, angle_of, complement, dtype, floors):
-                return edge if edge >= 2.0**FIRST_POWER else 2.0**FIRST_POWER
+    points = [(x, k, edge) for k in range(FIRST_POWER, top + 1)
+              for x, edge in ((2.0**k, 2.0 ** (k - 1)), (2.0**k * OFF_POWER, 2.0**k))]
+    for start in range(0, len(points), CHUNK):
+        chunk = points[start:start + CHUNK]
+        wrong = _first_wrong(chunk, models, exact, angle_of, complement, dtype, floors)
+        if wrong is not None:  # every point before it is below p_max² (_first_wrong stops there)
+            edge = chunk[wrong][2]
+            return edge if edge >= 2.0**FIRST_POWER else 2.0**FIRST_POWER
+        if chunk[-1][0] >= complement:  # the sweep reached p_max² with every form right
+            return 2.0**top
     return 2.0**top
 
 
@@ -86,40 +93,65 @@ def _floors(exact: Callable[[mpmath.mpf], dict[str, mpmath.mpf]], references: Ma
         return {"det_H": float(abs(exact(mpmath.mpf(10) ** -12)["det_H"]))}
 
 
-def _right_at(x: float, k: int, models: Mapping[str, Callable[..., Any]],
-              exact: Callable[[mpmath.mpf], dict[str, mpmath.mpf]],
-              angle_of: Callable[[float, int], mpmath.mpf],
-              complement: float, dtype: type, floors: Mapping[str, float]) -> bool:
-    """Whether every printed form is finite and within :data:`WRONG_ULP` at x (2^k ≤ x < 2^(k+1))
-    of its scale (:func:`_weight_and_scale`, at least ``floors``)."""
+def _first_wrong(points: list[tuple[float, int, float]], models: Mapping[str, Callable[..., Any]],
+                 exact: Callable[[mpmath.mpf], dict[str, mpmath.mpf]],
+                 angle_of: Callable[[float, int], mpmath.mpf],
+                 complement: float, dtype: type, floors: Mapping[str, float]) -> int | None:
+    """The index of the first of ``points`` (x, k, edge; 2^k ≤ x < 2^(k+1)) at which a printed
+    form is not finite or not within :data:`WRONG_ULP` of its scale (:func:`_weight_and_scale`, at
+    least ``floors``), or None. The references are computed point by point, up to the first that
+    cannot be (and only below ``complement``); each model is evaluated once on all of them (the
+    ideal-libm model is elementwise: one call per chunk, not one per point and form)."""
     epsilon = float(np.finfo(dtype).eps)
-    digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
-    with mpmath.workdps(digits):
-        s_exact = mpmath.sqrt(mpmath.mpf(x))
-        try:
-            phi = angle_of(x, digits)
-            values = exact(phi)
-        except (ZeroDivisionError, ValueError, OverflowError):
-            # φ is indistinguishable from the pole at this precision (p ~ e^(1/(φ_max − φ)),
-            # e.g. atanh): nothing beyond can be verified, so the domain ends here
-            return False
-        arguments = (dtype(x), dtype(float(phi)), dtype(float(s_exact)),
-                     dtype(complement - x if math.isfinite(complement) else 0.0))
-        for name, model in models.items():
-            reference = values[name]
-            if not mpmath.isfinite(reference):
-                continue
-            value = float(model(*arguments))
-            weight, scale = _weight_and_scale(name, values, s_exact)
-            scale = max(scale, floors.get(name, 0.0))
-            allowed = WRONG_ULP * epsilon * max(scale, float(np.finfo(dtype).tiny))
-            if not math.isfinite(value) or float(abs(mpmath.mpf(value) - reference) * weight) > allowed:
-                return False
-    return True
+    tiny = float(np.finfo(dtype).tiny)
+    exact_values: list[tuple[mpmath.mpf, dict[str, mpmath.mpf]] | None] = []
+    columns: list[list[float]] = [[], [], [], []]
+    for x, k, _ in points:
+        if x >= complement:
+            break
+        digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
+        with mpmath.workdps(digits):
+            s_exact = mpmath.sqrt(mpmath.mpf(x))
+            try:
+                phi = angle_of(x, digits)
+                values = exact(phi)
+            except (ZeroDivisionError, ValueError, OverflowError):
+                # φ is indistinguishable from the pole at this precision (p ~ e^(1/(φ_max − φ)),
+                # e.g. atanh): nothing beyond can be verified, so the domain ends here
+                exact_values.append(None)
+                break
+        exact_values.append((s_exact, values))
+        for column, value in zip(columns, (x, float(phi), float(s_exact),
+                                           complement - x if math.isfinite(complement) else 0.0),
+                                 strict=True):
+            column.append(value)
+    measured = len(columns[0])
+    arguments: list[np.ndarray] = [np.asarray(column, dtype=dtype) for column in columns]
+    printed = {name: np.broadcast_to(np.asarray(model(*arguments), dtype=np.float64), (measured,))
+               for name, model in models.items()} if measured else {}
+    for index, known in enumerate(exact_values):
+        if known is None:
+            return index
+        s_exact, values = known
+        tensor_scales: dict[str, float] = {}
+        with mpmath.workdps(40 + points[index][1] // 3):
+            for name in models:
+                reference = values[name]
+                if not mpmath.isfinite(reference):
+                    continue
+                value = float(printed[name][index])
+                weight, scale = _weight_and_scale(name, values, s_exact, tensor_scales)
+                scale = max(scale, floors.get(name, 0.0))
+                allowed = WRONG_ULP * epsilon * max(scale, tiny)
+                if not math.isfinite(value) or float(abs(mpmath.mpf(value) - reference) * weight) > allowed:
+                    return index
+    return None
 
 
-def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf) -> tuple[mpmath.mpf, float]:
-    """How an error in coefficient ``name`` shows in the output, and the output's scale.
+def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf,
+                      tensor_scales: dict[str, float] | None = None) -> tuple[mpmath.mpf, float]:
+    """How an error in coefficient ``name`` shows in the output, and the output's scale
+    (``tensor_scales``: the scales of the tensors at this point, filled as they are computed).
 
     A tensor coefficient c_k multiplies (p×)^k, of norm s^k: its error counts as |δc_k| s^k against
     the tensor's size max_j |c_j| s^j (the across-axis part t = c₀ − c₂ s² multiplies I, as the plan
@@ -131,8 +163,11 @@ def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf
     tensor, _, power = name.rpartition("_")
     if tensor and (power.isdigit() or power == "across") and f"{tensor}_0" in values:
         weight = s ** int(power) if power.isdigit() else mpmath.mpf(1)
-        scale = max(abs(values.get(f"{tensor}_{j}", mpmath.mpf(0))) * s**j for j in range(3))
-        return weight, float(scale)
+        known = {} if tensor_scales is None else tensor_scales
+        if tensor not in known:
+            sizes = (abs(values.get(f"{tensor}_{j}", mpmath.mpf(0))) * s**j for j in range(3))
+            known[tensor] = float(max(sizes))
+        return weight, known[tensor]
     if name == "nu":
         return s / 2, 1.0
     return mpmath.mpf(1), float(abs(values[name]))

@@ -162,3 +162,33 @@ def test_an_ill_conditioned_det_h_of_a_bounded_p_does_not_end_the_range() -> Non
     limit = domain_limit(printed, {"det_H": det_h}, derivation.p, None, phi_max, p_max, np.float64)
     assert limit > p_max**2
     assert _floors(lambda phi: {"det_H": mpmath.mpf(1)}, {"det_H": det_h}, bounded=False) == {}
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_the_sweep_in_chunks_ends_where_the_sweep_point_by_point_ends(
+        dtype: type, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The domain sweep evaluates each model once per chunk of points (symrot.domain.CHUNK) instead
+    of once per point. Wiener–Milenkovic's H₀ = 16/(x + 16) written 16x(x + 17)/(x³ + 33x² + 272x)
+    goes to 0 where x³ overflows, inside a chunk of the sweep (x ≈ 2^341 in float64, 2^43 in
+    float32), and a chunk's first point is wrong when x² + 33x + 272 is the denominator (2^512,
+    2^64): sweeping one point at a time ends the domain at the same power of two, below the
+    overflow."""
+    from symrot import domain
+    from symrot.algebraic import S, X
+    from symrot.singularities import validity
+
+    derivation = derive("wiener_milenkovic").derivation
+    limits = validity(derivation)
+    phi_max, p_max = float(limits.phi_max_float), float(limits.p_max_float)
+    references = {f"H_{k}": derivation.planned_expressions()[f"H_{k}"] for k in range(3)}
+    inverse = 4 * sp.atan(S / 4)
+    for power, form in ((3, 16 * X * (X + 17) / (X**3 + 33 * X**2 + 272 * X)),
+                        (2, 16 * (X + 17) / (X**2 + 33 * X + 272))):
+        printed = {"H_0": ("algebraic", form)}
+        monkeypatch.setattr(domain, "CHUNK", 16)
+        chunked = domain.domain_limit(printed, references, derivation.p, inverse, phi_max, p_max, dtype)
+        monkeypatch.setattr(domain, "CHUNK", 1)
+        one_by_one = domain.domain_limit(printed, references, derivation.p, inverse, phi_max, p_max, dtype)
+        assert chunked == one_by_one, power
+        overflow = float(np.finfo(dtype).max) ** (1 / power)  # x^power overflows beyond it
+        assert overflow / 4 <= chunked <= overflow, power
