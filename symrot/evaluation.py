@@ -72,6 +72,13 @@ def _cached(name: str, arguments: tuple[float, ...], single: bool) -> float:
     return float(np.float32(value)) if single else value
 
 
+ARRAY_BYTES_KEPT = 1 << 26
+"""Bytes of arguments and results :func:`_elementwise` remembers per process (then it starts
+again): a plan's distinct calls take well under a megabyte."""
+_ARRAYS: dict[tuple[Any, ...], np.ndarray] = {}
+_array_bytes = [0]
+
+
 def _elementwise(name: str) -> Callable[..., Any]:
     def apply(*arguments: Any) -> Any:
         dtype = np.result_type(*arguments)  # Python numbers are weak: float32 stays float32
@@ -79,6 +86,14 @@ def _elementwise(name: str) -> Callable[..., Any]:
             dtype = np.dtype(np.float64)
         single = dtype == np.float32
         arrays = [np.asarray(a) for a in arguments]
+        # the same call on the same arrays recurs: every form of every coefficient of a plan is
+        # measured on one set of inputs (sin(φ/2) of the same angles dozens of times), so whole
+        # results are remembered by the arguments' bytes (a copy is returned: callers own it)
+        contents = [a.tobytes() for a in arrays]
+        key = (name, single, *((a.dtype.str, a.shape) for a in arrays), *contents)
+        known = _ARRAYS.get(key)
+        if known is not None:
+            return known.copy() if known.ndim else known[()]
         shape = max((a.shape for a in arrays), key=len)
         if any(a.shape not in ((), shape) for a in arrays):
             arrays = list(np.broadcast_arrays(*arrays))
@@ -87,6 +102,12 @@ def _elementwise(name: str) -> Callable[..., Any]:
                    for a in arrays]
         values = [_cached(name, lane, single) for lane in zip(*columns, strict=True)]
         out = np.array(values, dtype=dtype).reshape(shape)
+        kept = out.nbytes + sum(map(len, contents))
+        if _array_bytes[0] + kept > ARRAY_BYTES_KEPT:
+            _ARRAYS.clear()
+            _array_bytes[0] = 0
+        _ARRAYS[key] = out.copy()
+        _array_bytes[0] += kept
         return out if out.ndim else out[()]
 
     apply.__name__ = name
@@ -171,14 +192,41 @@ class ModelPrinter(PythonCodePrinter):
         return repr(math.e)
 
 
+ModelKey = tuple[sp.Expr, tuple[str, ...]]
+"""(expression, names of its variables): what a model's source is printed from."""
+SOURCES_KEPT = 4096
+"""Printed model sources remembered per process (a plan prints a few hundred)."""
+_SOURCES: dict[ModelKey, str] = {}
+
+
+def model_key(expr: sp.Expr, variables: Sequence[sp.Symbol]) -> ModelKey:
+    return expr, tuple(str(v) for v in variables)
+
+
+def model_source(key: ModelKey) -> str:
+    """The Python source of the model of ``key`` (:func:`model_function`), printed once per process:
+    a plan measures most forms in both precisions and in several places (branch, domain sweep), and
+    SymPy's printer costs milliseconds per form. :func:`remember_sources` takes sources printed
+    in another process."""
+    if key not in _SOURCES:
+        if len(_SOURCES) >= SOURCES_KEPT:
+            _SOURCES.clear()
+        expr, names = key
+        _SOURCES[key] = f"def f({', '.join(names)}):\n    return {ModelPrinter().doprint(expr)}\n"
+    return _SOURCES[key]
+
+
+def remember_sources(sources: dict[ModelKey, str]) -> None:
+    """Sources of :func:`model_source` printed elsewhere (a forked child), the same text."""
+    _SOURCES.update(sources)
+
+
 def model_function(expr: sp.Expr, variables: Sequence[sp.Symbol]) -> Callable[..., Any]:
     """``expr`` as a function of ``variables`` evaluated with the ideal libm (module docstring).
 
     Call it with NumPy arrays or scalars of the target dtype (float32 or float64); the result has
     that dtype. Floating-point exceptions are silenced (inf and NaN are results like others)."""
-    names = [str(v) for v in variables]
-    body = ModelPrinter().doprint(expr)
-    source = f"def f({', '.join(names)}):\n    return {body}\n"
+    source = model_source(model_key(expr, variables))
     namespace: dict[str, Any] = {"_m": _MODEL, "_sign": np.sign}
     exec(compile(source, "<symrot model>", "exec"), namespace)
     function = namespace["f"]

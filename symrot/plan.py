@@ -60,7 +60,7 @@ from .algebraic import X as X  # re-exported: the symbol of the coefficients' va
 from .core import Derivation, derive_expression
 from .domain import FIRST_POWER, domain_limit
 from .errors import SymrotError
-from .evaluation import log_grid, model_function
+from .evaluation import ModelKey, log_grid, model_function, model_key, model_source, remember_sources
 from .forked import first_here_others_in_children
 from .functions import RealCbrt, mpmath_namespace
 from .measurement import (
@@ -341,6 +341,8 @@ depends on (not the precision)."""
 _CANDIDATES: dict[FormsKey, tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]] = {}
 CANDIDATES_KEPT = 4096
 """Most entries :func:`candidate_forms` remembers (then it starts again)."""
+BRANCH_VARIABLES = (PHI, S, X, D)
+"""The variables of a branch's closed form as :func:`_branch_for` measures it."""
 
 
 def candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse: sp.Expr | None,
@@ -538,7 +540,7 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                 dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...],
                 floors: tuple[np.ndarray, ...] | None = None) -> Branch:
     epsilon, tiny = float(np.finfo(dtype).eps), float(np.finfo(dtype).tiny)
-    model_closed = model_function(closed, [PHI, S, X, D])
+    model_closed = model_function(closed, BRANCH_VARIABLES)
     angles = angle_grid(phi_max)
     t_values = _switch_values(variable_of_phi, phi_max, dtype)
     scale0 = abs(float(series[0])) or 1.0
@@ -755,7 +757,10 @@ def _prepare_shared_work(shared: _SharedWork) -> None:
             step()
     keys = _branch_keys(shared)
     computed = computed_in_two_processes(_forms_or_failure, keys, [int(sp.count_ops(k[0])) for k in keys])
-    _CANDIDATES.update({key: forms for key, forms in computed.items() if forms is not None})
+    for key, result in computed.items():
+        if result is not None:
+            _CANDIDATES[key] = result[0]
+            remember_sources(result[1])
 
 
 def _branch_keys(shared: _SharedWork) -> list[FormsKey]:
@@ -774,13 +779,22 @@ def _branch_keys(shared: _SharedWork) -> list[FormsKey]:
                               for form in closed))
 
 
-def _forms_or_failure(key: FormsKey) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]] | None:
-    """:func:`_candidate_forms`, or None where a step fails in any way: the plan then computes them
-    again in its place and meets the failure there, as it did before they were computed ahead."""
+def _forms_or_failure(key: FormsKey) -> tuple[tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]],
+                                              dict[ModelKey, str]] | None:
+    """:func:`_candidate_forms` and the sources of their models as :func:`_branch_for` measures them
+    (printed here, where the forms are computed, half in a forked child, instead of once in each
+    precision's process), or None where a step fails in any way: the plan then computes them again in
+    its place and meets the failure there, as it did before they were computed ahead."""
     try:
-        return _candidate_forms(*key)
+        forms = _candidate_forms(*key)
     except Exception:  # re-raised where the plan needs the forms
         return None
+    sources = {}
+    for form in forms[1]:
+        printed = model_key(form, BRANCH_VARIABLES)
+        with suppress(ValueError):  # no model for a function: _branch_for meets it in its place
+            sources[printed] = model_source(printed)
+    return forms, sources
 
 
 def _prepare(derivation: Derivation, coefficient: str) -> None:

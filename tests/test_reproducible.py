@@ -97,6 +97,48 @@ def test_model_functions_are_correctly_rounded() -> None:
     assert single.dtype == np.float32
 
 
+def test_a_remembered_model_call_is_the_call_and_its_result_belongs_to_the_caller() -> None:
+    """The model remembers whole results of an elementary call by its arguments' bytes (a plan makes
+    the same call dozens of times): a repeated call returns the same values in the same dtype, a
+    caller that writes into a result changes no later one, and arguments that differ in one lane,
+    in dtype or in shape are other calls."""
+    from symrot import evaluation
+
+    evaluation._ARRAYS.clear()
+    sine = model_function(sp.sin(PHI / 2), [PHI])
+    x = np.array([0.1, 1.0, 3.0])
+    first = sine(x)
+    first[:] = -7.0  # the caller owns what it got
+    again = sine(x)
+    with mpmath.workdps(60):
+        exact = [float(mpmath.sin(mpmath.mpf(float(v)) / 2)) for v in x]
+    assert again.tolist() == exact
+    other = x.copy()
+    other[2] = 3.5
+    assert sine(other)[2] == float(mpmath.sin(mpmath.mpf(1.75)))
+    assert sine(x.astype(np.float32)).dtype == np.float32
+    assert sine(x[:2]).shape == (2,)
+    assert float(sine(np.float64(1.0))) == exact[1]
+    assert len(evaluation._ARRAYS) == 5
+
+
+def test_a_model_source_is_printed_once_per_form_and_can_come_from_another_process() -> None:
+    """Model sources are remembered per (form, variables): the plan prints the candidate forms'
+    models where it computes the forms (half in a forked child) and takes the child's sources."""
+    from symrot import evaluation
+
+    form = sp.cos(PHI / 3) / (1 + PHI**2)
+    key = evaluation.model_key(form, [PHI])
+    source = evaluation.model_source(key)
+    assert evaluation.model_source(key) is source
+    evaluation._SOURCES.pop(key)
+    evaluation.remember_sources({key: source})
+    assert evaluation.model_source(key) is source
+    with mpmath.workdps(60):
+        cosine = float(mpmath.cos(mpmath.mpf(2 / 3)))  # the model's cos is correctly rounded
+    assert model_function(form, [PHI])(np.array([2.0])).tolist() == [cosine / 5]
+
+
 def test_model_treats_points_off_the_real_domain_as_nan() -> None:
     values = model_function(sp.sqrt(1 - PHI) + sp.asin(PHI), [PHI])(np.array([0.5, 2.0]))
     assert np.isfinite(values[0]) and np.isnan(values[1])
