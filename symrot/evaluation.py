@@ -17,6 +17,10 @@ So this module models an *ideal* libm and leaves nothing to the CPU:
   and rounded to the dtype: within 0.5 ulp (+2⁻⁴⁰) of the exact value, deterministically;
 * grids are built in mpmath and rounded (:func:`log_grid`).
 
+A plan measures hundreds of forms on one set of inputs, so the model remembers what it repeats: each
+elementary call by its arguments (the same sin(φ/2) of the same angles serves every form) and each
+form's printed source. Neither changes a value.
+
 The measured error is thus the error of the *formula* under ≤ ½-ulp elementary functions; a real
 libm adds at most its own documented error per call, which the accuracy benchmark measures on the
 printed code (docs/accuracy.md).
@@ -200,6 +204,7 @@ _SOURCES: dict[ModelKey, str] = {}
 
 
 def model_key(expr: sp.Expr, variables: Sequence[sp.Symbol]) -> ModelKey:
+    """The key of :func:`model_source` for ``expr`` as a function of ``variables``."""
     return expr, tuple(str(v) for v in variables)
 
 
