@@ -109,7 +109,7 @@ def _first_wrong(points: list[tuple[float, int, float]], models: Mapping[str, Ca
     for x, k, _ in points:
         if x >= complement:
             break
-        digits = 40 + k // 3  # φ_max − φ ~ 1/√x must be resolved
+        digits = _digits(k)
         with mpmath.workdps(digits):
             s_exact = mpmath.sqrt(mpmath.mpf(x))
             try:
@@ -134,7 +134,7 @@ def _first_wrong(points: list[tuple[float, int, float]], models: Mapping[str, Ca
             return index
         s_exact, values = known
         tensor_scales: dict[str, float] = {}
-        with mpmath.workdps(40 + points[index][1] // 3):
+        with mpmath.workdps(_digits(points[index][1])):
             for name in models:
                 reference = values[name]
                 if not mpmath.isfinite(reference):
@@ -146,6 +146,11 @@ def _first_wrong(points: list[tuple[float, int, float]], models: Mapping[str, Ca
                 if not math.isfinite(value) or float(abs(mpmath.mpf(value) - reference) * weight) > allowed:
                     return index
     return None
+
+
+def _digits(k: int) -> int:
+    """The working digits at x ≥ 2^k: φ_max − φ ~ 1/√x must be resolved."""
+    return 40 + k // 3
 
 
 def _weight_and_scale(name: str, values: Mapping[str, mpmath.mpf], s: mpmath.mpf,

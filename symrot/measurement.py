@@ -146,7 +146,7 @@ def with_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         written = _with_product_length(written, argument)
     if argument.is_Add and written.has(*argument.atoms(sp.Function)):
         written = _with_equal_sums(written, argument)
-        factored = sp.factor_terms(argument)  # 13φ³cosh(φ/2)/3 + φ cosh(φ/2) = φ(13φ²/3 + 1) cosh(φ/2)
+        factored = _factored(argument)
         if factored.is_Mul:
             written = _with_product_length(written, factored)
     return written
@@ -227,6 +227,13 @@ def _with_product_length(expr: sp.Expr, argument: sp.Expr) -> sp.Expr:
         return term * rest ** -k * length
 
     return expr.replace(holds_a_power, factor_out)
+
+
+@lru_cache(maxsize=16)
+def _factored(argument: sp.Expr) -> sp.Expr:
+    """p with its terms' common factors taken out, once per p (every candidate form of a plan asks):
+    13φ³cosh(φ/2)/3 + φ cosh(φ/2) = φ(13φ²/3 + 1) cosh(φ/2)."""
+    return sp.factor_terms(argument)
 
 
 def _primitive(base: sp.Expr) -> tuple[sp.Rational, sp.Expr]:
