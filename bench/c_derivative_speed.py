@@ -11,6 +11,7 @@ Run: ``python bench/c_derivative_speed.py`` (prints a Markdown table for docs/pe
 
 from __future__ import annotations
 
+import argparse
 import ctypes
 import subprocess
 import sys
@@ -67,7 +68,9 @@ def pool(expression: str, dtype: type, rng: np.random.Generator) -> np.ndarray:
     return np.ascontiguousarray(axes / np.linalg.norm(axes, axis=1)[:, None] * sizes[:, None], dtype=dtype)
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                            epilog="Prints a Markdown table for docs/performance.md.").parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "speed.c"
         path.write_text(source(), encoding="utf-8")

@@ -23,6 +23,7 @@ interpreter and SymPy start-ups (about 1.4 s each on this machine). What start-u
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import queue
@@ -337,7 +338,10 @@ def run_all_preloaded(corpus: list[list[str]], budget: float, workers: int = 2) 
 
 
 def main(argv: list[str]) -> int:
-    budget = float(argv[0]) if argv else 60.0
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("budget", nargs="?", type=float, default=60.0,
+                        help="seconds each input may take (--timeout of every command; default 60)")
+    budget: float = parser.parse_args(argv).budget
     started = time.monotonic()
     outcomes = run_all(QUICK + EXTRA + HEAVY, budget)
     bad = 0

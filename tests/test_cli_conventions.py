@@ -127,3 +127,20 @@ def test_progress_is_drawn_on_a_terminal_and_quiet_silences_it(tmp_path: Path) -
     status, output = _run_on_a_terminal("--quiet", "derive", "cayley_gibbs_rodrigues", "--emit", "c",
                                         "--out", str(tmp_path))
     assert status == 0 and "symrot: --emit" not in output and "symrot_cayley_gibbs_rodrigues.h" in output
+
+
+BENCH = Path(__file__).resolve().parent.parent / "bench"
+BENCH_DRIVERS = sorted(path.name for path in BENCH.glob("*.py")
+                       if "__main__" in path.read_text(encoding="utf-8"))
+
+
+@pytest.mark.parametrize("driver", BENCH_DRIVERS)
+def test_every_bench_driver_answers_help_without_running(driver: str) -> None:
+    """``python bench/X.py --help`` prints a usage and exits 0 at once: before, two drivers ran their
+    benchmark (c_derivative_speed.py) or ended in a traceback (hostile_cli.py took "--help" for its
+    budget). accuracy_operations.py is part of accuracy.py and says so."""
+    result = subprocess.run([sys.executable, str(BENCH / driver), "--help"], capture_output=True, text=True,
+                            timeout=120, check=False)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert "Traceback" not in result.stderr
+    assert result.stdout.startswith("usage: ") or "accuracy.py" in result.stdout, result.stdout[:500]
