@@ -395,7 +395,7 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type, argument: sp.Expr = PHI, inverse: sp.Expr | None = None,
                 complement: sp.Rational | None = None, part: TensorPart | None = None,
-                extra_forms: tuple[sp.Expr, ...] = ()) -> Branch:
+                extra_forms: tuple[sp.Expr, ...] = (), challengers: tuple[sp.Expr, ...] = ()) -> Branch:
     """Choose the form, the switch t₀ and the Horner degree for one coefficient in one precision.
 
     The coefficient is evaluated from s = ``argument``(φ) (p for the coefficients of x, φ itself
@@ -406,30 +406,53 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     the inputs of :func:`measured_inputs` against one reference at REFERENCE_DIGITS. A coefficient of a tensor
     (``part``) is measured as it enters the tensor: relative to ‖T‖/|p|^k where that is below c(0)
     (:func:`_branch_for`). ``extra_forms``: more candidates, already in the backends' variables
-    (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part)."""
+    (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part). ``challengers``: forms in the
+    backends' variables (:func:`definition_forms`) that replace the choice only where they are
+    measurably better: a smaller error class or a shorter polynomial (:func:`_accuracy_first`)."""
     plain, candidates = candidate_forms(closed, argument, phi_max, inverse, complement)
     forms = [*candidates, *extra_forms]
     inputs = measured_inputs(argument, phi_max, dtype, complement)
     reference = reference_values(plain, argument, phi_max, dtype, complement)
     floors = None if part is None else tensor_floors(part, argument, phi_max, dtype, complement)
-    branches = []
-    for form in dict.fromkeys(forms):
-        try:
-            branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype, inputs, reference,
-                                        floors))
-        except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
-            continue
+
+    def measured(candidates: list[sp.Expr]) -> list[Branch]:
+        branches = []
+        for form in dict.fromkeys(candidates):
+            try:
+                branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype, inputs, reference,
+                                            floors))
+            except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
+                continue
+        return branches
+
+    branches = measured(forms)
     if not branches:
         raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: every form divides "
                                      "by zero on the grid")
-    # the smallest worst error class, then the smaller other class (sinh φ: H₂ through √(1 + x) is
-    # 3.5 ulp at the edge where the form in φ̂ is 7, both 11 inside: the edge decides); equally
-    # accurate forms: the shortest polynomial, then a form in φ alone (a form in s and x is taken
-    # where it is measurably more accurate), then the fewest sin/cos arguments
-    return min(branches, key=lambda b: (*sorted((_error_class(b.measured_ulp), _error_class(b.edge_ulp)),
-                                                reverse=True),
-                                        len(b.smallest_switch[1]), b.closed.has(S, X),
-                                        trig_arguments(b.closed), b.edge_ulp, b.measured_ulp))
+    chosen = min(branches, key=_preference)
+    others = measured([form for form in challengers if form not in forms])
+    if others:
+        challenger = min(others, key=_preference)
+        if _accuracy_first(challenger) < _accuracy_first(chosen):
+            chosen = challenger
+    return chosen
+
+
+def _accuracy_first(branch: Branch) -> tuple[float, float, int]:
+    """The worse and the better of the branch's error classes (inside, at the edge), then the
+    length of its polynomial: what makes one branch measurably better than another."""
+    worse, better = sorted((_error_class(branch.measured_ulp), _error_class(branch.edge_ulp)), reverse=True)
+    return worse, better, len(branch.smallest_switch[1])
+
+
+def _preference(branch: Branch) -> tuple[float, float, int, bool, int, float, float]:
+    """The order of :func:`plan_branch`'s choice: the smallest worst error class, then the smaller
+    other class (sinh φ: H₂ through √(1 + x) is 3.5 ulp at the edge where the form in φ̂ is 7, both 11
+    inside: the edge decides); equally accurate forms: the shortest polynomial, then a form in φ alone
+    (a form in s and x is taken where it is measurably more accurate), then the fewest sin/cos
+    arguments."""
+    return (*_accuracy_first(branch), branch.closed.has(S, X), trig_arguments(branch.closed),
+            branch.edge_ulp, branch.measured_ulp)
 
 
 class TensorPart(NamedTuple):
@@ -774,6 +797,8 @@ def _branch_keys(shared: _SharedWork) -> list[FormsKey]:
     for name in names:
         with suppress(SymrotError):
             closed.append(derivation.simplified_form(name))
+            if name not in derivation.slopes and not shared.unbounded:  # see definition_forms
+                closed.append(derivation.expression(name))
     closed.append(quaternion_scalar())
     return list(dict.fromkeys((form, p, shared.phi_max, shared.inverse, shared.complement)
                               for form in closed))
@@ -834,10 +859,12 @@ def _precision_plan(shared: _SharedWork, label: str, dtype: type[np.floating]) -
         series = derivation.series_in_x(coefficient, MAX_TERMS)
         simplest_form = derivation.simplified_form(coefficient)
         extra = difference_forms(coefficients, tensor, complement) if tensor is not None else ()
+        definition = () if unbounded else definition_forms(derivation.expression(coefficient), simplest_form,
+                                                           p, phi_max, inverse, complement)
         coefficients[coefficient] = plan_branch(simplest_form, series, x_of_phi, phi_max, dtype, p,
                                                 inverse, complement,
                                                 tensor_part(derivation, coefficient, shared.det_h_own_scale),
-                                                extra)
+                                                extra, definition)
     coefficients[QUATERNION_SCALAR] = _quaternion_scalar(derivation, inverse, complement, phi_max, p_max,
                                                          dtype)
     scale = _quaternion_scale(derivation.p, min(phi_max, float(np.pi)), dtype)
@@ -867,6 +894,28 @@ def _precision_plan(shared: _SharedWork, label: str, dtype: type[np.floating]) -
     if slopes_unrepresentable:  # the derivative functions are NaN everywhere in this format
         slope_limit = 0.0
     return PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale, limit, slope_limit)
+
+
+def definition_forms(raw: sp.Expr, simplified: sp.Expr, p: sp.Expr, phi_max: float, inverse: sp.Expr | None,
+                     complement: sp.Rational | None) -> tuple[sp.Expr, ...]:
+    """The candidate forms of a coefficient's definition ``raw`` (eqs 14, 22, 26, 81, 83 before
+    simplification) that go through s or x: challengers of :func:`plan_branch`'s choice, taken only
+    where measurably better; none when the definition is its simplified form or a step fails.
+
+    Simplification can cancel p out of a coefficient and with it the form through x: G₂ =
+    (1 − cos(φ/2))/p² of 4 sin(φ/4) cosh φ simplifies to 1/(8 cosh²φ), which inherits the rounding
+    of φ̂ through cosh (float32 ``root_matrix`` 8.8 ulp next to 2π); 2 sin²(φ/4)/x, the definition
+    through x, does not (1.4 ulp). Forms of the definition in φ alone are left out: the simplified
+    form's stand for them. Not offered where p is unbounded: the branch is chosen before the domain
+    sweep, and a definition through powers of x overflows before the value does (tan φ + tan³φ/3:
+    float32's domain ended at |p|² = 2⁷⁵ instead of beyond 2⁸⁰)."""
+    if raw == simplified:
+        return ()
+    try:
+        forms = candidate_forms(raw, p, phi_max, inverse, complement)[1]
+    except Exception:  # optional candidates: a failing step only leaves them out
+        return ()
+    return tuple(form for form in forms if form.has(S, X))
 
 
 def difference_forms(coefficients: dict[str, Coefficient], tensor: str,

@@ -269,3 +269,37 @@ def test_a_closed_inverse_that_cancels_is_rejected_not_crashed() -> None:
     assert len(forms) >= 2
     for form in forms:
         assert closed_angle_error(form, p, 2 * float(np.pi), np.float64) > ANGLE_TOLERANCE_ULP, form
+
+
+
+def test_a_coefficient_whose_simplification_cancels_p_keeps_its_definition_through_x() -> None:
+    """G₂ = (1 − cos(φ/2))/p² of 4 sin(φ/4) cosh φ simplifies to 1/(8 cosh²φ): p cancels, and with it
+    every form through x. Next to 2π that form inherits the rounding of φ̂ through cosh, and t = 1 −
+    G₂x doubles it: float32 ``root_matrix`` was 8.8 ulp off (a held-out hypothesis function). The
+    definition through x, 2 sin²(φ/4)/x, is a candidate too (plan.definition_forms): within 4 ulp of
+    the independent reference of tests/reference.py (eq 76 at φ of the rounded p, 60 digits)."""
+    from symrot.backends.numpy_backend import module_source
+    from tests.reference import GeneratingFunction, Reference
+
+    expression = "4*sin(phi/4)*cosh(phi)"
+    plan = evaluation_plan(derive(expression).derivation, "root")
+    namespace: dict[str, object] = {}
+    exec(compile(module_source(plan), "<root>", "exec"), namespace)
+    function = GeneratingFunction(expression)
+    reference = Reference(function)
+    rng = np.random.default_rng(7)
+    eps = float(np.finfo(np.float32).eps)
+    worst = 0.0
+    for gap in ("0.1", "0.03", "0.003", "1e-5"):
+        angle = 2 * mpmath.pi - mpmath.mpf(gap)
+        with mpmath.workdps(40):
+            size = float(function.value(angle))
+        for _ in range(8):
+            axis = rng.normal(size=3)
+            p = (size * axis / np.linalg.norm(axis)).astype(np.float32)
+            with mpmath.workdps(60):
+                exact = reference.state([mpmath.mpf(float(v)) for v in p], angle).G
+            root = namespace["root_matrix"](p).astype(np.float64)  # type: ignore[operator]
+            error = max(abs(float(root[i, j] - exact[i, j])) for i in range(3) for j in range(3))
+            worst = max(worst, error / eps)
+    assert worst <= 4, worst

@@ -254,8 +254,8 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 592 */
+ * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
+ * ops: 580 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -275,17 +275,16 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
     if (x < 0.1103124080629894) {
         c_H_across = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = cos(w0);
-        c_H_across = sin(phi)/s;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*(-3*phi + 8*w1*w3 - 1.0/2.0*sin(2*phi))/(w2*(phi - 2*w1*w3));
+        const double w0 = sin(phi)/s;
+        const double w1 = 1.0/x;
+        const double w2 = pow(sin((1.0/2.0)*phi), 2);
+        c_H_across = w0;
+        c_H_1 = 2*w1*w2;
+        c_H_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : w1*(-w0 + (1.0/4.0)*x/w2);
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -355,25 +354,15 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double a2_a = 2*phi;
-            const double a2_q = rint(a2_a*0.6366197723675814);
-            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
-            const double a2_z = a2_r*a2_r;
-            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
-            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
-            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
-            const double a2_h = rint(0.5*a2_j - 0.25);
-            const double a2_odd = a2_j - 2*a2_h;
-            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const double w0 = (sin1*sin1);
-            c_H_across_lanes[k] = sin0/s;
+            const double w0 = sin0/s;
+            const double w1 = (sin1*sin1);
+            const double w2 = 1.0/x;
+            c_H_across_lanes[k] = w0;
             poly_H_across_lanes[k] = 1 + (-3.0/20.0)*x;
-            c_H_1_lanes[k] = 2*w0/x;
+            c_H_1_lanes[k] = 2*w1*w2;
             poly_H_1_lanes[k] = x*(x*((-23.0/1008000.0)*x - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-            c_H_2_lanes[k] = -1.0/12.0*(8*cos1*sin1 - 3*phi - 1.0/2.0*sin2)/(w0*(-2*cos1*sin1 + phi));
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+            c_H_2_lanes[k] = w2*(-w0 + (1.0/4.0)*x/w1);
+            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -388,7 +377,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             c_H_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_1;
             const double closed_H_2 = c_H_2_lanes[k];
             const double poly_H_2 = poly_H_2_lanes[k];
-            const double v_H_2 = x < 2.6302227241416043 ? poly_H_2 : closed_H_2;
+            const double v_H_2 = x < 1.4342812090283275 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_2;
         }
         for (k = 0; k < m; ++k) {
@@ -409,10 +398,10 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
 
 /* symrot_det_h_one_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.110312, else s*sin(phi)/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 595 */
+ * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
+ * ops: 597 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -435,14 +424,13 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 1.0/w2;
-        const double w4 = 6*phi;
-        const double w5 = w1*cos(w0);
-        c_H_inverse_across = (1.0/4.0)*s*w3*sin(phi);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w3*(-8*w2 + w4*w5 + pow(1 - 2*w2, 2) - 1)/pow(cbrt(w4 - 12*w5), 4);
+        const double w0 = 1.0/x;
+        const double w1 = sin(phi);
+        const double w2 = w0*(w1*w1);
+        const double w3 = w1/s;
+        const double w4 = cos(phi);
+        c_H_inverse_across = w3/(4*w0*pow(sin((1.0/2.0)*phi), 4) + w2);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : w0*((1.0/3.0)*w0*(6 - 6*w4) - w3/(w0*pow(1 - w4, 2) + w2));
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -459,12 +447,12 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
  * Hinv[9*k..9*k+8], k < n; the same plan, vectorizable: blocks of SYMROT_BATCH_BLOCK
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
- * Scalar pass: s, phi, u0 = cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)).
+ * Scalar pass: s, phi.
  * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t start, k;
     for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
         const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
@@ -472,31 +460,26 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.243134665607636) || x < 3.327466624075446e-08) {
+            if (!(x <= 11.243134665607636) || x < 0.00016163055520154135) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
-                const double u0 = cbrt(6*phi - 12*sin((1.0/2.0)*phi)*cos((1.0/2.0)*phi));
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
-                u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
             s_lanes[k] = 0;
             phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
-            const double u0 = u0_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = rint(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
@@ -507,8 +490,6 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double a0_h = rint(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a0_up = fabs(a0_j - 1.5) - 0.5;
-            const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double a1_a = phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
@@ -519,11 +500,14 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = (sin0*sin0);
-            const double w1 = 1.0/w0;
-            c_H_inverse_across_lanes[k] = (1.0/4.0)*s*sin1*w1;
-            poly_H_inverse_across_lanes[k] = 1 + (-1.0/10.0)*x;
-            c_H_inverse_2_lanes[k] = -1.0/2.0*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u0*u0*u0*u0);
+            const double a1_up = fabs(a1_j - 1.5) - 0.5;
+            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const double w0 = 1.0/x;
+            const double w1 = (sin1*sin1)*w0;
+            const double w2 = sin1/s;
+            c_H_inverse_across_lanes[k] = w2/(4*(sin0*sin0*sin0*sin0)*w0 + w1);
+            poly_H_inverse_across_lanes[k] = x*(x*((-23.0/126000.0)*x - 9.0/2800.0) - 1.0/10.0) + 1;
+            c_H_inverse_2_lanes[k] = w0*((1.0/3.0)*w0*(6 - 6*cos1) - w2/(w0*((1 - cos1)*(1 - cos1)) + w1));
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -531,7 +515,7 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
             const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const double v_H_inverse_across = x < 3.327466624075446e-08 ? poly_H_inverse_across : closed_H_inverse_across;
+            const double v_H_inverse_across = x < 0.00016163055520154135 ? poly_H_inverse_across : closed_H_inverse_across;
             c_H_inverse_across_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x <= 11.243134665607636) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
@@ -850,10 +834,10 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
 
 /* symrot_det_h_one_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.110312, else s*sin(phi)/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 594 */
+ * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
+ * ops: 596 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -870,14 +854,13 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 1.0/w2;
-        const double w4 = 6*phi;
-        const double w5 = w1*cos(w0);
-        c_H_inverse_across = (1.0/4.0)*s*w3*sin(phi);
-        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : -1.0/2.0*w3*(-8*w2 + w4*w5 + pow(1 - 2*w2, 2) - 1)/pow(cbrt(w4 - 12*w5), 4);
+        const double w0 = 1.0/x;
+        const double w1 = sin(phi);
+        const double w2 = w0*(w1*w1);
+        const double w3 = w1/s;
+        const double w4 = cos(phi);
+        c_H_inverse_across = w3/(4*w0*pow(sin((1.0/2.0)*phi), 4) + w2);
+        c_H_inverse_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0 : w0*((1.0/3.0)*w0*(6 - 6*w4) - w3/(w0*pow(1 - w4, 2) + w2));
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -892,8 +875,8 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 591 */
+ * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
+ * ops: 579 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -907,17 +890,16 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
     if (x < 0.1103124080629894) {
         c_H_across = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = cos(w0);
-        c_H_across = sin(phi)/s;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*(-3*phi + 8*w1*w3 - 1.0/2.0*sin(2*phi))/(w2*(phi - 2*w1*w3));
+        const double w0 = sin(phi)/s;
+        const double w1 = 1.0/x;
+        const double w2 = pow(sin((1.0/2.0)*phi), 2);
+        c_H_across = w0;
+        c_H_1 = 2*w1*w2;
+        c_H_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : w1*(-w0 + (1.0/4.0)*x/w2);
     }
     const double w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const double w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -1261,11 +1243,11 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 897 */
+ * ops: 888 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1284,33 +1266,34 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     if (x < 0.1103124080629894) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 2*phi;
-        const double w4 = sin(w3);
-        const double w5 = cos(w0);
-        const double w6 = w1*w5;
-        const double w7 = 2*w6;
-        const double w8 = 1.0/(phi - w7);
-        const double w9 = 1.0/w2;
-        const double w10 = w8*w9;
-        const double w11 = 6*phi;
-        const double w12 = w11 - 12*w6;
-        const double w13 = w5/(w1*w1*w1);
-        const double w14 = cbrt(w12);
-        const double w15 = 16*w1*w5 - w11 - w4;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*w10*(-3*phi + 8*w1*w5 - 1.0/2.0*w4);
-        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w8);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : (1.0/48.0)*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(-8*w2 - cos(w3) + 1));
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 1.0/w3;
+        const double w5 = cos(w1);
+        const double w6 = w5/(w2*w2*w2);
+        const double w7 = w2*w5;
+        const double w8 = 2*w7;
+        const double w9 = 1.0/(phi - w8);
+        const double w10 = 6*phi;
+        const double w11 = w10 - 12*w7;
+        const double w12 = (1.0/48.0)*w4;
+        const double w13 = cbrt(w11);
+        const double w14 = 2*phi;
+        const double w15 = -w10 + 16*w2*w5 - sin(w14);
+        c_H_1 = 2*w0*w3;
+        c_H_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : w0*((1.0/4.0)*w4*x - sin(phi)/s);
+        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : w11*w12*(-3.0/2.0*w6 + 2*w9);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w4*(-8.0/3.0*(w2*w2*w2*w2)*w9 + w8)/w13;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : w12*w13*w9*((1.0/4.0)*w15*w6 + (1.0/2.0)*w15*w9 - 1.0/2.0*w4*(-8*w3 - cos(w14) + 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1356,11 +1339,11 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 903 */
+ * ops: 894 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1379,33 +1362,34 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     if (x < 0.1103124080629894) {
         c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 2*phi;
-        const double w4 = sin(w3);
-        const double w5 = cos(w0);
-        const double w6 = w1*w5;
-        const double w7 = 2*w6;
-        const double w8 = 1.0/(phi - w7);
-        const double w9 = 1.0/w2;
-        const double w10 = w8*w9;
-        const double w11 = 6*phi;
-        const double w12 = w11 - 12*w6;
-        const double w13 = w5/(w1*w1*w1);
-        const double w14 = cbrt(w12);
-        const double w15 = 16*w1*w5 - w11 - w4;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*w10*(-3*phi + 8*w1*w5 - 1.0/2.0*w4);
-        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w9*(-3.0/2.0*w13 + 2*w8);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w9*(-8.0/3.0*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : (1.0/48.0)*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w8 - 1.0/2.0*w9*(-8*w2 - cos(w3) + 1));
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = (w2*w2);
+        const double w4 = 1.0/w3;
+        const double w5 = cos(w1);
+        const double w6 = w5/(w2*w2*w2);
+        const double w7 = w2*w5;
+        const double w8 = 2*w7;
+        const double w9 = 1.0/(phi - w8);
+        const double w10 = 6*phi;
+        const double w11 = w10 - 12*w7;
+        const double w12 = (1.0/48.0)*w4;
+        const double w13 = cbrt(w11);
+        const double w14 = 2*phi;
+        const double w15 = -w10 + 16*w2*w5 - sin(w14);
+        c_H_1 = 2*w0*w3;
+        c_H_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : w0*((1.0/4.0)*w4*x - sin(phi)/s);
+        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : w11*w12*(-3.0/2.0*w6 + 2*w9);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w4*(-8.0/3.0*(w2*w2*w2*w2)*w9 + w8)/w13;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : w12*w13*w9*((1.0/4.0)*w15*w6 + (1.0/2.0)*w15*w9 - 1.0/2.0*w4*(-8*w3 - cos(w14) + 1));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_0_x;
@@ -1453,11 +1437,11 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 21 in x below x = 2.63022, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
+ * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
  * H_inverse_0_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 2.63022, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 648 */
+ * ops: 661 */
 static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1480,23 +1464,25 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
         c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.497844255354877e-25)*x + 7.196733448736306e-24) + 7.96467075122581e-23) + 8.807039512596957e-22) + 9.729237867259716e-21) + 1.0736521110134332e-19) + 1.1833776459135935e-18) + 1.3025203655982459e-17) + 1.4313863004846702e-16) + 1.5701034167431574e-15) + 1.718530004160428e-14) + 1.8761222591988522e-13) + 2.0417396933193335e-12) + 2.213352732046947e-11) + 2.3875903447241837e-10) + 2.559013270547286e-09) + 11192989.0/411675264000000.0) + 604523.0/2118916800000.0) + 3293.0/1121120000.0) + 947.0/32340000.0) + 23.0/84000.0) + 3.0/1400.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 1.0/w2;
-        const double w4 = 6*phi;
-        const double w5 = cos(w0);
-        const double w6 = w1*w5;
-        const double w7 = cbrt(w4 - 12*w6);
-        const double w8 = 1 - 2*w2;
-        const double w9 = -8*w2 + w4*w6 + (w8*w8) - 1;
-        const double w10 = 2*w6;
-        const double w11 = (w1*w1*w1*w1);
-        const double w12 = 1.0/(phi - w10);
-        const double w13 = (8.0/3.0)*w12;
-        c_H_inverse_2 = -1.0/2.0*w3*w9/(w7*w7*w7*w7);
-        c_H_inverse_0_x = (1.0/4.0)*w3*(w10 - w11*w13)/w7;
-        c_H_inverse_2_x = -1.0/96.0*w12*(3*phi*w8 - w10 - w13*w2*w9 - 4*w6*w8 - w5*w9/w1)/w11;
+        const double s = sqrt(x);
+        const double w0 = 1.0/x;
+        const double w1 = cos(phi);
+        const double w2 = sin(phi);
+        const double w3 = (1.0/2.0)*phi;
+        const double w4 = sin(w3);
+        const double w5 = (w4*w4);
+        const double w6 = 6*phi;
+        const double w7 = cos(w3);
+        const double w8 = w4*w7;
+        const double w9 = 2*w8;
+        const double w10 = (w4*w4*w4*w4);
+        const double w11 = 1.0/(phi - w9);
+        const double w12 = (8.0/3.0)*w11;
+        const double w13 = 1 - 2*w5;
+        const double w14 = (w13*w13) - 8*w5 + w6*w8 - 1;
+        c_H_inverse_2 = w0*((1.0/3.0)*w0*(6 - 6*w1) - w2/(s*(w0*(w2*w2) + w0*pow(1 - w1, 2))));
+        c_H_inverse_0_x = (1.0/4.0)*(-w10*w12 + w9)/(w5*cbrt(w6 - 12*w8));
+        c_H_inverse_2_x = -1.0/96.0*w11*(3*phi*w13 - w12*w14*w5 - 4*w13*w8 - w14*w7/w4 - w9)/w10;
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_inverse_0_x;
@@ -1539,11 +1525,11 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0: Horner degree 7 in x below x = 0.110312, else x/(4*sin(phi/2)**2)
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 21 in x below x = 2.63022, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 2.63022, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 860 */
+ * ops: 851 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1557,34 +1543,36 @@ static inline void symrot_det_h_one_angular_acceleration(const double p[3], cons
     if (x < 0.1103124080629894) {
         c_H_0 = x*(x*(x*(x*(x*(x*((99681.0/7623616000000.0)*x + 151439.0/977961600000.0) + 1213.0/655200000.0) + 387.0/17248000.0) + 1.0/3600.0) + 1.0/280.0) + 1.0/20.0) + 1;
         c_H_1 = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         c_H_0_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0;
         c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0;
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0;
     } else {
         const double phi = symrot_det_h_one__phi(sqrt(x));
+        const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
         const double w1 = sin(w0);
         const double w2 = (w1*w1);
         const double w3 = 1.0/w2;
-        const double w4 = 2*phi;
-        const double w5 = sin(w4);
+        const double w4 = (1.0/4.0)*w3*x;
+        const double w5 = 1.0/x;
         const double w6 = cos(w0);
-        const double w7 = w1*w6;
-        const double w8 = 2*w7;
-        const double w9 = 1.0/(phi - w8);
-        const double w10 = w3*w9;
+        const double w7 = w6/(w1*w1*w1);
+        const double w8 = w1*w6;
+        const double w9 = 2*w8;
+        const double w10 = 1.0/(phi - w9);
         const double w11 = 6*phi;
-        const double w12 = w11 - 12*w7;
-        const double w13 = w6/(w1*w1*w1);
+        const double w12 = w11 - 12*w8;
+        const double w13 = (1.0/48.0)*w3;
         const double w14 = cbrt(w12);
-        const double w15 = 16*w1*w6 - w11 - w5;
-        c_H_0 = (1.0/4.0)*w3*x;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.499151775319712e-24)*x + 1.7102707948061374e-23) + 1.9524132761456664e-22) + 2.230454684338051e-21) + 2.5501224371929e-20) + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : -1.0/12.0*w10*(-3*phi + 8*w1*w6 - 1.0/2.0*w5);
-        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : (1.0/48.0)*w12*w3*(-3.0/2.0*w13 + 2*w9);
-        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w3*(-8.0/3.0*(w1*w1*w1*w1)*w9 + w8)/w14;
-        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : (1.0/48.0)*w10*w14*((1.0/4.0)*w13*w15 + (1.0/2.0)*w15*w9 - 1.0/2.0*w3*(-8*w2 - cos(w4) + 1));
+        const double w15 = 2*phi;
+        const double w16 = 16*w1*w6 - w11 - sin(w15);
+        c_H_0 = w4;
+        c_H_1 = 2*w2*w5;
+        c_H_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0 : w5*(w4 - sin(phi)/s);
+        c_H_0_x = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((4.002447216098616e-21)*x + 4.349386634459199e-20) + 4.717726508806865e-19) + 5.106798451593866e-18) + 5.515287671491515e-17) + 5.941040609907155e-16) + 6.3808204484355186e-15) + 6.829994494116056e-14) + 7.28213114499937e-13) + 7.72847448568504e-12) + 8.157249203307483e-11) + 8.552722954369029e-10) + 8.893908470961609e-09) + 99681.0/1089088000000.0) + 151439.0/162993600000.0) + 1213.0/131040000.0) + 387.0/4312000.0) + 1.0/1200.0) + 1.0/140.0) + 1.0/20.0 : w12*w13*(2*w10 - 3.0/2.0*w7);
+        c_H_1_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.713507963984835e-25)*x - 1.9911676878064524e-24) - 2.3176419769991988e-23) - 2.70256607423881e-22) - 3.1578003265100976e-21) - 3.6980551434799796e-20) - 4.341734551994152e-19) - 5.112093930302394e-18) - 6.03885929516599e-17) - 7.160541684001784e-16) - 8.527828450903873e-15) - 1.0208698466596667e-13) - 1.2296404066927483e-12) - 1.4922439654526148e-11) - 1.82786662181949e-10) - 11192989.0/4940103168000000.0) - 604523.0/21189168000000.0) - 3293.0/8968960000.0) - 947.0/194040000.0) - 23.0/336000.0) - 3.0/2800.0) - 1.0/40.0 : (1.0/8.0)*w3*(-8.0/3.0*(w1*w1*w1*w1)*w10 + w9)/w14;
+        c_H_2_x = x < 2.6302227241416043 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.892762495883202e-24)*x + 3.1482187281713954e-23) + 3.420541589612275e-22) + 3.7095852246767656e-21) + 4.0148184318084914e-20) + 4.33520814322793e-19) + 4.669072870028677e-18) + 5.0138978831741045e-17) + 5.366101196045172e-16) + 5.720735574459431e-15) + 6.07110621699205e-14) + 6.408275407599445e-13) + 6.7204125962478614e-12) + 6.991927888549271e-11) + 7.202293014205498e-10) + 7.324395211380149e-09) + 99681.0/1361360000000.0) + 151439.0/211891680000.0) + 1213.0/180180000.0) + 129.0/2156000.0) + 1.0/2100.0) + 1.0/350.0 : w10*w13*w14*((1.0/2.0)*w10*w16 + (1.0/4.0)*w16*w7 - 1.0/2.0*w3*(-8*w2 - cos(w15) + 1));
     }
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
@@ -1930,7 +1918,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * ops: 484 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
@@ -1955,13 +1943,12 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = cosf(w0);
-        c_H_across = sinf(phi)/s;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*(-3*phi + 8*w1*w3 - 1.0F/2.0F*sinf(2*phi))/(w2*(phi - 2*w1*w3));
+        const float w0 = sinf(phi)/s;
+        const float w1 = 1.0F/x;
+        const float w2 = powf(sinf((1.0F/2.0F)*phi), 2);
+        c_H_across = w0;
+        c_H_1 = 2*w1*w2;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : w1*(-w0 + (1.0F/4.0F)*x/w2);
     }
     H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
     H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
@@ -2031,24 +2018,14 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
-            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float a2_a = 2*phi;
-            const float a2_q = rintf(a2_a*0.63661975F);
-            const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
-            const float a2_z = a2_r*a2_r;
-            const float a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*((1.0F/362880.0F)*a2_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
-            const float a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a2_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
-            const float a2_j = a2_q - 4*rintf(0.25F*a2_q - 0.375F);
-            const float a2_h = rintf(0.5F*a2_j - 0.25F);
-            const float a2_odd = a2_j - 2*a2_h;
-            const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
-            const float w0 = (sin1*sin1);
-            c_H_across_lanes[k] = sin0/s;
+            const float w0 = sin0/s;
+            const float w1 = (sin1*sin1);
+            const float w2 = 1.0F/x;
+            c_H_across_lanes[k] = w0;
             poly_H_across_lanes[k] = 1;
-            c_H_1_lanes[k] = 2*w0/x;
+            c_H_1_lanes[k] = 2*w1*w2;
             poly_H_1_lanes[k] = x*((-3.0F/5600.0F)*x - 1.0F/40.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = -1.0F/12.0F*(8*cos1*sin1 - 3*phi - 1.0F/2.0F*sin2)/(w0*(-2*cos1*sin1 + phi));
+            c_H_2_lanes[k] = w2*(-w0 + (1.0F/4.0F)*x/w1);
             poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2085,10 +2062,10 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
 
 /* symrot_det_h_one_tangent_inverse_f: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 1.43428, else s*sin(phi)/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 487 */
+ * ops: 492 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2111,14 +2088,15 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 1.0F/w2;
-        const float w4 = 6*phi;
-        const float w5 = w1*cosf(w0);
-        c_H_inverse_across = (1.0F/4.0F)*s*w3*sinf(phi);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w3*(-8*w2 + w4*w5 + powf(1 - 2*w2, 2) - 1)/powf(cbrtf(w4 - 12*w5), 4);
+        const float w0 = sinf(phi);
+        const float w1 = 1.0F/x;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = (w3*w3);
+        const float w5 = 6*phi;
+        const float w6 = w3*cosf(w2);
+        c_H_inverse_across = w0/(s*((w0*w0)*w1 + 4*w1*(w3*w3*w3*w3)));
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*(-8*w4 + w5*w6 + powf(1 - 2*w4, 2) - 1)/(w4*powf(cbrtf(w5 - 12*w6), 4));
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -2148,7 +2126,7 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x <= 11.2431345F) || x < 0.21121144F) {
+            if (!(x <= 11.2431345F) || x < 1.9211895e-14F) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
                 u0_lanes[k] = 0;
@@ -2195,11 +2173,11 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float a1_h = rintf(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float w0 = (sin0*sin0);
-            const float w1 = 1.0F/w0;
-            c_H_inverse_across_lanes[k] = (1.0F/4.0F)*s*sin1*w1;
-            poly_H_inverse_across_lanes[k] = x*(x*((-23.0F/126000.0F)*x - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
-            c_H_inverse_2_lanes[k] = -1.0F/2.0F*w1*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/(u0*u0*u0*u0);
+            const float w0 = 1.0F/x;
+            const float w1 = (sin0*sin0);
+            c_H_inverse_across_lanes[k] = sin1/(s*(4*(sin0*sin0*sin0*sin0)*w0 + (sin1*sin1)*w0));
+            poly_H_inverse_across_lanes[k] = 1;
+            c_H_inverse_2_lanes[k] = -1.0F/2.0F*(6*cos0*phi*sin0 - 8*w1 + ((1 - 2*w1)*(1 - 2*w1)) - 1)/((u0*u0*u0*u0)*w1);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2207,7 +2185,7 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float x = x_lanes[k];
             const float closed_H_inverse_across = c_H_inverse_across_lanes[k];
             const float poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const float v_H_inverse_across = x < 0.21121144F ? poly_H_inverse_across : closed_H_inverse_across;
+            const float v_H_inverse_across = x < 1.9211895e-14F ? poly_H_inverse_across : closed_H_inverse_across;
             c_H_inverse_across_lanes[k] = !(x <= 11.2431345F) ? NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x <= 11.2431345F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
@@ -2531,10 +2509,10 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
 
 /* symrot_det_h_one_pdot_f: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 1.43428, else s*sin(phi)/(4*sin(phi/2)**2)
+ * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 486 */
+ * ops: 491 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2551,14 +2529,15 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 1.0F/w2;
-        const float w4 = 6*phi;
-        const float w5 = w1*cosf(w0);
-        c_H_inverse_across = (1.0F/4.0F)*s*w3*sinf(phi);
-        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*w3*(-8*w2 + w4*w5 + powf(1 - 2*w2, 2) - 1)/powf(cbrtf(w4 - 12*w5), 4);
+        const float w0 = sinf(phi);
+        const float w1 = 1.0F/x;
+        const float w2 = (1.0F/2.0F)*phi;
+        const float w3 = sinf(w2);
+        const float w4 = (w3*w3);
+        const float w5 = 6*phi;
+        const float w6 = w3*cosf(w2);
+        c_H_inverse_across = w0/(s*((w0*w0)*w1 + 4*w1*(w3*w3*w3*w3)));
+        c_H_inverse_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F : -1.0F/2.0F*(-8*w4 + w5*w6 + powf(1 - 2*w4, 2) - 1)/(w4*powf(cbrtf(w5 - 12*w6), 4));
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -2573,7 +2552,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * ops: 483 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
@@ -2592,13 +2571,12 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = cosf(w0);
-        c_H_across = sinf(phi)/s;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*(-3*phi + 8*w1*w3 - 1.0F/2.0F*sinf(2*phi))/(w2*(phi - 2*w1*w3));
+        const float w0 = sinf(phi)/s;
+        const float w1 = 1.0F/x;
+        const float w2 = powf(sinf((1.0F/2.0F)*phi), 2);
+        c_H_across = w0;
+        c_H_1 = 2*w1*w2;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : w1*(-w0 + (1.0F/4.0F)*x/w2);
     }
     const float w0 = p[1]*pdot[2] - p[2]*pdot[1];
     const float w1 = -p[0]*pdot[2] + p[2]*pdot[0];
@@ -2936,11 +2914,11 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 783 */
+ * ops: 786 */
 static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2965,27 +2943,28 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 2*phi;
-        const float w4 = sinf(w3);
-        const float w5 = cosf(w0);
-        const float w6 = w1*w5;
-        const float w7 = 2*w6;
-        const float w8 = 1.0F/(phi - w7);
-        const float w9 = 1.0F/w2;
-        const float w10 = w8*w9;
-        const float w11 = 6*phi;
-        const float w12 = w11 - 12*w6;
-        const float w13 = w5/(w1*w1*w1);
-        const float w14 = cbrtf(w12);
-        const float w15 = 16*w1*w5 - w11 - w4;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*w10*(-3*phi + 8*w1*w5 - 1.0F/2.0F*w4);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w9*(-3.0F/2.0F*w13 + 2*w8);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w9*(-8.0F/3.0F*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : (1.0F/48.0F)*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(-8*w2 - cosf(w3) + 1));
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 1.0F/w3;
+        const float w5 = cosf(w1);
+        const float w6 = w5/(w2*w2*w2);
+        const float w7 = w2*w5;
+        const float w8 = 2*w7;
+        const float w9 = 1.0F/(phi - w8);
+        const float w10 = 6*phi;
+        const float w11 = w10 - 12*w7;
+        const float w12 = (1.0F/48.0F)*w4;
+        const float w13 = cbrtf(w11);
+        const float w14 = 2*phi;
+        const float w15 = -w10 + 16*w2*w5 - sinf(w14);
+        c_H_1 = 2*w0*w3;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : w0*((1.0F/4.0F)*w4*x - sinf(phi)/s);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : w11*w12*(-3.0F/2.0F*w6 + 2*w9);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w4*(-8.0F/3.0F*(w2*w2*w2*w2)*w9 + w8)/w13;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : w12*w13*w9*((1.0F/4.0F)*w15*w6 + (1.0F/2.0F)*w15*w9 - 1.0F/2.0F*w4*(-8*w3 - cosf(w14) + 1));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3031,11 +3010,11 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 789 */
+ * ops: 792 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3060,27 +3039,28 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 2*phi;
-        const float w4 = sinf(w3);
-        const float w5 = cosf(w0);
-        const float w6 = w1*w5;
-        const float w7 = 2*w6;
-        const float w8 = 1.0F/(phi - w7);
-        const float w9 = 1.0F/w2;
-        const float w10 = w8*w9;
-        const float w11 = 6*phi;
-        const float w12 = w11 - 12*w6;
-        const float w13 = w5/(w1*w1*w1);
-        const float w14 = cbrtf(w12);
-        const float w15 = 16*w1*w5 - w11 - w4;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*w10*(-3*phi + 8*w1*w5 - 1.0F/2.0F*w4);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w9*(-3.0F/2.0F*w13 + 2*w8);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w9*(-8.0F/3.0F*(w1*w1*w1*w1)*w8 + w7)/w14;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : (1.0F/48.0F)*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w8 - 1.0F/2.0F*w9*(-8*w2 - cosf(w3) + 1));
+        const float s = sqrtf(x);
+        const float w0 = 1.0F/x;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = (w2*w2);
+        const float w4 = 1.0F/w3;
+        const float w5 = cosf(w1);
+        const float w6 = w5/(w2*w2*w2);
+        const float w7 = w2*w5;
+        const float w8 = 2*w7;
+        const float w9 = 1.0F/(phi - w8);
+        const float w10 = 6*phi;
+        const float w11 = w10 - 12*w7;
+        const float w12 = (1.0F/48.0F)*w4;
+        const float w13 = cbrtf(w11);
+        const float w14 = 2*phi;
+        const float w15 = -w10 + 16*w2*w5 - sinf(w14);
+        c_H_1 = 2*w0*w3;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : w0*((1.0F/4.0F)*w4*x - sinf(phi)/s);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : w11*w12*(-3.0F/2.0F*w6 + 2*w9);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w4*(-8.0F/3.0F*(w2*w2*w2*w2)*w9 + w8)/w13;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : w12*w13*w9*((1.0F/4.0F)*w15*w6 + (1.0F/2.0F)*w15*w9 - 1.0F/2.0F*w4*(-8*w3 - cosf(w14) + 1));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_0_x;
@@ -3214,11 +3194,11 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_0: Horner degree 7 in x below x = 1.43428, else x/(4*sin(phi/2)**2)
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
- * H_2: Horner degree 17 in x below x = 4.61948, else -(-3*phi + 8*sin(phi/2)*cos(phi/2) - sin(2*phi)/2)/(12*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
+ * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 746 */
+ * ops: 749 */
 static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3238,28 +3218,30 @@ static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], con
         c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F;
     } else {
         const float phi = symrot_det_h_one__phi_f(sqrtf(x));
+        const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
         const float w1 = sinf(w0);
         const float w2 = (w1*w1);
         const float w3 = 1.0F/w2;
-        const float w4 = 2*phi;
-        const float w5 = sinf(w4);
+        const float w4 = (1.0F/4.0F)*w3*x;
+        const float w5 = 1.0F/x;
         const float w6 = cosf(w0);
-        const float w7 = w1*w6;
-        const float w8 = 2*w7;
-        const float w9 = 1.0F/(phi - w8);
-        const float w10 = w3*w9;
+        const float w7 = w6/(w1*w1*w1);
+        const float w8 = w1*w6;
+        const float w9 = 2*w8;
+        const float w10 = 1.0F/(phi - w9);
         const float w11 = 6*phi;
-        const float w12 = w11 - 12*w7;
-        const float w13 = w6/(w1*w1*w1);
+        const float w12 = w11 - 12*w8;
+        const float w13 = (1.0F/48.0F)*w3;
         const float w14 = cbrtf(w12);
-        const float w15 = 16*w1*w6 - w11 - w5;
-        c_H_0 = (1.0F/4.0F)*w3*x;
-        c_H_1 = 2*w2/x;
-        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : -1.0F/12.0F*w10*(-3*phi + 8*w1*w6 - 1.0F/2.0F*w5);
-        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : (1.0F/48.0F)*w12*w3*(-3.0F/2.0F*w13 + 2*w9);
-        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w3*(-8.0F/3.0F*(w1*w1*w1*w1)*w9 + w8)/w14;
-        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : (1.0F/48.0F)*w10*w14*((1.0F/4.0F)*w13*w15 + (1.0F/2.0F)*w15*w9 - 1.0F/2.0F*w3*(-8*w2 - cosf(w4) + 1));
+        const float w15 = 2*phi;
+        const float w16 = 16*w1*w6 - w11 - sinf(w15);
+        c_H_0 = w4;
+        c_H_1 = 2*w2*w5;
+        c_H_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F : w5*(w4 - sinf(phi)/s);
+        c_H_0_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.3730916e-23F)*x + 3.677082e-22F) + 4.002447e-21F) + 4.3493867e-20F) + 4.7177264e-19F) + 5.1067984e-18F) + 5.5152876e-17F) + 5.9410404e-16F) + 6.3808203e-15F) + 6.8299946e-14F) + 7.282131e-13F) + 7.728474e-12F) + 8.157249e-11F) + 8.552723e-10F) + 8.893909e-09F) + 9.152704e-08F) + 9.291101e-07F) + 9.256715e-06F) + 387.0F/4312000.0F) + 1.0F/1200.0F) + 1.0F/140.0F) + 1.0F/20.0F : w12*w13*(2*w10 - 3.0F/2.0F*w7);
+        c_H_1_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-3.1578004e-21F)*x - 3.698055e-20F) - 4.3417346e-19F) - 5.112094e-18F) - 6.038859e-17F) - 7.160542e-16F) - 8.527829e-15F) - 1.02086986e-13F) - 1.2296404e-12F) - 1.492244e-11F) - 1.8278666e-10F) - 2.2657398e-09F) - 2.8529813e-08F) - 3.6715517e-07F) - 4.8804372e-06F) - 23.0F/336000.0F) - 3.0F/2800.0F) - 1.0F/40.0F : (1.0F/8.0F)*w3*(-8.0F/3.0F*(w1*w1*w1*w1)*w10 + w9)/w14;
+        c_H_2_x = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.8927624e-24F)*x + 3.1482186e-23F) + 3.4205415e-22F) + 3.709585e-21F) + 4.0148184e-20F) + 4.335208e-19F) + 4.6690727e-18F) + 5.013898e-17F) + 5.3661014e-16F) + 5.7207356e-15F) + 6.071106e-14F) + 6.4082756e-13F) + 6.7204124e-12F) + 6.991928e-11F) + 7.202293e-10F) + 7.3243953e-09F) + 7.322163e-08F) + 7.147001e-07F) + 6.7321566e-06F) + 129.0F/2156000.0F) + 1.0F/2100.0F) + 1.0F/350.0F : w10*w13*w14*((1.0F/2.0F)*w10*w16 + (1.0F/4.0F)*w16*w7 - 1.0F/2.0F*w3*(-8*w2 - cosf(w15) + 1));
     }
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];

@@ -2158,7 +2158,7 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * K_across: Horner degree 7 in x below x = 1.59536, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 1.59536, else 2*sin(phi/4)**2/x
- * K_2: Horner degree 13 in x below x = 2.86277, else (-6*sin(phi/2)/s + 9/sqrt(d))/(6*s**2)
+ * K_2: Horner degree 13 in x below x = 2.86277, else (-sin(phi/2)/s + 3/(2*sqrt(d)))/s**2
  * ops: 145 */
 static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
 {
@@ -2187,7 +2187,7 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
         const float w0 = sinf((1.0F/2.0F)*phi)/s;
         c_K_across = w0;
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
-        c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (1.0F/6.0F)*(-6*w0 + 9/sqrtf(d))/(s*s);
+        c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (-w0 + (3.0F/2.0F)/sqrtf(d))/(s*s);
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2268,7 +2268,7 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             poly_K_across_lanes[k] = 1.0F/2.0F;
             c_K_1_lanes[k] = 2*(sin1*sin1)/x;
             poly_K_1_lanes[k] = x*(x*((55.0F/7962624.0F)*x + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/6.0F)*(9*u0 - 6*w0)/(s*s);
+            c_K_2_lanes[k] = ((3.0F/2.0F)*u0 - w0)/(s*s);
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */

@@ -334,7 +334,7 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
 
 /* symrot_sine_m5_tangent_inverse: inverse tangent tensor H^-1, pdot = H^-1 omega (eq 26).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*cos(phi/2)/(2*sin(phi/2))
+ * H_inverse_across: Horner degree 7 in x below x = 0.212112, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
  * ops: 114 */
@@ -360,12 +360,14 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = cos(w0)/sin(w0);
-        const double w2 = (1.0/5.0)*phi;
+        const double w0 = sin(phi);
+        const double w1 = 1.0/x;
+        const double w2 = (1.0/2.0)*phi;
         const double w3 = sin(w2);
-        c_H_inverse_across = (1.0/2.0)*s*w1;
-        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(-5.0/2.0*w1*w3 + cos(w2))/(w3*w3);
+        const double w4 = (1.0/5.0)*phi;
+        const double w5 = sin(w4);
+        c_H_inverse_across = w0/(s*((w0*w0)*w1 + 4*w1*(w3*w3*w3*w3)));
+        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(cos(w4) - 5.0/2.0*w5*cos(w2)/w3)/(w5*w5);
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -395,7 +397,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
-            if (!(x < 22.612712429686844) || x < 0.002201880264785416) {
+            if (!(x < 22.612712429686844) || x < 3.327466626289853e-08) {
                 s_lanes[k] = 0;
                 phi_lanes[k] = 0;
             } else {
@@ -427,7 +429,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double a1_a = (1.0/5.0)*phi;
+            const double a1_a = phi;
             const double a1_q = rint(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -437,12 +439,22 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double a1_h = rint(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double a1_up = fabs(a1_j - 1.5) - 0.5;
-            const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double w0 = cos0/sin0;
-            c_H_inverse_across_lanes[k] = (1.0/2.0)*s*w0;
-            poly_H_inverse_across_lanes[k] = x*(x*(x*((-7229.0/2500000000.0)*x - 181.0/2500000.0) - 101.0/50000.0) - 9.0/100.0) + 1;
-            c_H_inverse_2_lanes[k] = (1.0/25.0)*(cos1 - 5.0/2.0*sin1*w0)/(sin1*sin1);
+            const double a2_a = (1.0/5.0)*phi;
+            const double a2_q = rint(a2_a*0.6366197723675814);
+            const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
+            const double a2_z = a2_r*a2_r;
+            const double a2_s = a2_r + (a2_r*a2_z)*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/355687428096000.0)*a2_z - 1.0/1307674368000.0) + 1.0/6227020800.0) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0);
+            const double a2_c = 1 + a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*(a2_z*((1.0/20922789888000.0)*a2_z - 1.0/87178291200.0) + 1.0/479001600.0) - 1.0/3628800.0) + 1.0/40320.0) - 1.0/720.0) + 1.0/24.0) - 1.0/2.0);
+            const double a2_j = a2_q - 4*rint(0.25*a2_q - 0.375);
+            const double a2_h = rint(0.5*a2_j - 0.25);
+            const double a2_odd = a2_j - 2*a2_h;
+            const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
+            const double a2_up = fabs(a2_j - 1.5) - 0.5;
+            const double cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
+            const double w0 = 1.0/x;
+            c_H_inverse_across_lanes[k] = sin1/(s*(4*(sin0*sin0*sin0*sin0)*w0 + (sin1*sin1)*w0));
+            poly_H_inverse_across_lanes[k] = 1 + (-9.0/100.0)*x;
+            c_H_inverse_2_lanes[k] = (1.0/25.0)*(-5.0/2.0*cos0*sin2/sin0 + cos2)/(sin2*sin2);
             poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -450,7 +462,7 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double x = x_lanes[k];
             const double closed_H_inverse_across = c_H_inverse_across_lanes[k];
             const double poly_H_inverse_across = poly_H_inverse_across_lanes[k];
-            const double v_H_inverse_across = x < 0.002201880264785416 ? poly_H_inverse_across : closed_H_inverse_across;
+            const double v_H_inverse_across = x < 3.327466626289853e-08 ? poly_H_inverse_across : closed_H_inverse_across;
             c_H_inverse_across_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_H_inverse_across;
             c_H_inverse_1_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
@@ -777,7 +789,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
 
 /* symrot_sine_m5_pdot: pdot = H^-1 omega (eq 25).
  * Valid for |p| < 4.7552825814757682 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * H_inverse_across: Horner degree 7 in x below x = 0.212112, else s*cos(phi/2)/(2*sin(phi/2))
+ * H_inverse_across: Horner degree 7 in x below x = 0.212112, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 2.78761, else (-5*sin(phi/5)*cos(phi/2)/(2*sin(phi/2)) + cos(phi/5))/(25*sin(phi/5)**2)
  * ops: 113 */
@@ -797,12 +809,14 @@ static inline void symrot_sine_m5_pdot(const double p[3], const double omega[3],
     } else {
         const double phi = symrot_sine_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = cos(w0)/sin(w0);
-        const double w2 = (1.0/5.0)*phi;
+        const double w0 = sin(phi);
+        const double w1 = 1.0/x;
+        const double w2 = (1.0/2.0)*phi;
         const double w3 = sin(w2);
-        c_H_inverse_across = (1.0/2.0)*s*w1;
-        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(-5.0/2.0*w1*w3 + cos(w2))/(w3*w3);
+        const double w4 = (1.0/5.0)*phi;
+        const double w5 = sin(w4);
+        c_H_inverse_across = w0/(s*((w0*w0)*w1 + 4*w1*(w3*w3*w3*w3)));
+        c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(cos(w4) - 5.0/2.0*w5*cos(w2)/w3)/(w5*w5);
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];

@@ -332,8 +332,8 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_across: Horner degree 7 in x below x = 0.41316, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
- * ops: 99 */
+ * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (x/25 + 1 - 2*sin(phi/2)*cos(phi/2)/(s*(4*sin(phi/2)**4/x + 4*sin(phi/2)**2*cos(phi/2)**2/x)))/x
+ * ops: 117 */
 static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -352,14 +352,17 @@ static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double H
     double c_H_inverse_across, c_H_inverse_2;
     if (x < 0.4131604136062581) {
         c_H_inverse_across = x*(x*(x*(x*(x*(x*((117.0/3125000000000000.0)*x - 113.0/62500000000000.0) + 7.0/125000000000.0) - 29.0/2500000000.0) - 3.0/2500000.0) - 21.0/50000.0) - 7.0/100.0) + 1;
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        const double w1 = (1.0/2.0)*s*cos(w0)/sin(w0);
-        c_H_inverse_across = w1;
-        c_H_inverse_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0 : (-w1 + (1.0/25.0)*x + 1)/x;
+        const double w1 = cos(w0);
+        const double w2 = sin(w0);
+        const double w3 = 1.0/x;
+        const double w4 = 4*w3;
+        c_H_inverse_across = (1.0/2.0)*s*w1/w2;
+        c_H_inverse_2 = x < 6.511791226584059 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0 : w3*((1.0/25.0)*x + 1 - 2*w1*w2/(s*((w1*w1)*(w2*w2)*w4 + (w2*w2*w2*w2)*w4)));
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
@@ -421,11 +424,12 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double w0 = (1.0/2.0)*cos0*s/sin0;
-            c_H_inverse_across_lanes[k] = w0;
+            const double w0 = 1.0/x;
+            const double w1 = 4*w0;
+            c_H_inverse_across_lanes[k] = (1.0/2.0)*cos0*s/sin0;
             poly_H_inverse_across_lanes[k] = 1 + (-7.0/100.0)*x;
-            c_H_inverse_2_lanes[k] = (-w0 + (1.0/25.0)*x + 1)/x;
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+            c_H_inverse_2_lanes[k] = w0*(-2*cos0*sin0/(s*((cos0*cos0)*(sin0*sin0)*w1 + (sin0*sin0*sin0*sin0)*w1)) + (1.0/25.0)*x + 1);
+            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -437,7 +441,7 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             c_H_inverse_1_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : -1.0/2.0;
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const double poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
-            const double v_H_inverse_2 = x < 3.1374537386488126 ? poly_H_inverse_2 : closed_H_inverse_2;
+            const double v_H_inverse_2 = x < 6.511791226584059 ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x <= 236.80339887498948) ? (double)NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
@@ -757,8 +761,8 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_across: Horner degree 7 in x below x = 0.41316, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
- * ops: 98 */
+ * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (x/25 + 1 - 2*sin(phi/2)*cos(phi/2)/(s*(4*sin(phi/2)**4/x + 4*sin(phi/2)**2*cos(phi/2)**2/x)))/x
+ * ops: 116 */
 static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -771,14 +775,17 @@ static inline void symrot_tangent_m5_pdot(const double p[3], const double omega[
     double c_H_inverse_across, c_H_inverse_2;
     if (x < 0.4131604136062581) {
         c_H_inverse_across = x*(x*(x*(x*(x*(x*((117.0/3125000000000000.0)*x - 113.0/62500000000000.0) + 7.0/125000000000.0) - 29.0/2500000000.0) - 3.0/2500000.0) - 21.0/50000.0) - 7.0/100.0) + 1;
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
         const double w0 = (1.0/2.0)*phi;
-        const double w1 = (1.0/2.0)*s*cos(w0)/sin(w0);
-        c_H_inverse_across = w1;
-        c_H_inverse_2 = x < 3.1374537386488126 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0 : (-w1 + (1.0/25.0)*x + 1)/x;
+        const double w1 = cos(w0);
+        const double w2 = sin(w0);
+        const double w3 = 1.0/x;
+        const double w4 = 4*w3;
+        c_H_inverse_across = (1.0/2.0)*s*w1/w2;
+        c_H_inverse_2 = x < 6.511791226584059 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0 : w3*((1.0/25.0)*x + 1 - 2*w1*w2/(s*((w1*w1)*(w2*w2)*w4 + (w2*w2*w2*w2)*w4)));
     }
     const double w0 = -omega[1]*p[2] + omega[2]*p[1];
     const double w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -1323,11 +1330,11 @@ static inline void symrot_tangent_m5_tangent_transpose_derivative(const double p
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 12 in x below x = 3.13745, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
+ * H_inverse_2: Horner degree 18 in x below x = 6.51179, else (x/25 + 1 - 2*sin(phi/2)*cos(phi/2)/(s*(4*sin(phi/2)**4/x + 4*sin(phi/2)**2*cos(phi/2)**2/x)))/x
  * H_inverse_0_x = 1/25 (algebraic in x)
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 6.51179, else 5*(-5*s*(1 - 2*sin(phi/2)**2)/(2*sin(phi/2)**2) + 4*s*(s**2/25 + 1)/5 + 5*s*cos(phi/2)**2/sin(phi/2)**2 - 5*(s**2/25 + 1)*cos(phi/2)/sin(phi/2) - 10*(s**2/25 + 1)*(2*s**2/25 - s*cos(phi/2)/sin(phi/2) + 2)/s)/(4*s**3*(x + 25))
- * ops: 225 */
+ * ops: 243 */
 static inline void symrot_tangent_m5_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1345,23 +1352,26 @@ static inline void symrot_tangent_m5_tangent_inverse_derivative(const double p[3
     }
     const double c_H_inverse_0_x = 1.0/25.0;
     double c_H_inverse_2, c_H_inverse_2_x;
-    if (x < 3.1374537386488126) {
-        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.34371456e-22 + (-1.597977344e-23)*x) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+    if (x < 6.511791226584059) {
+        c_H_inverse_2 = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
         c_H_inverse_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.322761367777524e-35 + (-4.7283264209457356e-37)*x) - 3.7200737055323752e-34) + 1.0523099660610621e-32) - 2.995843178059776e-31) + 8.589770227948544e-30) - 2.48248932851712e-28) + 7.238659410816e-27) - 2.132050450432e-25) + 6.35205036544e-24) - 1.9175728128e-22) + 5.878086016e-21) - 1.8345344e-19) + 5.8500288e-18) - 1.9136e-16) + 6.48368e-15) - 351.0/1562500000000000.0) + 113.0/12500000000000.0) - 7.0/31250000000.0) + 87.0/2500000000.0) + 3.0/1250000.0) + 21.0/50000.0;
     } else {
         const double phi = symrot_tangent_m5__phi(sqrt(x));
         const double s = sqrt(x);
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = cos(w0);
-        const double w3 = w2/w1;
-        const double w4 = s*w3;
-        const double w5 = (s*s);
-        const double w6 = (1.0/25.0)*w5 + 1;
-        const double w7 = (w1*w1);
-        const double w8 = 1.0/w7;
-        c_H_inverse_2 = (-1.0/2.0*w4 + (1.0/25.0)*x + 1)/x;
-        c_H_inverse_2_x = x < 6.511791226584059 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(1.322761367777524e-35 + (-4.7283264209457356e-37)*x) - 3.7200737055323752e-34) + 1.0523099660610621e-32) - 2.995843178059776e-31) + 8.589770227948544e-30) - 2.48248932851712e-28) + 7.238659410816e-27) - 2.132050450432e-25) + 6.35205036544e-24) - 1.9175728128e-22) + 5.878086016e-21) - 1.8345344e-19) + 5.8500288e-18) - 1.9136e-16) + 6.48368e-15) - 351.0/1562500000000000.0) + 113.0/12500000000000.0) - 7.0/31250000000.0) + 87.0/2500000000.0) + 3.0/1250000.0) + 21.0/50000.0 : (5.0/4.0)*(5*s*(w2*w2)*w8 + (4.0/5.0)*s*w6 - 5.0/2.0*s*w8*(1 - 2*w7) - 5*w3*w6 - 10*w6*(-w4 + (2.0/25.0)*w5 + 2)/s)/((s*s*s)*(x + 25));
+        const double w0 = 1.0/x;
+        const double w1 = 1.0/s;
+        const double w2 = (1.0/2.0)*phi;
+        const double w3 = sin(w2);
+        const double w4 = cos(w2);
+        const double w5 = 4*w0;
+        const double w6 = (w3*w3);
+        const double w7 = (w4*w4);
+        const double w8 = (s*s);
+        const double w9 = (1.0/25.0)*w8 + 1;
+        const double w10 = 1.0/w6;
+        const double w11 = w4/w3;
+        c_H_inverse_2 = w0*(-2*w1*w3*w4/((w3*w3*w3*w3)*w5 + w5*w6*w7) + (1.0/25.0)*x + 1);
+        c_H_inverse_2_x = (5.0/4.0)*(5*s*w10*w7 - 5.0/2.0*s*w10*(1 - 2*w6) + (4.0/5.0)*s*w9 - 10*w1*w9*(-s*w11 + (2.0/25.0)*w8 + 2) - 5*w11*w9)/((s*s*s)*(x + 25));
     }
     const double dw0 = a[0]*p[0];
     const double dw1 = 2*c_H_inverse_0_x;
@@ -1876,7 +1886,7 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_across: Horner degree 6 in x below x = 6.51179, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (x/25 + 1 - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
  * ops: 79 */
 static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float Hinv[9])
 {
@@ -1901,9 +1911,10 @@ static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float H
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = (1.0F/2.0F)*s*cosf(w0)/sinf(w0);
-        c_H_inverse_across = w1;
-        c_H_inverse_2 = (-w1 + (1.0F/25.0F)*x + 1)/x;
+        const float w1 = 1.0F/x;
+        const float w2 = sinf(phi);
+        c_H_inverse_across = (1.0F/2.0F)*s*cosf(w0)/sinf(w0);
+        c_H_inverse_2 = w1*((1.0F/25.0F)*x + 1 - w2/(s*(w1*(w2*w2) + w1*powf(1 - cosf(phi), 2))));
     }
     Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
     Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
@@ -1965,11 +1976,23 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = (1.0F/2.0F)*cos0*s/sin0;
-            c_H_inverse_across_lanes[k] = w0;
+            const float a1_a = phi;
+            const float a1_q = rintf(a1_a*0.63661975F);
+            const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
+            const float a1_z = a1_r*a1_r;
+            const float a1_s = a1_r + (a1_r*a1_z)*(a1_z*(a1_z*((1.0F/362880.0F)*a1_z - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F);
+            const float a1_c = 1 + a1_z*(a1_z*(a1_z*(a1_z*(1.0F/40320.0F + (-1.0F/3628800.0F)*a1_z) - 1.0F/720.0F) + 1.0F/24.0F) - 1.0F/2.0F);
+            const float a1_j = a1_q - 4*rintf(0.25F*a1_q - 0.375F);
+            const float a1_h = rintf(0.5F*a1_j - 0.25F);
+            const float a1_odd = a1_j - 2*a1_h;
+            const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
+            const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
+            const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
+            const float w0 = 1.0F/x;
+            c_H_inverse_across_lanes[k] = (1.0F/2.0F)*cos0*s/sin0;
             poly_H_inverse_across_lanes[k] = 1;
-            c_H_inverse_2_lanes[k] = (-w0 + (1.0F/25.0F)*x + 1)/x;
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(1.16e-08F + (-5.6e-11F)*x) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
+            c_H_inverse_2_lanes[k] = w0*((1.0F/25.0F)*x + 1 - sin1/(s*((sin1*sin1)*w0 + w0*((1 - cos1)*(1 - cos1)))));
+            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1981,7 +2004,7 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             c_H_inverse_1_lanes[k] = !(x < 236.8034F) ? NAN : -1.0F/2.0F;
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             const float poly_H_inverse_2 = poly_H_inverse_2_lanes[k];
-            const float v_H_inverse_2 = x < 3.1374536F ? poly_H_inverse_2 : closed_H_inverse_2;
+            const float v_H_inverse_2 = x < 6.5117908F ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x < 236.8034F) ? NAN : v_H_inverse_2;
         }
         for (k = 0; k < m; ++k) {
@@ -2159,7 +2182,7 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * K_across: Horner degree 6 in x below x = 1.57118, else sin(phi/2)/s
  * K_1: Horner degree 6 in x below x = 1.57118, else 2*sin(phi/4)**2/x
- * K_2: Horner degree 14 in x below x = 6.51179, else (125/(x + 25) - 10*sin(phi/2)/s)/(10*s**2)
+ * K_2: Horner degree 14 in x below x = 6.51179, else (1/(2*(s**2/25 + 1)) - sin(phi/2)/s)/s**2
  * ops: 121 */
 static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9])
 {
@@ -2185,9 +2208,10 @@ static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9]
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = sinf((1.0F/2.0F)*phi)/s;
+        const float w1 = (s*s);
         c_K_across = w0;
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
-        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (1.0F/10.0F)*(-10*w0 + 125/(x + 25))/(s*s);
+        c_K_2 = x < 6.5117908F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F : (-w0 + (1.0F/2.0F)/((1.0F/25.0F)*w1 + 1))/w1;
     }
     K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
     K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
@@ -2258,11 +2282,12 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = sin0/s;
+            const float w1 = (s*s);
             c_K_across_lanes[k] = w0;
             poly_K_across_lanes[k] = 1.0F/2.0F;
             c_K_1_lanes[k] = 2*(sin1*sin1)/x;
             poly_K_1_lanes[k] = x*((841.0F/3200000.0F)*x - 19.0F/3200.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/10.0F)*(-10*w0 + 125/(x + 25))/(s*s);
+            c_K_2_lanes[k] = (-w0 + (1.0F/2.0F)/((1.0F/25.0F)*w1 + 1))/w1;
             poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -2301,7 +2326,7 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_across: Horner degree 6 in x below x = 6.51179, else s*cos(phi/2)/(2*sin(phi/2))
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (x/25 + 1 - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
  * ops: 78 */
 static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
@@ -2320,9 +2345,10 @@ static inline void symrot_tangent_m5_pdot_f(const float p[3], const float omega[
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
         const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = (1.0F/2.0F)*s*cosf(w0)/sinf(w0);
-        c_H_inverse_across = w1;
-        c_H_inverse_2 = (-w1 + (1.0F/25.0F)*x + 1)/x;
+        const float w1 = 1.0F/x;
+        const float w2 = sinf(phi);
+        c_H_inverse_across = (1.0F/2.0F)*s*cosf(w0)/sinf(w0);
+        c_H_inverse_2 = w1*((1.0F/25.0F)*x + 1 - w2/(s*(w1*(w2*w2) + w1*powf(1 - cosf(phi), 2))));
     }
     const float w0 = -omega[1]*p[2] + omega[2]*p[1];
     const float w1 = omega[0]*p[2] - omega[2]*p[0];
@@ -2868,11 +2894,11 @@ static inline void symrot_tangent_m5_tangent_transpose_derivative_f(const float 
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 15.388417685876266 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * H_inverse_1 = -1/2 (constant)
- * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (-s*cos(phi/2)/(2*sin(phi/2)) + x/25 + 1)/x
+ * H_inverse_2: Horner degree 6 in x below x = 6.51179, else (x/25 + 1 - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
  * H_inverse_0_x = 1/25 (algebraic in x)
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 8 in x below x = 6.51179, else 5*(-5*s*(1 - 2*sin(phi/2)**2)/(2*sin(phi/2)**2) + 4*s*(s**2/25 + 1)/5 + 5*s*sin(phi)**2/(4*sin(phi/2)**4) - 5*(s**2/25 + 1)*sin(phi)/(2*sin(phi/2)**2) - 10*(s**2/25 + 1)*(2*s**2/25 - s*sin(phi)/(2*sin(phi/2)**2) + 2)/s)/(4*s**3*(x + 25))
- * ops: 180 */
+ * ops: 187 */
 static inline void symrot_tangent_m5_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2896,17 +2922,18 @@ static inline void symrot_tangent_m5_tangent_inverse_derivative_f(const float p[
     } else {
         const float phi = symrot_tangent_m5__phi_f(sqrtf(x));
         const float s = sqrtf(x);
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (1.0F/2.0F)*s;
-        const float w3 = (s*s);
-        const float w4 = (1.0F/25.0F)*w3 + 1;
-        const float w5 = sinf(phi);
-        const float w6 = (w1*w1);
-        const float w7 = 1.0F/w6;
-        const float w8 = w5*w7;
-        c_H_inverse_2 = ((1.0F/25.0F)*x + 1 - w2*cosf(w0)/w1)/x;
-        c_H_inverse_2_x = (5.0F/4.0F)*((4.0F/5.0F)*s*w4 - 5.0F/2.0F*s*w7*(1 - 2*w6) + (5.0F/4.0F)*s*(w5*w5)/(w1*w1*w1*w1) - 5.0F/2.0F*w4*w8 - 10*w4*(-w2*w8 + (2.0F/25.0F)*w3 + 2)/s)/((s*s*s)*(x + 25));
+        const float w0 = 1.0F/x;
+        const float w1 = sinf(phi);
+        const float w2 = 1.0F/s;
+        const float w3 = (w1*w1);
+        const float w4 = (s*s);
+        const float w5 = (1.0F/25.0F)*w4 + 1;
+        const float w6 = sinf((1.0F/2.0F)*phi);
+        const float w7 = (w6*w6);
+        const float w8 = 1.0F/w7;
+        const float w9 = s*w8;
+        c_H_inverse_2 = w0*(-w1*w2/(w0*w3 + w0*powf(1 - cosf(phi), 2)) + (1.0F/25.0F)*x + 1);
+        c_H_inverse_2_x = (5.0F/4.0F)*((5.0F/4.0F)*s*w3/(w6*w6*w6*w6) + (4.0F/5.0F)*s*w5 - 5.0F/2.0F*w1*w5*w8 - 10*w2*w5*(-1.0F/2.0F*w1*w9 + (2.0F/25.0F)*w4 + 2) - 5.0F/2.0F*w9*(1 - 2*w7))/((s*s*s)*(x + 25));
     }
     const float dw0 = a[0]*p[0];
     const float dw1 = 2*c_H_inverse_0_x;

@@ -213,13 +213,9 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
         t = x
-        series = 1.499151775319712e-24
-        series = 1.7102707948061374e-23 + t * series
-        series = 1.9524132761456664e-22 + t * series
-        series = 2.230454684338051e-21 + t * series
-        series = 2.5501224371929e-20 + t * series
+        series = 2.5501224371929e-20
         series = 2.918170543767923e-19 + t * series
         series = 3.3425985887827363e-18 + t * series
         series = 3.8329294257465515e-17 + t * series
@@ -238,17 +234,13 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*numpy.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi)), dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+    out = numpy.asarray(((0.25)*x/sin_half**2 - numpy.sin(phi)/s)/x, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
-    small = x < 2.6302227241416043
+    small = x < 1.4342812090283275
     if small.any():
         t = x[small]
-        series = 1.499151775319712e-24
-        series = 1.7102707948061374e-23 + t * series
-        series = 1.9524132761456664e-22 + t * series
-        series = 2.230454684338051e-21 + t * series
-        series = 2.5501224371929e-20 + t * series
+        series = 2.5501224371929e-20
         series = 2.918170543767923e-19 + t * series
         series = 3.3425985887827363e-18 + t * series
         series = 3.8329294257465515e-17 + t * series
@@ -326,10 +318,10 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.002142857142857143 + t * series
         series = 0.05 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    w1 = 6*phi
-    w2 = cos_half*sin_half
-    out = numpy.asarray(-0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4), dtype=x.dtype)
+    w0 = x**(-1.0)
+    w1 = numpy.cos(phi)
+    w2 = numpy.sin(phi)
+    out = numpy.asarray(w0*((0.3333333333333333)*w0*(6 - 6*w1) - w2/(s*(w0*w2**2 + w0*(1 - w1)**2))), dtype=x.dtype)
     if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
         return out
     small = x < 2.6302227241416043
@@ -524,18 +516,24 @@ def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 3.327466624075446e-08:  # every lane on the polynomial
+    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
         t = x
-        series = -0.1
+        series = -0.00018253968253968255
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*s*numpy.sin(phi)/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 3.327466624075446e-08:  # every lane on the closed form
+    w0 = numpy.sin(phi)
+    w1 = x**(-1.0)
+    out = numpy.asarray(w0/(s*(4*sin_half**4*w1 + w0**2*w1)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
         return out
-    small = x < 3.327466624075446e-08
+    small = x < 0.00016163055520154135
     if small.any():
         t = x[small]
-        series = -0.1
+        series = -0.00018253968253968255
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
         series = 1.0 + t * series
         out[small] = series
     return out
@@ -1319,7 +1317,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(-0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*numpy.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi)), dtype=x.dtype)
+    out = numpy.asarray(((0.25)*x/sin_half**2 - numpy.sin(phi)/s)/x, dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478
@@ -1591,23 +1589,16 @@ def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.2112114357353433:  # every lane on the polynomial
-        t = x
-        series = -0.00018253968253968255
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*s*numpy.sin(phi)/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.2112114357353433:  # every lane on the closed form
+    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
+        return numpy.full_like(x, 1.0)
+    w0 = numpy.sin(phi)
+    w1 = x**(-1.0)
+    out = numpy.asarray(w0/(s*(4*sin_half**4*w1 + w0**2*w1)), dtype=x.dtype)
+    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
         return out
-    small = x < 0.2112114357353433
+    small = x < 1.921189444436213e-14
     if small.any():
-        t = x[small]
-        series = -0.00018253968253968255
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
-        series = 1.0 + t * series
+        series = 1.0
         out[small] = series
     return out
 
@@ -2223,8 +2214,8 @@ _USES_PHI = {
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'p_prime': 0.00016163055520154135, 'nu': 1.9211893090849666e-14, 'epsilon': 9.999999999999995e-15, 'mu': 0.0022017832983058567, 'R_1': 1.9211893090849666e-14, 'R_2': 0.00016163055520154135, 'H_0': 0.0022017832983058567, 'H_1': 0.00016163055520154135, 'H_2': 2.6302227241416043, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 1.9211893090849666e-14, 'G_2': 0.004229756532686548, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 1.9211893090849666e-14, 'H_inverse_across': 3.327466624075446e-08, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
-    "32": {'p_prime': 0.008125106898670383, 'nu': 1.921189444436213e-14, 'epsilon': 1.0000000233721947e-14, 'mu': 0.7648242161335777, 'R_1': 1.921189444436213e-14, 'R_2': 0.7648242161335777, 'H_0': 0.7648242161335777, 'H_1': 0.008125106898670383, 'H_2': 4.619481091176478, 'H_inverse_0': 0.7648242161335777, 'H_inverse_2': 4.619481091176478, 'G_1': 1.921189444436213e-14, 'G_2': 0.7648242161335777, 'K_0': 0.7648242161335777, 'K_1': 0.7648242161335777, 'K_2': 4.619481091176478, 'H_across': 1.921189444436213e-14, 'H_inverse_across': 0.2112114357353433, 'K_across': 1.921189444436213e-14, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
+    "64": {'p_prime': 0.00016163055520154135, 'nu': 1.9211893090849666e-14, 'epsilon': 9.999999999999995e-15, 'mu': 0.0022017832983058567, 'R_1': 1.9211893090849666e-14, 'R_2': 0.00016163055520154135, 'H_0': 0.0022017832983058567, 'H_1': 0.00016163055520154135, 'H_2': 1.4342812090283275, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 1.9211893090849666e-14, 'G_2': 0.004229756532686548, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 1.9211893090849666e-14, 'H_inverse_across': 0.00016163055520154135, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
+    "32": {'p_prime': 0.008125106898670383, 'nu': 1.921189444436213e-14, 'epsilon': 1.0000000233721947e-14, 'mu': 0.7648242161335777, 'R_1': 1.921189444436213e-14, 'R_2': 0.7648242161335777, 'H_0': 0.7648242161335777, 'H_1': 0.008125106898670383, 'H_2': 4.619481091176478, 'H_inverse_0': 0.7648242161335777, 'H_inverse_2': 4.619481091176478, 'G_1': 1.921189444436213e-14, 'G_2': 0.7648242161335777, 'K_0': 0.7648242161335777, 'K_1': 0.7648242161335777, 'K_2': 4.619481091176478, 'H_across': 1.921189444436213e-14, 'H_inverse_across': 1.921189444436213e-14, 'K_across': 1.921189444436213e-14, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)

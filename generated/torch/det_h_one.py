@@ -325,13 +325,9 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.6302227241416043
+    small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 1.499151775319712e-24 + 0.0 * x
-    series = 1.7102707948061374e-23 + t * series
-    series = 1.9524132761456664e-22 + t * series
-    series = 2.230454684338051e-21 + t * series
-    series = 2.5501224371929e-20 + t * series
+    series = 2.5501224371929e-20 + 0.0 * x
     series = 2.918170543767923e-19 + t * series
     series = 3.3425985887827363e-18 + t * series
     series = 3.8329294257465515e-17 + t * series
@@ -349,10 +345,11 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0002380952380952381 + t * series
     series = 0.002857142857142857 + t * series
     series = 0.2 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    closed = -0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*_xp.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi))
+    phi = _where(small, 1.2281574046507382, phi)
+    s = _where(small, 1.197614799937078, s)
+    x = _where(small, 1.4342812090283275, x)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    closed = ((0.25)*x/sin_half**2 - _xp.sin(phi)/s)/x
     return _where(small, series, closed)
 
 
@@ -403,12 +400,12 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.002142857142857143 + t * series
     series = 0.05 + t * series
     phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    w0 = sin_half**2
-    w1 = 6*phi
-    w2 = cos_half*sin_half
-    closed = -0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*_cbrt(w1 - 12*w2)**4)
+    s = _where(small, 1.6217961413635205, s)
+    x = _where(small, 2.6302227241416043, x)
+    w0 = x**(-1.0)
+    w1 = _xp.cos(phi)
+    w2 = _xp.sin(phi)
+    closed = w0*((0.3333333333333333)*w0*(6 - 6*w1) - w2/(s*(w0*w2**2 + w0*(1 - w1)**2)))
     return _where(small, series, closed)
 
 
@@ -542,8 +539,11 @@ def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
     series = 1.0 + t * series
     phi = _where(small, 0.33274666277661247, phi)
     s = _where(small, 0.33213311798583023, s)
+    x = _where(small, 0.1103124080629894, x)
     sin_half = _where(small, 0.1656068549609148, sin_half)
-    closed = (0.25)*s*_xp.sin(phi)/sin_half**2
+    w0 = _xp.sin(phi)
+    w1 = x**(-1.0)
+    closed = w0/(s*(4*sin_half**4*w1 + w0**2*w1))
     return _where(small, series, closed)
 
 
@@ -1102,9 +1102,10 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.002857142857142857 + t * series
     series = 0.2 + t * series
     phi = _where(small, 2.3595228756885396, phi)
+    s = _where(small, 2.149297813514097, s)
+    x = _where(small, 4.619481091176478, x)
     sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = -0.08333333333333333*(8*cos_half*sin_half - 3*phi - 0.5*_xp.sin(2*phi))/(sin_half**2*(-2*cos_half*sin_half + phi))
+    closed = ((0.25)*x/sin_half**2 - _xp.sin(phi)/s)/x
     return _where(small, series, closed)
 
 
@@ -1288,8 +1289,11 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     series = 1.0 + t * series
     phi = _where(small, 1.2281574046507382, phi)
     s = _where(small, 1.1976147966353403, s)
+    x = _where(small, 1.4342812011199078, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    closed = (0.25)*s*_xp.sin(phi)/sin_half**2
+    w0 = _xp.sin(phi)
+    w1 = x**(-1.0)
+    closed = w0/(s*(4*sin_half**4*w1 + w0**2*w1))
     return _where(small, series, closed)
 
 
