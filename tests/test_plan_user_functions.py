@@ -271,12 +271,11 @@ def test_a_closed_inverse_that_cancels_is_rejected_not_crashed() -> None:
         assert closed_angle_error(form, p, 2 * float(np.pi), np.float64) > ANGLE_TOLERANCE_ULP, form
 
 
-
 def test_a_coefficient_whose_simplification_cancels_p_keeps_its_definition_through_x() -> None:
     """G₂ = (1 − cos(φ/2))/p² of 4 sin(φ/4) cosh φ simplifies to 1/(8 cosh²φ): p cancels, and with it
     every form through x. Next to 2π that form inherits the rounding of φ̂ through cosh, and t = 1 −
     G₂x doubles it: float32 ``root_matrix`` was 8.8 ulp off (a held-out hypothesis function). The
-    definition through x, 2 sin²(φ/4)/x, is a candidate too (plan.definition_forms): within 4 ulp of
+    definition through x, 2 sin²(φ/4)/x, is a challenger (plan.definition_forms): within 4 ulp of
     the independent reference of tests/reference.py (eq 76 at φ of the rounded p, 60 digits)."""
     from symrot.backends.numpy_backend import module_source
     from tests.reference import GeneratingFunction, Reference
