@@ -59,7 +59,7 @@ from .algebraic import (
 from .algebraic import X as X  # re-exported: the symbol of the coefficients' variable x = |p|²
 from .core import Derivation, derive_expression
 from .domain import FIRST_POWER, domain_limit
-from .errors import SymrotError
+from .errors import SymrotError, SymrotTimeout
 from .evaluation import ModelKey, log_grid, model_function, model_key, model_source, remember_sources
 from .forked import first_here_others_in_children
 from .functions import RealCbrt, mpmath_namespace
@@ -913,6 +913,8 @@ def definition_forms(raw: sp.Expr, simplified: sp.Expr, p: sp.Expr, phi_max: flo
         return ()
     try:
         forms = candidate_forms(raw, p, phi_max, inverse, complement)[1]
+    except SymrotTimeout:  # a time bound expired: left out, the plan would depend on the machine
+        raise
     except Exception:  # optional candidates: a failing step only leaves them out
         return ()
     return tuple(form for form in forms if form.has(S, X))

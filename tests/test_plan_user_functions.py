@@ -302,3 +302,24 @@ def test_a_coefficient_whose_simplification_cancels_p_keeps_its_definition_throu
             error = max(abs(float(root[i, j] - exact[i, j])) for i in range(3) for j in range(3))
             worst = max(worst, error / eps)
     assert worst <= 4, worst
+
+
+def test_a_definition_form_that_runs_out_of_time_stops_the_plan_instead_of_being_left_out(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """definition_forms leaves out forms whose computation fails, but not on an expired time bound:
+    whether that happens depends on the machine, and so would the plan (docs/architecture.md)."""
+    import symrot.plan as plan_module
+    from symrot.errors import SymrotTimeout
+
+    def expired(*_: object) -> None:
+        raise SymrotTimeout("bound expired")
+
+    def broken(*_: object) -> None:
+        raise ValueError("a failing rewrite")
+
+    raw, simplified = (1 - sp.cos(PHI / 2)) / PHI**2, sp.Integer(1) / 8
+    monkeypatch.setattr(plan_module, "candidate_forms", broken)
+    assert plan_module.definition_forms(raw, simplified, PHI, 6.0, None, None) == ()
+    monkeypatch.setattr(plan_module, "candidate_forms", expired)
+    with pytest.raises(SymrotTimeout):
+        plan_module.definition_forms(raw, simplified, PHI, 6.0, None, None)
