@@ -91,6 +91,12 @@ def has_radical(expr: sp.Expr) -> bool:
     return any(isinstance(e, sp.Pow) and not e.exp.is_Integer for e in sp.preorder_traversal(expr))
 
 
+def has_nested_radical(expr: sp.Expr) -> bool:
+    """Whether ``expr`` has a root of an expression with a root, such as √(√(4x + 1) + 1)."""
+    return any(isinstance(e, sp.Pow) and not e.exp.is_Integer and has_radical(e.base)
+               for e in sp.preorder_traversal(expr))
+
+
 @lru_cache(maxsize=1024)
 def expanded_in_s(closed: sp.Expr, inverse: sp.Expr) -> sp.Expr | None:
     """c(φ(s)) with multiple and half angles of the base angle expanded, before simplification;
@@ -204,7 +210,12 @@ def algebraic_in_x(closed: sp.Expr, inverse: sp.Expr, p_max: float) -> sp.Expr |
     if reduced is None:
         return None
     candidates = [reduced]
-    for make in (lambda e: sp.factor(sp.radsimp(e)), lambda e: sp.factor(1 / sp.radsimp(1 / e))):
+    # rationalized numerator or denominator; not of nested roots, where radsimp ran for minutes on
+    # 28 operations (4/((4x + 1)^(1/4) (2 (4x + 1)^(1/4) + √2 √(√(4x + 1) + 1)) (√(4x + 1) + 1)),
+    # a coefficient of tan(2φ)/2), past the safety bound: the emit failed
+    makers = () if has_nested_radical(reduced) else (lambda e: sp.factor(sp.radsimp(e)),
+                                                    lambda e: sp.factor(1 / sp.radsimp(1 / e)))
+    for make in makers:
         alternative = bounded(4, None, make, reduced)
         if alternative is not None and alternative not in candidates and not alternative.has(sp.I):
             candidates.append(alternative)

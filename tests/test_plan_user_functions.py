@@ -323,3 +323,21 @@ def test_a_definition_form_that_runs_out_of_time_stops_the_plan_instead_of_being
     monkeypatch.setattr(plan_module, "candidate_forms", expired)
     with pytest.raises(SymrotTimeout):
         plan_module.definition_forms(raw, simplified, PHI, 6.0, None, None)
+
+
+def test_nested_roots_are_not_rationalized_so_tan_2phi_over_2_can_be_emitted() -> None:
+    """tan(2φ)/2 (held-out sample, seed 2027): H's c₀ of its inverse atan(2s)/2 reduces to
+    4/((4x + 1)^(1/4) (2 (4x + 1)^(1/4) + √2 √(√(4x + 1) + 1)) (√(4x + 1) + 1)), and ``radsimp`` of
+    that ran past its 120 s safety bound: ``--emit`` failed after two minutes. Nested roots now skip
+    the rationalized alternatives (the reduced form itself is still measured)."""
+    from symrot.algebraic import algebraic_in_x, has_nested_radical, reduce_to_x
+    from symrot.timeouts import time_limit
+
+    p = sp.tan(2 * PHI) / 2
+    inverse = closed_inverse(p, sp.Integer(1))
+    assert inverse is not None
+    closed = sp.cos(2 * PHI) ** 2 / ((sp.cos(PHI) + 1) * sp.cos(PHI) ** 2)
+    reduced = reduce_to_x(closed, inverse)
+    assert reduced is not None and has_nested_radical(reduced)
+    with time_limit(30):  # well under a second with the fix; minutes without
+        algebraic_in_x(closed, inverse, float("inf"))
