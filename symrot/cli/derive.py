@@ -39,23 +39,36 @@ def register(subparsers: Any) -> None:
         "--terms", type=int, default=DEFAULT_SERIES_TERMS, choices=range(1, 25),
         metavar="N", help=f"series terms in x = |p|^2 (default {DEFAULT_SERIES_TERMS}, max 24)",
     )
-    parser.add_argument("--emit", metavar="BACKEND", help="write code with this backend (e.g. numpy)")
+    parser.add_argument("--emit", metavar="BACKEND[,BACKEND...]",
+                        help="write code with this backend (e.g. numpy); several, comma-separated (e.g. "
+                        "c,numpy,jax,torch), share one evaluation plan and write into OUT/BACKEND/")
     parser.add_argument("--name", help="module name for --emit (default: registry name or 'rotation')")
     parser.add_argument("--out", default=".", help="output directory for --emit (default: .)")
     parser.set_defaults(run=run)
 
 
-def _check_emit_options(args: argparse.Namespace) -> None:
-    """Refuse a bad --name or --emit before any derivation is spent on them."""
+def backend_names(text: str) -> list[str]:
+    """The backends of ``--emit`` (comma-separated, each once, in the order given)."""
     from ..backends import emitter
 
+    names = [part.strip() for part in text.split(",")]
+    if not all(names):
+        raise SymrotError(f"--emit {text!r}: an empty backend name")
+    for name in names:
+        emitter(name)
+    return list(dict.fromkeys(names))
+
+
+def _check_emit_options(args: argparse.Namespace) -> None:
+    """Refuse a bad --name or --emit before any derivation is spent on them."""
     if args.name is not None and not IDENTIFIER.fullmatch(args.name):
         raise SymrotError(f"--name {args.name!r} is not a valid identifier")
-    emitter(args.emit)
+    backend_names(args.emit)
 
 
 def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
-    """Plan, print into a scratch directory, then write the files into ``--out``."""
+    """Plan once, print with every backend of ``--emit`` into a scratch directory, then write the
+    files into ``--out`` (nothing is written when a backend fails)."""
     import tempfile
     from pathlib import Path
 
@@ -65,21 +78,25 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
     from .progress import stages
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
-    emit = emitter(args.emit)
+    backends = backend_names(args.emit)
     output_directory(Path(args.out))
-    with stages(f"symrot: --emit {args.emit}", 3) as progress:
+    with stages(f"symrot: --emit {','.join(backends)}", 3) as progress:
         progress.start("validity range (Section 3.4)")
         with stage("validity analysis"):
             validity(result.derivation)
         progress.start("evaluation plan (float64, float32)")
         with stage("planning"):
-            evaluation_plan(result.derivation, name)  # cached: the backend reuses it
+            evaluation_plan(result.derivation, name)  # cached: every backend reuses it
         progress.start("printing")
         with tempfile.TemporaryDirectory(prefix="symrot-emit-") as scratch:
+            printed: list[tuple[Path, Path]] = []
             with stage("printing"):
-                printed = emit(result.derivation, name, Path(scratch))
-            for path in printed:
-                write_file(Path(args.out), path.name, path.read_text(encoding="utf-8"))
+                for backend in backends:  # several: each into OUT/BACKEND (NumPy, JAX, PyTorch: NAME.py)
+                    target = Path(args.out) / backend if len(backends) > 1 else Path(args.out)
+                    printed += [(target, path) for path in
+                                emitter(backend)(result.derivation, name, Path(scratch) / backend)]
+            for target, path in printed:
+                write_file(target, path.name, path.read_text(encoding="utf-8"))
     return 0
 
 

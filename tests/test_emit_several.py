@@ -1,0 +1,39 @@
+"""``symrot derive EXPR --emit A,B,…``: several backends from one evaluation plan."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+FAST = "cayley_gibbs_rodrigues"
+"""A parameterization whose plan takes about a second."""
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "symrot", *args], capture_output=True, text=True,
+                          timeout=300, check=False)
+
+
+def files(folder: Path) -> dict[str, bytes]:
+    return {str(path.relative_to(folder)): path.read_bytes() for path in sorted(folder.rglob("*"))
+            if path.is_file()}
+
+
+def test_several_backends_share_one_plan_and_write_into_their_own_directories(tmp_path: Path) -> None:
+    result = run_cli("derive", FAST, "--emit", "numpy,jax,c,numpy", "--out", str(tmp_path / "all"))
+    assert result.returncode == 0, result.stderr
+    assert set(files(tmp_path / "all")) == {f"numpy/{FAST}.py", f"jax/{FAST}.py", f"c/symrot_{FAST}.h"}
+    single = run_cli("derive", FAST, "--emit", "jax", "--out", str(tmp_path / "one"))
+    assert single.returncode == 0, single.stderr
+    assert files(tmp_path / "one")[f"{FAST}.py"] == files(tmp_path / "all")[f"jax/{FAST}.py"]
+
+
+@pytest.mark.parametrize("emit", ["numpy,", "numpy,fortran", ",", "numpy, "])
+def test_a_bad_backend_list_is_one_line_and_writes_nothing(tmp_path: Path, emit: str) -> None:
+    result = run_cli("derive", FAST, "--emit", emit, "--out", str(tmp_path / "out"))
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+    assert not (tmp_path / "out").exists()
