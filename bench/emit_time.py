@@ -8,10 +8,11 @@ one at a time. Reported: wall seconds and the CPU seconds of the process and its
 CLI's worker), which the load of a shared machine inflates less than wall time; and the machine's
 load average before the run.
 
-Run: ``python bench/emit_time.py [--only I,J] [--names] [--backends numpy,c] [--out docs/emit_time.md]
-[--json FILE]``; ``--backends derive`` times the summary. ``--only`` takes indices of
-tests/corpus.py; ``--names`` adds the named parameterizations and the sine/tangent family headers
-of generated/c (their C emits).
+Run: ``python bench/emit_time.py [--only I,J] [--names] [--backends numpy,c] [--warm] [--out
+docs/emit_time.md] [--json FILE]``; ``--backends derive`` times the summary, ``numpy+c`` one
+``--emit numpy,c``; ``--warm`` times a repeated emit, whose plan comes from the plan cache.
+``--only`` takes indices of tests/corpus.py; ``--names`` adds the named parameterizations and the
+sine/tangent family headers of generated/c (their C emits).
 """
 
 from __future__ import annotations
@@ -48,16 +49,23 @@ def target_seconds(kind: str, backend: str) -> float:
     return USER_TARGET_S if kind == "user" else FAMILY_TARGET_S
 
 
-def time_emit(expression: str, backend: str) -> dict[str, float | str]:
+def time_emit(expression: str, backend: str, warm: bool = False) -> dict[str, float | str]:
     """Wall and CPU seconds of one ``symrot derive EXPR --emit BACKEND`` process (no ``--emit`` for
-    the backend ``derive``), or its error."""
-    with tempfile.TemporaryDirectory() as out:
-        emit = [] if backend == "derive" else ["--name", "timed", "--emit", backend, "--out", out, "-q"]
+    the backend ``derive``; ``a+b`` is ``--emit a,b``, one plan for both), or its error. Without the
+    plan cache (``--no-cache``: a first emit), or with ``warm``: after an untimed run of the same
+    command has kept the plan in a temporary cache directory (a repeated emit)."""
+    with tempfile.TemporaryDirectory() as out, tempfile.TemporaryDirectory() as plans:
+        emit = [] if backend == "derive" else ["--name", "timed", "--emit", backend.replace("+", ","),
+                                               "--out", out, "-q"]
+        if backend != "derive" and not warm:
+            emit.append("--no-cache")
+        command = [sys.executable, "-m", "symrot", "derive", expression, *emit, "--timeout", str(TIMEOUT_S)]
+        environment = {**os.environ, "SYMROT_CACHE_DIR": plans, "SYMROT_NO_CACHE": ""}
+        if warm:
+            subprocess.run(command, capture_output=True, cwd=out, env=environment, check=False)
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
-        run = subprocess.run([sys.executable, "-m", "symrot", "derive", expression, *emit,
-                              "--timeout", str(TIMEOUT_S)],
-                             capture_output=True, text=True, cwd=out, check=False)
+        run = subprocess.run(command, capture_output=True, text=True, cwd=out, env=environment, check=False)
         wall = time.perf_counter() - start
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -114,7 +122,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", default=None, help="comma-separated indices of tests/corpus.py")
     parser.add_argument("--names", action="store_true", help="also the named parameterizations and families")
     parser.add_argument("--no-corpus", action="store_true")
-    parser.add_argument("--backends", default="numpy,c")
+    parser.add_argument("--backends", default="numpy,c",
+                        help="comma-separated; numpy+c times one --emit numpy,c (one plan for both)")
+    parser.add_argument("--warm", action="store_true",
+                        help="time a repeated emit: the plan read back from the cache an untimed "
+                        "first run filled (default: a first emit, --no-cache)")
     parser.add_argument("--out", type=Path, default=None)
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args(argv)
@@ -131,7 +143,7 @@ def main(argv: list[str] | None = None) -> int:
         row: dict[str, Any] = {"index": index, "expression": expression, "kind": kind,
                                   "target": USER_TARGET_S if kind == "user" else FAMILY_TARGET_S}
         for backend in backends:
-            row[backend] = time_emit(expression, backend)
+            row[backend] = time_emit(expression, backend, args.warm)
         rows.append(row)
         print(f"{index} {expression}: " + ", ".join(
             f"{b} {row[b]['wall']:.1f} s" for b in backends), flush=True)
@@ -141,9 +153,12 @@ def main(argv: list[str] | None = None) -> int:
     title = "Derivation summary time" if backends == ["derive"] else "Emit time"
     report = (f"# {title}\n\nProduced by `{command}` at commit {commit} "
               f"({time.strftime('%Y-%m-%d')}; 1-minute load average {load:.2f} before the run, 2 cores). "
-              "Each run is its own `python -m symrot derive EXPR [--emit BACKEND] --timeout 600` process "
-              "(backend `derive`: no `--emit`, the printed summary), one at a time; CPU s counts the "
-              "process and its children.\n\n"
+              "Each run is its own `python -m symrot derive EXPR [--emit BACKEND] --timeout 600` "
+              "process (backend `derive`: no `--emit`, the printed summary; `a+b`: `--emit a,b`), one at a "
+              "time; CPU s counts the process and its children. "
+              + ("Warm: each timed run reads the plan that an untimed run of the same command kept in the "
+                 "plan cache (a repeated emit).\n\n" if args.warm else
+                 "Each emit computes its plan (`--no-cache`: a first emit).\n\n")
               + summary(rows, backends) + "\n" + table(rows, backends))
     print(report)
     if args.out:

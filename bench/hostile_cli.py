@@ -343,7 +343,10 @@ def main(argv: list[str]) -> int:
                         help="seconds each input may take (--timeout of every command; default 60)")
     budget: float = parser.parse_args(argv).budget
     started = time.monotonic()
-    outcomes = run_all(QUICK + EXTRA + HEAVY, budget)
+    with tempfile.TemporaryDirectory(prefix="symrot-hostile-plans-") as plans:
+        # the plan cache of --emit takes part, in a directory of its own instead of ~/.cache
+        os.environ.setdefault("SYMROT_CACHE_DIR", plans)
+        outcomes = run_all(QUICK + EXTRA + HEAVY, budget)
     bad = 0
     for outcome in outcomes:
         problems = outcome.problems(budget)

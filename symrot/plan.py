@@ -1147,6 +1147,17 @@ _edge_exponent = lru_cache(maxsize=64)(edge_exponent)
 """Both precisions' plans share one estimate of the edge exponent."""
 
 
+_GIVEN_PLANS: dict[tuple[sp.Expr, str], EvaluationPlan] = {}
+"""Plans handed to :func:`remember_plan` (e.g. read back from disk by the CLI), by (p, name)."""
+
+
+def remember_plan(plan: EvaluationPlan) -> None:
+    """Let :func:`evaluation_plan` return ``plan`` for its p and name in this process instead of
+    computing it: for a caller that kept the plan of an earlier run (``symrot.cli.plan_cache``)."""
+    _GIVEN_PLANS[(plan.p, plan.name)] = plan
+
+
 def evaluation_plan(derivation: Derivation, name: str) -> EvaluationPlan:
     """The plan of every coefficient of ``derivation`` in float64 and float32."""
-    return _plan_for(derivation.p, name)
+    given = _GIVEN_PLANS.get((derivation.p, name))
+    return given if given is not None else _plan_for(derivation.p, name)

@@ -44,6 +44,9 @@ def register(subparsers: Any) -> None:
                         "c,numpy,jax,torch), share one evaluation plan and write into OUT/BACKEND/")
     parser.add_argument("--name", help="module name for --emit (default: registry name or 'rotation')")
     parser.add_argument("--out", default=".", help="output directory for --emit (default: .)")
+    parser.add_argument("--no-cache", action="store_true",
+                        help="compute the evaluation plan even when an earlier --emit of the same p "
+                        "kept it (in $SYMROT_CACHE_DIR, default ~/.cache/symrot/plans)")
     parser.set_defaults(run=run)
 
 
@@ -75,6 +78,7 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
     from ..backends import emitter
     from ..plan import evaluation_plan
     from ..singularities import validity
+    from .plan_cache import cached_plan
     from .progress import stages
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
@@ -85,8 +89,11 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
         with stage("validity analysis"):
             validity(result.derivation)
         progress.start("evaluation plan (float64, float32)")
-        with stage("planning"):
-            evaluation_plan(result.derivation, name)  # cached: every backend reuses it
+        with stage("planning"):  # remembered in this process: the backends print it
+            if args.no_cache:
+                evaluation_plan(result.derivation, name)
+            else:
+                cached_plan(result.derivation, name)
         progress.start("printing")
         with tempfile.TemporaryDirectory(prefix="symrot-emit-") as scratch:
             printed: list[tuple[Path, Path]] = []
