@@ -148,6 +148,33 @@ def near_half_turn(expr: sp.Expr) -> sp.Expr:
     return expr.replace(lambda e: parts(e) is not None, doubled)
 
 
+def half_angle_sums(expr: sp.Expr) -> sp.Expr:
+    """Replace k − k cos a by 2k sin²(a/2) and k + k cos a by 2k cos²(a/2), and no other cos call:
+    the sums that cancel become products, while a factor cos a that vanishes at a pole stays, so that
+    :func:`symrot.pole.with_pole_factor` can still write it through s. H₂ of 4√(2φ² + 1) tan(φ/4) has
+    cos⁴(φ/4)/((cos(φ/4) − 1)(cos(φ/4) + 1)): through s entirely, cos(φ/4) − 1 cancelled (38 ulp of the
+    tangent at φ = 0.5); in half angles entirely (:func:`well_conditioned`), cos⁴(φ/4) from φ̂ lost
+    every digit next to the pole at 2π; this form lets each part take the accurate one."""
+    def parts(e: sp.Basic) -> tuple[sp.Expr, sp.Expr, sp.Expr] | None:
+        """(k, sign, a) when e = k + sign·k cos(a) with a number k."""
+        if not (isinstance(e, sp.Add) and len(e.args) == 2):
+            return None
+        constant, term = sorted(e.args, key=lambda a: not a.is_number)
+        factor, cosine = term.as_coeff_Mul()
+        if (constant.is_number and constant != 0 and abs(factor) == abs(constant)
+                and isinstance(cosine, sp.cos)):
+            return constant, factor / constant, cosine.args[0]
+        return None
+
+    def product(e: sp.Add) -> sp.Expr:
+        found = parts(e)
+        assert found is not None
+        constant, sign, angle = found
+        half = sp.cos(angle / 2) if sign == 1 else sp.sin(angle / 2)
+        return 2 * constant * half**2
+    return expr.replace(lambda e: parts(e) is not None, product)
+
+
 def gudermannian(expr: sp.Expr) -> sp.Expr:
     """Replace asin(tanh a) by atan(sinh a), the same function (the Gudermannian), accurate for large
     a, where tanh a rounds next to 1 and asin's slope 1/√(1 − u²) = cosh a multiplies its rounding:
@@ -366,7 +393,8 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
     (:func:`symrot.algebraic.with_inverse`); each as the backends print it (base angle of the
     tangent family, fold complement d of the sine family)."""
     forms = [half_angle(closed)] if closed.has(sp.sin(PHI), sp.cos(PHI)) else []
-    forms += [well_conditioned(closed), near_half_turn(closed)] if closed.has(sp.cos) else []
+    forms += ([well_conditioned(closed), near_half_turn(closed), half_angle_sums(closed)]
+              if closed.has(sp.cos) else [])
     forms.append(closed)
     if closed.has(sp.asin, sp.atanh):
         forms.append(gudermannian(closed))

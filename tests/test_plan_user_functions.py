@@ -341,3 +341,36 @@ def test_nested_roots_are_not_rationalized_so_tan_2phi_over_2_can_be_emitted() -
     assert reduced is not None and has_nested_radical(reduced)
     with time_limit(30):  # well under a second with the fix; minutes without
         algebraic_in_x(closed, inverse, float("inf"))
+
+
+def test_a_sum_that_cancels_takes_half_angles_while_the_pole_factor_goes_through_s() -> None:
+    """H₂ of 4√(2φ² + 1) tan(φ/4) (held-out sample, seed 2027) is cos⁴(φ/4)/((cos(φ/4) − 1)(cos(φ/4) +
+    1)) times factors: written through s entirely, cos(φ/4) − 1 cancels (float64 ``tangent`` 26 ulp at
+    φ = 0.5); in half angles entirely, cos⁴(φ/4) from φ̂ loses its digits next to the pole at 2π. The
+    candidate of plan.half_angle_sums takes half angles for the sums only: within 4 ulp of the
+    independent reference of tests/reference.py, at 0.5 and next to the pole."""
+    from symrot.backends.numpy_backend import module_source
+    from tests.reference import GeneratingFunction, Reference
+
+    expression = "4*sqrt(2*phi**2 + 1)*tan(phi/4)"
+    plan = evaluation_plan(derive(expression).derivation, "tangent")
+    namespace: dict[str, object] = {}
+    exec(compile(module_source(plan), "<tangent>", "exec"), namespace)
+    function = GeneratingFunction(expression)
+    reference = Reference(function)
+    rng = np.random.default_rng(11)
+    eps = float(np.finfo(np.float64).eps)
+    worst = 0.0
+    for angle in (mpmath.mpf("0.3"), mpmath.mpf("0.5"), mpmath.mpf("1"), 2 * mpmath.pi - mpmath.mpf("0.01")):
+        with mpmath.workdps(40):
+            size = float(function.value(angle))
+        for _ in range(6):
+            axis = rng.normal(size=3)
+            p = size * axis / np.linalg.norm(axis)
+            with mpmath.workdps(60):
+                exact = reference.state([mpmath.mpf(float(v)) for v in p], angle).H
+            tangent = namespace["tangent"](p)  # type: ignore[operator]
+            scale = max(1.0, max(abs(float(exact[i, j])) for i in range(3) for j in range(3)))
+            error = max(abs(float(tangent[i, j] - exact[i, j])) for i in range(3) for j in range(3))
+            worst = max(worst, error / (scale * eps))
+    assert worst <= 4, worst

@@ -583,7 +583,8 @@ def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = -0.15 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     w0 = sin_half**2
-    out = numpy.asarray((0.125)*(-1.3333333333333333*cos_half*sin_half**3/(-2*cos_half*sin_half + phi) - 2*w0 + 1)/w0, dtype=x.dtype)
+    w1 = numpy.sin(phi)
+    out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + numpy.cos(phi))/w0, dtype=x.dtype)
     if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
     small = x < 1.4342812090283275
@@ -786,11 +787,9 @@ def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
         t = x
-        series = 2.892762495883202e-24
-        series = 3.1482187281713954e-23 + t * series
-        series = 3.420541589612275e-22 + t * series
+        series = 3.420541589612275e-22
         series = 3.7095852246767656e-21 + t * series
         series = 4.0148184318084914e-20 + t * series
         series = 4.33520814322793e-19 + t * series
@@ -811,22 +810,19 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.0004761904761904762 + t * series
         series = 0.002857142857142857 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    w1 = w0**(-1.0)
-    w2 = cos_half*sin_half
-    w3 = (phi - 2*w2)**(-1.0)
-    w4 = 6*phi
-    w5 = 2*phi
-    w6 = 16*cos_half*sin_half - w4 - numpy.sin(w5)
-    out = numpy.asarray(-0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - numpy.cos(w5) + 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+    w0 = sin_half**(-2.0)
+    w1 = numpy.sin(phi)
+    w2 = (phi - w1)**(-1.0)
+    w3 = 6*phi
+    w4 = 2*phi
+    w5 = 8*w1 - w3 - numpy.sin(w4)
+    out = numpy.asarray(-0.020833333333333332*w0*w2*(-0.5*w0*(4*numpy.cos(phi) - numpy.cos(w4) - 3) + (0.5)*w2*w5 + (0.125)*w1*w5/sin_half**4)*numpy.cbrt(6*w1 - w3), dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
-    small = x < 2.6302227241416043
+    small = x < 1.4342812090283275
     if small.any():
         t = x[small]
-        series = 2.892762495883202e-24
-        series = 3.1482187281713954e-23 + t * series
-        series = 3.420541589612275e-22 + t * series
+        series = 3.420541589612275e-22
         series = 3.7095852246767656e-21 + t * series
         series = 4.0148184318084914e-20 + t * series
         series = 4.33520814322793e-19 + t * series
@@ -1637,7 +1633,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
         return numpy.asarray(series, dtype=x.dtype)
     w0 = sin_half**2
     w1 = numpy.sin(phi)
-    out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) - 2*w0 + 1)/w0, dtype=x.dtype)
+    out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + numpy.cos(phi))/w0, dtype=x.dtype)
     if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
         return out
     small = x < 2.630222574480542
@@ -2214,7 +2210,7 @@ _USES_PHI = {
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'p_prime': 0.00016163055520154135, 'nu': 1.9211893090849666e-14, 'epsilon': 9.999999999999995e-15, 'mu': 0.0022017832983058567, 'R_1': 1.9211893090849666e-14, 'R_2': 0.00016163055520154135, 'H_0': 0.0022017832983058567, 'H_1': 0.00016163055520154135, 'H_2': 1.4342812090283275, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 1.9211893090849666e-14, 'G_2': 0.004229756532686548, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 1.9211893090849666e-14, 'H_inverse_across': 0.00016163055520154135, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 2.6302227241416043, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
+    "64": {'p_prime': 0.00016163055520154135, 'nu': 1.9211893090849666e-14, 'epsilon': 9.999999999999995e-15, 'mu': 0.0022017832983058567, 'R_1': 1.9211893090849666e-14, 'R_2': 0.00016163055520154135, 'H_0': 0.0022017832983058567, 'H_1': 0.00016163055520154135, 'H_2': 1.4342812090283275, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 1.9211893090849666e-14, 'G_2': 0.004229756532686548, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 1.9211893090849666e-14, 'H_inverse_across': 0.00016163055520154135, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 1.4342812090283275, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
     "32": {'p_prime': 0.008125106898670383, 'nu': 1.921189444436213e-14, 'epsilon': 1.0000000233721947e-14, 'mu': 0.7648242161335777, 'R_1': 1.921189444436213e-14, 'R_2': 0.7648242161335777, 'H_0': 0.7648242161335777, 'H_1': 0.008125106898670383, 'H_2': 4.619481091176478, 'H_inverse_0': 0.7648242161335777, 'H_inverse_2': 4.619481091176478, 'G_1': 1.921189444436213e-14, 'G_2': 0.7648242161335777, 'K_0': 0.7648242161335777, 'K_1': 0.7648242161335777, 'K_2': 4.619481091176478, 'H_across': 1.921189444436213e-14, 'H_inverse_across': 1.921189444436213e-14, 'K_across': 1.921189444436213e-14, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold

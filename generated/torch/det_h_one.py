@@ -590,9 +590,9 @@ def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
     series = -0.15 + t * series
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    cos_half = _where(small, 0.8173046507362676, cos_half)
     w0 = sin_half**2
-    closed = (0.125)*(-1.3333333333333333*cos_half*sin_half**3/(-2*cos_half*sin_half + phi) - 2*w0 + 1)/w0
+    w1 = _xp.sin(phi)
+    closed = (0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + _xp.cos(phi))/w0
     return _where(small, series, closed)
 
 
@@ -696,11 +696,9 @@ def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.6302227241416043
+    small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 2.892762495883202e-24 + 0.0 * x
-    series = 3.1482187281713954e-23 + t * series
-    series = 3.420541589612275e-22 + t * series
+    series = 3.420541589612275e-22 + 0.0 * x
     series = 3.7095852246767656e-21 + t * series
     series = 4.0148184318084914e-20 + t * series
     series = 4.33520814322793e-19 + t * series
@@ -720,17 +718,15 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     series = 5.983302411873841e-05 + t * series
     series = 0.0004761904761904762 + t * series
     series = 0.002857142857142857 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    w0 = sin_half**2
-    w1 = w0**(-1.0)
-    w2 = cos_half*sin_half
-    w3 = (phi - 2*w2)**(-1.0)
-    w4 = 6*phi
-    w5 = 2*phi
-    w6 = 16*cos_half*sin_half - w4 - _xp.sin(w5)
-    closed = -0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - _xp.cos(w5) + 1) + (0.5)*w3*w6)*_cbrt(12*w2 - w4)
+    phi = _where(small, 1.2281574046507382, phi)
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    w0 = sin_half**(-2.0)
+    w1 = _xp.sin(phi)
+    w2 = (phi - w1)**(-1.0)
+    w3 = 6*phi
+    w4 = 2*phi
+    w5 = 8*w1 - w3 - _xp.sin(w4)
+    closed = -0.020833333333333332*w0*w2*(-0.5*w0*(4*_xp.cos(phi) - _xp.cos(w4) - 3) + (0.5)*w2*w5 + (0.125)*w1*w5/sin_half**4)*_cbrt(6*w1 - w3)
     return _where(small, series, closed)
 
 
@@ -1335,7 +1331,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     sin_half = _where(small, 0.7520427801883164, sin_half)
     w0 = sin_half**2
     w1 = _xp.sin(phi)
-    closed = (0.125)*(-0.6666666666666666*w0*w1/(phi - w1) - 2*w0 + 1)/w0
+    closed = (0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + _xp.cos(phi))/w0
     return _where(small, series, closed)
 
 
