@@ -277,30 +277,9 @@ def test_a_coefficient_whose_simplification_cancels_p_keeps_its_definition_throu
     G₂x doubles it: float32 ``root_matrix`` was 8.8 ulp off (a held-out hypothesis function). The
     definition through x, 2 sin²(φ/4)/x, is a challenger (plan.definition_forms): within 4 ulp of
     the independent reference of tests/reference.py (eq 76 at φ of the rounded p, 60 digits)."""
-    from symrot.backends.numpy_backend import module_source
-    from tests.reference import GeneratingFunction, Reference
-
-    expression = "4*sin(phi/4)*cosh(phi)"
-    plan = evaluation_plan(derive(expression).derivation, "root")
-    namespace: dict[str, object] = {}
-    exec(compile(module_source(plan), "<root>", "exec"), namespace)
-    function = GeneratingFunction(expression)
-    reference = Reference(function)
-    rng = np.random.default_rng(7)
-    eps = float(np.finfo(np.float32).eps)
-    worst = 0.0
-    for gap in ("0.1", "0.03", "0.003", "1e-5"):
-        angle = 2 * mpmath.pi - mpmath.mpf(gap)
-        with mpmath.workdps(40):
-            size = float(function.value(angle))
-        for _ in range(8):
-            axis = rng.normal(size=3)
-            p = (size * axis / np.linalg.norm(axis)).astype(np.float32)
-            with mpmath.workdps(60):
-                exact = reference.state([mpmath.mpf(float(v)) for v in p], angle).G
-            root = namespace["root_matrix"](p).astype(np.float64)  # type: ignore[operator]
-            error = max(abs(float(root[i, j] - exact[i, j])) for i in range(3) for j in range(3))
-            worst = max(worst, error / eps)
+    gaps = ("0.1", "0.03", "0.003", "1e-5")
+    worst = _worst_tensor_ulp("4*sin(phi/4)*cosh(phi)", "root_matrix", "G",
+                              [2 * mpmath.pi - mpmath.mpf(gap) for gap in gaps], np.float32, axes=8, seed=7)
     assert worst <= 4, worst
 
 
@@ -349,28 +328,38 @@ def test_a_sum_that_cancels_takes_half_angles_while_the_pole_factor_goes_through
     φ = 0.5); in half angles entirely, cos⁴(φ/4) from φ̂ loses its digits next to the pole at 2π. The
     candidate of plan.half_angle_sums takes half angles for the sums only: within 4 ulp of the
     independent reference of tests/reference.py, at 0.5 and next to the pole."""
+    angles = [mpmath.mpf("0.3"), mpmath.mpf("0.5"), mpmath.mpf("1"), 2 * mpmath.pi - mpmath.mpf("0.01")]
+    worst = _worst_tensor_ulp("4*sqrt(2*phi**2 + 1)*tan(phi/4)", "tangent", "H", angles, np.float64,
+                              axes=6, seed=11)
+    assert worst <= 4, worst
+
+
+def _worst_tensor_ulp(expression: str, function: str, tensor: str, angles: list[mpmath.mpf], dtype: type,
+                      axes: int, seed: int) -> float:
+    """The worst error of the emitted NumPy ``function`` at p = p(angle)·n on ``axes`` random axes n per
+    angle, in ulp of max(1, the largest entry) of the independent reference (tests/reference.py: eq 1
+    at φ of the rounded p, H and K from their definitions, 60 digits)."""
     from symrot.backends.numpy_backend import module_source
     from tests.reference import GeneratingFunction, Reference
 
-    expression = "4*sqrt(2*phi**2 + 1)*tan(phi/4)"
-    plan = evaluation_plan(derive(expression).derivation, "tangent")
+    plan = evaluation_plan(derive(expression).derivation, "probe")
     namespace: dict[str, object] = {}
-    exec(compile(module_source(plan), "<tangent>", "exec"), namespace)
-    function = GeneratingFunction(expression)
-    reference = Reference(function)
-    rng = np.random.default_rng(11)
-    eps = float(np.finfo(np.float64).eps)
+    exec(compile(module_source(plan), "<probe>", "exec"), namespace)
+    generating = GeneratingFunction(expression)
+    reference = Reference(generating)
+    rng = np.random.default_rng(seed)
+    eps = float(np.finfo(dtype).eps)
     worst = 0.0
-    for angle in (mpmath.mpf("0.3"), mpmath.mpf("0.5"), mpmath.mpf("1"), 2 * mpmath.pi - mpmath.mpf("0.01")):
+    for angle in angles:
         with mpmath.workdps(40):
-            size = float(function.value(angle))
-        for _ in range(6):
+            size = float(generating.value(angle))
+        for _ in range(axes):
             axis = rng.normal(size=3)
-            p = size * axis / np.linalg.norm(axis)
+            p = (size * axis / np.linalg.norm(axis)).astype(dtype)
             with mpmath.workdps(60):
-                exact = reference.state([mpmath.mpf(float(v)) for v in p], angle).H
-            tangent = namespace["tangent"](p)  # type: ignore[operator]
+                exact = getattr(reference.state([mpmath.mpf(float(v)) for v in p], angle), tensor)
+            got = namespace[function](p).astype(np.float64)  # type: ignore[operator]
             scale = max(1.0, max(abs(float(exact[i, j])) for i in range(3) for j in range(3)))
-            error = max(abs(float(tangent[i, j] - exact[i, j])) for i in range(3) for j in range(3))
+            error = max(abs(float(got[i, j] - exact[i, j])) for i in range(3) for j in range(3))
             worst = max(worst, error / (scale * eps))
-    assert worst <= 4, worst
+    return worst
