@@ -153,3 +153,14 @@ def test_a_read_only_cache_directory_only_costs_the_plan(tmp_path: Path) -> None
                                   plan_cache.DISABLE_VARIABLE: ""})
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "out" / f"{FAST}.py").is_file()
+
+
+def test_a_plan_that_cannot_be_written_is_not_an_error(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    plan = evaluation_plan(derive(FAST).derivation, "unwritable")
+
+    def refuse(*_: object, **__: object) -> None:
+        raise pickle.PicklingError("cannot pickle this")
+
+    monkeypatch.setattr(plan_cache.pickle, "dump", refuse)
+    plan_cache.store(plan)
+    assert not list(cache.glob("*"))  # neither an entry nor a temporary file

@@ -133,7 +133,7 @@ def store(plan: EvaluationPlan) -> None:
         entries = sorted(folder.glob("*.pickle"), key=lambda path: path.stat().st_mtime, reverse=True)
         for old in entries[KEPT:]:
             old.unlink(missing_ok=True)
-    except OSError:  # a read-only or full disk: the next run computes the plan again
+    except Exception:  # a read-only or full disk, a plan pickle cannot write: computed next time
         return
 
 
