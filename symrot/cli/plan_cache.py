@@ -34,10 +34,12 @@ import numpy
 import sympy as sp
 
 from ..core import Derivation
-from ..entry import SEED
 from ..plan import evaluation_plan, remember_plan
 from ..plan_ir import EvaluationPlan
 
+COMMANDS_HASH_SEED = "0"
+"""``symrot.entry.SEED``, the hash seed every command runs with (not imported: ``symrot.entry`` imports
+the CLI; tests/test_plan_cache.py checks that the two agree)."""
 KEPT = 256
 """Plans kept on disk; storing one more removes the least recently used."""
 DISABLE_VARIABLE = "SYMROT_NO_CACHE"
@@ -49,7 +51,7 @@ def enabled() -> bool:
     or 0, and only in a process with the commands' hash seed (:mod:`symrot.entry`), whose plans are
     the canonical ones (with another seed SymPy may return another of equally accurate forms)."""
     return (os.environ.get(DISABLE_VARIABLE, "") in ("", "0")
-            and os.environ.get("PYTHONHASHSEED") == SEED)
+            and os.environ.get("PYTHONHASHSEED") == COMMANDS_HASH_SEED)
 
 
 def directory() -> Path:
