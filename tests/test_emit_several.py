@@ -31,7 +31,14 @@ def test_several_backends_share_one_plan_and_write_into_their_own_directories(tm
     assert files(tmp_path / "one")[f"{FAST}.py"] == files(tmp_path / "all")[f"jax/{FAST}.py"]
 
 
-@pytest.mark.parametrize("emit", ["numpy,", "numpy,fortran", ",", "numpy, "])
+def test_all_is_every_backend(tmp_path: Path) -> None:
+    result = run_cli("derive", FAST, "--emit", "all", "--out", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    assert set(files(tmp_path)) == {f"numpy/{FAST}.py", f"jax/{FAST}.py", f"torch/{FAST}.py",
+                                    f"c/symrot_{FAST}.h"}
+
+
+@pytest.mark.parametrize("emit", ["numpy,", "numpy,fortran", ",", "numpy, ", "all,numpy"])
 def test_a_bad_backend_list_is_one_line_and_writes_nothing(tmp_path: Path, emit: str) -> None:
     result = run_cli("derive", FAST, "--emit", emit, "--out", str(tmp_path / "out"))
     assert result.returncode == 2

@@ -41,7 +41,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("--emit", metavar="BACKEND[,BACKEND...]",
                         help="write code with this backend (e.g. numpy); several, comma-separated (e.g. "
-                        "c,numpy,jax,torch), share one evaluation plan and write into OUT/BACKEND/")
+                        "c,numpy), or all, share one evaluation plan and write into OUT/BACKEND/")
     parser.add_argument("--name", help="module name for --emit (default: registry name or 'rotation')")
     parser.add_argument("--out", default=".", help="output directory for --emit (default: .)")
     parser.add_argument("--no-cache", action="store_true",
@@ -51,10 +51,11 @@ def register(subparsers: Any) -> None:
 
 
 def backend_names(text: str) -> list[str]:
-    """The backends of ``--emit`` (comma-separated, each once, in the order given)."""
-    from ..backends import emitter
+    """The backends of ``--emit`` (comma-separated, each once, in the order given; ``all``: every
+    registered backend)."""
+    from ..backends import EMITTERS, emitter
 
-    names = [part.strip() for part in text.split(",")]
+    names = list(EMITTERS) if text.strip() == "all" else [part.strip() for part in text.split(",")]
     if not all(names):
         raise SymrotError(f"--emit {text!r}: an empty backend name")
     for name in names:
