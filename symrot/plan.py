@@ -126,26 +126,40 @@ def well_conditioned(expr: sp.Expr) -> sp.Expr:
     return expr.replace(lambda e: isinstance(e, sp.cos), lambda e: 1 - 2 * sp.sin(e.args[0] / 2) ** 2)
 
 
+def _cos_sum(e: sp.Basic) -> tuple[sp.Expr, sp.Expr, sp.Expr] | None:
+    """(k, sign, a) when e = k + sign·k cos(a), a two-term sum with a number k ≠ 0 and sign ±1
+    (SymPy distributes 7 (1 + cos φ))."""
+    if not (isinstance(e, sp.Add) and len(e.args) == 2):
+        return None
+    constant, term = sorted(e.args, key=lambda a: not a.is_number)
+    factor, cosine = term.as_coeff_Mul()
+    if constant.is_number and constant != 0 and abs(factor) == abs(constant) and isinstance(cosine, sp.cos):
+        return constant, factor / constant, cosine.args[0]
+    return None
+
+
+def _cos_sums_as_products(expr: sp.Expr, signs: tuple[int, ...]) -> sp.Expr:
+    """``expr`` with each sum k + sign·k cos a (sign in ``signs``) written as 2k cos²(a/2) (sign 1)
+    or 2k sin²(a/2) (sign −1), exactly; no other call changes."""
+    def chosen(e: sp.Basic) -> bool:
+        found = _cos_sum(e)
+        return found is not None and found[1] in signs
+
+    def product(e: sp.Add) -> sp.Expr:
+        found = _cos_sum(e)
+        assert found is not None
+        constant, sign, angle = found
+        half = sp.cos(angle / 2) if sign == 1 else sp.sin(angle / 2)
+        return 2 * constant * half**2
+    return expr.replace(chosen, product)
+
+
 def near_half_turn(expr: sp.Expr) -> sp.Expr:
     """Replace k(1 + cos a) by 2k cos²(a/2), exact and accurate next to a = π, where 1 + cos a rounds
     to 0: p′ of 4 tan(φ/2) cosh(φ/3)/7 + … has 4 cosh(φ/3)/(7 (cos φ + 1)), infinite in float64
     within 3·10⁻⁹ of its pole at π (hypothesis row 113). The form is a candidate beside
     :func:`well_conditioned`'s, whose 1 − 2 sin²(a/2) cancels there too."""
-    def parts(e: sp.Basic) -> tuple[sp.Expr, sp.Expr] | None:
-        """(k, a) when e = k + k cos(a) with a number k (SymPy distributes 7 (1 + cos φ))."""
-        if not (isinstance(e, sp.Add) and len(e.args) == 2):
-            return None
-        constant, term = sorted(e.args, key=lambda a: not a.is_number)
-        factor, cosine = term.as_coeff_Mul()
-        if constant.is_number and constant != 0 and factor == constant and isinstance(cosine, sp.cos):
-            return constant, cosine.args[0]
-        return None
-
-    def doubled(e: sp.Add) -> sp.Expr:
-        found = parts(e)
-        assert found is not None
-        return 2 * found[0] * sp.cos(found[1] / 2) ** 2
-    return expr.replace(lambda e: parts(e) is not None, doubled)
+    return _cos_sums_as_products(expr, (1,))
 
 
 def half_angle_sums(expr: sp.Expr) -> sp.Expr:
@@ -153,26 +167,9 @@ def half_angle_sums(expr: sp.Expr) -> sp.Expr:
     the sums that cancel become products, while a factor cos a that vanishes at a pole stays, so that
     :func:`symrot.pole.with_pole_factor` can still write it through s. H₂ of 4√(2φ² + 1) tan(φ/4) has
     cos⁴(φ/4)/((cos(φ/4) − 1)(cos(φ/4) + 1)): through s entirely, cos(φ/4) − 1 cancelled (float64
-    ``tangent`` 26 ulp at φ = 0.5); in half angles entirely (:func:`well_conditioned`), cos⁴(φ/4) from φ̂ lost
-    every digit next to the pole at 2π; this form lets each part take the accurate one."""
-    def parts(e: sp.Basic) -> tuple[sp.Expr, sp.Expr, sp.Expr] | None:
-        """(k, sign, a) when e = k + sign·k cos(a) with a number k."""
-        if not (isinstance(e, sp.Add) and len(e.args) == 2):
-            return None
-        constant, term = sorted(e.args, key=lambda a: not a.is_number)
-        factor, cosine = term.as_coeff_Mul()
-        if (constant.is_number and constant != 0 and abs(factor) == abs(constant)
-                and isinstance(cosine, sp.cos)):
-            return constant, factor / constant, cosine.args[0]
-        return None
-
-    def product(e: sp.Add) -> sp.Expr:
-        found = parts(e)
-        assert found is not None
-        constant, sign, angle = found
-        half = sp.cos(angle / 2) if sign == 1 else sp.sin(angle / 2)
-        return 2 * constant * half**2
-    return expr.replace(lambda e: parts(e) is not None, product)
+    ``tangent`` 26 ulp at φ = 0.5); in half angles entirely (:func:`well_conditioned`), cos⁴(φ/4)
+    from φ̂ lost every digit next to the pole at 2π; this form lets each part take the accurate one."""
+    return _cos_sums_as_products(expr, (1, -1))
 
 
 def gudermannian(expr: sp.Expr) -> sp.Expr:
@@ -941,7 +938,7 @@ def definition_forms(raw: sp.Expr, simplified: sp.Expr, p: sp.Expr, phi_max: flo
         return ()
     try:
         forms = candidate_forms(raw, p, phi_max, inverse, complement)[1]
-    except SymrotTimeout:  # a time bound expired: left out, the plan would depend on the machine
+    except SymrotTimeout:  # re-raised: leaving the forms out would make the plan depend on the machine
         raise
     except Exception:  # optional candidates: a failing step only leaves them out
         return ()

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import os
 import random
+import subprocess
+import sys
 from collections.abc import Callable
+from pathlib import Path
 
 import mpmath
 import sympy as sp
@@ -38,3 +42,15 @@ def random_axis(rng: random.Random) -> mpmath.matrix:
 
 def max_abs(m: mpmath.matrix) -> mpmath.mpf:
     return max(abs(m[i, j]) for i in range(m.rows) for j in range(m.cols))
+
+
+def run_symrot(*args: str, environment: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    """``python -m symrot *args`` (as a user runs it), with ``environment`` over this process's."""
+    return subprocess.run([sys.executable, "-m", "symrot", *args], capture_output=True, text=True,
+                          timeout=300, check=False, env={**os.environ, **(environment or {})})
+
+
+def files(folder: Path) -> dict[str, bytes]:
+    """Every file under ``folder`` by its relative path, with its bytes."""
+    return {str(path.relative_to(folder)): path.read_bytes() for path in sorted(folder.rglob("*"))
+            if path.is_file()}

@@ -2,24 +2,15 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from tests.helpers import files
+from tests.helpers import run_symrot as run_cli
+
 FAST = "cayley_gibbs_rodrigues"
 """A parameterization whose plan takes about a second."""
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "symrot", *args], capture_output=True, text=True,
-                          timeout=300, check=False)
-
-
-def files(folder: Path) -> dict[str, bytes]:
-    return {str(path.relative_to(folder)): path.read_bytes() for path in sorted(folder.rglob("*"))
-            if path.is_file()}
 
 
 def test_several_backends_share_one_plan_and_write_into_their_own_directories(tmp_path: Path) -> None:

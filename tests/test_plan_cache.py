@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import os
 import pickle
-import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -21,6 +19,8 @@ from symrot.api import derive
 from symrot.cli import plan_cache
 from symrot.entry import SEED
 from symrot.plan import evaluation_plan
+from tests.helpers import files
+from tests.helpers import run_symrot as run_cli
 
 FAST = "cayley_gibbs_rodrigues"
 """A parameterization whose plan takes about a second."""
@@ -35,16 +35,6 @@ def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     # only into this temporary directory)
     monkeypatch.setenv("PYTHONHASHSEED", SEED)
     return folder
-
-
-def run_cli(*args: str, environment: dict[str, str]) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "symrot", *args], capture_output=True, text=True,
-                          timeout=300, check=False, env={**os.environ, **environment})
-
-
-def files(folder: Path) -> dict[str, bytes]:
-    return {str(path.relative_to(folder)): path.read_bytes() for path in sorted(folder.rglob("*"))
-            if path.is_file()}
 
 
 def test_the_cache_requires_the_seed_the_commands_run_with() -> None:
