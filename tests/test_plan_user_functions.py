@@ -363,3 +363,28 @@ def _worst_tensor_ulp(expression: str, function: str, tensor: str, angles: list[
             error = max(abs(float(got[i, j] - exact[i, j])) for i in range(3) for j in range(3))
             worst = max(worst, error / (scale * eps))
     return worst
+
+
+def test_solutions_are_checked_numerically_not_by_sympy(monkeypatch: pytest.MonkeyPatch) -> None:
+    """solve(…, check=False) returns the roots that squaring adds (−√(√(4s² + 1)/2 − 1/2) for
+    φ√(1 + φ²)); the numeric checks keep the one that starts as s/κ and solves p(φ) = s. SymPy's
+    own symbolic check was 1.5 of the 2 s that log((1 + φ/2)/(1 − φ/2)) spent solving."""
+    from symrot import plan
+
+    s = sp.Symbol("s", nonnegative=True)
+    checked: list[object] = []
+    original = sp.solve
+
+    def solve_recording(*args: object, **flags: object) -> object:
+        checked.append(flags.get("check", True))
+        return original(*args, **flags)
+
+    monkeypatch.setattr(plan.sp, "solve", solve_recording)
+    inverse = closed_inverse(PHI * sp.sqrt(1 + PHI**2), sp.Integer(1))
+    assert checked == [False]
+    root = sp.sqrt(sp.sqrt(4 * s**2 + 1) / 2 - sp.Rational(1, 2))
+    assert inverse is not None and sp.simplify(inverse - root) == 0
+    assert closed_inverse(sp.log((1 + PHI / 2) / (1 - PHI / 2)), sp.Integer(1)) == 2 * sp.tanh(s / 2)
+    probe = sp.Rational(1, 1000)
+    assert plan._solves(PHI * sp.sqrt(1 + PHI**2), (-root).subs(s, probe).evalf(30), probe) is False
+
