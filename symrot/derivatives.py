@@ -124,16 +124,18 @@ def _jacobian_in_scalars() -> sp.Matrix:
     return jacobian.xreplace({f(x): VALUES[k] for k, f in enumerate(functions)})
 
 
+_COMPONENTS = len(_P) + len(_A)
+"""A monomial of :func:`_ring`'s first exponents count p and a; the scalars' follow."""
+
+
 @lru_cache(maxsize=1)
-def _ring() -> tuple[PolyRing, int]:
-    """The polynomial ring over QQ in p, a and the scalars (c_k′, c_k), and the number of vector
-    components (6) that a monomial's first exponents count."""
-    return ring([*_P, *_A, *SLOPES, *VALUES], QQ)[0], 6
+def _ring() -> PolyRing:
+    """The polynomial ring over QQ in p, a and the scalars (c_k′, c_k)."""
+    return ring([*_P, *_A, *SLOPES, *VALUES], QQ)[0]
 
 
 def _polynomials(matrix: sp.Matrix) -> list[PolyElement]:
-    polynomial_ring, _ = _ring()
-    return [polynomial_ring(entry) for entry in matrix]
+    return [_ring()(entry) for entry in matrix]
 
 
 def _coordinates(target: list[Monomials], basis: list[list[Monomials]]) -> list[sp.Rational]:
@@ -160,8 +162,7 @@ def _in_vectors(matrix: sp.Matrix) -> list[Monomials]:
 def _part_in(element: PolyElement, scalar: int | None) -> Monomials:
     """{monomial in p, a: coefficient} of the terms of ``element`` with the scalar of that index
     among the ring's generators (linear in the scalars), or of all its terms (``None``)."""
-    _, components = _ring()
-    return {m[:components]: c for m, c in element.terms() if scalar is None or m[scalar] == 1}
+    return {m[:_COMPONENTS]: c for m, c in element.terms() if scalar is None or m[scalar] == 1}
 
 
 @lru_cache(maxsize=1)
@@ -173,10 +174,9 @@ def tensor_derivative() -> TensorDerivative:
     jacobian = _polynomials(_jacobian_in_scalars())
     tensors = basis(_P, _A)
     spanning = [_in_vectors(tensor) for tensor in tensors.values()]
-    _, components = _ring()
     terms: dict[sp.Symbol, dict[str, sp.Rational]] = {}
     for offset, scalar in enumerate((*SLOPES, *VALUES)):
-        part = [_part_in(entry, components + offset) for entry in jacobian]
+        part = [_part_in(entry, _COMPONENTS + offset) for entry in jacobian]
         if not any(part):
             continue
         coordinates = _coordinates(part, spanning)
