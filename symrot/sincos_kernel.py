@@ -2,7 +2,8 @@
 
 The closed forms of the evaluation plan (:mod:`symrot.plan`) call sin and cos of arguments c·φ.
 A loop that calls libm's ``sin`` cannot be vectorized, so the batch kernels of the C backend
-evaluate those calls with this kernel instead, written with +, ×, ``rint`` and selects only:
+evaluate those calls with this kernel instead, written with +, ×, ``rint`` and selects only (the C
+headers print rint as ``SYMROT_NEAREST``, :data:`symrot.backends.c_sincos.NEAREST`):
 
 * **reduction** (Cody–Waite): q = rint(a·2/π), r = ((a − q·P₁) − q·P₂) − q·P₃ with
   P₁ + P₂ + P₃ = π/2 to 2(m − g) + m bits. P₁ and P₂ have m − g significant bits, so q·P₁ and

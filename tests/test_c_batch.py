@@ -14,6 +14,8 @@ calls are in test_c_backend.py.)
 from __future__ import annotations
 
 import ctypes
+import itertools
+import platform
 import re
 import subprocess
 from pathlib import Path
@@ -29,10 +31,12 @@ from symrot.backends.c_printer import Precision
 from symrot.backends.templating import environment
 
 from . import c_harness
-from .test_c_backend import GENERATED
+from .test_c_backend import GENERATED, limits
 
 CANDIDATES = "/* every candidate value, unconditionally */"
 COEFFICIENT_LOOP = "for (k = 0; k < SYMROT_BATCH_BLOCK; ++k)"
+SINCOS_KERNEL = re.compile(r"\ba\d+_q = ")
+"""The kernel's quadrant q (symrot.backends.c_sincos), in the loops that compute sin/cos inline."""
 KERNEL_ULP = 1.5
 """Measured: 1.28 ulp in double, 1.41 in float (libm: about 0.5). The reduced argument r is
 rounded once (0.5 ulp of r carried into sin r), and 1 + z·Q(z) adds the rounding of z = r²."""
@@ -45,7 +49,8 @@ def kernel_source(precision: Precision) -> str:
     statements = BatchWriter(writer).sincos.kernel_statements("a[k]", 0, {"sin0", "cos0"})
     body = environment().get_template("c/statements.j2").module.block(statements, "        ")  # type: ignore[attr-defined]
     t = precision
-    return (f"#include <math.h>\n#include <stddef.h>\n"
+    nearest = environment().get_template("c/nearest.h.j2").render()
+    return (f"#include <float.h>\n#include <math.h>\n#include <stddef.h>\n{nearest}\n"
             f"void kernel_{t}(size_t n, const {t} *a, {t} *s, {t} *c) {{\n"
             f"    size_t k;\n    for (k = 0; k < n; ++k) {{\n{body}"
             f"        s[k] = sin0;\n        c[k] = cos0;\n    }}\n}}\n")
@@ -108,9 +113,10 @@ def test_sincos_kernel_is_within_one_and_a_half_ulp(label: str, precision: str, 
     assert min(worst) > 0  # the sweep does reach rounding errors
 
 
-def vectorized_lines(compiler: str, source: Path, work: Path) -> set[tuple[str, int]]:
-    """(header, line) of every loop the compiler reports as vectorized at -O2 -mavx2 -mfma."""
-    flags = [*c_harness.STRICT_C, "-O2", "-mavx2", "-mfma", f"-I{GENERATED}", "-c", str(source),
+def vectorized_lines(compiler: str, source: Path, work: Path,
+                     target: tuple[str, ...] = ("-mavx2", "-mfma")) -> set[tuple[str, int]]:
+    """(header, line) of every loop the compiler reports as vectorized at -O2 and ``target``."""
+    flags = [*c_harness.STRICT_C, "-O2", *target, f"-I{GENERATED}", "-c", str(source),
              "-o", str(work / f"{compiler}.o")]
     report = ["-fopt-info-vec-optimized"] if compiler == "gcc" else ["-Rpass=loop-vectorize"]
     result = subprocess.run([compiler, *flags, *report], capture_output=True, text=True, timeout=600,
@@ -143,6 +149,60 @@ def test_every_coefficient_loop_is_vectorized(compiler: str, tmp_path: Path) -> 
     assert kernels - 4 <= candidates <= kernels
     assert expected == kernels + candidates
     assert not missing, f"{compiler}: coefficient loops not vectorized (header, line): {missing}"
+
+
+@pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="baseline x86-64 SSE2 codegen")
+def test_sin_cos_loops_are_vectorized_at_baseline_x86_64(tmp_path: Path) -> None:
+    """gcc -O2 without -m flags (SSE2, no FMA, no SSE4.1 roundsd): every candidate loop that holds
+    the sin/cos kernel is vectorized. It was not while the kernel rounded with rint(), which gcc
+    writes there as a compare-and-branch sequence; the header's SYMROT_NEAREST adds and subtracts
+    1.5·2^52 instead (issue 21: the rotation vector's batch was 2.2× SciPy at baseline x86-64)."""
+    source = tmp_path / "all.c"
+    source.write_text(c_harness.translation_unit(COVERED), encoding="utf-8")
+    vectorized = vectorized_lines("gcc", source, tmp_path, target=())
+    kernel_loops, missing = 0, []
+    for name in COVERED:
+        lines = (GENERATED / f"symrot_{name}.h").read_text(encoding="utf-8").splitlines()
+        for number, line in enumerate(lines, start=1):
+            if COEFFICIENT_LOOP in line and lines[number - 2].strip() == CANDIDATES:
+                body = "\n".join(itertools.takewhile(lambda text: COEFFICIENT_LOOP not in text,
+                                                     lines[number:]))
+                if SINCOS_KERNEL.search(body):
+                    kernel_loops += 1
+                    if (name, number) not in vectorized:
+                        missing.append((name, number))
+    assert kernel_loops >= 4 * sum(f.kind == "matrix" for f in FUNCTIONS)  # several headers, both precisions
+    assert not missing, f"sin/cos loops not vectorized at baseline x86-64 (header, line): {missing}"
+
+
+def test_the_rounding_macro_gives_the_bits_of_rint(tmp_path: Path) -> None:
+    """The batch kernels built with the header's SYMROT_NEAREST (1.5·2^52 added and subtracted)
+    and with rint/rintf put in its place give the same bits, on angles across the whole range."""
+    source = tmp_path / "kernels.c"
+    names = [name for name in COVERED
+             if "SYMROT_NEAREST(" in (GENERATED / f"symrot_{name}.h").read_text(encoding="utf-8")]
+    assert {"rotation_vector", "det_h_one", "sine_m5", "tangent_m5"} <= set(names)
+    source.write_text(c_harness.translation_unit(names), encoding="utf-8")
+    libraries = []
+    for define in ([], ["-DSYMROT_NEAREST(y)=rint(y)", "-DSYMROT_NEARESTF(y)=rintf(y)"]):
+        out = tmp_path / f"kernels_{len(define)}.so"
+        subprocess.run(["gcc", *c_harness.STRICT_C, "-O2", *define, f"-I{GENERATED}", "-shared", "-fPIC",
+                        str(source), "-o", str(out), "-lm"], check=True, capture_output=True, timeout=300)
+        libraries.append(c_harness.Library(ctypes.CDLL(str(out)), names))
+    rng = np.random.default_rng(21)
+    directions = rng.normal(size=(2000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    for name in names:
+        p_max = float(limits(name).p_max_float)
+        top = p_max if np.isfinite(p_max) else 1e3
+        magnitudes = np.concatenate([rng.uniform(0, top, 1500), top * (1 - np.geomspace(1e-1, 1e-9, 500))])
+        p = directions * magnitudes[:, None]
+        for function in FUNCTIONS:
+            if function.kind != "matrix":
+                continue
+            for precision in ("double", "float"):
+                results = [library.call(name, function, precision, p, batch=True) for library in libraries]
+                assert results[0].tobytes() == results[1].tobytes(), (name, function.name, precision)
 
 
 def test_the_block_size_is_a_compile_time_option_that_does_not_change_results(tmp_path: Path) -> None:

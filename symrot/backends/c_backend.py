@@ -31,6 +31,7 @@ from .c_derivatives import DerivativeWriter
 from .c_functions import FUNCTIONS, CFunction
 from .c_operations import OperationWriter
 from .c_printer import PRECISIONS, Precision
+from .c_sincos import NEAREST
 from .c_writer import FunctionWriter
 from .templating import render
 
@@ -60,7 +61,14 @@ def header_source(plan: EvaluationPlan, name: str, expression: str | None = None
         validity=FunctionWriter(plan, name, "double").validity_notes()[0],
         plan_note=f"the float64 and float32 plans of symrot.plan, {angle_kind(plan)} for phi",
         guard=f"SYMROT_{name.upper()}_H", functions=functions, block=DEFAULT_BLOCK,
+        nearest=_uses_nearest(functions),
     )
+
+
+def _uses_nearest(functions: list[dict[str, Any]]) -> bool:
+    """Whether a printed statement rounds with the header's SYMROT_NEAREST macros (the sin/cos
+    kernel of the _batch loops, :mod:`symrot.backends.c_sincos`)."""
+    return any(macro + "(" in repr(functions) for macro in NEAREST.values())
 
 
 def _precision_functions(plan: EvaluationPlan, name: str, precision: Precision) -> list[dict[str, Any]]:

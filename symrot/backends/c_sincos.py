@@ -5,7 +5,8 @@ The closed forms of a plan call sin, cos and tan of arguments c·φ, and φ neve
 branch-free kernel inline instead of calling libm:
 
 in the ``_batch`` kernels (:mod:`symrot.backends.c_batch`), because a loop with a library call
-in it is not vectorized. The single calls keep libm: the kernel is within 1.5 ulp of the exact
+in it is not vectorized (its roundings to an integer are the header's ``SYMROT_NEAREST`` macros,
+:data:`NEAREST`). The single calls keep libm: the kernel is within 1.5 ulp of the exact
 sin and cos (libm: about 0.5 ulp), and one call at a time it was not faster than glibc's
 ``sincos`` on the benchmark's angles (21.2 ns with libm, 22.3–22.6 ns with the kernel). The tests
 measure the kernel and every batch output built on it (tests/test_c_batch.py, test_c_backend.py).
@@ -22,6 +23,12 @@ from ..sincos_kernel import SinCosKernel, sincos_kernel
 from .c_printer import MANTISSA_BITS, Precision, SymrotCPrinter, horner
 
 TRIG = (sp.sin, sp.cos, sp.tan)
+NEAREST: dict[Precision, str] = {"double": "SYMROT_NEAREST", "float": "SYMROT_NEARESTF"}
+"""The header's macros for rint in the kernel (templates/c/nearest.h.j2): ``(y + 1.5·2^52) − 1.5·2^52``
+(1.5·2^23 in float), which rounds |y| < 2^51 (2^22) to the nearest integer, ties to even, exactly as
+rint does in the default rounding mode, and vectorizes with SSE2 alone: at baseline x86-64 gcc
+writes rint as a compare-and-branch sequence (no SSE4.1 ``roundsd``) and the loop holding it was not
+vectorized. The kernel's |q| stays below 2^20 (:data:`symrot.sincos_kernel.QUADRANT_BITS`)."""
 
 
 class SinCosWriter:
@@ -35,6 +42,7 @@ class SinCosWriter:
         self.phi_max = phi_max
         self.t = precision
         self.f = "" if precision == "double" else "f"
+        self.nearest = NEAREST[precision]
 
     def applies(self, argument: sp.Expr) -> bool:
         """sin/cos/tan of ``argument`` can use the kernel: c·φ with |c|·φ_max far inside its range."""
@@ -71,7 +79,7 @@ class SinCosWriter:
         Printed inline rather than as a helper function: in a translation unit with many callers a
         compiler may decline to inline a helper, and a loop with a call in it is not vectorized.
         """
-        kernel, literal, t, f = self.kernel, self.printer.literal, self.t, self.f
+        kernel, literal, t, f, nearest = self.kernel, self.printer.literal, self.t, self.f, self.nearest
         z = sp.Symbol(f"a{index}_z", real=True)
         first, second, third = (literal(part) for part in kernel.pio2_parts)
         sine = self.printer.doprint(horner(kernel.sin_coefficients, z))
@@ -83,13 +91,13 @@ class SinCosWriter:
 
         statements = [
             let("$a", argument),
-            let("$q", f"rint{f}($a*{literal(kernel.two_over_pi)})"),
+            let("$q", f"{nearest}($a*{literal(kernel.two_over_pi)})"),
             let("$r", f"(($a - $q*{first}) - $q*{second}) - $q*{third}"),
             let("$z", "$r*$r"),
             let("$s", f"$r + ($r*$z)*({sine})"),
             let("$c", f"1 + $z*({cosine})"),
-            let("$j", f"$q - 4*rint{f}({literal(0.25)}*$q - {literal(0.375)})"),
-            let("$h", f"rint{f}({literal(0.5)}*$j - {literal(0.25)})"),
+            let("$j", f"$q - 4*{nearest}({literal(0.25)}*$q - {literal(0.375)})"),
+            let("$h", f"{nearest}({literal(0.5)}*$j - {literal(0.25)})"),
             let("$odd", "$j - 2*$h"),
         ]
         if f"sin{index}" in wanted:
@@ -116,4 +124,4 @@ class SinCosWriter:
                 "quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.")
 
 
-__all__ = ["TRIG", "SinCosWriter"]
+__all__ = ["NEAREST", "TRIG", "SinCosWriter"]
