@@ -473,6 +473,26 @@ def test_a_user_header_whose_subexpressions_cancel_builds_with_werror(tmp_path: 
     assert np.all(np.isfinite(values))
 
 
+@pytest.mark.parametrize("compiler", ["gcc", "clang"])
+def test_fast_math_builds_stop_with_a_clear_error_unless_allowed(compiler: str, tmp_path: Path) -> None:
+    """-ffast-math reassociates the compensated complement (the linear parameterization's angle
+    next to its fold lost 1.8e6 ulp in a gcc -O2 -ffast-math build) and may drop the NaN tests:
+    the header refuses it with #error, and SYMROT_ALLOW_FAST_MATH is the explicit way past."""
+    source = tmp_path / "user.c"
+    source.write_text('#include "symrot_linear.h"\n'
+                      "int main(void) { double p[3] = {0.1, 0.2, 0.3}, R[9];\n"
+                      "    symrot_linear_rotation_matrix(p, R); return R[0] > 2.0; }\n", encoding="utf-8")
+    flags = ("-ffast-math", "-Ofast") if compiler == "gcc" else ("-ffast-math",)  # clang 19 deprecates -Ofast
+    for flag in flags:
+        command = [compiler, *c_harness.STRICT_C, "-O2", flag, f"-I{GENERATED}", "-c", str(source),
+                   "-o", str(tmp_path / "user.o")]
+        refused = subprocess.run(command, capture_output=True, text=True, timeout=120, check=False)
+        assert refused.returncode != 0 and "SYMROT_ALLOW_FAST_MATH" in refused.stderr, (flag, refused.stderr)
+        allowed = subprocess.run([*command, "-DSYMROT_ALLOW_FAST_MATH"], capture_output=True, text=True,
+                                 timeout=120, check=False)
+        assert allowed.returncode == 0, (flag, allowed.stderr[-2000:])
+
+
 def test_bad_name_is_a_one_line_error(tmp_path: Path) -> None:
     result = subprocess.run([sys.executable, "-m", "symrot", "derive", "phi", "--name", "bad name;",
                              "--emit", "c", "--out", str(tmp_path)], capture_output=True, text=True,

@@ -33,6 +33,12 @@
 #include <math.h>
 #include <stddef.h>
 
+#if (defined(__FAST_MATH__) || defined(_M_FP_FAST)) && !defined(SYMROT_ALLOW_FAST_MATH)
+/* -ffast-math, -Ofast, /fp:fast: reassociation undoes the compensated sums (angles next to a fold
+ * lose up to ~10^6 ulp) and the finite-math assumption may drop the NaN tests of the range. */
+#error "symrot: compile without -ffast-math, -Ofast or /fp:fast, or define SYMROT_ALLOW_FAST_MATH to accept lost accuracy"
+#endif
+
 #ifndef SYMROT_BATCH_BLOCK
 /* Vectors per block of the _batch kernels, a compile-time constant so that their coefficient loop
  * vectorizes; each kernel keeps about 8 arrays of this many numbers on the stack. */
