@@ -33,6 +33,7 @@ from pathlib import Path
 from types import ModuleType
 
 import numpy as np
+from machine import description  # bench/, next to this script
 from scipy.spatial.transform import Rotation
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -133,10 +134,10 @@ def main(argv: list[str] | None = None) -> int:
         + (f" --dtypes {args.dtypes}" if args.dtypes != "float64,float32" else "") \
         + (f" --repeat {args.repeat}" if args.repeat != 7 else "") \
         + (f" --only '{args.only}'" if args.only else "")
-    lines = [SECTION, "", f"`{command}`: thread CPU time, {args.repeat} interleaved paired repetitions "
-             "(3 at n ≥ 10⁶); ratio = SciPy time / symrot time (> 1: symrot faster), minimum and median "
-             "of the paired ratios; angles uniform in [0, 3) on random axes. SciPy computes in float64 "
-             "for float32 input too.", "",
+    lines = [SECTION, "", f"`{command}` ({description()}, shared): thread CPU time, {args.repeat} "
+             "interleaved paired repetitions (3 at n ≥ 10⁶); ratio = SciPy time / symrot time "
+             "(> 1: symrot faster), minimum and median of the paired ratios; angles uniform in [0, 3) "
+             "on random axes. SciPy computes in float64 for float32 input too.", "",
              "| symrot kernel \\| SciPy peer | dtype | n | symrot µs | SciPy µs | ratio min | ratio median |",
              "| --- | --- | ---: | ---: | ---: | ---: | ---: |"]
     lines += [f"| {label.replace('|', chr(92) + '|')} | {dtype} | {n} | {mine * 1e6:.1f} | "

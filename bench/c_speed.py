@@ -27,7 +27,6 @@ from __future__ import annotations
 import argparse
 import ctypes
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -39,6 +38,7 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import sympy as sp
+from machine import description  # bench/, next to this script
 
 from symrot.api import derive, validity_dict
 from symrot.functions import mpmath_namespace
@@ -357,11 +357,10 @@ def report(one_call: dict[str, dict[str, list[float]]], keys: dict[str, tuple[st
         (f" --batch {args.batch}" if args.batch != BATCH else "")
     if "SYMROT_SYMFORCE_PYTHON" in os.environ:
         command = "SYMROT_SYMFORCE_PYTHON=/tmp/symforce_venv/bin/python " + command
-    cpu = platform.processor() or platform.machine()
     lines = [
         SECTION, "",
-        f"Produced by `{command}` (gcc/g++ {' '.join(FLAGS)} for the one-call loops; {os.cpu_count()} "
-        f"cores, {cpu}, shared; SymForce {symforce_note}: its geo package's `sym::Rot3<double>::"
+        f"Produced by `{command}` (gcc/g++ {' '.join(FLAGS)} for the one-call loops; {description()}, "
+        f"shared; SymForce {symforce_note}: its geo package's `sym::Rot3<double>::"
         "FromTangent(v).ToRotationMatrix()` as its codegen writes it). Thread CPU time; "
         f"{args.repeat} interleaved repetitions; **ratio = peer time / symrot time (> 1: symrot "
         "faster)**, minimum and median of the paired per-repetition ratios. Inputs: 4096 random "

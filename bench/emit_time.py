@@ -35,6 +35,7 @@ from tests.corpus import CORPUS  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "bench"))
 from accuracy_derivatives import commit as checked_out_commit  # noqa: E402
+from machine import description  # noqa: E402
 
 USER_TARGET_S = 10.0
 FAMILY_TARGET_S = 5.0
@@ -152,7 +153,8 @@ def main(argv: list[str] | None = None) -> int:
     command = "python bench/emit_time.py " + " ".join(argv if argv is not None else sys.argv[1:])
     title = "Derivation summary time" if backends == ["derive"] else "Emit time"
     report = (f"# {title}\n\nProduced by `{command}` at commit {commit} "
-              f"({time.strftime('%Y-%m-%d')}; 1-minute load average {load:.2f} before the run, 2 cores). "
+              f"({time.strftime('%Y-%m-%d')}; {description()}; 1-minute load average {load:.2f} before the "
+              "run). "
               "Each run is its own `python -m symrot derive EXPR [--emit BACKEND] --timeout 600` "
               "process (backend `derive`: no `--emit`, the printed summary; `a+b`: `--emit a,b`), one at a "
               "time; CPU s counts the process and its children. "
