@@ -52,9 +52,11 @@ extern "C" {
 /* symrot_euler_rodrigues__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
- * error from the rounding of x stays below one ulp of d.
- * ops: 33 */
+ * fma; Fast2Sum, exact here: inside the range each running p_max^2 - p_0^2 - ...
+ * is at least the next square, or within a factor 2 of it); for x <= p_max^2/4
+ * (x <= d/3) plainly p_max^2 - x, whose error from the rounding of x stays
+ * below one ulp of d.
+ * ops: 24 */
 static inline double symrot_euler_rodrigues__complement(const double p[3], double x)
 {
     if (x <= 1.0) {
@@ -66,8 +68,7 @@ static inline double symrot_euler_rodrigues__complement(const double p[3], doubl
         const double square = p[i] * p[i];
         const double error = fma(p[i], p[i], -square);
         const double total = high - square;
-        const double virtual_ = total - high;
-        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        low = low + (((high - total) - square) - error);
         high = total;
     }
     return high + low;
@@ -1251,9 +1252,11 @@ static inline int symrot_euler_rodrigues_rescale_jacobian(const double p[3], dou
 /* symrot_euler_rodrigues__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
- * error from the rounding of x stays below one ulp of d.
- * ops: 33 */
+ * fma; Fast2Sum, exact here: inside the range each running p_max^2 - p_0^2 - ...
+ * is at least the next square, or within a factor 2 of it); for x <= p_max^2/4
+ * (x <= d/3) plainly p_max^2 - x, whose error from the rounding of x stays
+ * below one ulp of d.
+ * ops: 24 */
 static inline float symrot_euler_rodrigues__complement_f(const float p[3], float x)
 {
     if (x <= 1.0F) {
@@ -1265,8 +1268,7 @@ static inline float symrot_euler_rodrigues__complement_f(const float p[3], float
         const float square = p[i] * p[i];
         const float error = fmaf(p[i], p[i], -square);
         const float total = high - square;
-        const float virtual_ = total - high;
-        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        low = low + (((high - total) - square) - error);
         high = total;
     }
     return high + low;

@@ -52,9 +52,11 @@ extern "C" {
 /* symrot_sine_m4__complement: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
- * error from the rounding of x stays below one ulp of d.
- * ops: 33 */
+ * fma; Fast2Sum, exact here: inside the range each running p_max^2 - p_0^2 - ...
+ * is at least the next square, or within a factor 2 of it); for x <= p_max^2/4
+ * (x <= d/3) plainly p_max^2 - x, whose error from the rounding of x stays
+ * below one ulp of d.
+ * ops: 24 */
 static inline double symrot_sine_m4__complement(const double p[3], double x)
 {
     if (x <= 4.0) {
@@ -66,8 +68,7 @@ static inline double symrot_sine_m4__complement(const double p[3], double x)
         const double square = p[i] * p[i];
         const double error = fma(p[i], p[i], -square);
         const double total = high - square;
-        const double virtual_ = total - high;
-        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        low = low + (((high - total) - square) - error);
         high = total;
     }
     return high + low;
@@ -1300,9 +1301,11 @@ static inline int symrot_sine_m4_rescale_jacobian(const double p[3], double J[9]
 /* symrot_sine_m4__complement_f: internal: d = p_max^2 - |p|^2, compensated (eq 31-32, 36).
  * Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2
  * rounded would leave no correct digit of p_max^2 - x (error-free products by
- * fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose
- * error from the rounding of x stays below one ulp of d.
- * ops: 33 */
+ * fma; Fast2Sum, exact here: inside the range each running p_max^2 - p_0^2 - ...
+ * is at least the next square, or within a factor 2 of it); for x <= p_max^2/4
+ * (x <= d/3) plainly p_max^2 - x, whose error from the rounding of x stays
+ * below one ulp of d.
+ * ops: 24 */
 static inline float symrot_sine_m4__complement_f(const float p[3], float x)
 {
     if (x <= 4.0F) {
@@ -1314,8 +1317,7 @@ static inline float symrot_sine_m4__complement_f(const float p[3], float x)
         const float square = p[i] * p[i];
         const float error = fmaf(p[i], p[i], -square);
         const float total = high - square;
-        const float virtual_ = total - high;
-        low = low + (((high - (total - virtual_)) + (-square - virtual_)) - error);
+        low = low + (((high - total) - square) - error);
         high = total;
     }
     return high + low;

@@ -176,7 +176,14 @@ class FunctionWriter:
     def complement_function(self) -> dict[str, Any]:
         """d = p_max² − |p|²: for x ≤ p_max²/4 plainly (then x ≤ d/3, and the rounding error of x,
         at most 3 units of roundoff of x, stays below one ulp of d), else with exact products (fma)
-        and error-free sums (TwoSum), then one rounding."""
+        and error-free sums, then one rounding.
+
+        The sums are Fast2Sum (3 operations, not TwoSum's 6): inside the range each running value
+        high = p_max² − p₀² − … is at least the next square p_i² (the remaining squares and d are
+        not negative), and where its rounding puts it below p_i² the two are within a factor 2, so
+        high − p_i² is exact (Sterbenz) and the error term 0 is right. Every error term is then the
+        exact one that TwoSum gives, and d has the same bits (tests/test_c_complement.py). Outside
+        the range d is garbage, and every output is NaN by the test on x."""
         t = self.ctype
         fma = "fma" if t == "double" else "fmaf"
         complement = sp.Integer(self.plan.complement) if self.plan.complement is not None else sp.Integer(0)
@@ -190,9 +197,7 @@ class FunctionWriter:
             {"kind": "let", "type": t, "name": "square", "value": "p[i] * p[i]", "ops": 1},
             {"kind": "let", "type": t, "name": "error", "value": f"{fma}(p[i], p[i], -square)", "ops": 1},
             {"kind": "let", "type": t, "name": "total", "value": "high - square", "ops": 1},
-            {"kind": "let", "type": t, "name": "virtual_", "value": "total - high", "ops": 1},
-            {"kind": "set", "name": "low",
-             "value": "low + (((high - (total - virtual_)) + (-square - virtual_)) - error)", "ops": 6},
+            {"kind": "set", "name": "low", "value": "low + (((high - total) - square) - error)", "ops": 4},
             {"kind": "set", "name": "high", "value": "total", "ops": 0},
         ]
         statements.append({"kind": "loop", "header": "i = 0; i < 3; ++i", "body": body, "times": 3})
@@ -201,8 +206,10 @@ class FunctionWriter:
                 "equation": "31-32, 36", "ops": ops_of(statements),
                 "notes": ["Accurate to a few ulp of d even at the fold |p| -> p_max, where x = |p|^2",
                           "rounded would leave no correct digit of p_max^2 - x (error-free products by",
-                          "fma, TwoSum); for x <= p_max^2/4 (x <= d/3) plainly p_max^2 - x, whose",
-                          "error from the rounding of x stays below one ulp of d."],
+                          "fma; Fast2Sum, exact here: inside the range each running p_max^2 - p_0^2 - ...",
+                          "is at least the next square, or within a factor 2 of it); for x <= p_max^2/4",
+                          "(x <= d/3) plainly p_max^2 - x, whose error from the rounding of x stays",
+                          "below one ulp of d."],
                 "signature": f"{t} {self.complement_helper}(const {t} p[3], {t} x)", "statements": statements,
                 "batch_signature": None, "output": None}
 
