@@ -598,8 +598,7 @@ def _complement(p, x):
         for i in range(3):
             square, error = _two_square(p[..., i])
             total = high - square
-            virtual = total - high
-            low = low + ((high - (total - virtual)) + (-square - virtual)) - error
+            low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
             high = total
         value = high + low
     return _stop(value) + (_stop(x) - x)
