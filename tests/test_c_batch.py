@@ -175,58 +175,55 @@ def test_sin_cos_loops_are_vectorized_at_baseline_x86_64(tmp_path: Path) -> None
     assert not missing, f"sin/cos loops not vectorized at baseline x86-64 (header, line): {missing}"
 
 
+def assert_batch_bits_agree(names: list[str], builds: tuple[list[str], list[str]],
+                            inputs: dict[str, np.ndarray], work: Path) -> None:
+    """Every batch kernel of the headers ``names`` (both precisions) gives the same bits on
+    ``inputs[name]`` when the translation unit is compiled with either list of gcc flags."""
+    source = work / "kernels.c"
+    source.write_text(c_harness.translation_unit(names), encoding="utf-8")
+    libraries = []
+    for index, flags in enumerate(builds):
+        out = work / f"kernels_{index}.so"
+        subprocess.run(["gcc", *c_harness.STRICT_C, "-O2", *flags, f"-I{GENERATED}", "-shared", "-fPIC",
+                        str(source), "-o", str(out), "-lm"], check=True, capture_output=True, timeout=300)
+        libraries.append(c_harness.Library(ctypes.CDLL(str(out)), names))
+    for name in names:
+        for function in FUNCTIONS:
+            if function.kind != "matrix":
+                continue
+            for precision in ("double", "float"):
+                first, second = (library.call(name, function, precision, inputs[name], batch=True)
+                                 for library in libraries)
+                assert first.tobytes() == second.tobytes(), (name, function.name, precision)
+
+
 def test_the_rounding_macro_gives_the_bits_of_rint(tmp_path: Path) -> None:
     """The batch kernels built with the header's SYMROT_NEAREST (1.5·2^52 added and subtracted)
     and with rint/rintf put in its place give the same bits, on angles across the whole range."""
-    source = tmp_path / "kernels.c"
     # the kernel is the same text in every header; these four give it arguments c·φ over ranges of
     # several quadrants (a closed angle, a Newton angle, the sine and the tangent family)
     names = ["rotation_vector", "det_h_one", "sine_m5", "tangent_m5"]
     for name in names:
         assert "SYMROT_NEAREST(" in (GENERATED / f"symrot_{name}.h").read_text(encoding="utf-8"), name
-    source.write_text(c_harness.translation_unit(names), encoding="utf-8")
-    libraries = []
-    for define in ([], ["-DSYMROT_NEAREST(y)=rint(y)", "-DSYMROT_NEARESTF(y)=rintf(y)"]):
-        out = tmp_path / f"kernels_{len(define)}.so"
-        subprocess.run(["gcc", *c_harness.STRICT_C, "-O2", *define, f"-I{GENERATED}", "-shared", "-fPIC",
-                        str(source), "-o", str(out), "-lm"], check=True, capture_output=True, timeout=300)
-        libraries.append(c_harness.Library(ctypes.CDLL(str(out)), names))
     rng = np.random.default_rng(21)
     directions = rng.normal(size=(2000, 3))
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    inputs = {}
     for name in names:
         p_max = float(limits(name).p_max_float)
         top = p_max if np.isfinite(p_max) else 1e3
         magnitudes = np.concatenate([rng.uniform(0, top, 1500), top * (1 - np.geomspace(1e-1, 1e-9, 500))])
-        p = directions * magnitudes[:, None]
-        for function in FUNCTIONS:
-            if function.kind != "matrix":
-                continue
-            for precision in ("double", "float"):
-                results = [library.call(name, function, precision, p, batch=True) for library in libraries]
-                assert results[0].tobytes() == results[1].tobytes(), (name, function.name, precision)
+        inputs[name] = directions * magnitudes[:, None]
+    assert_batch_bits_agree(names, ([], ["-DSYMROT_NEAREST(y)=rint(y)", "-DSYMROT_NEARESTF(y)=rintf(y)"]),
+                            inputs, tmp_path)
 
 
 def test_the_block_size_is_a_compile_time_option_that_does_not_change_results(tmp_path: Path) -> None:
     """-DSYMROT_BATCH_BLOCK=3 (scalar-sized blocks) and the default 32 give the same bits
     (without FMA contraction, which the compiler may apply differently to vector and scalar code)."""
-    source = tmp_path / "some.c"
     names = ["rotation_vector", "det_h_one", "tangent_m5", "sine_m3"]
-    source.write_text(c_harness.translation_unit(names), encoding="utf-8")
-    libraries = []
-    for block in (None, 3):
-        out = tmp_path / f"block_{block}.so"
-        define = [f"-DSYMROT_BATCH_BLOCK={block}"] if block else []
-        subprocess.run(["gcc", *c_harness.STRICT_C, "-O2", "-mavx2", "-ffp-contract=off", *define,
-                        f"-I{GENERATED}", "-shared", "-fPIC", str(source), "-o", str(out), "-lm"],
-                       check=True, capture_output=True, timeout=300)
-        libraries.append(c_harness.Library(ctypes.CDLL(str(out)), names))
     rng = np.random.default_rng(11)
     p = rng.normal(size=(77, 3)) * rng.uniform(0, 2, size=(77, 1))
-    for name in names:
-        for function in FUNCTIONS:
-            if function.kind != "matrix":
-                continue
-            for precision in ("double", "float"):
-                results = [library.call(name, function, precision, p, batch=True) for library in libraries]
-                np.testing.assert_array_equal(results[0], results[1], err_msg=f"{name} {function.name}")
+    flags = ["-mavx2", "-ffp-contract=off"]
+    assert_batch_bits_agree(names, (flags, [*flags, "-DSYMROT_BATCH_BLOCK=3"]), dict.fromkeys(names, p),
+                            tmp_path)
