@@ -197,6 +197,19 @@ def test_a_cubic_in_the_cosine_is_left_to_the_numeric_scan() -> None:
     assert found.singularities[0].quantity == "p_prime" and found.numeric_only
 
 
+def test_inverse_functions_in_p_prime_are_left_to_the_numeric_scan() -> None:
+    """p′ of this function (held-out seed 2028, row 10) mixes atan and asin with radicals: solveset
+    ran 283 s on it, past its safety bound, and ``--emit`` exited 2. It is not attempted (shape, not
+    time); the scan finds the arcsine edge at 3/2, where p′ → ∞."""
+    text = ("4*sqrt(3*phi**2/2 + 1)*atan(2*phi)/35 + 2*atan(3*phi/2)/(35*(3*phi**2/2 + 1))"
+            " + 36*asin(2*phi/3)/(35*(2*phi**2/3 + 1))")
+    started = time.monotonic()
+    found = validity(derive_expression(parse_expression(text)))
+    assert found.phi_max == sp.Rational(3, 2) and found.numeric_only
+    assert {("p", "edge"), ("p_prime", "oo")} <= {(s.quantity, s.limit) for s in found.singularities}
+    assert time.monotonic() - started < 20
+
+
 def test_a_jump_of_p_itself_ends_the_range() -> None:
     """2 atan(tan(φ/2)) is φ up to π and falls to −π there, while SymPy's p′ is 1 everywhere: the
     analysis reported no singular angle in (0, 4π] and the emitted code an unbounded range. A fall
