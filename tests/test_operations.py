@@ -111,3 +111,23 @@ def test_composition_18_19_equals_matrix_product(name: str) -> None:
 def test_rescale_factor_closed_forms() -> None:
     assert sp.simplify(rescale_factor(4 * sp.tan(PHI / 4)) + 1 / sp.tan(PHI / 4) ** 2) == 0
     assert sp.simplify(rescale_factor(PHI) - (PHI - 2 * sp.pi) / PHI) == 0
+
+
+def test_the_scale_is_reduced_to_e0_only_for_trigonometric_p(monkeypatch: pytest.MonkeyPatch) -> None:
+    """σ = p/sin(φ/2) becomes algebraic in e₀ = cos(φ/2) (eq 74) for trigonometric p, and the
+    reduction's simplification (up to 3.2 s) is not run where another call of φ would leave a
+    transcendental function of acos e₀ (sinh, asin, atan, the real cube root of eq 35)."""
+    from symrot import quaternion_plan
+    from symrot.parsing import parse_expression
+
+    e0 = quaternion_plan.E0
+    assert sp.simplify(quaternion_plan.scale_in_e0(4 * sp.tan(PHI / 4)) - 4 / (e0 + 1)) == 0
+    assert sp.simplify(quaternion_plan.scale_in_e0(sp.sin(PHI)) - 2 * e0) == 0
+
+    def refused(*args: object) -> None:
+        raise AssertionError("the reduction ran")
+
+    monkeypatch.setattr(quaternion_plan, "bounded", refused)
+    for text in ("4*sqrt(3*phi**2/2 + 1)*sinh(2*phi)/35 + 36*cos(2*phi/3)*asin(2*phi/3)/35",
+                 "cbrt(6*(phi - sin(phi)))", "2*atan(phi/2)", "tanh(phi)"):
+        assert quaternion_plan.scale_in_e0(parse_expression(text)) is None, text
