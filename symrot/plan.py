@@ -126,15 +126,30 @@ def well_conditioned(expr: sp.Expr) -> sp.Expr:
     return expr.replace(lambda e: isinstance(e, sp.cos), lambda e: 1 - 2 * sp.sin(e.args[0] / 2) ** 2)
 
 
-def _cos_sum(e: sp.Basic) -> tuple[sp.Expr, sp.Expr, sp.Expr] | None:
-    """(k, sign, a) when e = k + sign·k cos(a), a two-term sum with a number k ≠ 0 and sign ±1
-    (SymPy distributes 7 (1 + cos φ))."""
-    if not (isinstance(e, sp.Add) and len(e.args) == 2):
+def _cos_sum(e: sp.Basic) -> tuple[sp.Expr, sp.Expr, sp.Expr, sp.Expr] | None:
+    """(k, sign, a, rest) when e = k + sign·k cos(a) + rest, with a number k ≠ 0 and sign ±1: a
+    two-term sum (rest = 0; SymPy distributes 7 (1 + cos φ)), or a longer one with a rational k,
+    whose first such cosine term in SymPy's order is taken. K₂ of 4 tan(3φ/4)/3 is
+    9 (cos(3φ/2) + 1 − 3 sin(φ/2)/tan(3φ/4))/(64 tan²(3φ/4)): next to the pole at 2π/3 the
+    cos(3φ/2) + 1 from φ̂ kept no digit beside the other term, whose pole factor goes through s
+    (4175 ulp of K at |p|² = 2³², where the domain sweep ended the range: NaN from φ = 2π/3 − 2.7·10⁻⁵)."""
+    if not isinstance(e, sp.Add):
         return None
-    constant, term = sorted(e.args, key=lambda a: not a.is_number)
-    factor, cosine = term.as_coeff_Mul()
-    if constant.is_number and constant != 0 and abs(factor) == abs(constant) and isinstance(cosine, sp.cos):
-        return constant, factor / constant, cosine.args[0]
+    if len(e.args) == 2:
+        constant, term = sorted(e.args, key=lambda a: not a.is_number)
+        factor, cosine = term.as_coeff_Mul()
+        if (constant.is_number and constant != 0 and abs(factor) == abs(constant)
+                and isinstance(cosine, sp.cos)):
+            return constant, factor / constant, cosine.args[0], sp.S.Zero
+        return None
+    constant, _ = e.as_coeff_Add()
+    if constant == 0:
+        return None
+    for term in e.args:
+        factor, cosine = term.as_coeff_Mul()
+        if isinstance(cosine, sp.cos) and abs(factor) == abs(constant):
+            rest = sp.Add(*[a for a in e.args if a is not term and not a.is_Number])
+            return constant, factor / constant, cosine.args[0], rest
     return None
 
 
@@ -148,9 +163,9 @@ def _cos_sums_as_products(expr: sp.Expr, signs: tuple[int, ...]) -> sp.Expr:
     def product(e: sp.Add) -> sp.Expr:
         found = _cos_sum(e)
         assert found is not None
-        constant, sign, angle = found
+        constant, sign, angle, rest = found
         half = sp.cos(angle / 2) if sign == 1 else sp.sin(angle / 2)
-        return 2 * constant * half**2
+        return 2 * constant * half**2 + rest
     return expr.replace(chosen, product)
 
 
