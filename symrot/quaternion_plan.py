@@ -20,6 +20,7 @@ Pure planning (SymPy + the plan's error model); backends print it.
 from __future__ import annotations
 
 import sympy as sp
+from sympy.functions.elementary.trigonometric import TrigonometricFunction
 
 from .core import Derivation
 from .parsing import PHI
@@ -61,22 +62,20 @@ def scale_series(p: sp.Expr, n_terms: int) -> list[sp.Expr]:
     return coefficient_list(taylor_series(scale_expression(p), order), 0, order)[0::2]
 
 
-TRIGONOMETRIC = (sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
-"""The calls of φ that :func:`scale_in_e0` can turn algebraic in e₀. Any other call (a hyperbolic,
-inverse or exponential function of φ, the real cube root of eq 35) leaves a transcendental function
-of acos e₀ in σ. The reduction found no algebraic σ for any of the 210 such p among the corpus, the
-default hypothesis sample, the seed-2028 held-out sample and the named parameterizations (284
-functions; up to 3.2 s each, 54 s in all, measured one at a time), so it is not attempted."""
-
-
 def scale_in_e0(p: sp.Expr) -> sp.Expr | None:
     """σ as an algebraic function of e₀ = cos(φ/2) ∈ (0, 1], or None.
 
     With φ = 2θ, θ = acos e₀ ∈ [0, π/2]: expand multiple angles, replace the half angles of θ
     by their (positive) radicals, substitute θ = acos e₀ and simplify (time-bounded).
+
+    Only for p whose calls of φ are all trigonometric: any other call (a hyperbolic, inverse or
+    exponential function of φ, the real cube root of eq 35) leaves a transcendental function of
+    acos e₀ in σ. The reduction found no algebraic σ for any of the 210 such p among the corpus, the
+    default hypothesis sample, the seed-2028 held-out sample and the named parameterizations (284
+    functions; up to 3.2 s each, 54 s in all, measured one at a time), so it is not attempted.
     """
-    if any(not isinstance(call, TRIGONOMETRIC) for call in p.atoms(sp.Function)):
-        return None  # see TRIGONOMETRIC
+    if any(not isinstance(call, TrigonometricFunction) for call in p.atoms(sp.Function)):
+        return None
     theta = sp.Symbol("theta", positive=True)
     half = theta / 2
     rules = {sp.sin: sp.sqrt((1 - sp.cos(theta)) / 2), sp.cos: sp.sqrt((1 + sp.cos(theta)) / 2),

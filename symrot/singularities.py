@@ -36,6 +36,8 @@ from functools import lru_cache
 import mpmath
 import numpy as np
 import sympy as sp
+from sympy.functions.elementary.hyperbolic import InverseHyperbolicFunction
+from sympy.functions.elementary.trigonometric import InverseTrigonometricFunction
 
 from .budget import stage
 from .core import Derivation, derive_expression
@@ -317,8 +319,7 @@ def _low_degree_in_calls(expr: sp.Expr) -> bool:
     return bool(sp.Poly(replaced, *generators).total_degree() <= MAX_CALL_DEGREE)
 
 
-_INVERSE = (sp.asin, sp.acos, sp.atan, sp.acot, sp.asec, sp.acsc, sp.asinh, sp.acosh, sp.atanh, sp.acoth,
-            sp.asech, sp.acsch)
+_INVERSE = (InverseTrigonometricFunction, InverseHyperbolicFunction)
 """Inverse functions in p′ (p = √(aφ² + 1)·atan(bφ), cos(φ/4)·atanh(3φ/2)) leave ``solveset`` an
 equation that mixes them with algebraic or trigonometric terms: on the 62 distinct such p′ of the
 corpus and the default hypothesis sample it returned a ConditionSet (alone, in a Complement or in a

@@ -13,6 +13,7 @@ from __future__ import annotations
 import ctypes
 import subprocess
 from fractions import Fraction
+from functools import cache
 
 import numpy as np
 import pytest
@@ -32,6 +33,7 @@ FOLDED = [name for name in COVERED
 about 2 minutes of CPU time in every pytest-xdist worker)."""
 
 
+@cache
 def squared_edge(name: str) -> Fraction:
     """k² = p_max² of the fold, from the inverse and the validity range (:func:`fold_complement`),
     without the plan."""
