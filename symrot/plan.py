@@ -444,7 +444,8 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
 def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type, argument: sp.Expr = PHI, inverse: sp.Expr | None = None,
                 complement: sp.Rational | None = None, part: TensorPart | None = None,
-                extra_forms: tuple[sp.Expr, ...] = (), challengers: tuple[sp.Expr, ...] = ()) -> Branch:
+                extra_forms: tuple[sp.Expr, ...] = (), challengers: tuple[sp.Expr, ...] = (),
+                whole: float | None = None) -> Branch:
     """Choose the form, the switch t₀ and the Horner degree for one coefficient in one precision.
 
     The coefficient is evaluated from s = ``argument``(φ) (p for the coefficients of x, φ itself
@@ -457,7 +458,8 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     (:func:`_branch_for`). ``extra_forms``: more candidates, already in the backends' variables
     (e.g. c₀ − c₂ x from algebraic c₀ and c₂ for the across-axis part). ``challengers``: forms in the
     backends' variables (:func:`definition_forms`) that replace the choice only where they are
-    measurably better: a smaller error class or a shorter polynomial (:func:`_accuracy_first`)."""
+    measurably better: a smaller error class or a shorter polynomial (:func:`_accuracy_first`).
+    ``whole``: the branch is the tail of Newton's ratio (:func:`_branch_for`)."""
     plain, candidates = candidate_forms(closed, argument, phi_max, inverse, complement)
     forms = [*candidates, *extra_forms]
     inputs = measured_inputs(argument, phi_max, dtype, complement)
@@ -469,7 +471,7 @@ def plan_branch(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         for form in dict.fromkeys(candidates):
             try:
                 branches.append(_branch_for(form, series, variable_of_phi, phi_max, dtype, inputs, reference,
-                                            floors))
+                                            floors, whole))
             except ZeroDivisionError:  # 0/0 of this form at a grid angle: another form is measured
                 continue
         return branches
@@ -610,12 +612,18 @@ def _magnitude(coefficient: sp.Expr) -> float:
 
 def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr, phi_max: float,
                 dtype: type, inputs: MeasuredInputs, reference: tuple[np.ndarray, ...],
-                floors: tuple[np.ndarray, ...] | None = None) -> Branch:
+                floors: tuple[np.ndarray, ...] | None = None, whole: float | None = None) -> Branch:
+    """The switch and polynomial of :func:`plan_branch` for one form ``closed``. ``whole``: the branch is
+    the tail g − g(0) of Newton's ratio g, whose errors count relative to |g(0)| = ``whole``, and its
+    polynomial is the longest that truncates below a quarter ulp on the grid's lower half
+    (φ below min(φ_max, 4π)/2), for every backend:
+    the residual (φ g(0) − s) + φ (g − g(0)) then keeps the digits that the closed form loses
+    (:class:`symrot.plan_ir.NewtonAngle`)."""
     epsilon, tiny = float(np.finfo(dtype).eps), float(np.finfo(dtype).tiny)
     model_closed = model_function(closed, BRANCH_VARIABLES)
     angles = angle_grid(phi_max)
     t_values = _switch_values(variable_of_phi, phi_max, dtype)
-    scale0 = abs(float(series[0])) or 1.0
+    scale0 = (abs(float(series[0])) or 1.0) if whole is None else whole
     # a coefficient of a tensor counts relative to what it adds to the tensor where that is below
     # c(0): G_2 ~ 2/x next to 2 pi (G_2 x is of order 1, c(0) = 1/8 would hide any relative error of
     # G_2 itself); H_across ~ mu next to 2 pi for phi + phi^3/6 (~ 0.05, with c(0) = 1)
@@ -649,7 +657,7 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         raise UnplannableCoefficient(f"cannot plan {closed} in {np.dtype(dtype).name}: its value at p = 0 "
                                      f"({float(series[0]):.3g}) is not finite in that format")
 
-    def tail(t: float, n: int) -> float:
+    def truncation(t: float, n: int) -> float:
         rest = floats[n:n + 2]
         with np.errstate(all="ignore"):  # coefficients beyond float64 are inf here: inf or NaN expected
             return sum(c * t ** (n + j) for j, c in enumerate(rest)) / (scale0 * epsilon)
@@ -658,10 +666,10 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     near_zero = int(np.searchsorted(angles, 0.5 * min(phi_max, 4 * np.pi)))
     for k in range(near_zero):
         worst_closed = float(np.max(closed_error[k:near_zero]))
-        worst = max(worst_closed, tail(t_values[k], top))
+        worst = max(worst_closed, truncation(t_values[k], top))
         if worst <= CLOSED_TOLERANCE_ULP and best <= CLOSED_TOLERANCE_ULP:
             # both acceptable: prefer the smaller switch (fewer terms)
-            if tail(t_values[k], top) <= tail(t_values[best_k], top):
+            if truncation(t_values[k], top) <= truncation(t_values[best_k], top):
                 best, best_k = worst, k
         elif worst < best:
             best, best_k = worst, k
@@ -670,20 +678,25 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                                      "series in x = |p|^2 is finite on the grid (p is too small or too large "
                                      "in scale)")
     def terms_at(threshold: float) -> int:
-        target = max(0.25, tail(threshold, top))
-        return next((n for n in range(1, top + 1) if tail(threshold, n) <= target), top)
+        target = max(0.25, truncation(threshold, top))
+        return next((n for n in range(1, top + 1) if truncation(threshold, n) <= target), top)
 
     accurate_threshold = float(t_values[best_k])
     # speed: a polynomial of up to CHEAP_TERMS terms costs less than the closed form's library
     # calls, so the switch moves up while such a polynomial still truncates below a quarter ulp
     # (the closed form then serves a smaller range, where its error can only be smaller)
-    while best_k + 1 < near_zero and tail(t_values[best_k + 1], min(CHEAP_TERMS, top)) <= 0.25:
+    while best_k + 1 < near_zero and truncation(t_values[best_k + 1], min(CHEAP_TERMS, top)) <= 0.25:
         best_k += 1
+    if whole is not None:  # Newton's ratio: the longest polynomial that truncates below a quarter ulp
+        while best_k + 1 < near_zero and truncation(t_values[best_k + 1], top) <= 0.25:
+            best_k += 1
     best = min(best, max(float(np.max(closed_error[best_k:near_zero])),
-                         tail(t_values[best_k], top)))
+                         truncation(t_values[best_k], top)))
     threshold = float(t_values[best_k])
     accurate_terms = terms_at(accurate_threshold)
     degree = max(terms_at(threshold), accurate_terms)
+    if whole is not None:  # every backend takes this switch: the accuracy is the point
+        accurate_threshold, accurate_terms = threshold, degree
     edge = float(np.max(closed_error[near_zero:])) if near_zero < len(angles) else 0.0
     return Branch(threshold, tuple(series[:degree]), closed, float(angles[best_k]), best, edge,
                   accurate_threshold, accurate_terms)
@@ -1124,14 +1137,17 @@ def _bracket_top(exact: sp.Expr, phi_max: float, dtype: type) -> float:
 
 @lru_cache(maxsize=64)
 def _newton_forms(p: sp.Expr) -> tuple[sp.Expr, list[sp.Expr], sp.Expr, list[sp.Expr], tuple[sp.Expr, ...]]:
-    """The symbolic part of :func:`_newton_angle`, the same for both precisions: Newton's ratio p/φ
-    and slope p′ (simplified, with their exact series in φ²) and the start's series φ(p)."""
+    """The symbolic part of :func:`_newton_angle`, the same for both precisions: the tail
+    g − g(0) of Newton's ratio g = p/φ and the slope p′ (simplified, with their exact series in φ²),
+    and the start's series φ(p)."""
     order = 2 * MAX_TERMS
     derivation = derive_expression(p)
     ratio_series = coefficient_list(taylor_series(p / PHI, order), 0, order)[0::2]
     slope_series = derivation.taylor_in_phi("p_prime", order)[0::2]
     reverted = derivation.phi_of_p(2 * START_TERMS)
-    return (sp.simplify(p / PHI), ratio_series, derivation.simplified_coefficients()["p_prime"], slope_series,
+    leading = ratio_series[0]
+    slope_form = derivation.simplified_coefficients()["p_prime"]
+    return (sp.simplify(p / PHI) - leading, [sp.Integer(0), *ratio_series[1:]], slope_form, slope_series,
             tuple(reverted[1::2][:START_TERMS]))
 
 
@@ -1139,17 +1155,19 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
                   bracket_top: float) -> NewtonAngle:
     p = derivation.p
     ratio_form, ratio_series, slope_form, slope_series, start = _newton_forms(p)
-    ratio = plan_branch(ratio_form, ratio_series, PHI ** 2, phi_max, dtype)
+    leading = derivation.kappa
+    ratio = plan_branch(ratio_form, ratio_series, PHI ** 2, phi_max, dtype, whole=abs(float(leading)))
     slope = plan_branch(slope_form, slope_series, PHI ** 2, phi_max, dtype)
     far = _far_start(p, p_max, phi_max, start)
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
     reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
-    lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0])
-    count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top)
+    lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0], float(leading))
+    count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, leading=float(leading))
     edge = _edge_exponent(p, far, phi_max)
     if edge is not None:
-        edge_count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, edge)
+        edge_count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, edge,
+                                         float(leading))
         # p′ = ∞ at the edge (k < 1): steps in φ overshoot past it and bisect (43 steps for asin(φ)
         # from a start at the edge, 6 in w), wherever the checks fall
         if edge < 1 or (-edge_count.unconverged, edge_count.steps) < (-count.unconverged, count.steps):
@@ -1157,7 +1175,8 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
         else:
             edge = None
     iterations = max(newton_iterations(far.measured, float(np.finfo(dtype).eps)), count.steps)
-    return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal, count.unconverged, edge)
+    return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal, count.unconverged,
+                       leading, edge)
 
 
 def _branch_model(branch: Branch, dtype: type) -> Callable[[np.ndarray], np.ndarray]:

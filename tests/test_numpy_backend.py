@@ -114,6 +114,30 @@ def test_accuracy_is_backward_stable_without_closed_inverse() -> None:
     assert not misses, misses
 
 
+def test_the_newton_angle_of_eq_35_is_within_one_ulp() -> None:
+    """The residual (φ − s) + φ(g − 1) of the Newton angle (plan_ir.NewtonAngle.leading), with
+    g − 1 by its series up to φ ≈ 2.4 (|p| ≈ 2.15): φ within 1 ulp of the exact angle of the rounded
+    |p| there (the residual φ·g − s with g = cbrt(6φ − 6 sin φ)/φ above φ = 0.89 left it 2.3 ulp
+    off at φ = 1.04). Above, the closed form's cancellation of 6φ − 6 sin φ remains (2.5 ulp at
+    |p| = 3.13, 2.4 before)."""
+    import mpmath
+
+    from tests.reference import GeneratingFunction
+
+    module = load(ROOT / "generated" / "numpy" / "det_h_one.py", "gen_det_h_one_angle")
+    function = GeneratingFunction("cbrt(6*(phi - sin(phi)))", cancels=True)
+    rng = np.random.default_rng(20)
+    sizes = np.concatenate([10.0 ** rng.uniform(-12, 0, 32), rng.uniform(0, 2.1, 128)])
+    angles = module.angle(sizes[:, None] * np.array([0.0, 0.0, 1.0]))
+    errors = []
+    with mpmath.workdps(40):
+        for size, angle in zip(sizes, angles, strict=True):
+            exact = function.inverse(mpmath.mpf(float(size)), None)
+            errors.append(float(abs(mpmath.mpf(float(angle)) - exact) / exact) / np.finfo(np.float64).eps)
+    over = {float(size): error for size, error in zip(sizes, errors, strict=True) if error > 1.0}
+    assert not over, over
+
+
 def test_operations_accuracy_on_a_small_grid() -> None:
     from accuracy_operations import measure_operations
 

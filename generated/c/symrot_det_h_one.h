@@ -69,8 +69,8 @@ extern "C" {
 #endif
 
 /* symrot_det_h_one__phi: internal: phi from s = |p| (eq 11).
- * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 475 */
+ * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
+ * ops: 583 */
 static inline double symrot_det_h_one__phi(double s)
 {
     const double s2 = (s*s);
@@ -91,19 +91,20 @@ static inline double symrot_det_h_one__phi(double s)
     }
     for (k = 0; k < 6; ++k) {
         const double t = (phi*phi);
-        double ratio, slope, value, residual, step;
-        if (t < 0.7851233626304374) {
-            ratio = t*(t*(t*(t*(t*(t*((-5.032990449379227e-15)*t - 41.0/254270016000000.0) + 19.0/1816214400000.0) + 1.0/349272000.0)) + 1.0/8400.0) - 1.0/60.0) + 1;
+        double ratio, slope, tail, residual, step;
+        if (t < 5.5673482008975155) {
+            ratio = t*(t*(t*(t*(t*(t*(t*(t*(t*(t*(t*(t*((3.3177115067548803e-26)*t + 2.66943145680867e-24) + 1.235992150768613e-22) - 1.2859517762333714e-22) - 6.676229535883005e-19) - 7.540360750643117e-17) - 5.032990449379227e-15) - 41.0/254270016000000.0) + 19.0/1816214400000.0) + 1.0/349272000.0)) + 1.0/8400.0) - 1.0/60.0);
         } else {
-            ratio = cbrt(6*phi - 6*sin(phi))/phi;
+            const double ratio_w0 = (1.0/2.0)*phi;
+            ratio = -1 + cbrt(6*phi - 12*sin(ratio_w0)*cos(ratio_w0))/phi;
         }
         if (t < 1.5083706105984371) {
             slope = t*(t*(t*(t*(t*(t*(t*(t*((-1.2684836118177708e-17)*t - 1.2818613276093299e-15) - 89.0/1178888256000000.0) - 41.0/19559232000000.0) + 19.0/165110400000.0) + 1.0/38808000.0)) + 1.0/1680.0) - 1.0/20.0) + 1;
         } else {
             slope = 2*(1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
         }
-        value = phi*ratio;
-        residual = value - s;
+        tail = phi*ratio;
+        residual = (phi - s) + tail;
         if (residual > 0) {
             high = phi;
         } else {
@@ -121,8 +122,8 @@ static inline double symrot_det_h_one__phi(double s)
 
 /* symrot_det_h_one_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 493 */
+ * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
+ * ops: 601 */
 static inline double symrot_det_h_one_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -146,7 +147,7 @@ static inline double symrot_det_h_one_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * R_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * ops: 528 */
+ * ops: 636 */
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -281,7 +282,7 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 580 */
+ * ops: 688 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -427,7 +428,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 597 */
+ * ops: 705 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -583,7 +584,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
- * ops: 529 */
+ * ops: 637 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -718,7 +719,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
  * K_across: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 17 in x below x = 1.43428, else (x/(8*sin(phi/2)**2) - sin(phi/2)/s)/x
- * ops: 581 */
+ * ops: 689 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -863,7 +864,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 596 */
+ * ops: 704 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -902,7 +903,7 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 579 */
+ * ops: 687 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -940,7 +941,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
  * nu: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)/s
- * ops: 495 */
+ * ops: 603 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1107,7 +1108,7 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 734 */
+ * ops: 842 */
 static inline void symrot_det_h_one_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1189,7 +1190,7 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 735 */
+ * ops: 843 */
 static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1269,7 +1270,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 882 */
+ * ops: 990 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1367,7 +1368,7 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 888 */
+ * ops: 996 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1467,7 +1468,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
  * H_inverse_0_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 2.63022, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 661 */
+ * ops: 769 */
 static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1555,7 +1556,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 845 */
+ * ops: 953 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1740,8 +1741,8 @@ static inline int symrot_det_h_one_rescale_jacobian(const double p[3], double J[
 }
 
 /* symrot_det_h_one__phi_f: internal: phi from s = |p| (eq 11).
- * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831850051879883]
- * ops: 379 */
+ * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831850051879883]
+ * ops: 385 */
 static inline float symrot_det_h_one__phi_f(float s)
 {
     const float s2 = (s*s);
@@ -1762,12 +1763,12 @@ static inline float symrot_det_h_one__phi_f(float s)
     }
     for (k = 0; k < 6; ++k) {
         const float t = (phi*phi);
-        float ratio, slope, value, residual, step;
+        float ratio, slope, tail, residual, step;
         if (t < 5.567348F) {
-            ratio = t*(t*(t*(t*((1.046132e-11F)*t + 2.8630982e-09F)) + 1.0F/8400.0F) - 1.0F/60.0F) + 1;
+            ratio = t*(t*(t*(t*((1.046132e-11F)*t + 2.8630982e-09F)) + 1.0F/8400.0F) - 1.0F/60.0F);
         } else {
             const float ratio_w0 = (1.0F/2.0F)*phi;
-            ratio = cbrtf(6*phi - 12*sinf(ratio_w0)*cosf(ratio_w0))/phi;
+            ratio = -1 + cbrtf(6*phi - 12*sinf(ratio_w0)*cosf(ratio_w0))/phi;
         }
         if (t < 5.567348F) {
             slope = t*(t*(t*(t*(t*(1.1507452e-10F + (-2.096197e-12F)*t) + 2.5767882e-08F)) + 1.0F/1680.0F) - 1.0F/20.0F) + 1;
@@ -1776,8 +1777,8 @@ static inline float symrot_det_h_one__phi_f(float s)
             const float slope_w1 = sinf(slope_w0);
             slope = 4*(slope_w1*slope_w1)/powf(cbrtf(6*phi - 12*slope_w1*cosf(slope_w0)), 2);
         }
-        value = phi*ratio;
-        residual = value - s;
+        tail = phi*ratio;
+        residual = (phi - s) + tail;
         if (residual > 0) {
             high = phi;
         } else {
@@ -1795,8 +1796,8 @@ static inline float symrot_det_h_one__phi_f(float s)
 
 /* symrot_det_h_one_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
- * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s from the reverted series, bracket [0, 6.2831850051879883]
- * ops: 397 */
+ * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831850051879883]
+ * ops: 403 */
 static inline float symrot_det_h_one_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1820,7 +1821,7 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/x
- * ops: 430 */
+ * ops: 436 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1947,7 +1948,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 484 */
+ * ops: 490 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2093,7 +2094,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 492 */
+ * ops: 498 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2255,7 +2256,7 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
  * G_2: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
- * ops: 433 */
+ * ops: 439 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2390,7 +2391,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
  * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
  * K_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 494 */
+ * ops: 500 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2540,7 +2541,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 491 */
+ * ops: 497 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2581,7 +2582,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 483 */
+ * ops: 489 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2619,7 +2620,7 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
  * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/s
- * ops: 399 */
+ * ops: 405 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2784,7 +2785,7 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 609 */
+ * ops: 615 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2867,7 +2868,7 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 610 */
+ * ops: 616 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2948,7 +2949,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 786 */
+ * ops: 792 */
 static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3044,7 +3045,7 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 792 */
+ * ops: 798 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3142,7 +3143,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
  * H_inverse_0_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 4.61948, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 552 */
+ * ops: 558 */
 static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3228,7 +3229,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 749 */
+ * ops: 755 */
 static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);

@@ -993,23 +993,30 @@ def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _ratio_64(t, phi):
-    small = t < 0.7851233626304374
+    small = t < 5.5673482008975155
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
-        series = -5.032990449379227e-15
+        series = 3.3177115067548803e-26
+        series = 2.66943145680867e-24 + t * series
+        series = 1.235992150768613e-22 + t * series
+        series = -1.2859517762333714e-22 + t * series
+        series = -6.676229535883005e-19 + t * series
+        series = -7.540360750643117e-17 + t * series
+        series = -5.032990449379227e-15 + t * series
         series = -1.6124590954522927e-13 + t * series
         series = 1.0461319985129509e-11 + t * series
         series = 2.863098101193339e-09 + t * series
         series = t * series
         series = 0.00011904761904761905 + t * series
         series = -0.016666666666666666 + t * series
-        series = 1.0 + t * series
+        series = t * series
         out[small] = series
     if not small.all():
         big = ~small
         phi = phi[big]
-        out[big] = numpy.cbrt(6*phi - 6*numpy.sin(phi))/phi
+        w0 = (0.5)*phi
+        out[big] = -1 + numpy.cbrt(6*phi - 12*numpy.sin(w0)*numpy.cos(w0))/phi
     return out
 
 
@@ -1080,8 +1087,8 @@ def _angle_64(s, d):
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
     for _ in range(6):
-        value = phi * _ratio_64(phi * phi, phi)
-        residual = value - s
+        tail = phi * _ratio_64(phi * phi, phi)
+        residual = (phi - s) + tail
         high = numpy.where(residual > 0, phi, high)
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
@@ -2016,19 +2023,22 @@ def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _ratio_32(t, phi):
-    small = t < 0.7851233424843009
+    small = t < 5.567347935831094
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
-        series = 0.00011904761904761905
+        series = 1.0461319985129509e-11
+        series = 2.863098101193339e-09 + t * series
+        series = t * series
+        series = 0.00011904761904761905 + t * series
         series = -0.016666666666666666 + t * series
-        series = 1.0 + t * series
+        series = t * series
         out[small] = series
     if not small.all():
         big = ~small
         phi = phi[big]
         w0 = (0.5)*phi
-        out[big] = numpy.cbrt(6*phi - 12*numpy.sin(w0)*numpy.cos(w0))/phi
+        out[big] = -1 + numpy.cbrt(6*phi - 12*numpy.sin(w0)*numpy.cos(w0))/phi
     return out
 
 
@@ -2096,8 +2106,8 @@ def _angle_32(s, d):
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185005187988)
     for _ in range(6):
-        value = phi * _ratio_32(phi * phi, phi)
-        residual = value - s
+        tail = phi * _ratio_32(phi * phi, phi)
+        residual = (phi - s) + tail
         high = numpy.where(residual > 0, phi, high)
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)

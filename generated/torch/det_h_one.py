@@ -823,18 +823,25 @@ def _e_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _ratio_64(t, phi):
-    small = t < 0.7851233626304374
+    small = t < 5.5673482008975155
     t = _where(small, t, 0.0)
-    series = -5.032990449379227e-15 + 0.0 * t
+    series = 3.3177115067548803e-26 + 0.0 * t
+    series = 2.66943145680867e-24 + t * series
+    series = 1.235992150768613e-22 + t * series
+    series = -1.2859517762333714e-22 + t * series
+    series = -6.676229535883005e-19 + t * series
+    series = -7.540360750643117e-17 + t * series
+    series = -5.032990449379227e-15 + t * series
     series = -1.6124590954522927e-13 + t * series
     series = 1.0461319985129509e-11 + t * series
     series = 2.863098101193339e-09 + t * series
     series = t * series
     series = 0.00011904761904761905 + t * series
     series = -0.016666666666666666 + t * series
-    series = 1.0 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    closed = _cbrt(6*phi - 6*_xp.sin(phi))/phi
+    series = t * series
+    phi = _where(small, 2.3595228756885396, phi)
+    w0 = (0.5)*phi
+    closed = -1 + _cbrt(6*phi - 12*_xp.sin(w0)*_xp.cos(w0))/phi
     return _where(small, series, closed)
 
 
@@ -900,8 +907,8 @@ def _newton_64(s):
     low = 0.0 * s
     high = low + 6.283185307179586
     for _ in range(6):
-        value = phi * _ratio_64(phi * phi, phi)
-        residual = value - s
+        tail = phi * _ratio_64(phi * phi, phi)
+        residual = (phi - s) + tail
         high = _where(residual > 0, phi, high)
         low = _where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
@@ -1562,10 +1569,10 @@ def _ratio_32(t, phi):
     series = t * series
     series = 0.00011904761904761905 + t * series
     series = -0.016666666666666666 + t * series
-    series = 1.0 + t * series
+    series = t * series
     phi = _where(small, 2.3595228756885396, phi)
     w0 = (0.5)*phi
-    closed = _cbrt(6*phi - 12*_xp.sin(w0)*_xp.cos(w0))/phi
+    closed = -1 + _cbrt(6*phi - 12*_xp.sin(w0)*_xp.cos(w0))/phi
     return _where(small, series, closed)
 
 
@@ -1630,8 +1637,8 @@ def _newton_32(s):
     low = 0.0 * s
     high = low + 6.283185005187988
     for _ in range(6):
-        value = phi * _ratio_32(phi * phi, phi)
-        residual = value - s
+        tail = phi * _ratio_32(phi * phi, phi)
+        residual = (phi - s) + tail
         high = _where(residual > 0, phi, high)
         low = _where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)

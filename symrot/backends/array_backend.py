@@ -42,9 +42,16 @@ from ..plan import (
     evaluation_plan,
     half_angle,
 )
-from ..plan_ir import ANGLE_CORRECTION_GROWTH
 from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
-from .numpy_backend import SUFFIX, angle_low_helpers, newton_step_lines, print_expression, uses_phi
+from .numpy_backend import (
+    SUFFIX,
+    angle_low_helpers,
+    newton_low_lines,
+    newton_residual_lines,
+    newton_step_lines,
+    print_expression,
+    uses_phi,
+)
 from .subexpressions import common_subexpressions
 from .templating import render
 
@@ -138,6 +145,7 @@ def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
 
 def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
     """The fixed-count safeguarded Newton iteration φ(s) (its derivative is the module's)."""
+    ratio = f"_ratio_{suffix}(phi * phi, phi)"
     start_lines = [f"start = {_literal(angle.start[-1])} + 0.0 * s"]
     start_lines += [f"start = {_literal(c)} + s2 * start" for c in reversed(angle.start[:-1])]
     far = angle.far
@@ -153,8 +161,7 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
         "low = 0.0 * s",
         f"high = low + {angle.phi_max!r}",
         f"for _ in range({angle.iterations}):",
-        f"    value = phi * _ratio_{suffix}(phi * phi, phi)",
-        "    residual = value - s",
+        *("    " + line for line in newton_residual_lines(angle, ratio, _literal)),
         "    high = _where(residual > 0, phi, high)",
         "    low = _where(residual <= 0, phi, low)",
         f"    slope = _slope_{suffix}(phi * phi, phi)",
@@ -168,14 +175,8 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
 def angle_low_lines(angle: NewtonAngle, suffix: str) -> list[str]:
     """λ ≈ φ* − φ, one more Newton correction of the iterate φ where p grows fast enough for it to
     help (0 elsewhere); see ``EvaluationPlan.angle_correction``."""
-    return [
-        f"value = phi * _ratio_{suffix}(phi * phi, phi)",
-        f"slope = _slope_{suffix}(phi * phi, phi)",
-        f"useful = phi * slope > {ANGLE_CORRECTION_GROWTH!r} * s",
-        "low = (s - value) / _where(useful, slope, 1.0)"
-        + (" * (value / _where(s > 0, s, 1.0))" if angle.reciprocal else ""),
-        "return _where(useful, low, 0.0)",
-    ]
+    return [*newton_residual_lines(angle, f"_ratio_{suffix}(phi * phi, phi)", _literal),
+            f"slope = _slope_{suffix}(phi * phi, phi)", *newton_low_lines(angle, "_where")]
 
 
 def _far_variable(far: FarStart) -> str:

@@ -242,7 +242,8 @@ class FunctionWriter:
             note = f"phi = {sp.sstr(angle.expression)} (closed inverse of p(phi))"
         else:
             statements = self.newton(angle)
-            note = (f"phi by {angle.iterations} safeguarded Newton steps on phi*g(phi^2) = s from the "
+            note = (f"phi by {angle.iterations} safeguarded Newton steps on phi*g(phi^2) = s, residual "
+                    f"(phi*g(0) - s) + phi*(g - g(0)), from the "
                     f"reverted series, bracket [0, {angle.phi_max:.17g}]")
         return {"c_name": self.angle_helper, "summary": "internal: phi from s = |p|", "equation": "11",
                 "notes": [note], "ops": ops_of(statements), "signature": signature,
@@ -254,11 +255,11 @@ class FunctionWriter:
         body: list[Statement] = [
             self.let("t", PHI_SYMBOL**2),
             {"kind": "declare", "type": self.ctype,
-             "names": ["ratio", "slope", "value", "residual", "step", *(["change"] if angle.edge else [])]},
+             "names": ["ratio", "slope", "tail", "residual", "step", *(["value"] if angle.reciprocal else []),
+                       *(["change"] if angle.edge else [])]},
             self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
             self.branch_value(angle.slope, T_SYMBOL, "slope"),
-            self.set("value", PHI_SYMBOL * sp.Symbol("ratio")),
-            self.set("residual", "value - s", ops=1),
+            *self.residual(angle, declared=True),
             {"kind": "if", "condition": "residual > 0", "then": [self.set("high", "phi")],
              "otherwise": [self.set("low", "phi")]},
             *self.newton_step(angle),
@@ -298,6 +299,18 @@ class FunctionWriter:
              "times": angle.iterations},
             {"kind": "return", "value": "phi"},
         ]
+
+    def residual(self, angle: NewtonAngle, declared: bool) -> list[Statement]:
+        """tail = φ·(g − g(0)), residual = (φ·g(0) − s) + tail, and value = p(φ) for the reciprocal
+        step (:class:`symrot.plan_ir.NewtonAngle`): the difference first, exact once φ is within a
+        factor 2 of s."""
+        head = "phi" if angle.leading == 1 else f"phi*{self.c(angle.leading)}"
+        values = [("tail", "phi*ratio", 1), ("residual", f"({head} - s) + tail", 3),
+                  *([("value", f"{head} + tail", 2)] if angle.reciprocal else [])]
+        if declared:
+            return [self.set(name, value, ops=ops) for name, value, ops in values]
+        return [{"kind": "let", "type": self.ctype, "name": name, "value": value, "ops": ops}
+                for name, value, ops in values]
 
     def newton_step(self, angle: NewtonAngle) -> list[Statement]:
         """The step of the safeguarded iteration and its acceptance: Newton in φ (on 1/p if
@@ -370,8 +383,8 @@ class FunctionWriter:
         functions = []
         angle = self.precision_plan.angle
         if correction[label] == label and isinstance(angle, NewtonAngle):
-            step = ("(s - value) / slope * (value / (s > 0 ? s : 1))" if angle.reciprocal
-                    else "(s - value) / slope")
+            step = ("-residual / slope * (value / (s > 0 ? s : 1))" if angle.reciprocal
+                    else "-residual / slope")
             growth = self.printer.literal(sp.Float(ANGLE_CORRECTION_GROWTH))
             signature = f"{t} {self.low_helper(self.precision)}({t} s, {t} phi)"
             statements: list[Statement] = [
@@ -379,7 +392,7 @@ class FunctionWriter:
                 {"kind": "declare", "type": t, "names": ["ratio", "slope"]},
                 self.branch_value(angle.ratio, T_SYMBOL, "ratio"),
                 self.branch_value(angle.slope, T_SYMBOL, "slope"),
-                self.let("value", PHI_SYMBOL * sp.Symbol("ratio")),
+                *self.residual(angle, declared=False),
                 {"kind": "return", "value": f"phi * slope > {growth} * s ? {step} : 0", "ops": 7},
             ]
             functions.append({

@@ -188,8 +188,7 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
         "low = numpy.zeros_like(s)",
         f"high = numpy.full_like(s, {angle.phi_max!r})",
         f"for _ in range({angle.iterations}):",
-        "    value = phi * _ratio(phi * phi)",
-        "    residual = value - s",
+        *("    " + line for line in newton_residual_lines(angle, "_ratio(phi * phi)", _literal)),
         "    high = numpy.where(residual > 0, phi, high)",
         "    low = numpy.where(residual <= 0, phi, low)",
         "    slope = _slope(phi * phi, phi)",
@@ -197,6 +196,27 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
         *newton_step_lines(angle),
         "    phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)",
         "return phi",
+    ]
+
+
+def newton_residual_lines(angle: NewtonAngle, ratio_call: str,
+                          literal: Callable[[sp.Expr], str]) -> list[str]:
+    """``tail`` = φ·(g − g(0)) and ``residual`` = (φ·g(0) − s) + tail of the Newton angle (the
+    difference first: exact once φ is within a factor 2 of s), and ``value`` = p(φ) where the
+    reciprocal step needs it (:class:`symrot.plan_ir.NewtonAngle`); ``ratio_call`` prints g − g(0)."""
+    head = "phi" if angle.leading == 1 else f"phi * {literal(angle.leading)}"
+    return [f"tail = phi * {ratio_call}", f"residual = ({head} - s) + tail",
+            *([f"value = {head} + tail"] if angle.reciprocal else [])]
+
+
+def newton_low_lines(angle: NewtonAngle, where: str) -> list[str]:
+    """λ = −residual/p′ where φ p′ > ANGLE_CORRECTION_GROWTH·s, 0 elsewhere (after
+    :func:`newton_residual_lines` and ``slope``): one more Newton correction of φ."""
+    return [
+        f"useful = phi * slope > {ANGLE_CORRECTION_GROWTH!r} * s",
+        f"low = -residual / {where}(useful, slope, 1.0)"
+        + (f" * (value / {where}(s > 0, s, 1.0))" if angle.reciprocal else ""),
+        f"return {where}(useful, low, 0.0)",
     ]
 
 
@@ -227,14 +247,9 @@ def newton_step_lines(angle: NewtonAngle, where: str = "numpy.where", module: st
 def _angle_low_lines(angle: NewtonAngle) -> list[str]:
     """λ ≈ φ* − φ, one more Newton correction of the iterate φ where p grows fast enough for it to
     help (0 elsewhere); see ``EvaluationPlan.angle_correction``."""
-    return [
-        "value = phi * _ratio(phi * phi)",
-        "slope = _slope(phi * phi, phi)",
-        f"useful = phi * slope > {ANGLE_CORRECTION_GROWTH!r} * s",
-        "low = (s - value) / numpy.where(useful, slope, 1.0)"
-        + (" * (value / numpy.where(s > 0, s, 1.0))" if angle.reciprocal else ""),
-        "return numpy.where(useful, low, 0.0).astype(s.dtype)",
-    ]
+    lines = [*newton_residual_lines(angle, "_ratio(phi * phi)", _literal), "slope = _slope(phi * phi, phi)",
+             *newton_low_lines(angle, "numpy.where")]
+    return [*lines[:-1], lines[-1] + ".astype(s.dtype)"]
 
 
 def _far_variable(far: FarStart) -> str:
