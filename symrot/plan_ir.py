@@ -137,7 +137,8 @@ class NewtonAngle:
     (:func:`symrot.newton_start.newton_step`): p_max − p ∝ (φ_max − φ)^k at the end of the range,
     a fold (k = 2, 3, 4) or an edge where p′ → ∞ (k = 1/2 for asin). The step from φ with
     δ = φ_max − φ and the Newton correction c = r/p′ is φ_max − δ(1 + u)^(1/k), u = k c/δ, printed
-    without cancellation (:func:`symrot.newton_start.edge_step`) and taken while δ > 0 and u > −1;
+    without cancellation (:func:`symrot.newton_start.edge_step`) and taken while δ > 0, with u raised to
+    :func:`symrot.newton_start.edge_floor` (> −1) where Newton in w would overshoot past the edge;
     Newton in φ converges only linearly next to a fold and overshoots past an asin edge (row 187
     of docs/accuracy_hypothesis.md was NaN for φ > 0.99995)."""
 

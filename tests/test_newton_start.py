@@ -138,3 +138,16 @@ def test_lanes_of_a_residual_far_off_in_float32_stay_finite_without_warnings() -
         lanes = newton_lanes(PHI, sp.Integer(1), np.array([0.5, 1.0]), 2 * math.pi, np.float32,
                              lambda t: np.full_like(t, 1e35))
     assert np.all(np.isfinite(lanes.tolerance)) and np.all(lanes.tolerance > 0)
+
+
+def test_the_tolerance_next_to_a_fold_is_the_width_of_the_angles_that_round_alike() -> None:
+    """At φ_max(1 − 10⁻⁹) of eq 35 (a triple fold at 2π), s = p(φ) rounds to float64's p_max and
+    the first-order tolerance 2ε s/p′ was infinite (p′ = 0 at the exact angle, 2π): any iterate
+    passed, and one that ended 0.35 rad off (a bisection, then linear steps in φ) was counted as
+    converged. The angles whose p lies within ε s of s span ~3·10⁻⁵ rad there (tolerance 9.7·10⁻⁵)."""
+    p = sp.cbrt(6 * (PHI - sp.sin(PHI)))
+    slope = sp.diff(p, PHI)
+    angles = np.array([2 * math.pi * (1 - 1e-9), 1.0])
+    lanes = newton_lanes(p, slope, angles, 2 * math.pi, np.float64, lambda phi: np.zeros_like(phi), 1.0)
+    assert lanes.tolerance[0] < 1e-3
+    assert lanes.tolerance[1] < 1e-14  # away from the fold the first-order width stands

@@ -138,6 +138,37 @@ def test_the_newton_angle_of_eq_35_is_within_one_ulp() -> None:
     assert not over, over
 
 
+def test_the_angle_at_the_fold_is_one_that_rounds_to_the_input() -> None:
+    """Eq 35 at |p| = p_max rounded (the fold at 2π, p_max − p ∝ (2π − φ)³): every angle within
+    3·10⁻⁵ of 2π gives a p that rounds to that |p|, and the Newton angle must be one of them. It was
+    5.93 for some axes: the residual at the clipped start 2π was positive by rounding, the bracket
+    bisected to π, and Newton in φ converged only linearly towards the fold (the plan's check
+    excused it: its first-order width ε s/p′ was infinite there; newton_start._width). Now Newton in
+    w = (2π − φ)³ with overshooting steps shrinking δ (newton_start.edge_floor)."""
+    import mpmath
+
+    from tests.reference import GeneratingFunction
+
+    module = load(ROOT / "generated" / "numpy" / "det_h_one.py", "gen_det_h_one_fold")
+    function = GeneratingFunction("cbrt(6*(phi - sin(phi)))", cancels=True)
+    rng = np.random.default_rng(35)
+    axes = rng.normal(size=(48, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    p_max = float(mpmath.cbrt(12 * mpmath.pi))
+    points = [axis * p_max * (1 - k * 2.0 ** -53) for axis in axes for k in (0, 1, 2)]
+    angles = module.angle(np.array(points))
+    off = {}
+    with mpmath.workdps(40):
+        for point, angle in zip(points, angles, strict=True):
+            if np.isnan(angle):  # |p|² rounds beyond p_max²: outside the range
+                continue
+            exact = function.inverse(mpmath.sqrt(sum(mpmath.mpf(float(c)) ** 2 for c in point)), None)
+            if abs(angle - exact) > 3e-5:
+                off[tuple(point)] = float(angle)
+    assert not off, off
+    assert np.sum(~np.isnan(angles)) > 48
+
+
 def test_operations_accuracy_on_a_small_grid() -> None:
     from accuracy_operations import measure_operations
 

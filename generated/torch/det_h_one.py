@@ -914,8 +914,15 @@ def _newton_64(s):
         slope = _slope_64(phi * phi, phi)
         safe = slope > 0
         safe = safe & _xp.isfinite(slope)
-        step = phi - residual / _where(safe, slope, 1.0)
-        inside = safe & (step >= low) & (step <= high)
+        change = residual / _where(safe, slope, 1.0)
+        delta = 6.283185307179586 - phi
+        u = 3.0 * change / _where(delta > 0, delta, 1.0)
+        change = _where(u < -0.9999990463256836, -0.9999990463256836 * delta / 3.0, change)
+        u = _where(u < -0.9999990463256836, -0.9999990463256836, u)
+        defined = delta > 0
+        u = _where(defined, u, 0.0)
+        step = -3*change/((u + 1)**(0.3333333333333333)*((u + 1)**(0.3333333333333333) + 1) + 1) + phi
+        inside = safe & defined & (step >= low) & (step <= high)
         phi = _where(inside, step, 0.5 * (low + high))
     return phi
 

@@ -39,7 +39,7 @@ import sympy as sp
 
 from ..algebraic import S, X
 from ..errors import NonFiniteLiteral
-from ..newton_start import CHANGE, EDGE_STEP, FarStart, edge_step
+from ..newton_start import CHANGE, EDGE_STEP, FarStart, edge_floor, edge_step
 from ..parsing import PHI
 from ..plan import half_angle
 from ..plan_ir import (
@@ -324,16 +324,19 @@ class FunctionWriter:
             return [step, {**bisect,
                            "condition": "slope > 0 && isfinite(slope) && step >= low && step <= high"}]
         top = self.printer.literal(angle.phi_max)
+        floor = self.printer.literal(sp.Float(edge_floor(angle.edge), 17))
         step = edge_step(angle.edge).xreplace({PHI: PHI_SYMBOL, EDGE_STEP: sp.Symbol("u", real=True),
                                                CHANGE: sp.Symbol("change", real=True)})
         return [
             self.set("change", "residual / slope", ops=1),
             {"kind": "let", "type": self.ctype, "name": "delta", "value": f"{top} - phi", "ops": 1},
-            {"kind": "let", "type": self.ctype, "name": "u", "ops": 4,
-             "value": f"delta > 0 ? {self.c(angle.edge)}*change/delta : 0"},
+            {"kind": "declare", "type": self.ctype, "ops": 4,  # not const: raised below
+             "names": [f"u = delta > 0 ? {self.c(angle.edge)}*change/delta : 0"]},
+            {"kind": "if", "condition": f"u < {floor}", "otherwise": [],  # raised u: c = u δ/k
+             "then": [self.set("u", floor), self.set("change", f"u*delta/{self.c(angle.edge)}", ops=2)]},
             self.set("step", step),
-            {**bisect, "condition": "slope > 0 && isfinite(slope) && delta > 0 && u > -1 && step >= low "
-                                    "&& step <= high"},
+            {**bisect,
+             "condition": "slope > 0 && isfinite(slope) && delta > 0 && step >= low && step <= high"},
         ]
 
     # -- λ, the Newton angle below φ's last bit ---------------------------------------------------

@@ -29,7 +29,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from ..algebraic import D, X
-from ..newton_start import FarStart, edge_step
+from ..newton_start import FarStart, edge_floor, edge_step
 from ..parsing import PHI
 from ..plan import (
     Algebraic,
@@ -232,12 +232,15 @@ def newton_step_lines(angle: NewtonAngle, where: str = "numpy.where", module: st
                 f"    step = phi - residual / {where}(safe, slope, 1.0)"
                 + (f" * (value / {where}(s > 0, s, 1.0))" if angle.reciprocal else ""),
                 "    inside = safe & (step >= low) & (step <= high)"]
+    floor = edge_floor(angle.edge)
     return [
         finite,
         f"    change = residual / {where}(safe, slope, 1.0)",
         f"    delta = {angle.phi_max!r} - phi",
         f"    u = {float(angle.edge)!r} * change / {where}(delta > 0, delta, 1.0)",
-        "    defined = (delta > 0) & (u > -1.0)",
+        f"    change = {where}(u < {floor!r}, {floor!r} * delta / {float(angle.edge)!r}, change)",
+        f"    u = {where}(u < {floor!r}, {floor!r}, u)",
+        "    defined = delta > 0",
         f"    u = {where}(defined, u, 0.0)",
         f"    step = {(printer or print_expression)(edge_step(angle.edge))}",
         "    inside = safe & defined & (step >= low) & (step <= high)",
