@@ -291,6 +291,24 @@ def _width(f: Callable[[Any], Any], f_slope: Callable[[Any], Any], s: Any, theta
     return float(max(theta - below, above - theta))
 
 
+def fold_top(p: sp.Expr, slope: sp.Expr, p_max: float, phi_max: float, dtype: type) -> float:
+    """For p with a fold at φ_max (p′(φ_max) = 0): the smallest angle whose p lies within ε of
+    ``p_max`` rounded to ``dtype``, rounded down. Every |p| from p(that angle) to p_max is p of an
+    angle in [that angle, φ_max] rounded, so the backends clip the Newton iterate to it (a backward
+    stable angle, where p′ > 0): at φ_max itself R, H and the derivatives through 1/p′ are infinite
+    or meaningless (eq 35 at float64's p_max: PyTorch's iterate was 2π for 29 of 116 points, its
+    dφ/d|p| infinite)."""
+    epsilon = float(np.finfo(dtype).eps)
+    f, f_slope = _p_function(p), _p_function(slope)
+    with mpmath.workdps(DIGITS):
+        size = mpmath.mpf(float(dtype(p_max))) * (1 - epsilon)
+        angle = angle_of_length(f, f_slope, size, mpmath.mpf(phi_max))
+        top = dtype(float(angle))
+        while mpmath.mpf(float(top)) > angle:
+            top = np.nextafter(top, dtype(0))
+    return float(top)
+
+
 CHANGE, EDGE_STEP = sp.symbols("change u", real=True)
 """The symbols of :func:`edge_step`: c = r/p′ and u = k c/δ, δ = φ_max − φ."""
 
@@ -351,7 +369,8 @@ def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarSt
                         printed: tuple[Callable[[np.ndarray], np.ndarray],
                                        Callable[[np.ndarray], np.ndarray]],
                         reciprocal: bool, bracket_top: float,
-                        edge: sp.Rational | None = None, leading: float = 0.0) -> NewtonCount:
+                        edge: sp.Rational | None = None, leading: float = 0.0,
+                        fold_top: float = math.inf) -> NewtonCount:
     """Steps the printed safeguarded Newton iteration needs, counted by running it.
 
     On the checks of ``lanes`` (:func:`newton_lanes`) the start (reverted series below
@@ -361,7 +380,8 @@ def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarSt
     (φ·``leading`` − s) + φ·(p(φ)/φ − ``leading``), with the steps of Newton on 1/p if
     ``reciprocal`` (:class:`symrot.plan_ir.NewtonAngle`) or in w = (φ_max − φ)^k for an ``edge``
     exponent k (:func:`newton_step`), in the bracket [0, ``bracket_top``] (the largest value of the
-    precision not above the exact φ_max).
+    precision not above the exact φ_max), each iterate clipped to ``fold_top`` as the backends clip the
+    last (:class:`symrot.plan_ir.NewtonAngle`).
     The steps are one more than the first step count after which every lane is within its
     tolerance, or ``MAX_ITERATIONS`` if no count is; then ``unconverged`` is the
     smallest s whose lane is still outside after ``MAX_ITERATIONS`` steps (the plan ends the
@@ -398,7 +418,7 @@ def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarSt
             step, defined = newton_step(phi, change, edge, bracket_top)
             inside = safe & defined & (step >= low) & (step <= high)
             phi = np.where(inside, step, 0.5 * (low + high)).astype(dtype)
-            converged = np.abs(phi.astype(np.float64) - theta) <= limit
+            converged = np.abs(np.minimum(phi, fold_top).astype(np.float64) - theta) <= limit
             if np.all(converged):
                 return NewtonCount(min(step_count + 1, MAX_ITERATIONS), math.inf)
     return NewtonCount(MAX_ITERATIONS, float(np.min(s_values[~converged])))

@@ -72,7 +72,14 @@ from .measurement import (
     reference_values,
     with_length,
 )
-from .newton_start import START_TOLERANCE, edge_exponent, far_start, measured_iterations, newton_lanes
+from .newton_start import (
+    START_TOLERANCE,
+    edge_exponent,
+    far_start,
+    fold_top,
+    measured_iterations,
+    newton_lanes,
+)
 from .newton_start import FarStart as FarStart
 from .parsing import PHI
 from .plan_ir import (
@@ -1159,15 +1166,18 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
     ratio = plan_branch(ratio_form, ratio_series, PHI ** 2, phi_max, dtype, whole=abs(float(leading)))
     slope = plan_branch(slope_form, slope_series, PHI ** 2, phi_max, dtype)
     far = _far_start(p, p_max, phi_max, start)
+    top = (fold_top(p, derivation.scalars["p_prime"], p_max, phi_max, dtype)
+           if far.kind == "fold" and math.isfinite(p_max) else math.inf)
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
     reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
     lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0], float(leading))
-    count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, leading=float(leading))
+    count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, leading=float(leading),
+                                fold_top=top)
     edge = _edge_exponent(p, far, phi_max)
     if edge is not None:
         edge_count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, edge,
-                                         float(leading))
+                                         float(leading), top)
         # p′ = ∞ at the edge (k < 1): steps in φ overshoot past it and bisect (43 steps for asin(φ)
         # from a start at the edge, 6 in w), wherever the checks fall
         if edge < 1 or (-edge_count.unconverged, edge_count.steps) < (-count.unconverged, count.steps):
@@ -1176,7 +1186,7 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
             edge = None
     iterations = max(newton_iterations(far.measured, float(np.finfo(dtype).eps)), count.steps)
     return NewtonAngle(start, ratio, slope, iterations, bracket_top, far, reciprocal, count.unconverged,
-                       leading, edge)
+                       leading, edge, top)
 
 
 def _branch_model(branch: Branch, dtype: type) -> Callable[[np.ndarray], np.ndarray]:

@@ -141,6 +141,9 @@ class NewtonAngle:
     :func:`symrot.newton_start.edge_floor` (> −1) where Newton in w would overshoot past the edge;
     Newton in φ converges only linearly next to a fold and overshoots past an asin edge (row 187
     of docs/accuracy_hypothesis.md was NaN for φ > 0.99995)."""
+    fold_top: float = math.inf
+    """For a fold at φ_max (p′(φ_max) = 0): the smallest angle whose p rounds like p_max
+    (:func:`symrot.newton_start.fold_top`); every backend clips the iterate to it. inf otherwise."""
 
 
 Coefficient = Constant | Algebraic | Branch

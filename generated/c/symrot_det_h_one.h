@@ -70,7 +70,7 @@ extern "C" {
 
 /* symrot_det_h_one__phi: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 697 */
+ * ops: 698 */
 static inline double symrot_det_h_one__phi(double s)
 {
     const double s2 = (s*s);
@@ -124,13 +124,16 @@ static inline double symrot_det_h_one__phi(double s)
             phi = (1.0/2.0)*high + (1.0/2.0)*low;
         }
     }
+    if (phi > 6.283157890564791) {
+        phi = 6.283157890564791;
+    }
     return phi;
 }
 
 /* symrot_det_h_one_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 715 */
+ * ops: 716 */
 static inline double symrot_det_h_one_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -154,7 +157,7 @@ static inline double symrot_det_h_one_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * R_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * ops: 750 */
+ * ops: 751 */
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -289,7 +292,7 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 802 */
+ * ops: 803 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -435,7 +438,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 819 */
+ * ops: 820 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -591,7 +594,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
- * ops: 751 */
+ * ops: 752 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -726,7 +729,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
  * K_across: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 17 in x below x = 1.43428, else (x/(8*sin(phi/2)**2) - sin(phi/2)/s)/x
- * ops: 803 */
+ * ops: 804 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -871,7 +874,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 818 */
+ * ops: 819 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -910,7 +913,7 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 801 */
+ * ops: 802 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -948,7 +951,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
  * nu: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)/s
- * ops: 717 */
+ * ops: 718 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1115,7 +1118,7 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 956 */
+ * ops: 957 */
 static inline void symrot_det_h_one_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1197,7 +1200,7 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 957 */
+ * ops: 958 */
 static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1277,7 +1280,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 1104 */
+ * ops: 1105 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1375,7 +1378,7 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 1110 */
+ * ops: 1111 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1475,7 +1478,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
  * H_inverse_0_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 2.63022, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 883 */
+ * ops: 884 */
 static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1563,7 +1566,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 1067 */
+ * ops: 1068 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1749,7 +1752,7 @@ static inline int symrot_det_h_one_rescale_jacobian(const double p[3], double J[
 
 /* symrot_det_h_one__phi_f: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831850051879883]
- * ops: 385 */
+ * ops: 386 */
 static inline float symrot_det_h_one__phi_f(float s)
 {
     const float s2 = (s*s);
@@ -1798,13 +1801,16 @@ static inline float symrot_det_h_one__phi_f(float s)
             phi = (1.0F/2.0F)*high + (1.0F/2.0F)*low;
         }
     }
+    if (phi > 6.258972F) {
+        phi = 6.258972F;
+    }
     return phi;
 }
 
 /* symrot_det_h_one_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831850051879883]
- * ops: 403 */
+ * ops: 404 */
 static inline float symrot_det_h_one_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1828,7 +1834,7 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/x
- * ops: 436 */
+ * ops: 437 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1955,7 +1961,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 490 */
+ * ops: 491 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2101,7 +2107,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 498 */
+ * ops: 499 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2263,7 +2269,7 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
  * G_2: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
- * ops: 439 */
+ * ops: 440 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2398,7 +2404,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
  * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
  * K_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 500 */
+ * ops: 501 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2548,7 +2554,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 497 */
+ * ops: 498 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2589,7 +2595,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 489 */
+ * ops: 490 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2627,7 +2633,7 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
  * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/s
- * ops: 405 */
+ * ops: 406 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2792,7 +2798,7 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 615 */
+ * ops: 616 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2875,7 +2881,7 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 616 */
+ * ops: 617 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2956,7 +2962,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 792 */
+ * ops: 793 */
 static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3052,7 +3058,7 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 798 */
+ * ops: 799 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3150,7 +3156,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
  * H_inverse_0_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 4.61948, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 558 */
+ * ops: 559 */
 static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3236,7 +3242,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 755 */
+ * ops: 756 */
 static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);

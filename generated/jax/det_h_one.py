@@ -886,7 +886,7 @@ def _newton_64(s):
         step = -3*change/((u + 1)**(0.3333333333333333)*((u + 1)**(0.3333333333333333) + 1) + 1) + phi
         inside = safe & defined & (step >= low) & (step <= high)
         phi = _where(inside, step, 0.5 * (low + high))
-    return phi
+    return _where(phi > 6.283157890564791, 6.283157890564791, phi)  # NewtonAngle.fold_top
 
 
 def _scale_64(e0, e_norm):
@@ -1616,7 +1616,7 @@ def _newton_32(s):
         step = phi - residual / _where(safe, slope, 1.0)
         inside = safe & (step >= low) & (step <= high)
         phi = _where(inside, step, 0.5 * (low + high))
-    return phi
+    return _where(phi > 6.25897216796875, 6.25897216796875, phi)  # NewtonAngle.fold_top
 
 
 def _scale_32(e0, e_norm):

@@ -1104,7 +1104,7 @@ def _angle_64(s, d):
         step = -3*change/((u + 1)**(0.3333333333333333)*((u + 1)**(0.3333333333333333) + 1) + 1) + phi
         inside = safe & defined & (step >= low) & (step <= high)
         phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)
-    return phi
+    return numpy.minimum(phi, 6.283157890564791).astype(s.dtype)  # NewtonAngle.fold_top
 
 
 def _scale_64(e0, e_norm):
@@ -2123,7 +2123,7 @@ def _angle_32(s, d):
         step = phi - residual / numpy.where(safe, slope, 1.0)
         inside = safe & (step >= low) & (step <= high)
         phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)
-    return phi
+    return numpy.minimum(phi, 6.25897216796875).astype(s.dtype)  # NewtonAngle.fold_top
 
 
 def _scale_32(e0, e_norm):

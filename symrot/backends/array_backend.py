@@ -168,7 +168,8 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
         "    safe = slope > 0",
         *newton_step_lines(angle, "_where", "_xp", print_array),
         "    phi = _where(inside, step, 0.5 * (low + high))",
-        "return phi",
+        *([f"return _where(phi > {angle.fold_top!r}, {angle.fold_top!r}, phi)  # NewtonAngle.fold_top"]
+          if math.isfinite(angle.fold_top) else ["return phi"]),
     ]
 
 

@@ -297,6 +297,9 @@ class FunctionWriter:
              "otherwise": []},
             {"kind": "loop", "header": f"k = 0; k < {angle.iterations}; ++k", "body": body,
              "times": angle.iterations},
+            *([{"kind": "if", "condition": f"phi > {self.printer.literal(angle.fold_top)}", "otherwise": [],
+                "then": [self.set("phi", self.printer.literal(angle.fold_top))]}]  # NewtonAngle.fold_top
+              if math.isfinite(angle.fold_top) else []),
             {"kind": "return", "value": "phi"},
         ]
 

@@ -195,7 +195,8 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
         "    safe = slope > 0",
         *newton_step_lines(angle),
         "    phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)",
-        "return phi",
+        *([f"return numpy.minimum(phi, {angle.fold_top!r}).astype(s.dtype)  # NewtonAngle.fold_top"]
+          if math.isfinite(angle.fold_top) else ["return phi"]),
     ]
 
 
