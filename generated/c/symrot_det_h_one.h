@@ -115,7 +115,7 @@ static inline double symrot_det_h_one__phi(double s)
         double u = delta > 0 ? 3*change/delta : 0;
         if (u < -0.9999990463256836) {
             u = -0.9999990463256836;
-            change = u*delta/3;
+            change = u*delta/(3);
         }
         step = -3*change/(cbrt(u + 1)*(cbrt(u + 1) + 1) + 1) + phi;
         if (slope > 0 && isfinite(slope) && delta > 0 && step >= low && step <= high) {

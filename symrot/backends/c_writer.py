@@ -336,7 +336,7 @@ class FunctionWriter:
             {"kind": "declare", "type": self.ctype, "ops": 4,  # not const: raised below
              "names": [f"u = delta > 0 ? {self.c(angle.edge)}*change/delta : 0"]},
             {"kind": "if", "condition": f"u < {floor}", "otherwise": [],  # raised u: c = u δ/k
-             "then": [self.set("u", floor), self.set("change", f"u*delta/{self.c(angle.edge)}", ops=2)]},
+             "then": [self.set("u", floor), self.set("change", f"u*delta/({self.c(angle.edge)})", ops=2)]},
             self.set("step", step),
             {**bisect,
              "condition": "slope > 0 && isfinite(slope) && delta > 0 && step >= low && step <= high"},
