@@ -294,7 +294,7 @@ def _width(f: Callable[[Any], Any], f_slope: Callable[[Any], Any], s: Any, theta
 def fold_top(p: sp.Expr, slope: sp.Expr, p_max: float, phi_max: float, dtype: type) -> float:
     """For p with a fold at φ_max (p′(φ_max) = 0): the smallest angle whose p lies within ε of
     ``p_max`` rounded to ``dtype``, rounded down. Every |p| from p(that angle) to p_max is p of an
-    angle in [that angle, φ_max] rounded, so the backends clip the Newton iterate to it (a backward
+    angle in [that angle, φ_max] rounded, so the backends clip the start and the last iterate to it (backward
     stable angle, where p′ > 0): at φ_max itself R, H and the derivatives through 1/p′ are infinite
     or meaningless (eq 35 at float64's p_max: PyTorch's iterate was 2π for 29 of 116 points, its
     dφ/d|p| infinite)."""
@@ -400,7 +400,8 @@ def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarSt
             series = (dtype(c) + s_values * s_values * series).astype(dtype)
         y = 2.0 * v_of_s(far.kind, far.scale, far.order, s_values) - 1.0
         far_value: np.ndarray = np.asarray(clenshaw(np.asarray(far.chebyshev), y), dtype=dtype)
-        phi = np.clip(np.where(s_values < far.switch, s_values * series, far_value), 0.0, bracket_top)
+        start_top = min(bracket_top, fold_top)  # a fold: the start below the angles that round alike
+        phi = np.clip(np.where(s_values < far.switch, s_values * series, far_value), 0.0, start_top)
         phi = phi.astype(dtype)
         low, high = np.zeros_like(s_values), np.full_like(s_values, bracket_top)
         for step_count in range(1, MAX_ITERATIONS + 1):

@@ -143,7 +143,8 @@ class NewtonAngle:
     of docs/accuracy_hypothesis.md was NaN for φ > 0.99995)."""
     fold_top: float = math.inf
     """For a fold at φ_max (p′(φ_max) = 0): the smallest angle whose p rounds like p_max
-    (:func:`symrot.newton_start.fold_top`); every backend clips the iterate to it. inf otherwise."""
+    (:func:`symrot.newton_start.fold_top`); every backend clips the start and the last iterate to it
+    (the residual there is negative beyond rounding). inf otherwise."""
 
 
 Coefficient = Constant | Algebraic | Branch

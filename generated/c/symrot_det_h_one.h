@@ -70,7 +70,7 @@ extern "C" {
 
 /* symrot_det_h_one__phi: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 698 */
+ * ops: 584 */
 static inline double symrot_det_h_one__phi(double s)
 {
     const double s2 = (s*s);
@@ -86,12 +86,12 @@ static inline double symrot_det_h_one__phi(double s)
     }
     double phi = s < 0.6986294588918609 ? s*(s2*(s2*(s2*(s2*(s2*(s2*((33227.0/38118080000000.0)*s2 + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) + 1.0/60.0) + 1) : b1*y - b2 + 3.4262488119907286, low = 0, high = 6.283185307179586;
     int k;
-    if (phi > 6.283185307179586) {
-        phi = high;
+    if (phi > 6.283157890564791) {
+        phi = 6.283157890564791;
     }
     for (k = 0; k < 6; ++k) {
         const double t = (phi*phi);
-        double ratio, slope, tail, residual, step, change;
+        double ratio, slope, tail, residual, step;
         if (t < 5.5673482008975155) {
             ratio = t*(t*(t*(t*(t*(t*(t*(t*(t*(t*(t*(t*((3.3177115067548803e-26)*t + 2.66943145680867e-24) + 1.235992150768613e-22) - 1.2859517762333714e-22) - 6.676229535883005e-19) - 7.540360750643117e-17) - 5.032990449379227e-15) - 41.0/254270016000000.0) + 19.0/1816214400000.0) + 1.0/349272000.0)) + 1.0/8400.0) - 1.0/60.0);
         } else {
@@ -110,15 +110,8 @@ static inline double symrot_det_h_one__phi(double s)
         } else {
             low = phi;
         }
-        change = residual / slope;
-        const double delta = 6.283185307179586 - phi;
-        double u = delta > 0 ? 3*change/delta : 0;
-        if (u < -0.9999990463256836) {
-            u = -0.9999990463256836;
-            change = u*delta/(3);
-        }
-        step = -3*change/(cbrt(u + 1)*(cbrt(u + 1) + 1) + 1) + phi;
-        if (slope > 0 && isfinite(slope) && delta > 0 && step >= low && step <= high) {
+        step = phi - residual/slope;
+        if (slope > 0 && isfinite(slope) && step >= low && step <= high) {
             phi = step;
         } else {
             phi = (1.0/2.0)*high + (1.0/2.0)*low;
@@ -133,7 +126,7 @@ static inline double symrot_det_h_one__phi(double s)
 /* symrot_det_h_one_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 716 */
+ * ops: 602 */
 static inline double symrot_det_h_one_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -157,7 +150,7 @@ static inline double symrot_det_h_one_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * R_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * ops: 751 */
+ * ops: 637 */
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -292,7 +285,7 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 803 */
+ * ops: 689 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -438,7 +431,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 820 */
+ * ops: 706 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -594,7 +587,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
- * ops: 752 */
+ * ops: 638 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -729,7 +722,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
  * K_across: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 17 in x below x = 1.43428, else (x/(8*sin(phi/2)**2) - sin(phi/2)/s)/x
- * ops: 804 */
+ * ops: 690 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -874,7 +867,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 819 */
+ * ops: 705 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -913,7 +906,7 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 802 */
+ * ops: 688 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -951,7 +944,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
  * nu: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)/s
- * ops: 718 */
+ * ops: 604 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1118,7 +1111,7 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 957 */
+ * ops: 843 */
 static inline void symrot_det_h_one_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1200,7 +1193,7 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 958 */
+ * ops: 844 */
 static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1280,7 +1273,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 1105 */
+ * ops: 991 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1378,7 +1371,7 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 1111 */
+ * ops: 997 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1478,7 +1471,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
  * H_inverse_0_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 2.63022, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 884 */
+ * ops: 770 */
 static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1566,7 +1559,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 1068 */
+ * ops: 954 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1768,8 +1761,8 @@ static inline float symrot_det_h_one__phi_f(float s)
     }
     float phi = s < 0.69862944F ? s*(s2*(s2*(s2*(s2*(s2*(s2*((8.716861e-10F)*s2 + 1.1911668e-08F) + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) + 1.0F/60.0F) + 1) : b1*y - b2 + 3.4262488F, low = 0, high = 6.283185F;
     int k;
-    if (phi > 6.283185F) {
-        phi = high;
+    if (phi > 6.258972F) {
+        phi = 6.258972F;
     }
     for (k = 0; k < 6; ++k) {
         const float t = (phi*phi);

@@ -865,7 +865,7 @@ def _newton_64(s):
     b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
     far = 3.4262488119907286 + y * b1 - b2
     phi = _where(s < 0.6986294588918609, s * start, far)
-    phi = _xp.clip(phi, 0.0, 6.283185307179586)
+    phi = _xp.clip(phi, 0.0, 6.283157890564791)
     low = 0.0 * s
     high = low + 6.283185307179586
     for _ in range(6):
@@ -876,15 +876,8 @@ def _newton_64(s):
         slope = _slope_64(phi * phi, phi)
         safe = slope > 0
         safe = safe & _xp.isfinite(slope)
-        change = residual / _where(safe, slope, 1.0)
-        delta = 6.283185307179586 - phi
-        u = 3.0 * change / _where(delta > 0, delta, 1.0)
-        change = _where(u < -0.9999990463256836, -0.9999990463256836 * delta / 3.0, change)
-        u = _where(u < -0.9999990463256836, -0.9999990463256836, u)
-        defined = delta > 0
-        u = _where(defined, u, 0.0)
-        step = -3*change/((u + 1)**(0.3333333333333333)*((u + 1)**(0.3333333333333333) + 1) + 1) + phi
-        inside = safe & defined & (step >= low) & (step <= high)
+        step = phi - residual / _where(safe, slope, 1.0)
+        inside = safe & (step >= low) & (step <= high)
         phi = _where(inside, step, 0.5 * (low + high))
     return _where(phi > 6.283157890564791, 6.283157890564791, phi)  # NewtonAngle.fold_top
 
@@ -1602,7 +1595,7 @@ def _newton_32(s):
     b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
     far = 3.4262488119907286 + y * b1 - b2
     phi = _where(s < 0.6986294588918609, s * start, far)
-    phi = _xp.clip(phi, 0.0, 6.283185005187988)
+    phi = _xp.clip(phi, 0.0, 6.25897216796875)
     low = 0.0 * s
     high = low + 6.283185005187988
     for _ in range(6):

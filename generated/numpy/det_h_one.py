@@ -1083,7 +1083,7 @@ def _angle_64(s, d):
     b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
     far = 3.4262488119907286 + y * b1 - b2
     phi = numpy.where(s < 0.6986294588918609, s * start, far)
-    phi = numpy.clip(phi, 0.0, 6.283185307179586).astype(s.dtype)
+    phi = numpy.clip(phi, 0.0, 6.283157890564791).astype(s.dtype)
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
     for _ in range(6):
@@ -1094,15 +1094,8 @@ def _angle_64(s, d):
         slope = _slope_64(phi * phi, phi)
         safe = slope > 0
         safe = safe & numpy.isfinite(slope)
-        change = residual / numpy.where(safe, slope, 1.0)
-        delta = 6.283185307179586 - phi
-        u = 3.0 * change / numpy.where(delta > 0, delta, 1.0)
-        change = numpy.where(u < -0.9999990463256836, -0.9999990463256836 * delta / 3.0, change)
-        u = numpy.where(u < -0.9999990463256836, -0.9999990463256836, u)
-        defined = delta > 0
-        u = numpy.where(defined, u, 0.0)
-        step = -3*change/((u + 1)**(0.3333333333333333)*((u + 1)**(0.3333333333333333) + 1) + 1) + phi
-        inside = safe & defined & (step >= low) & (step <= high)
+        step = phi - residual / numpy.where(safe, slope, 1.0)
+        inside = safe & (step >= low) & (step <= high)
         phi = numpy.where(inside, step, 0.5 * (low + high)).astype(s.dtype)
     return numpy.minimum(phi, 6.283157890564791).astype(s.dtype)  # NewtonAngle.fold_top
 
@@ -2109,7 +2102,7 @@ def _angle_32(s, d):
     b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
     far = 3.4262488119907286 + y * b1 - b2
     phi = numpy.where(s < 0.6986294588918609, s * start, far)
-    phi = numpy.clip(phi, 0.0, 6.283185005187988).astype(s.dtype)
+    phi = numpy.clip(phi, 0.0, 6.25897216796875).astype(s.dtype)
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185005187988)
     for _ in range(6):

@@ -157,7 +157,7 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
         *start_lines,
         *far_lines,
         f"phi = _where(s < {far.switch!r}, s * start, far)",
-        f"phi = _xp.clip(phi, 0.0, {angle.phi_max!r})",
+        f"phi = _xp.clip(phi, 0.0, {min(angle.phi_max, angle.fold_top)!r})",
         "low = 0.0 * s",
         f"high = low + {angle.phi_max!r}",
         f"for _ in range({angle.iterations}):",

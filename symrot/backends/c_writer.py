@@ -265,6 +265,7 @@ class FunctionWriter:
             *self.newton_step(angle),
         ]
         phi_max = self.printer.literal(angle.phi_max)
+        start_top = self.printer.literal(min(angle.phi_max, angle.fold_top))  # NewtonAngle.fold_top
         far = angle.far
         y, b1, b2 = (sp.Symbol(n, real=True) for n in ("y", "b1", "b2"))
         degree = len(far.chebyshev) - 1
@@ -293,7 +294,7 @@ class FunctionWriter:
             {"kind": "declare", "type": "int", "names": ["k"]},
             *([{"kind": "let", "type": self.ctype, "name": "s_or_one", "value": "s > 0 ? s : 1", "ops": 1}]
               if angle.reciprocal else []),
-            {"kind": "if", "condition": f"phi > {phi_max}", "then": [self.set("phi", "high")],
+            {"kind": "if", "condition": f"phi > {start_top}", "then": [self.set("phi", start_top)],
              "otherwise": []},
             {"kind": "loop", "header": f"k = 0; k < {angle.iterations}; ++k", "body": body,
              "times": angle.iterations},

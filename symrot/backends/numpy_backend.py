@@ -184,7 +184,7 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
         *start_lines,
         *far_lines,
         f"phi = numpy.where(s < {far.switch!r}, s * start, far)",
-        f"phi = numpy.clip(phi, 0.0, {angle.phi_max!r}).astype(s.dtype)",
+        f"phi = numpy.clip(phi, 0.0, {min(angle.phi_max, angle.fold_top)!r}).astype(s.dtype)",
         "low = numpy.zeros_like(s)",
         f"high = numpy.full_like(s, {angle.phi_max!r})",
         f"for _ in range({angle.iterations}):",
