@@ -294,8 +294,8 @@ def _width(f: Callable[[Any], Any], f_slope: Callable[[Any], Any], s: Any, theta
 def fold_top(p: sp.Expr, slope: sp.Expr, p_max: float, phi_max: float, dtype: type) -> float:
     """For p with a fold at φ_max (p′(φ_max) = 0): the smallest angle whose p lies within ε of
     ``p_max`` rounded to ``dtype``, rounded down. Every |p| from p(that angle) to p_max is p of an
-    angle in [that angle, φ_max] rounded, so the backends clip the start and the last iterate to it (backward
-    stable angle, where p′ > 0): at φ_max itself R, H and the derivatives through 1/p′ are infinite
+    angle in [that angle, φ_max] rounded, so the backends clip the start and the last iterate to it,
+    a backward stable angle where p′ > 0: at φ_max itself R, H and the derivatives through 1/p′ are infinite
     or meaningless (eq 35 at float64's p_max: PyTorch's iterate was 2π for 29 of 116 points, its
     dφ/d|p| infinite)."""
     epsilon = float(np.finfo(dtype).eps)
@@ -340,9 +340,10 @@ def _edge_step_function(edge: sp.Rational) -> Callable[..., Any]:
 def edge_floor(edge: sp.Rational) -> float:
     """The smallest u = k·c/δ that a step in w = δ^k takes: −1 + 2^−min(10k, 20). Below −1 Newton in
     w overshoots past the edge (w < 0); the step then shrinks δ by (1 + u)^(1/k), a factor of 2^−10
-    for k ≤ 2 (2^−6.7 for a triple fold), instead of bisecting the bracket: where the root lies
-    within the rounding of s of the fold (eq 35 at float64's p_max), every step overshoots, and
-    bisection took 15 steps from π to within 2·10⁻⁵ of 2π. Exact in float32 (a multiple of 2^−24)."""
+    for k ≤ 2 (2^−6.7 for k = 3, 2^−5 for k = 4), instead of bisecting the bracket: where the root
+    lies within the rounding of s of the fold, every step overshoots (eq 35 at float64's p_max, in
+    w = (2π − φ)³ before its start was clipped to ``fold_top``: 15 bisections from π to within
+    2·10⁻⁵ of 2π). Exact in float32 (a multiple of 2^−24)."""
     return -1.0 + 2.0 ** -min(10 * float(edge), 20.0)
 
 

@@ -32,7 +32,8 @@ for the sine family, ``D`` = p_max² − x):
 ``ClosedAngle(expression)``
     φ = expression(S), S = |p| = √x, the closed-form inverse of p(φ) (e.g. 4 atan(S/4); for the
     sine family k asin(S/k) becomes k atan2(S, √D), accurate up to the fold).
-``NewtonAngle(start, ratio, slope, iterations, phi_max, far, reciprocal, converges_below, leading, edge)``
+``NewtonAngle(start, ratio, slope, iterations, phi_max, far, reciprocal, converges_below, leading, edge,
+fold_top)``
     φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s (on 1/(φ·g(φ²)) − 1/s if ``reciprocal``),
     started from the odd reverted series φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from
     the fold-aware interpolant ``far`` (:mod:`symrot.newton_start`) above it, where g = p(φ)/φ =
@@ -131,7 +132,7 @@ class NewtonAngle:
     (φ g(0) − s) + φ (g − g(0)). φ − s is exact (Sterbenz) once φ is within a factor 2 of s, so
     the residual keeps the digits that rounding φ·g to s's precision loses (a half ulp of s, and
     the closed form's own ulps where the tail's polynomial applies instead): cbrt(6(φ − sin φ))
-    (eq 35) was up to 2.3 ulp off in float64 with r = φ·g − s, and 0.7 with this residual."""
+    (eq 35) was up to 2.33 ulp off in float64 with r = φ·g − s, and 0.91 with this residual."""
     edge: sp.Rational | None = None
     """k where the steps are Newton's in w = (φ_max − φ)^k instead of φ
     (:func:`symrot.newton_start.newton_step`): p_max − p ∝ (φ_max − φ)^k at the end of the range,
