@@ -229,14 +229,16 @@ class NewtonLanes(NamedTuple):
 
 
 def newton_lanes(p: sp.Expr, slope: sp.Expr, angles: np.ndarray, phi_max: float, dtype: type,
-                 ratio_model: Callable[[np.ndarray], np.ndarray], leading: float = 0.0) -> NewtonLanes:
+                 ratio_model: Callable[[np.ndarray], np.ndarray], leading: float = 0.0,
+                 series_below: float = 0.0) -> NewtonLanes:
     """At every angle of ``angles``: s = p(θ) rounded to ``dtype``, the exact angle θ* of that s
     (DIGITS), and the tolerance 2 ε θ* + 2 ε s/p′(θ*) (1 + e) (what one ε of s moves the angle:
     large next to a fold, p′ → 0), where e is the error in units of ε s, up to RESIDUAL_ULPS, of
     the printed residual's p(φ) = φ·``leading`` + φ·m(φ²) (``ratio_model`` = m as the plan prints
     it: the tail g − g(0) of g = p/φ with ``leading`` = g(0), or g itself with ``leading`` = 0;
     :class:`symrot.plan_ir.NewtonAngle`) at θ* rounded, the two products rounded and their sum
-    exact (the residual (φ·g(0) − s) + φ·m rounds only relative to itself): no iterate can pin
+    exact where φ² < ``series_below`` (the residual (φ·g(0) − s) + φ·m rounds only relative to
+    itself), φ·(g(0) + m) rounded above: no iterate can pin
     the angle closer than the residual it is steered by (at
     φ_max − 10⁻⁹ of the fold of row 57 of docs/accuracy_hypothesis.md, p(φ) is 3 ulp off in
     float64 and the iterate 2.9 ε s/p′). A printed form that is wrong beyond rounding is not
@@ -263,6 +265,9 @@ def newton_lanes(p: sp.Expr, slope: sp.Expr, angles: np.ndarray, phi_max: float,
             ratio: np.ndarray = np.asarray(ratio_model(rounded), dtype=dtype)
             tail: np.ndarray = np.asarray(rounded * ratio, dtype=dtype)
             head: np.ndarray = np.asarray(rounded * dtype(leading), dtype=dtype)
+            above = rounded * rounded >= series_below  # the residual φ·g − s: one rounded product
+            tail = np.where(above, np.asarray(rounded * (dtype(leading) + ratio), dtype=dtype), tail)
+            head = np.where(above, dtype(0), head)
         residual_error = [abs(mpmath.mpf(float(first)) + mpmath.mpf(float(second))
                               - f(mpmath.mpf(float(angle)))) if np.isfinite(second) else 0.0
                           for first, second, angle in zip(head, tail, rounded, strict=True)]
@@ -371,14 +376,15 @@ def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarSt
                                        Callable[[np.ndarray], np.ndarray]],
                         reciprocal: bool, bracket_top: float,
                         edge: sp.Rational | None = None, leading: float = 0.0,
-                        fold_top: float = math.inf) -> NewtonCount:
+                        fold_top: float = math.inf, series_below: float = 0.0) -> NewtonCount:
     """Steps the printed safeguarded Newton iteration needs, counted by running it.
 
     On the checks of ``lanes`` (:func:`newton_lanes`) the start (reverted series below
     ``far.switch``, the Chebyshev far start above) and the bracketed Newton steps are evaluated as
     the backends do, with ``printed`` = (p(φ)/φ − ``leading``, p′(φ)) as the plan's branches print
     them (evaluated with the ideal libm of :mod:`symrot.evaluation`) and the residual
-    (φ·``leading`` − s) + φ·(p(φ)/φ − ``leading``), with the steps of Newton on 1/p if
+    (φ·``leading`` − s) + φ·(p(φ)/φ − ``leading``) where φ² < ``series_below`` (the tail's polynomial),
+    φ·(``leading`` + (p(φ)/φ − ``leading``)) − s above, with the steps of Newton on 1/p if
     ``reciprocal`` (:class:`symrot.plan_ir.NewtonAngle`) or in w = (φ_max − φ)^k for an ``edge``
     exponent k (:func:`newton_step`), in the bracket [0, ``bracket_top``] (the largest value of the
     precision not above the exact φ_max), each iterate clipped to ``fold_top`` as the backends clip the
@@ -407,8 +413,10 @@ def measured_iterations(lanes: NewtonLanes, start: Sequence[sp.Expr], far: FarSt
         low, high = np.zeros_like(s_values), np.full_like(s_values, bracket_top)
         for step_count in range(1, MAX_ITERATIONS + 1):
             head = (phi * dtype(leading)).astype(dtype)
-            tail = (phi * np.asarray(ratio_model(phi), dtype=dtype)).astype(dtype)
-            residual = ((head - s_values).astype(dtype) + tail).astype(dtype)
+            ratio = np.asarray(ratio_model(phi), dtype=dtype)
+            tail = (phi * ratio).astype(dtype)
+            residual = np.where(phi * phi < series_below, ((head - s_values).astype(dtype) + tail),
+                                (phi * (dtype(leading) + ratio)).astype(dtype) - s_values).astype(dtype)
             value = (head + tail).astype(dtype)
             high = np.where(residual > 0, phi, high)
             low = np.where(residual <= 0, phi, low)

@@ -1171,13 +1171,15 @@ def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: t
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
     reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
-    lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0], float(leading))
+    below = float(ratio.threshold)
+    lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0], float(leading),
+                         below)
     count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, leading=float(leading),
-                                fold_top=top)
+                                fold_top=top, series_below=below)
     edge = _edge_exponent(p, far, phi_max)
     if edge is not None:
         edge_count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, edge,
-                                         float(leading), top)
+                                         float(leading), top, below)
         # p′ = ∞ at the edge (k < 1): steps in φ overshoot past it and bisect (43 steps for asin(φ)
         # from a start at the edge, 6 in w), wherever the checks fall
         if edge < 1 or (-edge_count.unconverged, edge_count.steps) < (-count.unconverged, count.steps):

@@ -70,7 +70,7 @@ extern "C" {
 
 /* symrot_det_h_one__phi: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 584 */
+ * ops: 602 */
 static inline double symrot_det_h_one__phi(double s)
 {
     const double s2 = (s*s);
@@ -104,7 +104,7 @@ static inline double symrot_det_h_one__phi(double s)
             slope = 2*(1 - cos(phi))/pow(cbrt(6*(phi - sin(phi))), 2);
         }
         tail = phi*ratio;
-        residual = (phi - s) + tail;
+        residual = t < 5.5673482008975155 ? (phi - s) + tail : phi*(1 + ratio) - s;
         if (residual > 0) {
             high = phi;
         } else {
@@ -126,7 +126,7 @@ static inline double symrot_det_h_one__phi(double s)
 /* symrot_det_h_one_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831853071795862]
- * ops: 602 */
+ * ops: 620 */
 static inline double symrot_det_h_one_angle(const double p[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -150,7 +150,7 @@ static inline double symrot_det_h_one_angle(const double p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * R_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
- * ops: 637 */
+ * ops: 655 */
 static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -285,7 +285,7 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 689 */
+ * ops: 707 */
 static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -431,7 +431,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 706 */
+ * ops: 724 */
 static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hinv[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -587,7 +587,7 @@ static inline double symrot_det_h_one_tangent_det(const double p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * G_2: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
- * ops: 638 */
+ * ops: 656 */
 static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -722,7 +722,7 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
  * K_across: Horner degree 7 in x below x = 0.110312, else sin(phi/2)/s
  * K_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 17 in x below x = 1.43428, else (x/(8*sin(phi/2)**2) - sin(phi/2)/s)/x
- * ops: 690 */
+ * ops: 708 */
 static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -867,7 +867,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
  * H_inverse_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 21 in x below x = 2.63022, else ((6 - 6*cos(phi))/(3*x) - sin(phi)/(s*((1 - cos(phi))**2/x + sin(phi)**2/x)))/x
- * ops: 705 */
+ * ops: 723 */
 static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3], double pdot[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -906,7 +906,7 @@ static inline void symrot_det_h_one_pdot(const double p[3], const double omega[3
  * H_across: Horner degree 7 in x below x = 0.110312, else sin(phi)/s
  * H_1: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 1.43428, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 688 */
+ * ops: 706 */
 static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3], double omega[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -944,7 +944,7 @@ static inline void symrot_det_h_one_omega(const double p[3], const double pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 7 in x below x = 0.110312, else cos(phi/2)
  * nu: Horner degree 7 in x below x = 0.110312, else 2*sin(phi/2)/s
- * ops: 604 */
+ * ops: 622 */
 static inline void symrot_det_h_one_to_quaternion(const double p[3], double e[4])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1111,7 +1111,7 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 843 */
+ * ops: 861 */
 static inline void symrot_det_h_one_rotation_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1193,7 +1193,7 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 844 */
+ * ops: 862 */
 static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1273,7 +1273,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 991 */
+ * ops: 1009 */
 static inline void symrot_det_h_one_tangent_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1371,7 +1371,7 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 997 */
+ * ops: 1015 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1471,7 +1471,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
  * H_inverse_0_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 2.63022, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 770 */
+ * ops: 788 */
 static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1559,7 +1559,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 954 */
+ * ops: 972 */
 static inline void symrot_det_h_one_angular_acceleration(const double p[3], const double pdot[3], const double pddot[3], double alpha[3])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1745,7 +1745,7 @@ static inline int symrot_det_h_one_rescale_jacobian(const double p[3], double J[
 
 /* symrot_det_h_one__phi_f: internal: phi from s = |p| (eq 11).
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831850051879883]
- * ops: 386 */
+ * ops: 404 */
 static inline float symrot_det_h_one__phi_f(float s)
 {
     const float s2 = (s*s);
@@ -1781,7 +1781,7 @@ static inline float symrot_det_h_one__phi_f(float s)
             slope = 4*(slope_w1*slope_w1)/powf(cbrtf(6*phi - 12*slope_w1*cosf(slope_w0)), 2);
         }
         tail = phi*ratio;
-        residual = (phi - s) + tail;
+        residual = t < 5.567348F ? (phi - s) + tail : phi*(1 + ratio) - s;
         if (residual > 0) {
             high = phi;
         } else {
@@ -1803,7 +1803,7 @@ static inline float symrot_det_h_one__phi_f(float s)
 /* symrot_det_h_one_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi by 6 safeguarded Newton steps on phi*g(phi^2) = s, residual (phi*g(0) - s) + phi*(g - g(0)), from the reverted series, bracket [0, 6.2831850051879883]
- * ops: 404 */
+ * ops: 422 */
 static inline float symrot_det_h_one_angle_f(const float p[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1827,7 +1827,7 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
  * R_0 = 1 (constant)
  * R_1: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * R_2: Horner degree 6 in x below x = 1.43428, else (1 - cos(phi))/x
- * ops: 437 */
+ * ops: 455 */
 static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1954,7 +1954,7 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 491 */
+ * ops: 509 */
 static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2100,7 +2100,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 499 */
+ * ops: 517 */
 static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hinv[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2262,7 +2262,7 @@ static inline float symrot_det_h_one_tangent_det_f(const float p[3])
  * G_0 = 1 (constant)
  * G_1: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
  * G_2: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
- * ops: 440 */
+ * ops: 458 */
 static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2397,7 +2397,7 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
  * K_across: Horner degree 6 in x below x = 1.43428, else sin(phi/2)/s
  * K_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/4)**2/x
  * K_2: Horner degree 18 in x below x = 4.61948, else (-sin(phi/2)/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)) + cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2/(8*sin(phi/2)**2))/cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**2
- * ops: 501 */
+ * ops: 519 */
 static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2547,7 +2547,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
  * H_inverse_across: Horner degree 7 in x below x = 1.43428, else sin(phi)/(s*(4*sin(phi/2)**4/x + sin(phi)**2/x))
  * H_inverse_1 = -1/2 (constant)
  * H_inverse_2: Horner degree 17 in x below x = 4.61948, else -(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)/(2*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))**4)
- * ops: 498 */
+ * ops: 516 */
 static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3], float pdot[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2588,7 +2588,7 @@ static inline void symrot_det_h_one_pdot_f(const float p[3], const float omega[3
  * H_across: Horner degree 6 in x below x = 1.43428, else sin(phi)/s
  * H_1: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)**2/x
  * H_2: Horner degree 17 in x below x = 4.61948, else (x/(4*sin(phi/2)**2) - sin(phi)/s)/x
- * ops: 490 */
+ * ops: 508 */
 static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3], float omega[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2626,7 +2626,7 @@ static inline void symrot_det_h_one_omega_f(const float p[3], const float pdot[3
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * e_0: Horner degree 6 in x below x = 1.43428, else cos(phi/2)
  * nu: Horner degree 6 in x below x = 1.43428, else 2*sin(phi/2)/s
- * ops: 406 */
+ * ops: 424 */
 static inline void symrot_det_h_one_to_quaternion_f(const float p[3], float e[4])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2791,7 +2791,7 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 616 */
+ * ops: 634 */
 static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2874,7 +2874,7 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 617 */
+ * ops: 635 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2955,7 +2955,7 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 793 */
+ * ops: 811 */
 static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3051,7 +3051,7 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 799 */
+ * ops: 817 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3149,7 +3149,7 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
  * H_inverse_0_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(4*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_inverse_1_x = 0 (constant)
  * H_inverse_2_x: Horner degree 21 in x below x = 4.61948, else -(3*phi*(1 - 2*sin(phi/2)**2) - 4*(1 - 2*sin(phi/2)**2)*sin(phi/2)*cos(phi/2) - (6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*cos(phi/2)/sin(phi/2) - 2*sin(phi/2)*cos(phi/2) - 8*(6*phi*sin(phi/2)*cos(phi/2) + (1 - 2*sin(phi/2)**2)**2 - 8*sin(phi/2)**2 - 1)*sin(phi/2)**2/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(96*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**4)
- * ops: 559 */
+ * ops: 577 */
 static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3235,7 +3235,7 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 756 */
+ * ops: 774 */
 static inline void symrot_det_h_one_angular_acceleration_f(const float p[3], const float pdot[3], const float pddot[3], float alpha[3])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);

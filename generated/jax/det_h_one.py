@@ -869,8 +869,9 @@ def _newton_64(s):
     low = 0.0 * s
     high = low + 6.283185307179586
     for _ in range(6):
-        tail = phi * _ratio_64(phi * phi, phi)
-        residual = (phi - s) + tail
+        ratio = _ratio_64(phi * phi, phi)
+        tail = phi * ratio
+        residual = _where(phi * phi < 5.5673482008975155, (phi - s) + tail, phi * (1.0 + ratio) - s)
         high = _where(residual > 0, phi, high)
         low = _where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
@@ -1599,8 +1600,9 @@ def _newton_32(s):
     low = 0.0 * s
     high = low + 6.283185005187988
     for _ in range(6):
-        tail = phi * _ratio_32(phi * phi, phi)
-        residual = (phi - s) + tail
+        ratio = _ratio_32(phi * phi, phi)
+        tail = phi * ratio
+        residual = _where(phi * phi < 5.567347935831094, (phi - s) + tail, phi * (1.0 + ratio) - s)
         high = _where(residual > 0, phi, high)
         low = _where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)

@@ -1087,8 +1087,9 @@ def _angle_64(s, d):
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185307179586)
     for _ in range(6):
-        tail = phi * _ratio_64(phi * phi, phi)
-        residual = (phi - s) + tail
+        ratio = _ratio_64(phi * phi, phi)
+        tail = phi * ratio
+        residual = numpy.where(phi * phi < 5.5673482008975155, (phi - s) + tail, phi * (1.0 + ratio) - s)
         high = numpy.where(residual > 0, phi, high)
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_64(phi * phi, phi)
@@ -2106,8 +2107,9 @@ def _angle_32(s, d):
     low = numpy.zeros_like(s)
     high = numpy.full_like(s, 6.283185005187988)
     for _ in range(6):
-        tail = phi * _ratio_32(phi * phi, phi)
-        residual = (phi - s) + tail
+        ratio = _ratio_32(phi * phi, phi)
+        tail = phi * ratio
+        residual = numpy.where(phi * phi < 5.567347935831094, (phi - s) + tail, phi * (1.0 + ratio) - s)
         high = numpy.where(residual > 0, phi, high)
         low = numpy.where(residual <= 0, phi, low)
         slope = _slope_32(phi * phi, phi)

@@ -161,7 +161,7 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
         "low = 0.0 * s",
         f"high = low + {angle.phi_max!r}",
         f"for _ in range({angle.iterations}):",
-        *("    " + line for line in newton_residual_lines(angle, ratio, _literal)),
+        *("    " + line for line in newton_residual_lines(angle, ratio, _literal, "_where")),
         "    high = _where(residual > 0, phi, high)",
         "    low = _where(residual <= 0, phi, low)",
         f"    slope = _slope_{suffix}(phi * phi, phi)",
@@ -176,7 +176,7 @@ def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
 def angle_low_lines(angle: NewtonAngle, suffix: str) -> list[str]:
     """λ ≈ φ* − φ, one more Newton correction of the iterate φ where p grows fast enough for it to
     help (0 elsewhere); see ``EvaluationPlan.angle_correction``."""
-    return [*newton_residual_lines(angle, f"_ratio_{suffix}(phi * phi, phi)", _literal),
+    return [*newton_residual_lines(angle, f"_ratio_{suffix}(phi * phi, phi)", _literal, "_where"),
             f"slope = _slope_{suffix}(phi * phi, phi)", *newton_low_lines(angle, "_where")]
 
 

@@ -305,11 +305,14 @@ class FunctionWriter:
         ]
 
     def residual(self, angle: NewtonAngle, declared: bool) -> list[Statement]:
-        """tail = φ·(g − g(0)), residual = (φ·g(0) − s) + tail, and value = p(φ) for the reciprocal
-        step (:class:`symrot.plan_ir.NewtonAngle`): the difference first, exact once φ is within a
-        factor 2 of s."""
+        """tail = φ·(g − g(0)), the residual (φ·g(0) − s) + tail where the tail's polynomial applies
+        (the difference first, exact once φ is within a factor 2 of s) and φ·(g(0) + ratio) − s =
+        φ·g − s above, and value = p(φ) for the reciprocal step (:class:`symrot.plan_ir.NewtonAngle`)."""
         head = "phi" if angle.leading == 1 else f"phi*{self.c(angle.leading)}"
-        values = [("tail", "phi*ratio", 1), ("residual", f"({head} - s) + tail", 3),
+        whole = "1" if angle.leading == 1 else self.c(angle.leading)
+        switch = self.printer.literal(angle.ratio.threshold)
+        values = [("tail", "phi*ratio", 1),
+                  ("residual", f"t < {switch} ? ({head} - s) + tail : phi*({whole} + ratio) - s", 6),
                   *([("value", f"{head} + tail", 2)] if angle.reciprocal else [])]
         if declared:
             return [self.set(name, value, ops=ops) for name, value, ops in values]

@@ -200,13 +200,17 @@ def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
     ]
 
 
-def newton_residual_lines(angle: NewtonAngle, ratio_call: str,
-                          literal: Callable[[sp.Expr], str]) -> list[str]:
-    """``tail`` = φ·(g − g(0)) and ``residual`` = (φ·g(0) − s) + tail of the Newton angle (the
-    difference first: exact once φ is within a factor 2 of s), and ``value`` = p(φ) where the
-    reciprocal step needs it (:class:`symrot.plan_ir.NewtonAngle`); ``ratio_call`` prints g − g(0)."""
+def newton_residual_lines(angle: NewtonAngle, ratio_call: str, literal: Callable[[sp.Expr], str],
+                          where: str = "numpy.where") -> list[str]:
+    """``tail`` = φ·(g − g(0)) and the residual of the Newton angle: (φ·g(0) − s) + tail where the
+    tail's polynomial applies (the difference first: exact once φ is within a factor 2 of s), and
+    φ·(g(0) + tail's ratio) − s = φ·g − s above (:class:`symrot.plan_ir.NewtonAngle`); ``value`` =
+    p(φ) where the reciprocal step needs it. ``ratio_call`` prints g − g(0)."""
     head = "phi" if angle.leading == 1 else f"phi * {literal(angle.leading)}"
-    return [f"tail = phi * {ratio_call}", f"residual = ({head} - s) + tail",
+    whole = "1.0" if angle.leading == 1 else literal(angle.leading)
+    return [f"ratio = {ratio_call}", "tail = phi * ratio",
+            f"residual = {where}(phi * phi < {angle.ratio.threshold!r}, ({head} - s) + tail, "
+            f"phi * ({whole} + ratio) - s)",
             *([f"value = {head} + tail"] if angle.reciprocal else [])]
 
 
