@@ -37,8 +37,9 @@ fold_top)``
     φ from s = |p| by Newton on r(φ) = φ·g(φ²) − s (on 1/(φ·g(φ²)) − 1/s if ``reciprocal``),
     started from the odd reverted series φ ≈ Σ start[k] s^(2k+1) below ``far.switch`` and from
     the fold-aware interpolant ``far`` (:mod:`symrot.newton_start`) above it, where g = p(φ)/φ =
-    ``leading`` + ``ratio`` (``ratio``: Branch in t = φ² for the tail g − g(0), Taylor-safe, printed
-    as r = (φ·leading − s) + φ·ratio) and ``slope`` (Branch in t = φ² for p′(φ)).
+    ``leading`` + ``ratio`` (``ratio``: Branch in t = φ² for the tail g − g(0), Taylor-safe, the
+    residual printed as (φ·leading − s) + φ·ratio below its switch) and ``slope`` (Branch in t = φ²
+    for p′(φ)).
     Safeguard: keep a bracket [lo, hi] ⊂ [0, phi_max] (``phi_max`` rounded down in the precision),
     shrink it by the sign of r and bisect when a step leaves it or p′ is not finite (a zero step
     from where the printed p′ overflows would stay there). With an ``edge`` exponent k the
@@ -129,10 +130,13 @@ class NewtonAngle:
     (:func:`symrot.newton_start.measured_iterations`); the precision's range ends below it."""
     leading: sp.Expr
     """g(0) = κ (eq 12): ``ratio`` is the tail g − g(0), and the backends print the residual as
-    (φ g(0) − s) + φ (g − g(0)). φ − s is exact (Sterbenz) once φ is within a factor 2 of s, so
-    the residual keeps the digits that rounding φ·g to s's precision loses (a half ulp of s, and
-    the closed form's own ulps where the tail's polynomial applies instead): cbrt(6(φ − sin φ))
-    (eq 35) was up to 2.33 ulp off in float64 with r = φ·g − s, and 0.91 with this residual."""
+    (φ g(0) − s) + φ (g − g(0)) where the tail's polynomial applies (φ² below ``ratio.threshold``),
+    φ (g(0) + (g − g(0))) − s = φ g − s above. φ − s is exact (Sterbenz) once φ is within a factor 2
+    of s, so there the residual keeps the digits that rounding φ·g to s's precision loses (a half
+    ulp of s, and the closed form's own ulps where the polynomial applies instead; above, the split
+    only added roundings where p/φ is far from 1: held-out seed 2029, float32 ω next to 2π):
+    cbrt(6(φ − sin φ)) (eq 35) was up to 2.33 ulp off in float64 with r = φ·g − s, and 0.91 with
+    this residual."""
     edge: sp.Rational | None = None
     """k where the steps are Newton's in w = (φ_max − φ)^k instead of φ
     (:func:`symrot.newton_start.newton_step`): p_max − p ∝ (φ_max − φ)^k at the end of the range,
