@@ -436,6 +436,9 @@ def _candidate_forms(closed: sp.Expr, argument: sp.Expr, phi_max: float, inverse
         conditioned = well_conditioned(form)
         if form.has(S, X) and conditioned not in forms:
             forms.append(conditioned)
+        halved = half_angle(form)
+        if form.has(S, X) and halved not in forms:
+            forms.append(halved)
     pole = pole_factor(argument, phi_max) if argument != PHI else None
     if pole is not None:  # p → ∞ at φ_max: its vanishing factor through s (symrot.pole)
         forms += [with_pole_factor(form, pole) for form in forms]
@@ -950,6 +953,8 @@ def _precision_plan(shared: _SharedWork, label: str, dtype: type[np.floating]) -
     elif inverse is not None:
         coefficients = {n: replace(c, closed=closed_with_base_angle(c.closed, inverse))
                         if isinstance(c, Branch) else c for n, c in coefficients.items()}
+    if isinstance(angle, NewtonAngle):
+        coefficients = {n: _single_switch(c) for n, c in coefficients.items()}
     if unbounded:  # x unbounded: (k x + a)^n overflows before the value does
         coefficients = {n: Algebraic(with_bounded_powers(c.expression)) if isinstance(c, Algebraic) else c
                         for n, c in coefficients.items()}
@@ -963,6 +968,19 @@ def _precision_plan(shared: _SharedWork, label: str, dtype: type[np.floating]) -
     if slopes_unrepresentable:  # the derivative functions are NaN everywhere in this format
         slope_limit = 0.0
     return PrecisionPlan(label, float(np.finfo(dtype).eps), angle, coefficients, scale, limit, slope_limit)
+
+
+def _single_switch(coefficient: Coefficient) -> Coefficient:
+    """A Branch whose smallest switch is its threshold (``Branch.smallest_switch``), for a plan whose
+    angle iterates (:class:`symrot.plan_ir.NewtonAngle`). The smaller switch trusts the closed form's
+    error measured on angles rounded to nearest (:func:`measured_inputs`), and an iterated angle
+    is only within about an ulp (eq 35: 0.91): eq 35's float64 H⁻¹ across the axis, its closed form
+    measured within 1.1 ulp, was 2.0 ulp off for |p| = 0.1–0.33 in the NumPy module, where the
+    threshold's polynomial (taken by the JAX and PyTorch modules) is 0.5. Where φ is iterated the
+    longer polynomial costs little beside the iteration."""
+    if isinstance(coefficient, Branch):
+        return replace(coefficient, accurate_threshold=None, accurate_terms=None)
+    return coefficient
 
 
 def definition_forms(raw: sp.Expr, simplified: sp.Expr, p: sp.Expr, phi_max: float, inverse: sp.Expr | None,

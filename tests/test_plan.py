@@ -74,6 +74,31 @@ def test_angle_without_closed_inverse_uses_newton(det_h_one_plan) -> None:
     assert angle.phi_max == pytest.approx(2 * np.pi)
 
 
+def test_an_iterated_angle_gives_every_backend_one_switch(det_h_one_plan) -> None:
+    """Where φ iterates, the smaller switch's closed forms (measured on angles rounded to nearest)
+    take the iteration's error too: eq 35's float64 H⁻¹ across the axis was 2.0 ulp off in the
+    NumPy module for |p| = 0.1–0.33, where the threshold's polynomial is 0.5. Such a plan gives
+    every backend the threshold (plan._single_switch); a plan with a closed angle keeps both."""
+    for precision in det_h_one_plan.precisions.values():
+        branches = [c for c in precision.coefficients.values() if isinstance(c, Branch)]
+        assert branches
+        for branch in branches:
+            assert branch.smallest_switch == (branch.threshold, branch.horner)
+    closed = evaluation_plan(derive("rotation_vector").derivation, "rotation_vector")
+    r_2 = closed.precisions["float64"].coefficients["R_2"]
+    assert isinstance(r_2, Branch) and r_2.smallest_switch[0] < r_2.threshold
+
+
+def test_forms_through_s_are_also_measured_in_half_angles(det_h_one_plan) -> None:
+    """s·sin φ/(4 sin²(φ/2)), H⁻¹'s part across the axis written through s, has the half-angle form
+    s cos(φ/2)/(2 sin(φ/2)) (one rounding of φ less): float32 eq 35 takes it (0.79 ulp on the plan's
+    grid; the form it replaced, 1.24)."""
+    branch = det_h_one_plan.precisions["float32"].coefficients["H_inverse_across"]
+    assert isinstance(branch, Branch)
+    half = PHI / 2
+    assert sp.simplify(branch.closed - S * sp.cos(half) / (2 * sp.sin(half))) == 0
+
+
 def test_sine_family_inverse_is_closed_form() -> None:
     plan = evaluation_plan(derive("sine_m4").derivation, "sine_m4")
     angle = plan.precisions["float32"].angle

@@ -61,6 +61,11 @@ def _stop(v):
     return lax.stop_gradient(v)
 
 
+def _sqrt(v):
+    """The square root (XLA's, rounded to nearest as NumPy's is)."""
+    return _xp.sqrt(v)
+
+
 def _wide(v):
     """v in float64 when JAX has it (jax_enable_x64), else unchanged."""
     return v.astype(_xp.float64) if jax.config.jax_enable_x64 else v
@@ -119,7 +124,7 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_xp.sqrt(x + 4)) + 0.0 * x
+    return (2/_sqrt(x + 4)) + 0.0 * x
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
@@ -175,11 +180,11 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    return (1/_xp.sqrt(x + 4)) + 0.0 * x
+    return (1/_sqrt(x + 4)) + 0.0 * x
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    return ((x + 2*_xp.sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x
+    return ((x + 2*_sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
@@ -187,11 +192,11 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((x + 2*_xp.sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x
+    return ((x + 2*_sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
-    return (-1/((x + 4)*(_xp.sqrt(x + 4) + 2))) + 0.0 * x
+    return (-1/((x + 4)*(_sqrt(x + 4) + 2))) + 0.0 * x
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half):
@@ -203,7 +208,7 @@ def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_across_64(x, phi, s, d, sin_half, cos_half):
-    return (1/_xp.sqrt(x + 4)) + 0.0 * x
+    return (1/_sqrt(x + 4)) + 0.0 * x
 
 
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
@@ -243,7 +248,7 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_xp.sqrt(x + 4)) + 0.0 * x
+    return (2/_sqrt(x + 4)) + 0.0 * x
 
 
 def _scale_64(e0, e_norm):
@@ -257,7 +262,7 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half):
 
 def _nu_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((2/_xp.sqrt(x + 4)) + 0.0 * x, s)
+    return _narrow((2/_sqrt(x + 4)) + 0.0 * x, s)
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
@@ -321,12 +326,12 @@ def _G_0_32(x, phi, s, d, sin_half, cos_half):
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((1/_xp.sqrt(x + 4)) + 0.0 * x, s)
+    return _narrow((1/_sqrt(x + 4)) + 0.0 * x, s)
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow(((x + 2*_xp.sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x, s)
+    return _narrow(((x + 2*_sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x, s)
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
@@ -336,12 +341,12 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow(((x + 2*_xp.sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x, s)
+    return _narrow(((x + 2*_sqrt(x + 4) + 4)**(-1.0)) + 0.0 * x, s)
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((-1/((x + 4)*(_xp.sqrt(x + 4) + 2))) + 0.0 * x, s)
+    return _narrow((-1/((x + 4)*(_sqrt(x + 4) + 2))) + 0.0 * x, s)
 
 
 def _H_across_32(x, phi, s, d, sin_half, cos_half):
@@ -355,7 +360,7 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
 
 def _K_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((1/_xp.sqrt(x + 4)) + 0.0 * x, s)
+    return _narrow((1/_sqrt(x + 4)) + 0.0 * x, s)
 
 
 def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
@@ -400,7 +405,7 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
-    return _narrow((2/_xp.sqrt(x + 4)) + 0.0 * x, s)
+    return _narrow((2/_sqrt(x + 4)) + 0.0 * x, s)
 
 
 def _scale_32(e0, e_norm):
@@ -527,7 +532,7 @@ def _scaled(v):
 
 def _norm_value(v):
     unit, nonzero, scale = _scaled(v)
-    return _where(nonzero, scale * _xp.sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
+    return _where(nonzero, scale * _sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
 
 
 def _direction(v):
@@ -554,7 +559,7 @@ def _norm_jvp(primals, tangents):
 def _length(p, x, suffix):
     """|p| from x = |p|^2, or without underflow or overflow where x is extreme."""
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
-    root = _xp.sqrt(_where(normal, x, 1.0))
+    root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
 
 

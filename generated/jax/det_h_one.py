@@ -63,6 +63,11 @@ def _stop(v):
     return lax.stop_gradient(v)
 
 
+def _sqrt(v):
+    """The square root (XLA's, rounded to nearest as NumPy's is)."""
+    return _xp.sqrt(v)
+
+
 def _wide(v):
     """v in float64 when JAX has it (jax_enable_x64), else unchanged."""
     return v.astype(_xp.float64) if jax.config.jax_enable_x64 else v
@@ -229,9 +234,10 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0007142857142857143 + t * series
     series = -0.15 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.33274666277661247, phi)
     s = _where(small, 0.33213311798583023, s)
-    closed = _xp.sin(phi)/s
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    cos_half = _where(small, 0.9861918523238541, cos_half)
+    closed = 2*cos_half*sin_half/s
     return _where(small, series, closed)
 
 
@@ -307,11 +313,11 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0002380952380952381 + t * series
     series = 0.002857142857142857 + t * series
     series = 0.2 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
     s = _where(small, 1.197614799937078, s)
     x = _where(small, 1.4342812090283275, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    closed = ((0.25)*x/sin_half**2 - _xp.sin(phi)/s)/x
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    closed = (-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x
     return _where(small, series, closed)
 
 
@@ -482,9 +488,10 @@ def _H_across_64(x, phi, s, d, sin_half, cos_half):
     series = 0.0007142857142857143 + t * series
     series = -0.15 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.33274666277661247, phi)
     s = _where(small, 0.33213311798583023, s)
-    closed = _xp.sin(phi)/s
+    sin_half = _where(small, 0.1656068549609148, sin_half)
+    cos_half = _where(small, 0.9861918523238541, cos_half)
+    closed = 2*cos_half*sin_half/s
     return _where(small, series, closed)
 
 
@@ -499,13 +506,12 @@ def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
     series = -0.0032142857142857142 + t * series
     series = -0.1 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 0.33274666277661247, phi)
     s = _where(small, 0.33213311798583023, s)
     x = _where(small, 0.1103124080629894, x)
     sin_half = _where(small, 0.1656068549609148, sin_half)
-    w0 = _xp.sin(phi)
-    w1 = x**(-1.0)
-    closed = w0/(s*(4*sin_half**4*w1 + w0**2*w1))
+    cos_half = _where(small, 0.9861918523238541, cos_half)
+    w0 = 4/x
+    closed = 2*cos_half*sin_half/(s*(cos_half**2*sin_half**2*w0 + sin_half**4*w0))
     return _where(small, series, closed)
 
 
@@ -991,9 +997,10 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0007142857142857143 + t * series
     series = -0.15 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
     s = _where(small, 1.1976147966353403, s)
-    closed = _xp.sin(phi)/s
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    closed = 2*cos_half*sin_half/s
     return _where(small, series, closed)
 
 
@@ -1067,11 +1074,11 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0002380952380952381 + t * series
     series = 0.002857142857142857 + t * series
     series = 0.2 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
     s = _where(small, 2.149297813514097, s)
     x = _where(small, 4.619481091176478, x)
     sin_half = _where(small, 0.9245151118510668, sin_half)
-    closed = ((0.25)*x/sin_half**2 - _xp.sin(phi)/s)/x
+    cos_half = _where(small, 0.3811453895287326, cos_half)
+    closed = (-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x
     return _where(small, series, closed)
 
 
@@ -1117,12 +1124,11 @@ def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.002142857142857143 + t * series
     series = 0.05 + t * series
     phi = _where(small, 2.3595228756885396, phi)
+    s = _where(small, 2.149297813514097, s)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
     w0 = sin_half**2
-    w1 = 6*phi
-    w2 = cos_half*sin_half
-    closed = -0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*_cbrt(w1 - 12*w2)**4)
+    closed = -0.5*(6*cos_half*phi*sin_half - 8*w0 + (1 - 2*w0)**2 - 1)/(s**4*w0)
     return _where(small, series, closed)
 
 
@@ -1236,9 +1242,10 @@ def _H_across_32(x, phi, s, d, sin_half, cos_half):
     series = 0.0007142857142857143 + t * series
     series = -0.15 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
     s = _where(small, 1.1976147966353403, s)
-    closed = _xp.sin(phi)/s
+    sin_half = _where(small, 0.5762057860563947, sin_half)
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    closed = 2*cos_half*sin_half/s
     return _where(small, series, closed)
 
 
@@ -1253,13 +1260,10 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     series = -0.0032142857142857142 + t * series
     series = -0.1 + t * series
     series = 1.0 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
     s = _where(small, 1.1976147966353403, s)
-    x = _where(small, 1.4342812011199078, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
-    w0 = _xp.sin(phi)
-    w1 = x**(-1.0)
-    closed = w0/(s*(4*sin_half**4*w1 + w0**2*w1))
+    cos_half = _where(small, 0.8173046507362676, cos_half)
+    closed = (0.5)*cos_half*s/sin_half
     return _where(small, series, closed)
 
 
@@ -1749,7 +1753,7 @@ def _scaled(v):
 
 def _norm_value(v):
     unit, nonzero, scale = _scaled(v)
-    return _where(nonzero, scale * _xp.sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
+    return _where(nonzero, scale * _sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
 
 
 def _direction(v):
@@ -1776,7 +1780,7 @@ def _norm_jvp(primals, tangents):
 def _length(p, x, suffix):
     """|p| from x = |p|^2, or without underflow or overflow where x is extreme."""
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
-    root = _xp.sqrt(_where(normal, x, 1.0))
+    root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
 
 

@@ -61,6 +61,11 @@ def _stop(v):
     return lax.stop_gradient(v)
 
 
+def _sqrt(v):
+    """The square root (XLA's, rounded to nearest as NumPy's is)."""
+    return _xp.sqrt(v)
+
+
 def _wide(v):
     """v in float64 when JAX has it (jax_enable_x64), else unchanged."""
     return v.astype(_xp.float64) if jax.config.jax_enable_x64 else v
@@ -115,7 +120,7 @@ P_MAX_SQUARED = 4.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)*_sqrt(d)) + 0.0 * x
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
@@ -123,15 +128,15 @@ def _nu_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_xp.sqrt(d)) + 0.0 * x
+    return (2/_sqrt(d)) + 0.0 * x
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_xp.sqrt(d)) + 0.0 * x
+    return (2/_sqrt(d)) + 0.0 * x
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_xp.sqrt(d)) + 0.0 * x
+    return (2/_sqrt(d)) + 0.0 * x
 
 
 def _R_0_64(x, phi, s, d, sin_half, cos_half):
@@ -139,7 +144,7 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)*_sqrt(d)) + 0.0 * x
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
@@ -147,7 +152,7 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_xp.sqrt(d)) + 0.0 * x
+    return (2/_sqrt(d)) + 0.0 * x
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
@@ -155,11 +160,11 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)/_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)/_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)*_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
@@ -179,15 +184,15 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)/(_xp.sqrt(d) + 2)) + 0.0 * x
+    return ((0.5)/(_sqrt(d) + 2)) + 0.0 * x
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
-    return (1/_xp.sqrt(d)) + 0.0 * x
+    return (1/_sqrt(d)) + 0.0 * x
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)/(_xp.sqrt(d) + 2)) + 0.0 * x
+    return ((0.5)/(_sqrt(d) + 2)) + 0.0 * x
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
@@ -202,17 +207,17 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.01171875 + t * series
     series = 0.0625 + t * series
     d = _where(small, 3.9653718649849328, d)
-    w0 = _xp.sqrt(d)
+    w0 = _sqrt(d)
     closed = (0.25)/(w0*((0.5)*w0 + 1))
     return _where(small, series, closed)
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)*_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)*_sqrt(d)) + 0.0 * x
 
 
 def _K_across_64(x, phi, s, d, sin_half, cos_half):
@@ -224,7 +229,7 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.25)/_xp.sqrt(d)) + 0.0 * x
+    return (-(0.25)/_sqrt(d)) + 0.0 * x
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -244,7 +249,7 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.25)/_xp.sqrt(d)) + 0.0 * x
+    return (-(0.25)/_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
@@ -256,7 +261,7 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)*_sqrt(d)) + 0.0 * x
 
 
 def _scale_64(e0, e_norm):
@@ -266,7 +271,7 @@ def _scale_64(e0, e_norm):
 def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half):
@@ -276,19 +281,19 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((2/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((2/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((2/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
 
 
 def _R_0_32(x, phi, s, d, sin_half, cos_half):
@@ -298,7 +303,7 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half):
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
@@ -308,7 +313,7 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
 def _H_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((2/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
@@ -318,13 +323,13 @@ def _H_1_32(x, phi, s, d, sin_half, cos_half):
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
@@ -346,19 +351,19 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)/(_xp.sqrt(d) + 2)) + 0.0 * x, s)
+    return _narrow(((0.5)/(_sqrt(d) + 2)) + 0.0 * x, s)
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((1/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((1/_sqrt(d)) + 0.0 * x, s)
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)/(_xp.sqrt(d) + 2)) + 0.0 * x, s)
+    return _narrow(((0.5)/(_sqrt(d) + 2)) + 0.0 * x, s)
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
@@ -373,7 +378,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.01171875 + t * series
     series = 0.0625 + t * series
     d = _where(small, 3.587290192979839, d)
-    w0 = _xp.sqrt(d)
+    w0 = _sqrt(d)
     closed = (0.25)/(w0*((0.5)*w0 + 1))
     return _where(small, series, closed)
 
@@ -381,13 +386,13 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
 def _H_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _K_across_32(x, phi, s, d, sin_half, cos_half):
@@ -401,7 +406,7 @@ def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-(0.25)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((-(0.25)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -427,7 +432,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-(0.25)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((-(0.25)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
@@ -441,7 +446,7 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _scale_32(e0, e_norm):
@@ -450,11 +455,11 @@ def _scale_32(e0, e_norm):
 
 
 def _angle_64(s, d):
-    return 2*_atan2(s, _xp.sqrt(d)) + 0.0 * s
+    return 2*_atan2(s, _sqrt(d)) + 0.0 * s
 
 
 def _angle_32(s, d):
-    return 2*_atan2(s, _xp.sqrt(d)) + 0.0 * s
+    return 2*_atan2(s, _sqrt(d)) + 0.0 * s
 
 
 _COEFFICIENTS = {
@@ -568,7 +573,7 @@ def _scaled(v):
 
 def _norm_value(v):
     unit, nonzero, scale = _scaled(v)
-    return _where(nonzero, scale * _xp.sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
+    return _where(nonzero, scale * _sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
 
 
 def _direction(v):
@@ -622,7 +627,7 @@ def _complement(p, x):
 def _length(p, x, suffix):
     """|p| from x = |p|^2, or without underflow or overflow where x is extreme."""
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
-    root = _xp.sqrt(_where(normal, x, 1.0))
+    root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
 
 

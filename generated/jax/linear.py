@@ -61,6 +61,11 @@ def _stop(v):
     return lax.stop_gradient(v)
 
 
+def _sqrt(v):
+    """The square root (XLA's, rounded to nearest as NumPy's is)."""
+    return _xp.sqrt(v)
+
+
 def _wide(v):
     """v in float64 when JAX has it (jax_enable_x64), else unchanged."""
     return v.astype(_xp.float64) if jax.config.jax_enable_x64 else v
@@ -115,19 +120,19 @@ P_MAX_SQUARED = 1.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
-    return (_xp.sqrt(d)) + 0.0 * x
+    return (_sqrt(d)) + 0.0 * x
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
-    return (1.4142135623730950488/_xp.sqrt(_xp.sqrt(d) + 1)) + 0.0 * x
+    return (1.4142135623730950488/_sqrt(_sqrt(d) + 1)) + 0.0 * x
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
-    return (2/(_xp.sqrt(d) + 1)) + 0.0 * x
+    return (2/(_sqrt(d) + 1)) + 0.0 * x
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half):
-    return (1/_xp.sqrt(d)) + 0.0 * x
+    return (1/_sqrt(d)) + 0.0 * x
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
@@ -143,7 +148,7 @@ def _det_H_64(x, phi, s, d, sin_half, cos_half):
     series = 1.0 + t * series
     cos_half = _where(small, 0.9992547118107894, cos_half)
     d = _where(small, 0.99404879695367, d)
-    closed = 1/(cos_half**2*_xp.sqrt(d))
+    closed = 1/(cos_half**2*_sqrt(d))
     return _where(small, series, closed)
 
 
@@ -156,15 +161,15 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
-    return ((_xp.sqrt(d) + 1)**(-1.0)) + 0.0 * x
+    return ((_sqrt(d) + 1)**(-1.0)) + 0.0 * x
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    return (1/_xp.sqrt(d)) + 0.0 * x
+    return (1/_sqrt(d)) + 0.0 * x
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((_xp.sqrt(d) + 1)**(-1.0)) + 0.0 * x
+    return ((_sqrt(d) + 1)**(-1.0)) + 0.0 * x
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
@@ -179,13 +184,13 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
     series = 0.375 + t * series
     series = 0.5 + t * series
     d = _where(small, 0.99404879695367, d)
-    w0 = _xp.sqrt(d)
+    w0 = _sqrt(d)
     closed = 1/(w0*(w0 + 1))
     return _where(small, series, closed)
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    return (_xp.sqrt(d)) + 0.0 * x
+    return (_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
@@ -193,7 +198,7 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.5)/(_xp.sqrt(d) + 1)) + 0.0 * x
+    return (-(0.5)/(_sqrt(d) + 1)) + 0.0 * x
 
 
 def _G_0_64(x, phi, s, d, sin_half, cos_half):
@@ -201,7 +206,7 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    return (0.7071067811865475244/_xp.sqrt(_xp.sqrt(d) + 1)) + 0.0 * x
+    return (0.7071067811865475244/_sqrt(_sqrt(d) + 1)) + 0.0 * x
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
@@ -230,7 +235,7 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)/_xp.sqrt(d)) + 0.0 * x
+    return ((0.5)/_sqrt(d)) + 0.0 * x
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
@@ -281,7 +286,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     x = _where(small, 0.116472206314816, x)
     cos_half = _where(small, 0.9848760306762097, cos_half)
     d = _where(small, 0.883527793685184, d)
-    closed = ((0.5)/_xp.sqrt(d) - (0.5)/cos_half)/x
+    closed = ((0.5)/_sqrt(d) - (0.5)/cos_half)/x
     return _where(small, series, closed)
 
 
@@ -290,11 +295,11 @@ def _H_across_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_xp.sqrt(d) + 0.5) + 0.0 * x
+    return ((0.5)*_sqrt(d) + 0.5) + 0.0 * x
 
 
 def _K_across_64(x, phi, s, d, sin_half, cos_half):
-    return (0.7071067811865475244/_xp.sqrt(_xp.sqrt(d) + 1)) + 0.0 * x
+    return (0.7071067811865475244/_sqrt(_sqrt(d) + 1)) + 0.0 * x
 
 
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
@@ -306,7 +311,7 @@ def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x
+    return ((0.5)/(_sqrt(d)*(_sqrt(d) + 1)**2)) + 0.0 * x
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
@@ -314,7 +319,7 @@ def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x
+    return ((0.5)/(_sqrt(d)*(_sqrt(d) + 1)**2)) + 0.0 * x
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -329,14 +334,14 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     series = 0.625 + t * series
     series = 0.375 + t * series
     d = _where(small, 0.99404879695367, d)
-    w0 = _xp.sqrt(d)
+    w0 = _sqrt(d)
     w1 = (w0 + 1)**(-1.0)
     closed = (0.5)*w1*(w1 + w0**(-1.0))/d
     return _where(small, series, closed)
 
 
 def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.5)/_xp.sqrt(d)) + 0.0 * x
+    return (-(0.5)/_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
@@ -344,7 +349,7 @@ def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.25)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x
+    return (-(0.25)/(_sqrt(d)*(_sqrt(d) + 1)**2)) + 0.0 * x
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
@@ -370,25 +375,25 @@ def _scale_64(e0, e_norm):
 def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((_sqrt(d)) + 0.0 * x, s)
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((1.4142135623730950488/_xp.sqrt(_xp.sqrt(d) + 1)) + 0.0 * x, s)
+    return _narrow((1.4142135623730950488/_sqrt(_sqrt(d) + 1)) + 0.0 * x, s)
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((2/(_xp.sqrt(d) + 1)) + 0.0 * x, s)
+    return _narrow((2/(_sqrt(d) + 1)) + 0.0 * x, s)
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((1/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((1/_sqrt(d)) + 0.0 * x, s)
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
@@ -404,7 +409,7 @@ def _det_H_32(x, phi, s, d, sin_half, cos_half):
     series = 1.0 + t * series
     cos_half = _where(small, 0.9848760306762097, cos_half)
     d = _where(small, 0.8835277928732658, d)
-    closed = 1/(cos_half**2*_xp.sqrt(d))
+    closed = 1/(cos_half**2*_sqrt(d))
     return _where(small, series, closed)
 
 
@@ -419,19 +424,19 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((_xp.sqrt(d) + 1)**(-1.0)) + 0.0 * x, s)
+    return _narrow(((_sqrt(d) + 1)**(-1.0)) + 0.0 * x, s)
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((1/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((1/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((_xp.sqrt(d) + 1)**(-1.0)) + 0.0 * x, s)
+    return _narrow(((_sqrt(d) + 1)**(-1.0)) + 0.0 * x, s)
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
@@ -446,7 +451,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     series = 0.375 + t * series
     series = 0.5 + t * series
     d = _where(small, 0.8835277928732658, d)
-    w0 = _xp.sqrt(d)
+    w0 = _sqrt(d)
     closed = 1/(w0*(w0 + 1))
     return _where(small, series, closed)
 
@@ -454,7 +459,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
@@ -464,7 +469,7 @@ def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-(0.5)/(_xp.sqrt(d) + 1)) + 0.0 * x, s)
+    return _narrow((-(0.5)/(_sqrt(d) + 1)) + 0.0 * x, s)
 
 
 def _G_0_32(x, phi, s, d, sin_half, cos_half):
@@ -474,7 +479,7 @@ def _G_0_32(x, phi, s, d, sin_half, cos_half):
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((0.7071067811865475244/_xp.sqrt(_xp.sqrt(d) + 1)) + 0.0 * x, s)
+    return _narrow((0.7071067811865475244/_sqrt(_sqrt(d) + 1)) + 0.0 * x, s)
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
@@ -496,7 +501,7 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.5)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
@@ -537,7 +542,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     sin_half = _where(small, 0.3127695234097699, sin_half)
     cos_half = _where(small, 0.9498290505275281, cos_half)
     d = _where(small, 0.6469796368596776, d)
-    closed = (0.25)*((0.5)/_xp.sqrt(d) - (0.5)/cos_half)/(cos_half**2*sin_half**2)
+    closed = (0.25)*((0.5)/_sqrt(d) - (0.5)/cos_half)/(cos_half**2*sin_half**2)
     return _where(small, series, closed)
 
 
@@ -548,13 +553,13 @@ def _H_across_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)*_xp.sqrt(d) + 0.5) + 0.0 * x, s)
+    return _narrow(((0.5)*_sqrt(d) + 0.5) + 0.0 * x, s)
 
 
 def _K_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((0.7071067811865475244/_xp.sqrt(_xp.sqrt(d) + 1)) + 0.0 * x, s)
+    return _narrow((0.7071067811865475244/_sqrt(_sqrt(d) + 1)) + 0.0 * x, s)
 
 
 def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
@@ -568,7 +573,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x, s)
+    return _narrow(((0.5)/(_sqrt(d)*(_sqrt(d) + 1)**2)) + 0.0 * x, s)
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
@@ -580,7 +585,7 @@ def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
 def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.5)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x, s)
+    return _narrow(((0.5)/(_sqrt(d)*(_sqrt(d) + 1)**2)) + 0.0 * x, s)
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -594,7 +599,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     series = 0.625 + t * series
     series = 0.375 + t * series
     d = _where(small, 0.935055474015082, d)
-    w0 = _xp.sqrt(d)
+    w0 = _sqrt(d)
     w1 = (w0 + 1)**(-1.0)
     closed = (0.5)*w1*(w1 + w0**(-1.0))/d
     return _where(small, series, closed)
@@ -603,7 +608,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-(0.5)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((-(0.5)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
@@ -613,7 +618,7 @@ def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-(0.25)/(_xp.sqrt(d)*(_xp.sqrt(d) + 1)**2)) + 0.0 * x, s)
+    return _narrow((-(0.25)/(_sqrt(d)*(_sqrt(d) + 1)**2)) + 0.0 * x, s)
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
@@ -638,11 +643,11 @@ def _scale_32(e0, e_norm):
 
 
 def _angle_64(s, d):
-    return _atan2(s, _xp.sqrt(d)) + 0.0 * s
+    return _atan2(s, _sqrt(d)) + 0.0 * s
 
 
 def _angle_32(s, d):
-    return _atan2(s, _xp.sqrt(d)) + 0.0 * s
+    return _atan2(s, _sqrt(d)) + 0.0 * s
 
 
 _COEFFICIENTS = {
@@ -756,7 +761,7 @@ def _scaled(v):
 
 def _norm_value(v):
     unit, nonzero, scale = _scaled(v)
-    return _where(nonzero, scale * _xp.sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
+    return _where(nonzero, scale * _sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
 
 
 def _direction(v):
@@ -810,7 +815,7 @@ def _complement(p, x):
 def _length(p, x, suffix):
     """|p| from x = |p|^2, or without underflow or overflow where x is extreme."""
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
-    root = _xp.sqrt(_where(normal, x, 1.0))
+    root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
 
 

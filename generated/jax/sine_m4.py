@@ -61,6 +61,11 @@ def _stop(v):
     return lax.stop_gradient(v)
 
 
+def _sqrt(v):
+    """The square root (XLA's, rounded to nearest as NumPy's is)."""
+    return _xp.sqrt(v)
+
+
 def _wide(v):
     """v in float64 when JAX has it (jax_enable_x64), else unchanged."""
     return v.astype(_xp.float64) if jax.config.jax_enable_x64 else v
@@ -115,23 +120,23 @@ P_MAX_SQUARED = 16.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.25)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.25)*_sqrt(d)) + 0.0 * x
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.25)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.25)*_sqrt(d)) + 0.0 * x
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
-    return (-2*_xp.sqrt(d)/(x - 8)) + 0.0 * x
+    return (-2*_sqrt(d)/(x - 8)) + 0.0 * x
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half):
-    return (4/_xp.sqrt(d)) + 0.0 * x
+    return (4/_sqrt(d)) + 0.0 * x
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.25)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.25)*_sqrt(d)) + 0.0 * x
 
 
 def _R_0_64(x, phi, s, d, sin_half, cos_half):
@@ -139,7 +144,7 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    return (-0.03125*_xp.sqrt(d)*(x - 8)) + 0.0 * x
+    return (-0.03125*_sqrt(d)*(x - 8)) + 0.0 * x
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
@@ -147,7 +152,7 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    return (4/_xp.sqrt(d)) + 0.0 * x
+    return (4/_sqrt(d)) + 0.0 * x
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half):
@@ -155,11 +160,11 @@ def _H_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
-    return (-0.03125*(x - 24)/_xp.sqrt(d)) + 0.0 * x
+    return (-0.03125*(x - 24)/_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.25)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.25)*_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
@@ -167,7 +172,7 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.25)/_xp.sqrt(d)) + 0.0 * x
+    return ((0.25)/_sqrt(d)) + 0.0 * x
 
 
 def _G_0_64(x, phi, s, d, sin_half, cos_half):
@@ -175,7 +180,7 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.125)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.125)*_sqrt(d)) + 0.0 * x
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
@@ -183,7 +188,7 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_xp.sqrt(d)) + 0.0 * x
+    return (2/_sqrt(d)) + 0.0 * x
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half):
@@ -191,19 +196,19 @@ def _K_1_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.125)/_xp.sqrt(d)) + 0.0 * x
+    return ((0.125)/_sqrt(d)) + 0.0 * x
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half):
-    return (-0.03125*_xp.sqrt(d)*(x - 8)) + 0.0 * x
+    return (-0.03125*_sqrt(d)*(x - 8)) + 0.0 * x
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
-    return (-0.5*(x - 8)/_xp.sqrt(d)) + 0.0 * x
+    return (-0.5*(x - 8)/_sqrt(d)) + 0.0 * x
 
 
 def _K_across_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.125)*_xp.sqrt(d)) + 0.0 * x
+    return ((0.125)*_sqrt(d)) + 0.0 * x
 
 
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
@@ -211,7 +216,7 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-0.03125*_xp.sqrt(d) + (0.015625)*(x - 8)/_xp.sqrt(d)) + 0.0 * x
+    return (-0.03125*_sqrt(d) + (0.015625)*(x - 8)/_sqrt(d)) + 0.0 * x
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -227,11 +232,11 @@ def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.03125)/_xp.sqrt(d) - 0.015625*(x - 24)/d**(1.5)) + 0.0 * x
+    return (-(0.03125)/_sqrt(d) - 0.015625*(x - 24)/d**(1.5)) + 0.0 * x
 
 
 def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.125)/_xp.sqrt(d)) + 0.0 * x
+    return (-(0.125)/_sqrt(d)) + 0.0 * x
 
 
 def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
@@ -247,37 +252,37 @@ def _e_0_64(x, phi, s, d, sin_half, cos_half):
 
 
 def _scale_64(e0, e_norm):
-    return (2.8284271247461900976/_xp.sqrt(e0 + 1)) + 0.0 * e0
+    return (2.8284271247461900976/_sqrt(e0 + 1)) + 0.0 * e0
 
 
 def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.25)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.25)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.25)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.25)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-2*_xp.sqrt(d)/(x - 8)) + 0.0 * x, s)
+    return _narrow((-2*_sqrt(d)/(x - 8)) + 0.0 * x, s)
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((4/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((4/_sqrt(d)) + 0.0 * x, s)
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.25)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.25)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _R_0_32(x, phi, s, d, sin_half, cos_half):
@@ -287,7 +292,7 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half):
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-0.03125*_xp.sqrt(d)*(x - 8)) + 0.0 * x, s)
+    return _narrow((-0.03125*_sqrt(d)*(x - 8)) + 0.0 * x, s)
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
@@ -299,7 +304,7 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
 def _H_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((4/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((4/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
@@ -311,13 +316,13 @@ def _H_1_32(x, phi, s, d, sin_half, cos_half):
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-0.03125*(x - 24)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((-0.03125*(x - 24)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.25)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.25)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
@@ -327,7 +332,7 @@ def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.25)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.25)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _G_0_32(x, phi, s, d, sin_half, cos_half):
@@ -337,7 +342,7 @@ def _G_0_32(x, phi, s, d, sin_half, cos_half):
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.125)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.125)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
@@ -347,7 +352,7 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((2/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half):
@@ -357,25 +362,25 @@ def _K_1_32(x, phi, s, d, sin_half, cos_half):
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.125)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.125)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-0.03125*_xp.sqrt(d)*(x - 8)) + 0.0 * x, s)
+    return _narrow((-0.03125*_sqrt(d)*(x - 8)) + 0.0 * x, s)
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-0.5*(x - 8)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((-0.5*(x - 8)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _K_across_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow(((0.125)*_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow(((0.125)*_sqrt(d)) + 0.0 * x, s)
 
 
 def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
@@ -385,7 +390,7 @@ def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-0.03125*_xp.sqrt(d) + (0.015625)*(x - 8)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((-0.03125*_sqrt(d) + (0.015625)*(x - 8)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -405,13 +410,13 @@ def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-(0.03125)/_xp.sqrt(d) - 0.015625*(x - 24)/d**(1.5)) + 0.0 * x, s)
+    return _narrow((-(0.03125)/_sqrt(d) - 0.015625*(x - 24)/d**(1.5)) + 0.0 * x, s)
 
 
 def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
     x = _wide(x)
     d = _wide(d)
-    return _narrow((-(0.125)/_xp.sqrt(d)) + 0.0 * x, s)
+    return _narrow((-(0.125)/_sqrt(d)) + 0.0 * x, s)
 
 
 def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
@@ -431,15 +436,15 @@ def _e_0_32(x, phi, s, d, sin_half, cos_half):
 
 def _scale_32(e0, e_norm):
     e0 = _wide(e0)
-    return _narrow((2.8284271247461900976/_xp.sqrt(e0 + 1)) + 0.0 * e0, e_norm)
+    return _narrow((2.8284271247461900976/_sqrt(e0 + 1)) + 0.0 * e0, e_norm)
 
 
 def _angle_64(s, d):
-    return 4*_atan2(s, _xp.sqrt(d)) + 0.0 * s
+    return 4*_atan2(s, _sqrt(d)) + 0.0 * s
 
 
 def _angle_32(s, d):
-    return 4*_atan2(s, _xp.sqrt(d)) + 0.0 * s
+    return 4*_atan2(s, _sqrt(d)) + 0.0 * s
 
 
 _COEFFICIENTS = {
@@ -553,7 +558,7 @@ def _scaled(v):
 
 def _norm_value(v):
     unit, nonzero, scale = _scaled(v)
-    return _where(nonzero, scale * _xp.sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
+    return _where(nonzero, scale * _sqrt(_where(nonzero, _dot(unit, unit), 1.0)), 0.0)
 
 
 def _direction(v):
@@ -607,7 +612,7 @@ def _complement(p, x):
 def _length(p, x, suffix):
     """|p| from x = |p|^2, or without underflow or overflow where x is extreme."""
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
-    root = _xp.sqrt(_where(normal, x, 1.0))
+    root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
 
 

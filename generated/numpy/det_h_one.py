@@ -37,20 +37,28 @@ P_MAX_SQUARED = 11.243134665607636  # fl(p_max^2); inside the range: x = |p|^2 <
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -4.563492063492064e-05
+        series = -6.473542653639692e-10
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.00016163055520154135
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -4.563492063492064e-05
+        series = -6.473542653639692e-10
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
@@ -59,57 +67,87 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -0.025
+        series = -9.035261398610608e-10
+        series = -1.244209181073502e-08 + t * series
+        series = -1.7778215165910478e-07 + t * series
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 1.9211893090849666e-14
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -0.025
+        series = -9.035261398610608e-10
+        series = -1.244209181073502e-08 + t * series
+        series = -1.7778215165910478e-07 + t * series
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 9.999999999999995e-15:  # every lane on the polynomial
+    if span is not None and span[1] < 0.05752053308030299:  # every lane on the polynomial
         t = x
-        series = 0.1
+        series = 7.141710355470859e-07
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 9.999999999999995e-15:  # every lane on the closed form
+    if span is not None and span[0] >= 0.05752053308030299:  # every lane on the closed form
         return out
-    small = x < 9.999999999999995e-15
+    small = x < 0.05752053308030299
     if small.any():
         t = x[small]
-        series = 0.1
+        series = 7.141710355470859e-07
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0022017832983058567:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = 2.2437384044526902e-05
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0022017832983058567:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.0022017832983058567
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = 2.2437384044526902e-05
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
@@ -127,38 +165,58 @@ def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -0.15
+        series = 8.716860870222215e-10
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
+    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 1.9211893090849666e-14
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -0.15
+        series = 8.716860870222215e-10
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -2.281746031746032e-05
+        series = -3.236771326819846e-10
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.00016163055520154135
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -2.281746031746032e-05
+        series = -3.236771326819846e-10
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
@@ -167,21 +225,27 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0022017832983058567:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = 2.2437384044526902e-05
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0022017832983058567:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.0022017832983058567
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = 2.2437384044526902e-05
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
+        series = 1.8513431013431014e-06 + t * series
+        series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
         series = 0.0035714285714285713 + t * series
         series = 0.05 + t * series
@@ -191,20 +255,28 @@ def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -2.281746031746032e-05
+        series = -3.236771326819846e-10
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.00016163055520154135
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -2.281746031746032e-05
+        series = -3.236771326819846e-10
+        series = -4.75496882809808e-09 + t * series
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
@@ -234,7 +306,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(((0.25)*x/sin_half**2 - numpy.sin(phi)/s)/x, dtype=x.dtype)
+    out = numpy.asarray((-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x, dtype=x.dtype)
     if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
         return out
     small = x < 1.4342812090283275
@@ -263,9 +335,11 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.015605974459691814:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -1.4686206650492366e-07
+        series = -6.473542653639692e-10
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
@@ -273,12 +347,14 @@ def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.015605974459691814:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.015605974459691814
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -1.4686206650492366e-07
+        series = -6.473542653639692e-10
+        series = -9.50993765619616e-09 + t * series
+        series = -1.4686206650492366e-07 + t * series
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
@@ -358,39 +434,57 @@ def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -0.0125
+        series = -4.517630699305304e-10
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 1.9211893090849666e-14
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -0.0125
+        series = -4.517630699305304e-10
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
         series = 0.5 + t * series
         out[small] = series
     return out
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.004229756532686548:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = 1.8955121406990826e-07
+        series = 5.844969408074523e-11
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.004229756532686548:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.004229756532686548
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = 1.8955121406990826e-07
+        series = 5.844969408074523e-11
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -400,21 +494,27 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.0022017832983058567:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = 1.1218692022263451e-05
+        series = 6.5376456526666615e-09
+        series = 7.742584166903895e-08 + t * series
+        series = 9.256715506715507e-07 + t * series
+        series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
         series = 0.0017857142857142857 + t * series
         series = 0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.0022017832983058567:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.0022017832983058567
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = 1.1218692022263451e-05
+        series = 6.5376456526666615e-09
+        series = 7.742584166903895e-08 + t * series
+        series = 9.256715506715507e-07 + t * series
+        series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
         series = 0.0017857142857142857 + t * series
         series = 0.025 + t * series
@@ -424,21 +524,27 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.004229756532686548:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = 1.8955121406990826e-07
+        series = 5.844969408074523e-11
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.004229756532686548:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.004229756532686548
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = 1.8955121406990826e-07
+        series = 5.844969408074523e-11
+        series = 8.286380574805527e-10 + t * series
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -498,40 +604,59 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -0.15
+        series = 8.716860870222215e-10
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
+    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 1.9211893090849666e-14
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -0.15
+        series = 8.716860870222215e-10
+        series = 1.1911667949082915e-08 + t * series
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
         series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.00016163055520154135:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -0.00018253968253968255
+        series = -5.178834122911754e-09
+        series = -6.656956359337311e-08 + t * series
+        series = -8.811723990295419e-07 + t * series
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
         series = -0.0032142857142857142 + t * series
         series = -0.1 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sin(phi)
-    w1 = x**(-1.0)
-    out = numpy.asarray(w0/(s*(4*sin_half**4*w1 + w0**2*w1)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.00016163055520154135:  # every lane on the closed form
+    w0 = 4/x
+    out = numpy.asarray(2*cos_half*sin_half/(s*(cos_half**2*sin_half**2*w0 + sin_half**4*w0)), dtype=x.dtype)
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 0.00016163055520154135
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -0.00018253968253968255
+        series = -5.178834122911754e-09
+        series = -6.656956359337311e-08 + t * series
+        series = -8.811723990295419e-07 + t * series
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
         series = -0.0032142857142857142 + t * series
         series = -0.1 + t * series
         series = 1.0 + t * series
@@ -540,18 +665,30 @@ def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -0.0125
+        series = -4.517630699305304e-10
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 1.9211893090849666e-14
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -0.0125
+        series = -4.517630699305304e-10
+        series = -6.22104590536751e-09 + t * series
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
         series = 0.5 + t * series
         out[small] = series
     return out
@@ -975,18 +1112,30 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.9211893090849666e-14:  # every lane on the polynomial
+    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
         t = x
-        series = -0.125
+        series = -8.286380574805527e-10
+        series = -1.2203463534465907e-08 + t * series
+        series = -1.8955121406990826e-07 + t * series
+        series = -3.189329117063492e-06 + t * series
+        series = -6.138392857142858e-05 + t * series
+        series = -0.0015625 + t * series
+        series = -0.125 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.array(cos_half, dtype=x.dtype)
-    if span is not None and span[0] >= 1.9211893090849666e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
         return out
-    small = x < 1.9211893090849666e-14
+    small = x < 0.1103124080629894
     if small.any():
         t = x[small]
-        series = -0.125
+        series = -8.286380574805527e-10
+        series = -1.2203463534465907e-08 + t * series
+        series = -1.8955121406990826e-07 + t * series
+        series = -3.189329117063492e-06 + t * series
+        series = -6.138392857142858e-05 + t * series
+        series = -0.0015625 + t * series
+        series = -0.125 + t * series
         series = 1.0 + t * series
         out[small] = series
     return out
@@ -1131,19 +1280,27 @@ def _scale_64(e0, e_norm):
 
 
 def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.008125106898670383:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = -0.0010714285714285715
+        series = -9.50993765619616e-09
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.008125106898670383:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.008125106898670383
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = -0.0010714285714285715
+        series = -9.50993765619616e-09
+        series = -1.4686206650492366e-07 + t * series
+        series = -2.440218511647083e-06 + t * series
+        series = -4.563492063492064e-05 + t * series
+        series = -0.0010714285714285715 + t * series
         series = -0.05 + t * series
         series = 1.0 + t * series
         out[small] = series
@@ -1151,35 +1308,68 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 1.0)
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+        t = x
+        series = -1.244209181073502e-08
+        series = -1.7778215165910478e-07 + t * series
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 1.921189444436213e-14
+    small = x < 1.4342812011199078
     if small.any():
-        series = 1.0
+        t = x[small]
+        series = -1.244209181073502e-08
+        series = -1.7778215165910478e-07 + t * series
+        series = -2.680413429576376e-06 + t * series
+        series = -4.402281746031746e-05 + t * series
+        series = -0.0008482142857142857 + t * series
+        series = -0.025 + t * series
+        series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.0000000233721947e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 1.0)
+    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+        t = x
+        series = 7.141710355470859e-07
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.0000000233721947e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
         return out
-    small = x < 1.0000000233721947e-14
+    small = x < 0.7648242161335777
     if small.any():
-        series = 1.0
+        t = x[small]
+        series = 7.141710355470859e-07
+        series = 5.063042332919034e-06 + t * series
+        series = 3.592768342768343e-05 + t * series
+        series = 0.0002554692331478046 + t * series
+        series = 0.0018253968253968255 + t * series
+        series = 0.013214285714285715 + t * series
+        series = 0.1 + t * series
+        series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = 1.548516833380779e-07
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1188,12 +1378,13 @@ def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = 1.548516833380779e-07
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1213,22 +1404,38 @@ def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 1.0)
-    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+        t = x
+        series = 1.1911667949082915e-08
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 1.921189444436213e-14
+    small = x < 1.4342812011199078
     if small.any():
-        series = 1.0
+        t = x[small]
+        series = 1.1911667949082915e-08
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = -7.343103325246183e-08
+        series = -4.75496882809808e-09
+        series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
@@ -1236,12 +1443,13 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray((1 - numpy.cos(phi))/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = -7.343103325246183e-08
+        series = -4.75496882809808e-09
+        series = -7.343103325246183e-08 + t * series
         series = -1.2201092558235415e-06 + t * series
         series = -2.281746031746032e-05 + t * series
         series = -0.0005357142857142857 + t * series
@@ -1252,9 +1460,10 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = 1.548516833380779e-07
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1263,12 +1472,13 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = 1.548516833380779e-07
+        series = 1.3075291305333323e-08
+        series = 1.548516833380779e-07 + t * series
         series = 1.8513431013431014e-06 + t * series
         series = 2.2437384044526902e-05 + t * series
         series = 0.0002777777777777778 + t * series
@@ -1280,19 +1490,27 @@ def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.008125106898670383:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = -0.0005357142857142857
+        series = -4.75496882809808e-09
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.008125106898670383:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.008125106898670383
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = -0.0005357142857142857
+        series = -4.75496882809808e-09
+        series = -7.343103325246183e-08 + t * series
+        series = -1.2201092558235415e-06 + t * series
+        series = -2.281746031746032e-05 + t * series
+        series = -0.0005357142857142857 + t * series
         series = -0.025 + t * series
         series = 0.5 + t * series
         out[small] = series
@@ -1321,7 +1539,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.002857142857142857 + t * series
         series = 0.2 + t * series
         return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(((0.25)*x/sin_half**2 - numpy.sin(phi)/s)/x, dtype=x.dtype)
+    out = numpy.asarray((-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x, dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478
@@ -1350,9 +1568,10 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = -1.4686206650492366e-07
+        series = -9.50993765619616e-09
+        series = -1.4686206650492366e-07 + t * series
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
@@ -1360,12 +1579,13 @@ def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 1.0 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*(1 - numpy.cos(phi))/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = -1.4686206650492366e-07
+        series = -9.50993765619616e-09
+        series = -1.4686206650492366e-07 + t * series
         series = -2.440218511647083e-06 + t * series
         series = -4.563492063492064e-05 + t * series
         series = -0.0010714285714285715 + t * series
@@ -1402,9 +1622,7 @@ def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.05 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     w0 = sin_half**2
-    w1 = 6*phi
-    w2 = cos_half*sin_half
-    out = numpy.asarray(-0.5*(-8*w0 + w1*w2 + (1 - 2*w0)**2 - 1)/(w0*numpy.cbrt(w1 - 12*w2)**4), dtype=x.dtype)
+    out = numpy.asarray(-0.5*(6*cos_half*phi*sin_half - 8*w0 + (1 - 2*w0)**2 - 1)/(s**4*w0), dtype=x.dtype)
     if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
         return out
     small = x < 4.619481091176478
@@ -1437,34 +1655,53 @@ def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 0.5)
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+        t = x
+        series = -6.22104590536751e-09
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 1.921189444436213e-14
+    small = x < 1.4342812011199078
     if small.any():
-        series = 0.5
+        t = x[small]
+        series = -6.22104590536751e-09
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
         out[small] = series
     return out
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = 1.8955121406990826e-07
+        series = 8.286380574805527e-10
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = 1.8955121406990826e-07
+        series = 8.286380574805527e-10
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -1474,9 +1711,10 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = 7.742584166903895e-08
+        series = 6.5376456526666615e-09
+        series = 7.742584166903895e-08 + t * series
         series = 9.256715506715507e-07 + t * series
         series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
@@ -1485,12 +1723,13 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
         series = 0.5 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = 7.742584166903895e-08
+        series = 6.5376456526666615e-09
+        series = 7.742584166903895e-08 + t * series
         series = 9.256715506715507e-07 + t * series
         series = 1.1218692022263451e-05 + t * series
         series = 0.0001388888888888889 + t * series
@@ -1502,21 +1741,25 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
         t = x
-        series = 1.8955121406990826e-07
+        series = 8.286380574805527e-10
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
         series = 0.125 + t * series
         return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 0.7648242161335777
+    small = x < 1.4342812011199078
     if small.any():
         t = x[small]
-        series = 1.8955121406990826e-07
+        series = 8.286380574805527e-10
+        series = 1.2203463534465907e-08 + t * series
+        series = 1.8955121406990826e-07 + t * series
         series = 3.189329117063492e-06 + t * series
         series = 6.138392857142858e-05 + t * series
         series = 0.0015625 + t * series
@@ -1580,42 +1823,87 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 1.0)
-    out = numpy.asarray(numpy.sin(phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+        t = x
+        series = 1.1911667949082915e-08
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 1.921189444436213e-14
+    small = x < 1.4342812011199078
     if small.any():
-        series = 1.0
+        t = x[small]
+        series = 1.1911667949082915e-08
+        series = 1.683039183039183e-07 + t * series
+        series = 2.4930426716141e-06 + t * series
+        series = 3.968253968253968e-05 + t * series
+        series = 0.0007142857142857143 + t * series
+        series = -0.15 + t * series
+        series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 1.0)
-    w0 = numpy.sin(phi)
-    w1 = x**(-1.0)
-    out = numpy.asarray(w0/(s*(4*sin_half**4*w1 + w0**2*w1)), dtype=x.dtype)
-    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+        t = x
+        series = -5.178834122911754e-09
+        series = -6.656956359337311e-08 + t * series
+        series = -8.811723990295419e-07 + t * series
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
+    out = numpy.asarray((0.5)*cos_half*s/sin_half, dtype=x.dtype)
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 1.921189444436213e-14
+    small = x < 1.4342812011199078
     if small.any():
-        series = 1.0
+        t = x[small]
+        series = -5.178834122911754e-09
+        series = -6.656956359337311e-08 + t * series
+        series = -8.811723990295419e-07 + t * series
+        series = -1.2201092558235416e-05 + t * series
+        series = -0.00018253968253968255 + t * series
+        series = -0.0032142857142857142 + t * series
+        series = -0.1 + t * series
+        series = 1.0 + t * series
         out[small] = series
     return out
 
 
 def _K_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 0.5)
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+        t = x
+        series = -6.22104590536751e-09
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
     out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 1.921189444436213e-14
+    small = x < 1.4342812011199078
     if small.any():
-        series = 0.5
+        t = x[small]
+        series = -6.22104590536751e-09
+        series = -8.889107582955239e-08 + t * series
+        series = -1.340206714788188e-06 + t * series
+        series = -2.201140873015873e-05 + t * series
+        series = -0.00042410714285714285 + t * series
+        series = -0.0125 + t * series
+        series = 0.5 + t * series
         out[small] = series
     return out
 
@@ -2011,14 +2299,29 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.921189444436213e-14:  # every lane on the polynomial
-        return numpy.full_like(x, 1.0)
+    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+        t = x
+        series = -1.2203463534465907e-08
+        series = -1.8955121406990826e-07 + t * series
+        series = -3.189329117063492e-06 + t * series
+        series = -6.138392857142858e-05 + t * series
+        series = -0.0015625 + t * series
+        series = -0.125 + t * series
+        series = 1.0 + t * series
+        return numpy.asarray(series, dtype=x.dtype)
     out = numpy.array(cos_half, dtype=x.dtype)
-    if span is not None and span[0] >= 1.921189444436213e-14:  # every lane on the closed form
+    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
         return out
-    small = x < 1.921189444436213e-14
+    small = x < 1.4342812011199078
     if small.any():
-        series = 1.0
+        t = x[small]
+        series = -1.2203463534465907e-08
+        series = -1.8955121406990826e-07 + t * series
+        series = -3.189329117063492e-06 + t * series
+        series = -6.138392857142858e-05 + t * series
+        series = -0.0015625 + t * series
+        series = -0.125 + t * series
+        series = 1.0 + t * series
         out[small] = series
     return out
 
@@ -2222,8 +2525,8 @@ _USES_PHI = {
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
 _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the closed form
-    "64": {'p_prime': 0.00016163055520154135, 'nu': 1.9211893090849666e-14, 'epsilon': 9.999999999999995e-15, 'mu': 0.0022017832983058567, 'R_1': 1.9211893090849666e-14, 'R_2': 0.00016163055520154135, 'H_0': 0.0022017832983058567, 'H_1': 0.00016163055520154135, 'H_2': 1.4342812090283275, 'H_inverse_0': 0.015605974459691814, 'H_inverse_2': 2.6302227241416043, 'G_1': 1.9211893090849666e-14, 'G_2': 0.004229756532686548, 'K_0': 0.0022017832983058567, 'K_1': 0.004229756532686548, 'K_2': 1.4342812090283275, 'H_across': 1.9211893090849666e-14, 'H_inverse_across': 0.00016163055520154135, 'K_across': 1.9211893090849666e-14, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 1.4342812090283275, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 1.9211893090849666e-14},
-    "32": {'p_prime': 0.008125106898670383, 'nu': 1.921189444436213e-14, 'epsilon': 1.0000000233721947e-14, 'mu': 0.7648242161335777, 'R_1': 1.921189444436213e-14, 'R_2': 0.7648242161335777, 'H_0': 0.7648242161335777, 'H_1': 0.008125106898670383, 'H_2': 4.619481091176478, 'H_inverse_0': 0.7648242161335777, 'H_inverse_2': 4.619481091176478, 'G_1': 1.921189444436213e-14, 'G_2': 0.7648242161335777, 'K_0': 0.7648242161335777, 'K_1': 0.7648242161335777, 'K_2': 4.619481091176478, 'H_across': 1.921189444436213e-14, 'H_inverse_across': 1.921189444436213e-14, 'K_across': 1.921189444436213e-14, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.921189444436213e-14},
+    "64": {'p_prime': 0.1103124080629894, 'nu': 0.1103124080629894, 'epsilon': 0.05752053308030299, 'mu': 0.1103124080629894, 'R_1': 0.1103124080629894, 'R_2': 0.1103124080629894, 'H_0': 0.1103124080629894, 'H_1': 0.1103124080629894, 'H_2': 1.4342812090283275, 'H_inverse_0': 0.1103124080629894, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.1103124080629894, 'G_2': 0.1103124080629894, 'K_0': 0.1103124080629894, 'K_1': 0.1103124080629894, 'K_2': 1.4342812090283275, 'H_across': 0.1103124080629894, 'H_inverse_across': 0.1103124080629894, 'K_across': 0.1103124080629894, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 1.4342812090283275, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 0.1103124080629894},
+    "32": {'p_prime': 1.4342812011199078, 'nu': 1.4342812011199078, 'epsilon': 0.7648242161335777, 'mu': 1.4342812011199078, 'R_1': 1.4342812011199078, 'R_2': 1.4342812011199078, 'H_0': 1.4342812011199078, 'H_1': 1.4342812011199078, 'H_2': 4.619481091176478, 'H_inverse_0': 1.4342812011199078, 'H_inverse_2': 4.619481091176478, 'G_1': 1.4342812011199078, 'G_2': 1.4342812011199078, 'K_0': 1.4342812011199078, 'K_1': 1.4342812011199078, 'K_2': 4.619481091176478, 'H_across': 1.4342812011199078, 'H_inverse_across': 1.4342812011199078, 'K_across': 1.4342812011199078, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.4342812011199078},
 }
 _BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)

@@ -59,7 +59,7 @@ FRAMEWORKS = ("jax", "torch")
 
 # NumPy names of the printed functions → the module's own (defined per framework in the prelude)
 _FUNCTIONS = {
-    "sin": "_xp.sin", "cos": "_xp.cos", "tan": "_xp.tan", "sqrt": "_xp.sqrt", "exp": "_xp.exp",
+    "sin": "_xp.sin", "cos": "_xp.cos", "tan": "_xp.tan", "sqrt": "_sqrt", "exp": "_xp.exp",
     "log": "_xp.log", "sinh": "_xp.sinh", "cosh": "_xp.cosh", "tanh": "_xp.tanh",
     "arcsin": "_xp.asin", "arccos": "_xp.acos", "arctan": "_xp.atan", "arcsinh": "_xp.asinh",
     "arccosh": "_xp.acosh", "arctanh": "_xp.atanh", "log1p": "_xp.log1p", "expm1": "_xp.expm1",
@@ -183,7 +183,7 @@ def angle_low_lines(angle: NewtonAngle, suffix: str) -> list[str]:
 def _far_variable(far: FarStart) -> str:
     if far.kind == "fold":
         inner = f"_xp.clip(1.0 - s / {far.scale!r}, 0.0, None)"
-        root = {2: f"_xp.sqrt({inner})", 3: f"_cbrt({inner})"}.get(
+        root = {2: f"_sqrt({inner})", 3: f"_cbrt({inner})"}.get(
             far.order, f"{inner} ** {1 / far.order!r}")
         return f"1.0 - {root}"
     if far.kind == "linear":
