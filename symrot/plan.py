@@ -1160,11 +1160,26 @@ def _bracket_top(exact: sp.Expr, phi_max: float, dtype: type) -> float:
     return float(top)
 
 
+class NewtonForms(NamedTuple):
+    """The symbolic part of :func:`_newton_angle`, the same for both precisions."""
+
+    leading: sp.Expr
+    """g(0) = κ (eq 12), the first term of g's series."""
+    tail: sp.Expr
+    """g − g(0), g = p/φ simplified."""
+    tail_series: list[sp.Expr]
+    """The exact series of the tail in φ² (its first term 0)."""
+    slope: sp.Expr
+    slope_series: list[sp.Expr]
+    """p′ simplified and its exact series in φ²."""
+    start: tuple[sp.Expr, ...]
+    """The start's series φ(p), odd powers of p."""
+
+
 @lru_cache(maxsize=64)
-def _newton_forms(p: sp.Expr) -> tuple[sp.Expr, list[sp.Expr], sp.Expr, list[sp.Expr], tuple[sp.Expr, ...]]:
-    """The symbolic part of :func:`_newton_angle`, the same for both precisions: the tail
-    g − g(0) of Newton's ratio g = p/φ and the slope p′ (simplified, with their exact series in φ²),
-    and the start's series φ(p)."""
+def _newton_forms(p: sp.Expr) -> NewtonForms:
+    """:class:`NewtonForms` of p: Newton's ratio g = p/φ split into g(0) and its tail, its slope p′
+    and the start φ(p)."""
     order = 2 * MAX_TERMS
     derivation = derive_expression(p)
     ratio_series = coefficient_list(taylor_series(p / PHI, order), 0, order)[0::2]
@@ -1172,24 +1187,24 @@ def _newton_forms(p: sp.Expr) -> tuple[sp.Expr, list[sp.Expr], sp.Expr, list[sp.
     reverted = derivation.phi_of_p(2 * START_TERMS)
     leading = ratio_series[0]
     slope_form = derivation.simplified_coefficients()["p_prime"]
-    return (sp.simplify(p / PHI) - leading, [sp.Integer(0), *ratio_series[1:]], slope_form, slope_series,
-            tuple(reverted[1::2][:START_TERMS]))
+    return NewtonForms(leading, sp.simplify(p / PHI) - leading, [sp.Integer(0), *ratio_series[1:]],
+                       slope_form, slope_series, tuple(reverted[1::2][:START_TERMS]))
 
 
 def _newton_angle(derivation: Derivation, phi_max: float, p_max: float, dtype: type,
                   bracket_top: float) -> NewtonAngle:
     p = derivation.p
-    ratio_form, ratio_series, slope_form, slope_series, start = _newton_forms(p)
-    leading = derivation.kappa
-    ratio = plan_branch(ratio_form, ratio_series, PHI ** 2, phi_max, dtype, whole=abs(float(leading)))
-    slope = plan_branch(slope_form, slope_series, PHI ** 2, phi_max, dtype)
+    forms = _newton_forms(p)
+    leading, start = forms.leading, forms.start
+    ratio = plan_branch(forms.tail, forms.tail_series, PHI ** 2, phi_max, dtype, whole=abs(float(leading)))
+    slope = plan_branch(forms.slope, forms.slope_series, PHI ** 2, phi_max, dtype)
     far = _far_start(p, p_max, phi_max, start)
     top = (fold_top(p, derivation.scalars["p_prime"], p_max, phi_max, dtype)
            if far.kind == "fold" and math.isfinite(p_max) else math.inf)
     grid = np.unique(np.concatenate([angle_grid(phi_max), phi_max * (1 - log_grid(1e-6, 1e-9, 4))]))
     printed = (_branch_model(ratio, dtype), _branch_model(slope, dtype))
     reciprocal = far.kind == "ratio"  # p unbounded: a pole at φ_max
-    below = float(ratio.threshold)
+    below = float(ratio.threshold)  # NewtonAngle.split_below
     lanes = newton_lanes(p, derivation.scalars["p_prime"], grid, phi_max, dtype, printed[0], float(leading),
                          below)
     count = measured_iterations(lanes, start, far, printed, reciprocal, bracket_top, leading=float(leading),

@@ -130,7 +130,7 @@ class NewtonAngle:
     (:func:`symrot.newton_start.measured_iterations`); the precision's range ends below it."""
     leading: sp.Expr
     """g(0) = κ (eq 12): ``ratio`` is the tail g − g(0), and the backends print the residual as
-    (φ g(0) − s) + φ (g − g(0)) where the tail's polynomial applies (φ² below ``ratio.threshold``),
+    (φ g(0) − s) + φ (g − g(0)) where the tail's polynomial applies (φ² below ``split_below``),
     φ (g(0) + (g − g(0))) − s = φ g − s above. φ − s is exact (Sterbenz) once φ is within a factor 2
     of s, so there the residual keeps the digits that rounding φ·g to s's precision loses (a half
     ulp of s, and the closed form's own ulps where the polynomial applies instead; above, the split
@@ -150,6 +150,18 @@ class NewtonAngle:
     """For a fold at φ_max (p′(φ_max) = 0): the smallest angle whose p rounds like p_max
     (:func:`symrot.newton_start.fold_top`); every backend clips the start and the last iterate to it
     (the residual there is negative beyond rounding). inf otherwise."""
+
+    def __post_init__(self) -> None:
+        if self.ratio.smallest_switch[0] != self.ratio.threshold:
+            raise ValueError("the tail of Newton's ratio has one switch for every backend "
+                             "(plan._branch_for with whole=...): split_below relies on it")
+
+    @property
+    def split_below(self) -> float:
+        """φ² below which the backends print the residual split, (φ g(0) − s) + φ (g − g(0)): the
+        switch of the tail's polynomial (``ratio``), which every backend takes for the tail
+        itself, so that the split applies exactly where the tail is its polynomial."""
+        return self.ratio.threshold
 
 
 Coefficient = Constant | Algebraic | Branch

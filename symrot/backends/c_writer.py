@@ -310,7 +310,7 @@ class FunctionWriter:
         φ·g − s above, and value = p(φ) for the reciprocal step (:class:`symrot.plan_ir.NewtonAngle`)."""
         head = "phi" if angle.leading == 1 else f"phi*{self.c(angle.leading)}"
         whole = "1" if angle.leading == 1 else self.c(angle.leading)
-        switch = self.printer.literal(angle.ratio.threshold)
+        switch = self.printer.literal(angle.split_below)
         values = [("tail", "phi*ratio", 1),
                   ("residual", f"t < {switch} ? ({head} - s) + tail : phi*({whole} + ratio) - s", 6),
                   *([("value", f"{head} + tail", 2)] if angle.reciprocal else [])]

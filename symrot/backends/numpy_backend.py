@@ -209,7 +209,7 @@ def newton_residual_lines(angle: NewtonAngle, ratio_call: str, literal: Callable
     head = "phi" if angle.leading == 1 else f"phi * {literal(angle.leading)}"
     whole = "1.0" if angle.leading == 1 else literal(angle.leading)
     return [f"ratio = {ratio_call}", "tail = phi * ratio",
-            f"residual = {where}(phi * phi < {angle.ratio.threshold!r}, ({head} - s) + tail, "
+            f"residual = {where}(phi * phi < {angle.split_below!r}, ({head} - s) + tail, "
             f"phi * ({whole} + ratio) - s)",
             *([f"value = {head} + tail"] if angle.reciprocal else [])]
 
