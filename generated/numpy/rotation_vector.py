@@ -1010,7 +1010,7 @@ def _angle_32(s, d):
 
 
 def _scale_32(e0, e_norm):
-    phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)
+    phi = 2.0 * numpy.arctan2(e_norm.astype(numpy.float64), e0.astype(numpy.float64))
     t = phi * phi
     small = t < 6.574623607796752e-14
     out = numpy.empty_like(t)
@@ -1021,7 +1021,7 @@ def _scale_32(e0, e_norm):
         big = ~small
         phi = phi[big]
         out[big] = phi/numpy.sin((0.5)*phi)
-    return out
+    return out.astype(numpy.float32)
 
 
 _COEFFICIENTS = {

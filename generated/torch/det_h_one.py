@@ -1672,7 +1672,7 @@ def _newton_32(s):
 
 
 def _scale_32(e0, e_norm):
-    phi = 2.0 * _atan2(e_norm, e0)
+    phi = 2.0 * _atan2(_wide(e_norm), _wide(e0))
     t = phi * phi
     small = t < 1.5011636704730478
     t = _where(small, t, 0.0)
@@ -1684,7 +1684,7 @@ def _scale_32(e0, e_norm):
     series = 2.0 + t * series
     phi = _where(small, 1.2252198223940611, phi)
     closed = _cbrt(6*phi - 6*_xp.sin(phi))/_xp.sin((0.5)*phi)
-    return _where(small, series, closed)
+    return _narrow(_where(small, series, closed), e0)
 
 
 def _angle_64(s, d):

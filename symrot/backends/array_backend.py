@@ -217,7 +217,13 @@ def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
         value = f"({print_array(expression)}) + 0.0 * e0"
         return [*lines, f"return _narrow({value}, e_norm)" if suffix == "32" else f"return {value}"]
     assert isinstance(scale.branch, Branch)
-    return ["phi = 2.0 * _atan2(e_norm, e0)", "t = phi * phi", *branch_lines(scale.branch, "t", None)]
+    lines = branch_lines(scale.branch, "t", None)
+    if suffix == "64":
+        return ["phi = 2.0 * _atan2(e_norm, e0)", "t = phi * phi", *lines]
+    # float32: φ and σ wide, rounded once (as the NumPy backend's _scale_lines)
+    assert lines[-1].startswith("return ")
+    return ["phi = 2.0 * _atan2(_wide(e_norm), _wide(e0))", "t = phi * phi", *lines[:-1],
+            f"return _narrow({lines[-1].removeprefix('return ')}, e0)"]
 
 
 def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:

@@ -361,8 +361,15 @@ def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
         return ["e0 = e0.astype(numpy.float64)",
                 f"return (({print_expression(expression)}) + 0.0 * e0).astype(numpy.float{suffix})"]
     assert isinstance(scale.branch, Branch)
-    return ["phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)", "t = phi * phi",
-            *_branch_lines(scale.branch, "t", "phi")]
+    lines = _branch_lines(scale.branch, "t", "phi")
+    if suffix == "64":
+        return ["phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)", "t = phi * phi", *lines]
+    # float32: φ and σ in float64, rounded once. Next to a pole at φ_max, rounding φ to float32
+    # costs more than the rounding of e does (3 cosh(2φ) atanh(φ/3) at φ = 3 − 10⁻⁶: 5.8·10⁴ ulp,
+    # more than 4 κ on one CPU's float32 libm; tests/test_plan_user_functions.py)
+    assert lines[-1] == "return out"
+    return ["phi = 2.0 * numpy.arctan2(e_norm.astype(numpy.float64), e0.astype(numpy.float64))",
+            "t = phi * phi", *lines[:-1], "return out.astype(numpy.float32)"]
 
 
 def module_source(plan: EvaluationPlan) -> str:
