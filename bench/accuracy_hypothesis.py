@@ -93,7 +93,10 @@ def misses(result: dict[str, Any]) -> list[str]:
             for t in result.get("tallies", []) if verdict([t]) not in GOOD]
 
 
-def report(results: list[dict[str, Any]], command: str, with_c: bool, held_out: bool = False) -> str:
+def report(results: list[dict[str, Any]], command: str, with_c: bool, held_out: bool = False,
+           indices: list[int] | None = None) -> str:
+    """The markdown table of ``results``; a row's number is its index in the sample (``indices``,
+    default 0, 1, …)."""
     columns = COLUMNS if with_c else COLUMNS[:2]
     met = [r for r in results if "tallies" in r and all(_verdicts(r).get(k) in GOOD for k in columns)]
     failed = [r for r in results if "tallies" not in r]
@@ -107,7 +110,7 @@ def report(results: list[dict[str, Any]], command: str, with_c: bool, held_out: 
              f"emit or worker failures: {len(failed)}.", "",
              "| # | p(φ) | emit s | φ_max | verdicts (" + ", ".join(f"{b} {p}" for b, p in columns)
              + ") | misses (worst 3) |", "|---|---|---|---|---|---|"]
-    for i, r in enumerate(results):
+    for i, r in zip(indices or range(len(results)), results, strict=True):
         if "tallies" not in r:
             reason = r.get("emit_error") or r.get("worker_error") or "no result"
             lines.append(f"| {i} | `{r['expression']}` | — | — | **failed**: {reason} | |")
@@ -148,6 +151,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int,
                         help="a held-out sample: draw with this seed instead, leaving out the default "
                              "sample's first 200 functions")
+    parser.add_argument("--leave-out", type=int, default=0, metavar="COUNT",
+                        help="measure only the functions that a run with --count COUNT did not (its "
+                             "functions are a subset, in another order); rows keep their index")
     parser.add_argument("--worker", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker is not None:
@@ -159,6 +165,9 @@ def main(argv: list[str] | None = None) -> int:
         a for a in (argv if argv is not None else sys.argv[1:]) if a != "--resume")
     expressions = (draw(args.count) if args.seed is None
                    else draw_held_out(args.count, args.seed, frozenset(draw(DEFAULT_COUNT))))
+    left_out = frozenset(draw(args.leave_out)) if args.leave_out else frozenset()
+    index = {e: i for i, e in enumerate(expressions)}
+    expressions = [e for e in expressions if e not in left_out]
     found: dict[str, dict[str, Any]] = {}
     if args.resume and Path(args.json).exists():
         found = {r["expression"]: r for r in json.loads(Path(args.json).read_text(encoding="utf-8"))
@@ -177,8 +186,8 @@ def main(argv: list[str] | None = None) -> int:
             results = [found[e] for e in expressions if e in found]
             if args.json:
                 Path(args.json).write_text(json.dumps(results, indent=1), encoding="utf-8")
-            Path(args.out).write_text(report(results, command.strip(), not args.no_c, args.seed is not None)
-                                      + "\n",
+            Path(args.out).write_text(report(results, command.strip(), not args.no_c, args.seed is not None,
+                                             [index[r["expression"]] for r in results]) + "\n",
                                       encoding="utf-8")
     return 0
 
