@@ -435,9 +435,9 @@ def test_float32_from_quaternion_next_to_a_pole_rounds_once() -> None:
     """3 cosh(2φ) atanh(φ/3) has a pole at φ_max = 3. σ = p(φ)/sin(φ/2) from φ = 2 atan2(|e|, e₀)
     rounded to float32 lost 5.8·10⁴ ulp at φ = 3 − 10⁻⁶, about the error of a 4 ε change of e
     there: the hypothesis sample measured it as a miss (more than 4 κ) on an Intel Xeon and as
-    within 4 κ on the AMD EPYC before it. φ and σ are now computed in float64 and
-    rounded once. The axis is e₁ so that |e| is exact: what
-    is left are the roundings of σ, 1/|e| and the products."""
+    within 4 κ on the AMD EPYC before it. φ and σ are now computed in float64 and rounded once.
+    The axis is e₁ so that |e| is exact: what is left are the roundings of σ, 1/|e| and the
+    products."""
     from symrot.backends.numpy_backend import module_source
 
     plan = evaluation_plan(derive("3*cosh(2*phi)*atanh(phi/3)").derivation, "atanh_pole")

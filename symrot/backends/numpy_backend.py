@@ -366,7 +366,7 @@ def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
         return ["phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)", "t = phi * phi", *lines]
     # float32: φ and σ in float64, rounded once. Next to a pole at φ_max, rounding φ to float32
     # costs more than the rounding of e does (3 cosh(2φ) atanh(φ/3) at φ = 3 − 10⁻⁶: 5.8·10⁴ ulp,
-    # more than 4 κ on one CPU's float32 libm; tests/test_plan_user_functions.py)
+    # more than 4 κ on one machine and less on another; tests/test_plan_user_functions.py)
     assert lines[-1] == "return out"
     return ["phi = 2.0 * numpy.arctan2(e_norm.astype(numpy.float64), e0.astype(numpy.float64))",
             "t = phi * phi", *lines[:-1], "return out.astype(numpy.float32)"]
