@@ -57,6 +57,7 @@ from functools import lru_cache
 
 import mpmath
 import sympy as sp
+from mpmath.libmp import from_rational
 
 from .functions import mpmath_namespace
 from .newton_start import FarStart
@@ -218,6 +219,16 @@ class EvaluationPlan:
     p_max_squared_exact: sp.Float | None = None
     """p_max² at 50 digits (None when p is unbounded): see :meth:`boundary`."""
 
+    def complement_parts(self, mantissa_bits: int) -> tuple[sp.Rational, sp.Rational]:
+        """(high, low): ``complement`` = p_max² rounded to nearest with ``mantissa_bits`` bits, and
+        what is left rounded the same way, so that a compensated sum started from high + low keeps
+        p_max² to twice the precision. low is 0 for the named families (k² = 1, 4, 9, …); 16/9, the
+        p_max² of (4/3) sin(3φ/4), is no float."""
+        assert self.complement is not None
+        squared = sp.Rational(self.complement)
+        high = _rounded(squared, mantissa_bits)
+        return high, _rounded(squared - high, mantissa_bits)
+
     def across_tensors(self) -> tuple[str, ...]:
         """The tensors T whose across-axis part t = c₀ − c₂|p|² is a coefficient of the plan
         (``T_across``, in every precision): backends write T = t I + c₁ (p×) + c₂ p pᵀ with it, and
@@ -307,3 +318,12 @@ def _grows_faster_than_angle(p: sp.Expr, phi_max: float, where_half_sine_is_ill:
             if isinstance(value, mpmath.mpf) and value > ANGLE_CORRECTION_GROWTH:
                 return True
     return False
+
+
+def _rounded(value: sp.Rational, mantissa_bits: int) -> sp.Rational:
+    """The number of ``mantissa_bits`` bits nearest to ``value`` (ties to even), exactly."""
+    if value == 0:
+        return sp.Integer(0)
+    size = abs(value)  # man_exp gives the magnitude's mantissa
+    mantissa, exponent = mpmath.mpf(from_rational(int(size.p), int(size.q), mantissa_bits, "n")).man_exp
+    return sp.sign(value) * sp.Integer(mantissa) * sp.Integer(2) ** exponent

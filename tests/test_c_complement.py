@@ -14,7 +14,9 @@ import ctypes
 import subprocess
 from fractions import Fraction
 from functools import cache
+from pathlib import Path
 
+import mpmath
 import numpy as np
 import pytest
 
@@ -120,3 +122,77 @@ def test_fast2sum_complement_has_the_bits_of_two_sum_and_is_accurate(name: str, 
         allowed = float(np.spacing(dtype(float(exact)))) + floor
         worst = max(worst, float(abs(Fraction(got) - exact)) / allowed)
     assert worst <= 1.0, (name, np.dtype(dtype).name, worst)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_a_fold_whose_p_max_squared_is_no_float(dtype: type, tmp_path: Path) -> None:
+    """(4/3) sin(3φ/4), a hypothesis function: p_max² = 16/9. The header printed
+    ``sp.Integer(16/9)`` = 1 as k², so d = 1 − x: the C angle was NaN for |p| > 1 (φ > 1.13, 6 NaN
+    at φ = 1.99 in the sweep) and wrong below, while NumPy printed 16/9. The compensated sum now
+    starts from 16/9 as two floats (high + low), and d is within one ulp of the exact
+    p_max² − |p|² up to 10⁻¹⁶ from the fold, as for the named families; the angle
+    (4/3) atan2(s, √d) stays within 2 ulp of (4/3) asin(3s/4)."""
+    from symrot.backends.c_backend import header_source
+    from symrot.plan import evaluation_plan
+
+    plan = evaluation_plan(derive("4*sin(3*phi/4)/3").derivation, "sin_three_quarters")
+    assert plan.complement == Fraction(16, 9)
+    (tmp_path / "symrot_sin_three_quarters.h").write_text(header_source(plan, "sin_three_quarters"),
+                                                          encoding="utf-8")
+    ctype_name, suffix = ("double", "") if dtype == np.float64 else ("float", "_f")
+    source = tmp_path / "fold.c"
+    source.write_text('#include "symrot_sin_three_quarters.h"\n'
+                      f"{ctype_name} t_d(const {ctype_name} *p, {ctype_name} x) "
+                      f"{{ return symrot_sin_three_quarters__complement{suffix}(p, x); }}\n"
+                      f"{ctype_name} t_angle(const {ctype_name} *p) "
+                      f"{{ return symrot_sin_three_quarters_angle{suffix}(p); }}\n", encoding="utf-8")
+    out = tmp_path / "fold.so"
+    command = ["gcc", *c_harness.STRICT_C, "-O2", "-ffp-contract=off", f"-I{tmp_path}", "-shared", "-fPIC",
+               str(source), "-o", str(out), "-lm"]
+    subprocess.run(command, check=True, capture_output=True, timeout=300)
+    library = ctypes.CDLL(str(out))
+    ctype = ctypes.c_double if dtype == np.float64 else ctypes.c_float
+    complement, angle = library.t_d, library.t_angle
+    complement.argtypes, complement.restype = [ctypes.POINTER(ctype), ctype], ctype
+    angle.argtypes, angle.restype = [ctypes.POINTER(ctype)], ctype
+    k2 = Fraction(16, 9)
+    vectors = fold_vectors(4 / 3, dtype, np.random.default_rng(43))
+    assert len(vectors) > 300
+    epsilon = float(np.finfo(dtype).eps)
+    worst_d = worst_angle = 0.0
+    for p in vectors:
+        p = np.ascontiguousarray(p, dtype=dtype)
+        x = (p[0] * p[0] + p[1] * p[1]) + p[2] * p[2]
+        pointer = p.ctypes.data_as(ctypes.POINTER(ctype))
+        exact = k2 - sum(Fraction(float(c)) ** 2 for c in p)
+        if x > dtype(float(k2) / 4):
+            got = Fraction(complement(pointer, ctype(x)))
+            allowed = float(np.spacing(dtype(float(exact)))) + 4 * epsilon**2 * float(k2)
+            worst_d = max(worst_d, float(abs(got - exact)) / allowed)
+        with mpmath.workdps(60):
+            s = mpmath.sqrt(sum(mpmath.mpf(float(c)) ** 2 for c in p))
+            reference = 4 * mpmath.asin(3 * s / 4) / 3
+            value = angle(pointer)
+            worst_angle = max(worst_angle, float(abs(value - reference) / reference) / epsilon)
+    assert worst_d <= 1.0 and worst_angle <= 2.0, (worst_d, worst_angle)
+
+
+def test_numpy_complement_of_a_p_max_squared_that_is_no_float() -> None:
+    """The NumPy module's d for (4/3) sin(3φ/4) starts from 16/9 as two floats as well: within one
+    ulp of the exact p_max² − |p|² next to the fold (with the float64 of 16/9 alone, up to
+    9.9·10⁻¹⁷ off, millions of ulp of d there)."""
+    from symrot.backends.numpy_backend import module_source
+    from symrot.plan import evaluation_plan
+
+    namespace: dict[str, object] = {}
+    plan = evaluation_plan(derive("4*sin(3*phi/4)/3").derivation, "sin_three_quarters")
+    exec(compile(module_source(plan), "<sin_three_quarters>", "exec"), namespace)
+    complement = namespace["_complement"]
+    vectors = fold_vectors(4 / 3, np.float64, np.random.default_rng(34))
+    got = complement(vectors)  # type: ignore[operator]
+    worst = 0.0
+    for p, d in zip(vectors, got, strict=True):
+        exact = Fraction(16, 9) - sum(Fraction(float(c)) ** 2 for c in p)
+        allowed = float(np.spacing(float(exact))) + 4 * float(np.finfo(float).eps) ** 2 * 16 / 9
+        worst = max(worst, float(abs(Fraction(float(d)) - exact)) / allowed)
+    assert worst <= 1.0, worst

@@ -46,6 +46,7 @@ from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 from .numpy_backend import (
     SUFFIX,
     angle_low_helpers,
+    complement_low,
     newton_low_lines,
     newton_residual_lines,
     newton_step_lines,
@@ -268,6 +269,7 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
             "e0_min": repr(plan.e0_min) if plan.e0_min is not None else None,
             "p_max": repr(plan.p_max) if finite_p_max else None, "phi_max": repr(plan.phi_max),
             "complement": str(plan.complement) if plan.complement is not None else None,
+            "complement_low": complement_low(plan),
             "p_max_squared": repr(squared) if math.isfinite(squared) else "math.inf",
             "inclusive": inclusive,
             "x_limit": {SUFFIX[label]: repr(precision.x_limit)

@@ -64,7 +64,7 @@ from .c_functions import (
     tensor_coefficients,
     tensor_entries,
 )
-from .c_printer import Precision, SymrotCPrinter, horner
+from .c_printer import MANTISSA_BITS, Precision, SymrotCPrinter, horner
 from .subexpressions import common_subexpressions
 
 # -- statements ------------------------------------------------------------------------------------
@@ -186,13 +186,15 @@ class FunctionWriter:
         the range d is garbage, and every output is NaN by the test on x."""
         t = self.ctype
         fma = "fma" if t == "double" else "fmaf"
-        complement = sp.Integer(self.plan.complement) if self.plan.complement is not None else sp.Integer(0)
+        assert self.plan.complement is not None
+        complement = sp.Rational(self.plan.complement)  # 16/9 for (4/3) sin(3φ/4): not an integer
         k2 = self.printer.literal(complement)
+        _high, tail = self.plan.complement_parts(MANTISSA_BITS[self.precision])
         near = {"kind": "if", "condition": f"x <= {self.printer.literal(complement / 4)}",
                 "then": [{"kind": "return", "value": f"{k2} - x", "ops": 1}], "otherwise": [], "ops": 0}
-        statements: list[Statement] = [near,
-                                       {"kind": "declare", "type": t, "names": [f"high = {k2}", "low = 0"]},
-                                       {"kind": "declare", "type": "int", "names": ["i"]}]
+        low = self.printer.literal(tail) if tail != 0 else "0"
+        start = {"kind": "declare", "type": t, "names": [f"high = {k2}", f"low = {low}"]}
+        statements: list[Statement] = [near, start, {"kind": "declare", "type": "int", "names": ["i"]}]
         body: list[Statement] = [
             {"kind": "let", "type": t, "name": "square", "value": "p[i] * p[i]", "ops": 1},
             {"kind": "let", "type": t, "name": "error", "value": f"{fma}(p[i], p[i], -square)", "ops": 1},

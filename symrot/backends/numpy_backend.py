@@ -283,6 +283,7 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "across": repr(tuple(sorted(plan.across_tensors()))),
             "p_max": repr(p_max) if np.isfinite(p_max) else None, "phi_max": repr(plan.phi_max),
             "complement": str(plan.complement) if plan.complement is not None else None,
+            "complement_low": complement_low(plan),
             "p_max_squared": repr(squared) if np.isfinite(squared) else "numpy.inf",
             "inclusive": inclusive,
             "x_limit": {SUFFIX[label]: repr(precision.x_limit)
@@ -370,6 +371,15 @@ def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
     assert lines[-1] == "return out"
     return ["phi = 2.0 * numpy.arctan2(e_norm.astype(numpy.float64), e0.astype(numpy.float64))",
             "t = phi * phi", *lines[:-1], "return out.astype(numpy.float32)"]
+
+
+def complement_low(plan: EvaluationPlan) -> str | None:
+    """The float64 literal of what p_max² − fl(p_max²) leaves (:meth:`EvaluationPlan.complement_parts`),
+    the start of the compensated sum's low part; None when p_max² is a float64 (the named families)."""
+    if plan.complement is None:
+        return None
+    _high, low = plan.complement_parts(53)
+    return repr(float(low)) if low != 0 else None
 
 
 def module_source(plan: EvaluationPlan) -> str:
