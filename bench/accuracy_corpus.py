@@ -94,6 +94,51 @@ class Tally:
     points: int = 0
 
 
+C_OPERATIONS: dict[str, tuple[tuple[str, ...], int]] = {
+    "to_quaternion": (("p",), 4), "from_quaternion": (("e",), 3), "rescale": (("p",), 3),
+    "compose": (("p", "p2"), 3)}
+"""The header's quaternion operations (eqs 67, 74–75 and the rescaling of eqs 40–47): their inputs
+and number of outputs. tests/c_harness.py wraps only the nine kinematic functions."""
+
+
+class COperations:
+    """The quaternion operations of a compiled C header, called through ctypes (gcc -O2
+    -ffp-contract=off, the configuration of the kinematic wrappers)."""
+
+    def __init__(self, directory: Path, header: str) -> None:
+        import ctypes
+
+        from tests.c_harness import build_config, compile_one
+
+        lines = [f'#include "symrot_{header}.h"']
+        for ctype, suffix in (("double", ""), ("float", "_f")):
+            for name, (inputs, _width) in C_OPERATIONS.items():
+                parameters = ", ".join(f"const {ctype} *{i}" for i in (*inputs, "out")).replace(
+                    f"const {ctype} *out", f"{ctype} *out")
+                signature = f"void o_{name}{suffix}({parameters})"
+                call = f"symrot_{header}_{name}{suffix}({', '.join(inputs)}, out)"
+                lines += [f"{signature};", f"{signature} {{ (void){call}; }}"]
+        out_dir = directory / "operations"
+        out_dir.mkdir()
+        source = out_dir / "operations.c"
+        source.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        self.dll = ctypes.CDLL(str(compile_one(build_config("gcc-O2-nofma"), source, directory, out_dir)))
+        self.ctypes = ctypes
+
+    def call(self, name: str, dtype: Any, *arrays: np.ndarray) -> np.ndarray:
+        """``name``'s outputs for one input (each array one vector), in ``dtype``."""
+        inputs, width = C_OPERATIONS[name]
+        ctype = self.ctypes.c_double if dtype == np.float64 else self.ctypes.c_float
+        pointer = self.ctypes.POINTER(ctype)
+        values = [np.ascontiguousarray(a, dtype=dtype) for a in arrays]
+        out = np.empty(width, dtype=dtype)
+        function = getattr(self.dll, f"o_{name}" + ("" if dtype == np.float64 else "_f"))
+        function.argtypes = [pointer] * (len(inputs) + 1)
+        function.restype = None
+        function(*[v.ctypes.data_as(pointer) for v in values], out.ctypes.data_as(pointer))
+        return out
+
+
 def _is_nan_reference(ref: Any) -> bool:
     values = [ref[i, j] for i in range(ref.rows) for j in range(ref.cols)] if isinstance(ref, mpmath.matrix) \
         else list(ref)
@@ -115,7 +160,9 @@ class Measurement:
     """The sweep of one corpus function against its reference (NumPy and, optionally, C)."""
 
     def __init__(self, function: GeneratingFunction, plan: Any, module: Any, library: Any,
-                 header: str | None, points: int, seed: int = 16) -> None:
+                 header: str | None, points: int, seed: int = 16,
+                 operations: COperations | None = None) -> None:
+        self.operations = operations
         self.reference = Reference(function)
         self.function = function
         self.plan = plan
@@ -205,6 +252,12 @@ class Measurement:
                 got = self.library.call(self.header, spec, precision, p[None, :], w[None, :])[0]
                 ulp, nonfinite = _error(got, refs[spec.name], spec.name, epsilon, tiny)
                 self.record(spec.name, label, "c", ulp, nonfinite, angle, kappa(spec.name))
+        if self.operations is not None:
+            inputs = {"p": p, "e": e, "p2": p2}
+            for name, (names, _width) in C_OPERATIONS.items():
+                got = self.operations.call(name, dtype, *(inputs[n] for n in names))
+                ulp, nonfinite = _error(got, refs[name], name, epsilon, tiny)
+                self.record(name, label, "c", ulp, nonfinite, angle, kappa(name))
 
     def condition(self, function: str, refs: dict[str, Any],
                   kinematic_at: Callable[[list[Any]], dict[str, Any]], p: list[Any], p2: list[Any],
@@ -277,9 +330,15 @@ def measure_expression(function: GeneratingFunction, name: str, points: int, wit
     with tempfile.TemporaryDirectory() as tmp:
         directory = Path(tmp)
         module = load_module(plan, directory)
+        operations = None
         if with_c:
             library, header, result["c"] = c_library(plan, name, directory)
-        measurement = Measurement(function, plan, module, library, header, points)
+            if header is not None:
+                try:
+                    operations = COperations(directory, header)
+                except Exception as error:  # recorded, the other measurements go on
+                    result["c"]["operations_error"] = one_line(error)
+        measurement = Measurement(function, plan, module, library, header, points, operations=operations)
         measurement.run()
     result["kernel_errors"] = measurement.errors[:5]
     result["tallies"] = [{"function": f, "precision": label, "backend": backend, **asdict(t.worst),

@@ -303,3 +303,16 @@ def test_hypothesis_sample_meets_the_target() -> None:
     check()
     assert not found, found
 
+
+
+def test_the_c_sweep_measures_the_quaternion_operations() -> None:
+    """bench/accuracy_corpus.py measures C's to_quaternion, from_quaternion, rescale and compose
+    beside the nine kinematic functions of tests/c_harness.py (before, only NumPy's were swept)."""
+    from accuracy_corpus import C_OPERATIONS, measure_expression
+
+    result = measure_expression(GeneratingFunction("4*atan(phi/4)"), "c_operations", 1, True, {})
+    assert "operations_error" not in result["c"], result["c"]
+    swept = [t for t in result["tallies"] if t["backend"] == "c" and t["function"] in C_OPERATIONS]
+    assert {(t["function"], t["precision"]) for t in swept} == {
+        (f, p) for f in C_OPERATIONS for p in ("float64", "float32")}
+    assert all(t["points"] > 0 and verdict([t]) in ("meets", "conditioned") for t in swept), swept
