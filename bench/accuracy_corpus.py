@@ -426,7 +426,8 @@ def report(results: list[dict[str, Any]], command: str, points: int) -> str:
              "from its smallest normal, random axes; φ_max = min(reference, plan). Error and verdict as "
              f"in docs/accuracy.md: *meets* ≤ {TARGET_ULP:g} ulp, *conditioned* ≤ {TARGET_ULP:g} κ ulp, "
              "*miss* otherwise, **NaN/Inf** when any output is not finite inside the validity range. "
-             "C: the header compiled with gcc -O2 -ffp-contract=off (kinematic functions only).", "",
+             "C: the header compiled with gcc -O2 -ffp-contract=off (the kinematic functions and the "
+             "quaternion operations; from_rotation_matrix is not swept).", "",
              "## Summary", "",
              "| # | p(φ) | category | edge | closed φ(p) | emit s (NumPy / C) | angle (f64) "
              "| φ_max ref / plan | NumPy f64 | NumPy f32 | C double | C float | NaN/Inf |",
