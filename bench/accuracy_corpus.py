@@ -113,8 +113,7 @@ class COperations:
         lines = [f'#include "symrot_{header}.h"']
         for ctype, suffix in (("double", ""), ("float", "_f")):
             for name, (inputs, _width) in C_OPERATIONS.items():
-                parameters = ", ".join(f"const {ctype} *{i}" for i in (*inputs, "out")).replace(
-                    f"const {ctype} *out", f"{ctype} *out")
+                parameters = ", ".join([*(f"const {ctype} *{i}" for i in inputs), f"{ctype} *out"])
                 signature = f"void o_{name}{suffix}({parameters})"
                 call = f"symrot_{header}_{name}{suffix}({', '.join(inputs)}, out)"
                 lines += [f"{signature};", f"{signature} {{ (void){call}; }}"]
