@@ -19,6 +19,7 @@ Run: ``python bench/accuracy_corpus.py [--points N] [--only I ...] [--no-c] [--o
 from __future__ import annotations
 
 import argparse
+import ctypes
 import json
 import subprocess
 import sys
@@ -106,8 +107,6 @@ class COperations:
     -ffp-contract=off, the configuration of the kinematic wrappers)."""
 
     def __init__(self, directory: Path, header: str) -> None:
-        import ctypes
-
         from tests.c_harness import build_config, compile_one
 
         lines = [f'#include "symrot_{header}.h"']
@@ -122,13 +121,12 @@ class COperations:
         source = out_dir / "operations.c"
         source.write_text("\n".join(lines) + "\n", encoding="utf-8")
         self.dll = ctypes.CDLL(str(compile_one(build_config("gcc-O2-nofma"), source, directory, out_dir)))
-        self.ctypes = ctypes
 
     def call(self, name: str, dtype: Any, *arrays: np.ndarray) -> np.ndarray:
         """``name``'s outputs for one input (each array one vector), in ``dtype``."""
         inputs, width = C_OPERATIONS[name]
-        ctype = self.ctypes.c_double if dtype == np.float64 else self.ctypes.c_float
-        pointer = self.ctypes.POINTER(ctype)
+        ctype = ctypes.c_double if dtype == np.float64 else ctypes.c_float
+        pointer = ctypes.POINTER(ctype)
         values = [np.ascontiguousarray(a, dtype=dtype) for a in arrays]
         out = np.empty(width, dtype=dtype)
         function = getattr(self.dll, f"o_{name}" + ("" if dtype == np.float64 else "_f"))
