@@ -668,9 +668,11 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
                                      f"({float(series[0]):.3g}) is not finite in that format")
 
     def truncation(t: float, n: int) -> float:
-        rest = floats[n:n + 2]
+        # the first two terms left out that are not zero: sin φ/p of p = φ − φ³/6 + φ⁵/120 is
+        # 1 − x³/5040 + …, and its terms x, x² (zero) said that 1 alone was exact up to x = 0.02
+        rest = [(j, c) for j, c in enumerate(floats[n:], start=n) if c != 0][:2]
         with np.errstate(all="ignore"):  # coefficients beyond float64 are inf here: inf or NaN expected
-            return sum(c * t ** (n + j) for j, c in enumerate(rest)) / (scale0 * epsilon)
+            return sum(c * t ** j for j, c in rest) / (scale0 * epsilon)
 
     best, best_k = np.inf, len(angles) - 1
     near_zero = int(np.searchsorted(angles, 0.5 * min(phi_max, 4 * np.pi)))

@@ -453,3 +453,28 @@ def test_float32_from_quaternion_next_to_a_pole_rounds_once() -> None:
         got = from_quaternion(e)  # type: ignore[operator]
         assert got.dtype == np.float32 and got[1] == got[2] == 0
         assert abs(mpmath.mpf(float(got[0])) - exact) <= 2 * np.spacing(np.float32(float(exact))), phi
+
+
+def test_a_series_with_zero_terms_is_cut_by_its_next_term_that_is_not_zero() -> None:
+    """p = φ − φ³/6 + φ⁵/120 (a fold at 1.59): sin φ/p = 1 − x³/5040 + … in x = |p|². The
+    truncation error of a polynomial was estimated from the next two terms, x and x², both zero,
+    so the rotation matrix took the polynomial 1 up to x = 0.02: 7·10⁴ ulp off at φ = 0.1 (and
+    the tangent 9·10⁵). Measured against the independent reference of tests/reference.py."""
+    from symrot.backends.numpy_backend import module_source
+    from tests.reference import GeneratingFunction, Reference
+
+    expression = "phi - phi**3/6 + phi**5/120"
+    plan = evaluation_plan(derive(expression).derivation, "sine_quintic")
+    namespace: dict[str, object] = {}
+    exec(compile(module_source(plan), "<sine_quintic>", "exec"), namespace)
+    reference = Reference(GeneratingFunction(expression, phi_max_text="1.5924504340362513"))
+    axis = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    epsilon = np.finfo(np.float64).eps
+    with mpmath.workdps(60):
+        for phi in (0.03, 0.06, 0.1, 0.14, 0.3):
+            p = float(reference.function.value(mpmath.mpf(phi))) * axis
+            state = reference.state([mpmath.mpf(float(v)) for v in p], phi)
+            for function, exact in (("rotation_matrix", state.R), ("tangent", state.H)):
+                got = namespace[function](p)  # type: ignore[operator]
+                error = max(abs(float(got[i, j]) - float(exact[i, j])) for i in range(3) for j in range(3))
+                assert error <= 4 * epsilon, (function, phi, error / epsilon)
