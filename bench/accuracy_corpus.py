@@ -397,11 +397,23 @@ def verdict(entries: list[dict[str, Any]]) -> str:
     return "**miss**"
 
 
+def miss_text(e: dict[str, Any]) -> str:
+    """Where a tally misses: its worst ulp/κ and that angle, then its worst ulp where that is
+    elsewhere (results written before ``excess_at`` existed give the worst ulp only)."""
+    nan = f" ({e['nonfinite']} NaN/Inf)" if e["nonfinite"] else ""
+    worst = f"{e['ulp']:.3g} ulp at φ = {e['at']:.3g}"
+    if "excess_at" not in e or e["excess_at"] == e["at"]:
+        return worst + (f" (κ {e['kappa']:.2g})" if e["kappa"] > 1 else "") + nan
+    return f"{e['excess']:.3g} κ ulp at φ = {e['excess_at']:.3g} (worst {worst}, κ {e['kappa']:.2g}){nan}"
+
+
 def _cell(e: dict[str, Any] | None) -> str:
     if e is None:
         return "—"
     nan = f"; {e['nonfinite']} NaN/Inf" if e["nonfinite"] else ""
-    return f"{e['ulp']:.3g} ({e['at']:.3g}; κ {e['kappa']:.2g}{nan})"
+    where = f"; {e['excess']:.3g} κ at {e['excess_at']:.3g}" \
+        if e["excess"] > TARGET_ULP and e.get("excess_at", e["at"]) != e["at"] else ""
+    return f"{e['ulp']:.3g} ({e['at']:.3g}; κ {e['kappa']:.2g}{where}{nan})"
 
 
 def _verdicts(result: dict[str, Any]) -> dict[tuple[str, str], str]:

@@ -85,11 +85,11 @@ def worker(expression: str, points: int, with_c: bool) -> dict[str, Any]:
 
 
 def misses(result: dict[str, Any]) -> list[str]:
-    """'precision backend function ulp at φ (κ)' of every tally that misses the target."""
-    from accuracy_corpus import verdict
+    """'backend precision function: worst ulp/κ at φ (worst ulp at φ)' of every tally that misses
+    the target."""
+    from accuracy_corpus import miss_text, verdict
 
-    return [f"{t['backend']} {t['precision']} {t['function']} {t['ulp']:.3g} ulp at φ = {t['at']:.3g}"
-            + (f" ({t['nonfinite']} NaN/Inf)" if t["nonfinite"] else "")
+    return [f"{t['backend']} {t['precision']} {t['function']} {miss_text(t)}"
             for t in result.get("tallies", []) if verdict([t]) not in GOOD]
 
 
