@@ -118,6 +118,9 @@ of one plan may simplify; past it, coefficients get branches. A count, not a tim
 the same on every machine and under any load."""
 PRECISIONS: dict[str, type[np.floating]] = {"float64": np.float64, "float32": np.float32}
 CLOSED_TOLERANCE_ULP = 1.5
+POLYNOMIAL_TOLERANCE_ULP = 2.0
+"""A branch's Horner polynomial, measured on the grid below its switch, must stay within this
+(the truncation estimate alone keeps it below a quarter ulp plus the rounding of Horner's steps)."""
 ANGLE_TOLERANCE_ULP = 2.0
 """A closed inverse φ(s) is printed only when its measured error (beyond the conditioning of φ(s),
 see :func:`closed_angle_error`) stays within this; otherwise the Newton angle is used."""
@@ -638,6 +641,19 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     # c(0): G_2 ~ 2/x next to 2 pi (G_2 x is of order 1, c(0) = 1/8 would hide any relative error of
     # G_2 itself); H_across ~ mu next to 2 pi for phi + phi^3/6 (~ 0.05, with c(0) = 1)
     closed_error = np.zeros(len(angles))
+
+    def relative_errors(values: np.ndarray, k: int) -> np.ndarray:
+        """ulp of ``values`` at grid angle k's points (inf where not finite)."""
+        exact = reference[k]
+        with np.errstate(all="ignore"):
+            floor = scale0 if floors is None else np.fmin(scale0, floors[k])
+            errors = np.abs(values - exact) / (np.maximum(np.abs(exact), floor) * epsilon)
+        # a value below the format's normal range has no digits to lose: every finite form ties
+        # there (det H ~ 1/x² of tan φ + tan³φ/3 underflows float32 next to its pole, and that tie
+        # chose the form in φ̂ over the one through s, which is right up to the underflow)
+        unmeasured = np.isnan(exact) | ((exact != 0) & (np.abs(exact) < tiny))
+        return np.where(np.isfinite(values), np.where(unmeasured, 0.0, errors), np.inf)
+
     # one evaluation over every grid angle's points (the model is elementwise), split per angle
     joined = [np.concatenate(columns) for columns in (inputs.angles, inputs.lengths, inputs.squares,
                                                       inputs.complements)]
@@ -647,16 +663,7 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         if not len(inputs.angles[k]):
             continue
         values = printed_all[ends[k] - len(inputs.angles[k]):ends[k]]
-        exact = reference[k]
-        with np.errstate(all="ignore"):
-            floor = scale0 if floors is None else np.fmin(scale0, floors[k])
-            errors = np.abs(values - exact) / (np.maximum(np.abs(exact), floor) * epsilon)
-        # a value below the format's normal range has no digits to lose: every finite form ties
-        # there (det H ~ 1/x² of tan φ + tan³φ/3 underflows float32 next to its pole, and that tie
-        # chose the form in φ̂ over the one through s, which is right up to the underflow)
-        unmeasured = np.isnan(exact) | ((exact != 0) & (np.abs(exact) < tiny))
-        errors = np.where(np.isfinite(values), np.where(unmeasured, 0.0, errors), np.inf)
-        closed_error[k] = float(np.max(errors))
+        closed_error[k] = float(np.max(relative_errors(values, k)))
     floats = [_magnitude(c) for c in series]
     # every Horner coefficient must be finite in the format (e.g. 1000 tan(φ/1000) has a
     # coefficient 1.1e42 of x in H⁻¹, beyond float32): the polynomial keeps only the leading terms
@@ -704,8 +711,40 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
             best_k += 1
     best = min(best, max(float(np.max(closed_error[best_k:near_zero])),
                          truncation(t_values[best_k], top)))
-    threshold = float(t_values[best_k])
+
+    def polynomial_misses(below: float, terms: int) -> bool:
+        """Whether the first ``terms`` terms, measured on the grid points with t < ``below`` (Horner
+        in float64: for float32 the truncation alone), are somewhere off by more than
+        POLYNOMIAL_TOLERANCE_ULP and by more than the closed form at that grid angle."""
+        coefficients = [float(c) for c in series[:terms]]
+        for k in range(near_zero):
+            t = inputs.squares[k].astype(np.float64)
+            if not len(t) or not t.min() < below:
+                continue
+            value = np.zeros_like(t)
+            for c in reversed(coefficients):
+                value = value * t + c
+            error = float(np.max(relative_errors(value, k)[t < below]))
+            if error > max(POLYNOMIAL_TOLERANCE_ULP, closed_error[k]):
+                return True
+        return False
+
+    # the truncation is an estimate from a few terms: the polynomials are also measured against the
+    # reference, and a switch moves down while its polynomial misses
     accurate_terms = terms_at(accurate_threshold)
+    lowered = False
+    while best_k > 0 and polynomial_misses(float(t_values[best_k]),
+                                           max(terms_at(float(t_values[best_k])), accurate_terms)):
+        best_k, lowered = best_k - 1, True
+        if float(t_values[best_k]) < accurate_threshold:
+            accurate_threshold = float(t_values[best_k])
+            accurate_terms = terms_at(accurate_threshold)
+    while accurate_threshold > float(t_values[0]) and polynomial_misses(accurate_threshold, accurate_terms):
+        accurate_threshold = float(t_values[int(np.searchsorted(t_values, accurate_threshold)) - 1])
+        accurate_terms = terms_at(accurate_threshold)
+    if lowered:  # the closed form now serves more of the range
+        best = max(float(np.max(closed_error[best_k:near_zero])), truncation(t_values[best_k], top))
+    threshold = float(t_values[best_k])
     degree = max(terms_at(threshold), accurate_terms)
     if whole is not None:  # every backend takes this switch: the accuracy is the point
         accurate_threshold, accurate_terms = threshold, degree

@@ -478,3 +478,21 @@ def test_a_series_with_zero_terms_is_cut_by_its_next_term_that_is_not_zero() -> 
                 got = namespace[function](p)  # type: ignore[operator]
                 error = max(abs(float(got[i, j]) - float(exact[i, j])) for i in range(3) for j in range(3))
                 assert error <= 4 * epsilon, (function, phi, error / epsilon)
+
+
+def test_a_polynomial_is_measured_below_its_switch_not_only_estimated() -> None:
+    """The same coefficient, sin φ/p of p = φ − φ³/6 + φ⁵/120, given a series that wrongly ends
+    after its first term (every later term zero): the estimate then says 1 is exact everywhere,
+    and only the measurement against the reference moves the switch down to where 1 is within
+    POLYNOMIAL_TOLERANCE_ULP of sin φ/p = 1 − x³/5040 + …"""
+    from symrot.plan import POLYNOMIAL_TOLERANCE_ULP, plan_branch
+
+    p = PHI - PHI**3 / 6 + PHI**5 / 120
+    wrong_series = [sp.Integer(1)] + [sp.Integer(0)] * 10
+    for dtype in (np.float64, np.float32):
+        branch = plan_branch(sp.sin(PHI) / p, wrong_series, p**2, 1.5924504340362513, dtype, p)
+        epsilon = float(np.finfo(dtype).eps)
+        for threshold in (branch.threshold, branch.smallest_switch[0]):
+            # where the polynomial 1 is used, x³/5040 is its error (measured up to the grid point
+            # below the switch: a factor 1.5 for the step to the switch)
+            assert threshold**3 / 5040 <= 1.5 * POLYNOMIAL_TOLERANCE_ULP * epsilon, (dtype, threshold)
