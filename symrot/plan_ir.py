@@ -320,10 +320,15 @@ def _grows_faster_than_angle(p: sp.Expr, phi_max: float, where_half_sine_is_ill:
     return False
 
 
+def nearest_binary(value: sp.Rational, mantissa_bits: int) -> mpmath.mpf:
+    """The number of ``mantissa_bits`` bits nearest to ``value`` (ties to even), as an mpmath
+    number: what a compiler makes of a literal of ``value`` in a format of that precision."""
+    return mpmath.mpf(from_rational(int(value.p), int(value.q), mantissa_bits, "n"))
+
+
 def _rounded(value: sp.Rational, mantissa_bits: int) -> sp.Rational:
-    """The number of ``mantissa_bits`` bits nearest to ``value`` (ties to even), exactly."""
+    """:func:`nearest_binary` as an exact rational."""
     if value == 0:
         return sp.Integer(0)
-    size = abs(value)  # man_exp gives the magnitude's mantissa
-    mantissa, exponent = mpmath.mpf(from_rational(int(size.p), int(size.q), mantissa_bits, "n")).man_exp
+    mantissa, exponent = nearest_binary(abs(value), mantissa_bits).man_exp  # of the magnitude
     return sp.sign(value) * sp.Integer(mantissa) * sp.Integer(2) ** exponent

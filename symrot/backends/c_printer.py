@@ -26,11 +26,11 @@ from typing import Any, Literal
 import mpmath
 import numpy as np
 import sympy as sp
-from mpmath.libmp import from_rational
 from sympy.codegen.ast import float32, float64, real
 from sympy.printing.c import C99CodePrinter
 
 from ..errors import NonFiniteLiteral
+from ..plan_ir import nearest_binary
 
 Precision = Literal["double", "float"]
 PRECISIONS: tuple[Precision, ...] = ("double", "float")
@@ -62,7 +62,7 @@ class SymrotCPrinter(C99CodePrinter):
         bits = MANTISSA_BITS[self.precision]
         number = sp.sympify(value)
         if number.is_Rational:
-            rounded = mpmath.mpf(from_rational(int(number.p), int(number.q), bits, "n"))
+            rounded = nearest_binary(number, bits)
         else:
             with mpmath.workprec(bits):
                 rounded = +sp.Float(number, 70)._to_mpmath(240)

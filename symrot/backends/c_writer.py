@@ -188,8 +188,8 @@ class FunctionWriter:
         fma = "fma" if t == "double" else "fmaf"
         assert self.plan.complement is not None
         complement = sp.Rational(self.plan.complement)  # 16/9 for (4/3) sin(3φ/4): not an integer
-        k2 = self.printer.literal(complement)
-        _high, tail = self.plan.complement_parts(MANTISSA_BITS[self.precision])
+        high, tail = self.plan.complement_parts(MANTISSA_BITS[self.precision])
+        k2 = self.printer.literal(high)  # exact in the type: the literal of p_max² rounded
         near = {"kind": "if", "condition": f"x <= {self.printer.literal(complement / 4)}",
                 "then": [{"kind": "return", "value": f"{k2} - x", "ops": 1}], "otherwise": [], "ops": 0}
         low = self.printer.literal(tail) if tail != 0 else "0"
