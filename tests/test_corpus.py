@@ -316,3 +316,20 @@ def test_the_c_sweep_measures_the_quaternion_operations() -> None:
     assert {(t["function"], t["precision"]) for t in swept} == {
         (f, p) for f in C_OPERATIONS for p in ("float64", "float32")}
     assert all(t["points"] > 0 and verdict([t]) in ("meets", "conditioned") for t in swept), swept
+
+
+def test_a_miss_is_reported_where_its_error_exceeds_the_condition() -> None:
+    """The worst ulp and the worst ulp/κ may be at different angles: corpus entry 5 (φ − φ³/6 + φ⁵/120)
+    had 1.15·10¹² ulp at its fold, within κ there, and was reported at the fold while it missed by
+    9·10⁵ κ at φ = 0.1. A tally keeps both, and the report names the second."""
+    from accuracy import Worst
+    from accuracy_corpus import miss_text
+
+    worst = Worst()
+    worst.add(7.8e4, 0.1, 0.09)
+    worst.add(1.15e12, 1.59, 1.09e12)
+    worst.add(2.0, 1.0, 1.0)
+    assert (worst.ulp, worst.at, worst.excess, worst.excess_at) == (1.15e12, 1.59, 7.8e4, 0.1)
+    tally = {"ulp": worst.ulp, "at": worst.at, "kappa": worst.kappa, "excess": worst.excess,
+             "excess_at": worst.excess_at, "nonfinite": 0}
+    assert miss_text(tally).startswith("7.8e+04 κ ulp at φ = 0.1 (worst 1.15e+12 ulp at φ = 1.59")
