@@ -640,30 +640,30 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
     # a coefficient of a tensor counts relative to what it adds to the tensor where that is below
     # c(0): G_2 ~ 2/x next to 2 pi (G_2 x is of order 1, c(0) = 1/8 would hide any relative error of
     # G_2 itself); H_across ~ mu next to 2 pi for phi + phi^3/6 (~ 0.05, with c(0) = 1)
-    closed_error = np.zeros(len(angles))
-
-    def relative_errors(values: np.ndarray, k: int) -> np.ndarray:
-        """ulp of ``values`` at grid angle k's points (inf where not finite)."""
-        exact = reference[k]
-        with np.errstate(all="ignore"):
-            floor = scale0 if floors is None else np.fmin(scale0, floors[k])
-            errors = np.abs(values - exact) / (np.maximum(np.abs(exact), floor) * epsilon)
-        # a value below the format's normal range has no digits to lose: every finite form ties
-        # there (det H ~ 1/x² of tan φ + tan³φ/3 underflows float32 next to its pole, and that tie
-        # chose the form in φ̂ over the one through s, which is right up to the underflow)
-        unmeasured = np.isnan(exact) | ((exact != 0) & (np.abs(exact) < tiny))
-        return np.where(np.isfinite(values), np.where(unmeasured, 0.0, errors), np.inf)
-
-    # one evaluation over every grid angle's points (the model is elementwise), split per angle
+    # every grid angle's points at once (the models are elementwise); per angle k: points_of[k]
     joined = [np.concatenate(columns) for columns in (inputs.angles, inputs.lengths, inputs.squares,
                                                       inputs.complements)]
-    printed_all = np.broadcast_to(np.asarray(model_closed(*joined), dtype=np.float64), joined[0].shape)
     ends = np.cumsum([len(a) for a in inputs.angles])
-    for k in range(len(angles)):
-        if not len(inputs.angles[k]):
-            continue
-        values = printed_all[ends[k] - len(inputs.angles[k]):ends[k]]
-        closed_error[k] = float(np.max(relative_errors(values, k)))
+    points_of = [slice(int(end) - len(a), int(end)) for end, a in zip(ends, inputs.angles, strict=True)]
+    exact = np.concatenate(reference) if len(reference) else np.zeros(0)
+    floor = scale0 if floors is None else np.fmin(scale0, np.concatenate(floors))
+    with np.errstate(all="ignore"):
+        scale = np.maximum(np.abs(exact), floor)
+    # a value below the format's normal range has no digits to lose: every finite form ties
+    # there (det H ~ 1/x² of tan φ + tan³φ/3 underflows float32 next to its pole, and that tie
+    # chose the form in φ̂ over the one through s, which is right up to the underflow)
+    unmeasured = np.isnan(exact) | ((exact != 0) & (np.abs(exact) < tiny))
+
+    def relative_errors(values: np.ndarray) -> np.ndarray:
+        """ulp of ``values`` at every grid point (inf where not finite)."""
+        with np.errstate(all="ignore"):
+            errors = np.abs(values - exact) / (scale * epsilon)
+        return np.where(np.isfinite(values), np.where(unmeasured, 0.0, errors), np.inf)
+
+    closed_errors = relative_errors(np.broadcast_to(np.asarray(model_closed(*joined), dtype=np.float64),
+                                                    joined[0].shape))
+    closed_error = np.array([float(np.max(closed_errors[points])) if points.stop > points.start else 0.0
+                             for points in points_of])
     floats = [_magnitude(c) for c in series]
     # every Horner coefficient must be finite in the format (e.g. 1000 tan(φ/1000) has a
     # coefficient 1.1e42 of x in H⁻¹, beyond float32): the polynomial keeps only the leading terms
@@ -716,18 +716,16 @@ def _branch_for(closed: sp.Expr, series: list[sp.Expr], variable_of_phi: sp.Expr
         """Whether the first ``terms`` terms, measured on the grid points with t < ``below`` (Horner
         in float64: for float32 the truncation alone), are somewhere off by more than
         POLYNOMIAL_TOLERANCE_ULP and by more than the closed form at that grid angle."""
-        coefficients = [float(c) for c in series[:terms]]
-        for k in range(near_zero):
-            t = inputs.squares[k].astype(np.float64)
-            if not len(t) or not t.min() < below:
-                continue
-            value = np.zeros_like(t)
-            for c in reversed(coefficients):
-                value = value * t + c
-            error = float(np.max(relative_errors(value, k)[t < below]))
-            if error > max(POLYNOMIAL_TOLERANCE_ULP, closed_error[k]):
-                return True
-        return False
+        value = np.zeros_like(squares)
+        for c in reversed([float(c) for c in series[:terms]]):
+            value = value * squares + c
+        served = below_edge & (squares < below)
+        return bool(np.any(relative_errors(value)[served] > allowed[served]))
+
+    squares = joined[2].astype(np.float64)
+    # the grid's lower half (a polynomial's range), and per point the closed form's worst at its angle
+    below_edge = np.arange(len(squares)) < (int(ends[near_zero - 1]) if near_zero else 0)
+    allowed = np.maximum(POLYNOMIAL_TOLERANCE_ULP, np.repeat(closed_error, np.diff(ends, prepend=0)))
 
     # the truncation is an estimate from a few terms: the polynomials are also measured against the
     # reference, and a switch moves down while its polynomial misses
