@@ -102,6 +102,11 @@ ANGLE_CORRECTION_GROWTH = 4.0
 (``EvaluationPlan.angle_correction``): λ's error is about (k + ½) ε s/p′ for a residual k units of
 roundoff off, φ's rounding ½ ε φ, so λ gains where φ p′/p > 2k + 1 (k ≈ 1–2 for the plans' ratios)."""
 
+NARROW_CORRECTION_GROWTH = 1.0
+"""φ p′/p above which a float32 closed angle takes λ from float64's angle next to 2π: that λ is exact
+to float32's eyes, so it gains wherever s is better conditioned than φ. 3 sinh(φ/3) (φ p′/p = 2.2 at
+2π) had float32 ``tangent_inverse`` 1.8·10⁷ ulp, 5.7 times its condition number, at 2π − 10⁻⁶."""
+
 ANGLE_CORRECTION_LIMIT = 4
 """λ is applied while |λ| ≤ ANGLE_CORRECTION_LIMIT ε φ (``EvaluationPlan.angle_correction_bound``):
 a larger λ means the iterate φ was not converged and one Newton correction would not be exact."""
@@ -262,15 +267,16 @@ class EvaluationPlan:
         where p grows that fast next to 2π, where sin(φ/2) is ill conditioned in φ (not at the
         tangent family's poles, where it is not: there λ would only cost time), and not for p whose
         plan has a complement d (float32's d would have to be widened exactly)."""
-        if not self.grows_faster_than_angle():
-            return {}
-        newton = [label for label, precision in self.precisions.items()
-                  if isinstance(precision.angle, NewtonAngle)]
-        correction = {label: "float64" if "float64" in newton else label for label in newton}
+        correction: dict[str, str] = {}
+        if self.grows_faster_than_angle():
+            newton = [label for label, precision in self.precisions.items()
+                      if isinstance(precision.angle, NewtonAngle)]
+            correction = {label: "float64" if "float64" in newton else label for label in newton}
         narrow = self.precisions.get("float32")
         if (narrow is not None and isinstance(narrow.angle, ClosedAngle) and "float64" in self.precisions
                 and self.complement is None and narrow.uses_angle()
-                and _grows_faster_than_angle(self.p, self.phi_max, where_half_sine_is_ill=True)):
+                and _grows_faster_than_angle(self.p, self.phi_max, where_half_sine_is_ill=True,
+                                             growth_above=NARROW_CORRECTION_GROWTH)):
             correction["float32"] = "float64"
         return correction
 
@@ -299,10 +305,11 @@ class EvaluationPlan:
 
 
 @lru_cache(maxsize=64)
-def _grows_faster_than_angle(p: sp.Expr, phi_max: float, where_half_sine_is_ill: bool = False) -> bool:
-    """See ``EvaluationPlan.grows_faster_than_angle``; with ``where_half_sine_is_ill``, only at
-    angles where sin(φ/2) is ill conditioned in φ, |(φ/2) cot(φ/2)| > ANGLE_CORRECTION_GROWTH
-    (φ > 5.8: next to 2π)."""
+def _grows_faster_than_angle(p: sp.Expr, phi_max: float, where_half_sine_is_ill: bool = False,
+                             growth_above: float = ANGLE_CORRECTION_GROWTH) -> bool:
+    """See ``EvaluationPlan.grows_faster_than_angle`` (φ p′/p > ``growth_above`` somewhere); with
+    ``where_half_sine_is_ill``, only at angles where sin(φ/2) is ill conditioned in φ,
+    |(φ/2) cot(φ/2)| > ANGLE_CORRECTION_GROWTH (φ > 5.8: next to 2π)."""
     end = phi_max if math.isfinite(phi_max) else 4 * math.pi
     growth = sp.lambdify(PHI, PHI * sp.diff(p, PHI) / p, modules=[mpmath_namespace(), "mpmath"])
     with mpmath.workdps(30):
@@ -315,7 +322,7 @@ def _grows_faster_than_angle(p: sp.Expr, phi_max: float, where_half_sine_is_ill:
                 value = growth(angle)
             except (ZeroDivisionError, ValueError, OverflowError):
                 continue
-            if isinstance(value, mpmath.mpf) and value > ANGLE_CORRECTION_GROWTH:
+            if isinstance(value, mpmath.mpf) and value > growth_above:
                 return True
     return False
 

@@ -149,3 +149,39 @@ def test_c_float_functions_of_a_closed_angle_use_no_double() -> None:
     text = header_source(plan_of(CLOSED), "corrected")
     float_part = "\n".join(line for line in text.splitlines() if "_f(" in line or "float" in line)
     assert "half_low" not in text and "(double)" not in float_part
+
+
+def test_a_closed_angle_growing_slower_than_four_phi_corrects_float32_too() -> None:
+    """3 sinh(φ/3): φ p′/p = 2.2 at 2π, below ANGLE_CORRECTION_GROWTH, so its float32 closed angle
+    had no λ, and float32 ``tangent_inverse`` was 7.1 times its condition number off on these
+    points next to 2π (5.7 at 2π − 10⁻⁶ in the hypothesis sample). float64's λ is exact to float32's
+    eyes, so a float32 closed angle takes it wherever φ p′/p > 1 next to 2π
+    (NARROW_CORRECTION_GROWTH). The reference is tests/reference.py; κ as docs/accuracy.md."""
+    import sys
+
+    from .reference import GeneratingFunction, Reference
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
+    from accuracy import condition
+
+    expression = "3*sinh(phi/3)"
+    assert plan_of(expression).angle_correction() == {"float32": "float64"}
+    function = GeneratingFunction(expression, phi_max_text="2*pi")
+    reference = Reference(function)
+    axes = np.random.default_rng(5).normal(size=(4, 3))
+    worst = []
+    with mpmath.workdps(60):
+        for text in ("6.28318", "6.283184", "6.2831843"):
+            for axis in axes / np.linalg.norm(axes, axis=1)[:, None]:
+                p = (float(function.value(mpmath.mpf(text))) * axis).astype(np.float32)
+                inputs = [mpmath.mpf(float(v)) for v in p]
+                exact = reference.state(inputs, float(text)).H_inverse
+                entries = [exact[i, j] for i in range(3) for j in range(3)]
+                scale = max(1.0, max(float(abs(v)) for v in entries))
+                got = np.asarray(numpy_module(expression)["tangent_inverse"](p), dtype=np.float64).ravel()
+                ulp = max(float(abs(mpmath.mpf(float(g)) - v)) for g, v in zip(got, entries, strict=True)) \
+                    / (scale * float(np.finfo(np.float32).eps))
+                kappa = condition(lambda x, t=float(text): {"f": reference.state(x, t).H_inverse}, inputs,
+                                  {"f": exact}, {"f": scale})["f"]
+                worst.append((ulp / max(1.0, kappa), text))
+    assert max(worst)[0] <= 4.0, max(worst)
