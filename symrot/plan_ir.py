@@ -264,7 +264,8 @@ class EvaluationPlan:
         A float32 closed angle takes λ = φ₆₄(s) − φ, float64's angle (closed, or one Newton step
         from φ with float64's helpers) minus its own, wherever it is used: that λ is exact to
         float32's eyes. 2 sinh(3φ/2)/3 at φ = 6.283: float32 ``pdot`` was 1.8·10⁶ ulp off. Only
-        where p grows that fast next to 2π, where sin(φ/2) is ill conditioned in φ (not at the
+        where φ p′/p > :data:`NARROW_CORRECTION_GROWTH` (any growth faster than φ: the λ is exact)
+        next to 2π, where sin(φ/2) is ill conditioned in φ (not at the
         tangent family's poles, where it is not: there λ would only cost time), and not for p whose
         plan has a complement d (float32's d would have to be widened exactly)."""
         correction: dict[str, str] = {}
