@@ -9,7 +9,7 @@ import pytest
 import sympy as sp
 
 from symrot.api import derive
-from symrot.parsing import PHI
+from symrot.parsing import PHI, parse_expression
 from symrot.plan import ClosedAngle, S, closed_angle_error, closed_inverse, evaluation_plan, half_angle_sums
 
 
@@ -496,3 +496,30 @@ def test_a_polynomial_is_measured_below_its_switch_not_only_estimated() -> None:
             # where the polynomial 1 is used, x³/5040 is its error (measured up to the grid point
             # below the switch: a factor 1.5 for the step to the switch)
             assert threshold**3 / 5040 <= 1.5 * POLYNOMIAL_TOLERANCE_ULP * epsilon, (dtype, threshold)
+
+
+def test_a_bounded_p_is_valid_up_to_p_max_even_where_the_domain_sweep_stops_early() -> None:
+    """A held-out function (seed 2030, row 17): p is bounded (p_max = 2.39·10⁶ at 2π), and the
+    domain sweep put x_limit at 2⁴² (φ ≈ 6.23), judging forms through sin(φ/2) of the rounded angle
+    without the λ the backends apply. The NumPy module tested x < x_limit for every p and gave NaN
+    for every function from φ ≈ 6.23 to 2π; the C header tests x_limit only for unbounded p. Now
+    NumPy (and JAX/PyTorch) test it as C does."""
+    from symrot.backends.numpy_backend import module_source
+
+    expression = "9*phi**3*cos(phi/4)/5 + 2*phi*cosh(phi/4)/5 + 3*sinh(2*phi)*cosh(3*phi/4)/10"
+    plan = evaluation_plan(derive(expression).derivation, "bounded_early_limit")
+    assert plan.precisions["float64"].x_limit < plan.p_max**2  # the case of this test
+    namespace: dict[str, object] = {}
+    exec(compile(module_source(plan), "<bounded_early_limit>", "exec"), namespace)
+    p_of = sp.lambdify(PHI, parse_expression(expression), "mpmath")
+    for text in ("6.25", "6.27", "6.283"):
+        with mpmath.workdps(40):
+            s = float(p_of(mpmath.mpf(text)))
+            exact = mpmath.findroot(lambda phi, s=s: p_of(phi) - s, mpmath.mpf(text))
+        for dtype in (np.float64, np.float32):
+            p = np.array([0.6 * s, 0.8 * s, 0.0], dtype=dtype)
+            got = namespace["angle"](p)  # type: ignore[operator]
+            tolerance = 4 * float(np.finfo(dtype).eps) * float(exact)
+            assert abs(float(got) - float(exact)) <= tolerance, (text, dtype)
+            for function in ("rotation_matrix", "tangent", "tangent_inverse"):
+                assert np.all(np.isfinite(namespace[function](p))), (function, text, dtype)  # type: ignore[operator]

@@ -825,9 +825,8 @@ def _length(p, suffix):
 
 
 def _inside(x, suffix):
-    """The validity test on x = |p|^2 (as in the C header); x >= _X_LIMIT (at most 2^600, 2^100 in
-    float32) is outside even when p is unbounded."""
-    return (x < P_MAX_SQUARED) & (x < _X_LIMIT[suffix])
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x < P_MAX_SQUARED
 
 
 def _span(x, suffix):

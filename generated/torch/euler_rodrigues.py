@@ -668,8 +668,8 @@ def _length(p, x, suffix):
 
 
 def _inside(x, suffix):
-    """The validity test on x = |p|^2; x >= _X_LIMIT is outside even when p is unbounded."""
-    return (x < P_MAX_SQUARED) & (x < _X_LIMIT[suffix])
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x < P_MAX_SQUARED
 
 
 def _prepare(p, names):
