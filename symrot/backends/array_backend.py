@@ -271,6 +271,7 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
             "complement": str(plan.complement) if plan.complement is not None else None,
             "complement_low": complement_low(plan),
             "p_max_squared": repr(squared) if math.isfinite(squared) else "math.inf",
+            "p_max_squared_finite": math.isfinite(squared),
             "inclusive": inclusive,
             "x_limit": {SUFFIX[label]: repr(precision.x_limit)
                         for label, precision in plan.precisions.items()},

@@ -285,6 +285,7 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "complement": str(plan.complement) if plan.complement is not None else None,
             "complement_low": complement_low(plan),
             "p_max_squared": repr(squared) if np.isfinite(squared) else "numpy.inf",
+            "p_max_squared_finite": bool(np.isfinite(squared)),
             "inclusive": inclusive,
             "x_limit": {SUFFIX[label]: repr(precision.x_limit)
                         for label, precision in plan.precisions.items()},
