@@ -18,6 +18,7 @@ from pathlib import Path
 
 from . import strict_json
 from .api import derive
+from .atomic import write_atomic
 from .forked import in_child
 from .registry import NAMED
 from .timeouts import deterministic
@@ -279,7 +280,7 @@ def write(root: Path, files: dict[str, Content], prefixes: list[str]) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         data = _encode(content)
         if not path.exists() or path.read_bytes() != data:
-            path.write_bytes(data)
+            write_atomic(path, data)
 
 
 def check(root: Path, files: dict[str, Content], prefixes: list[str], name: str | None = None) -> list[str]:

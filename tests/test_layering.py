@@ -34,7 +34,7 @@ LAYER_OF_PREFIX: dict[str, str] = {
     **{f"symrot.{name}": "core" for name in (
         "axial", "core", "errors", "functions", "operations", "parsing", "registry", "series",
         "series_engine", "simplify", "singularities", "solve", "timeouts", "validation", "budget", "forked",
-        "two_processes", "derivatives",
+        "two_processes", "derivatives", "atomic",
     )},
 }
 MAY_IMPORT: dict[str, set[str]] = {

@@ -29,6 +29,7 @@ import mpmath
 import sympy as sp
 
 from ..algebraic import D, X
+from ..atomic import write_atomic
 from ..newton_start import FarStart
 from ..parsing import PHI
 from ..plan import (
@@ -294,5 +295,5 @@ def emit_framework(derivation: Any, name: str, out: Path, framework: str) -> lis
     """Write ``out/NAME.py`` for ``framework``; return the written paths."""
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"{name}.py"
-    path.write_text(module_source(evaluation_plan(derivation, name), framework), encoding="utf-8")
+    write_atomic(path, module_source(evaluation_plan(derivation, name), framework))
     return [path]

@@ -19,6 +19,7 @@ from typing import Any
 
 import sympy as sp
 
+from ..atomic import write_atomic
 from ..core import Derivation, derive_expression
 from ..derivatives import rate_vector, tensor_derivative
 from ..errors import SymrotError
@@ -110,7 +111,7 @@ def emit(derivation: Derivation, name: str, out: Path) -> list[Path]:
     text = header_source(plan_for(derivation, name), name)
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"symrot_{name}.h"
-    path.write_text(text, encoding="utf-8")
+    write_atomic(path, text)
     return [path]
 
 

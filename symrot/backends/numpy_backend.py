@@ -29,6 +29,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from ..algebraic import D, X
+from ..atomic import write_atomic
 from ..newton_start import FarStart, edge_floor, edge_step
 from ..parsing import PHI
 from ..plan import (
@@ -394,5 +395,5 @@ def emit(derivation: Any, name: str, out: Path) -> list[Path]:
     """Write ``out/NAME.py`` for ``derivation``; return the written paths."""
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"{name}.py"
-    path.write_text(module_source(evaluation_plan(derivation, name)), encoding="utf-8")
+    write_atomic(path, module_source(evaluation_plan(derivation, name)))
     return [path]

@@ -2,9 +2,12 @@
 
 Any :class:`~symrot.errors.SymrotError` becomes one line on stderr and exit status 2; nothing
 the user types produces a traceback. Every command runs under one time budget (``--timeout``,
-default :data:`DEFAULT_TIMEOUT` s) that covers everything from parsing to writing files; from
+default :data:`DEFAULT_TIMEOUT` s, at most :data:`MAX_TIMEOUT` s) that covers everything from
+parsing to writing files; from
 the real command line (``main()`` without arguments) it runs in a worker process that also has
-an address-space limit (:mod:`symrot.cli.worker`). Exit status 70 is kept for genuine bugs.
+an address-space limit (:mod:`symrot.cli.worker`). Exit status 70 is kept for genuine bugs;
+SIGINT ends a command with 130 and SIGTERM with 143, in both cases after the temporary files are
+removed and with every output file whole (:mod:`symrot.atomic`).
 Conventions: ``symrot`` alone prints the help (exit 0, as ``--help``); misuse is exit 2;
 ``--version``; ``--quiet`` silences the progress that long steps draw on stderr (drawn only when
 stderr is a terminal).
@@ -28,6 +31,12 @@ COMMANDS = [derive, solve, latex_commands, plot, audit]
 
 EXIT_USAGE = 2
 EXIT_INTERNAL = 70
+EXIT_INTERRUPTED = 130
+"""Exit status after SIGINT (Ctrl-C), as a shell reports it: 128 + 2."""
+EXIT_TERMINATED = worker.EXIT_TERMINATED
+"""Exit status after SIGTERM: 128 + 15, once the files are whole and the scratch files removed."""
+MAX_TIMEOUT = 1e6
+"""The largest ``--timeout`` in seconds (about 11.6 days); past it, exit 2 before any work."""
 DEFAULT_TIMEOUT = 60.0
 """Seconds per command unless the command sets its own ``default_timeout`` (audit)."""
 INT_DIGITS = 20_000
@@ -44,6 +53,9 @@ def _seconds(text: str) -> float:
         raise argparse.ArgumentTypeError(f"invalid number of seconds: {text!r}") from None
     if not math.isfinite(value) or value < 0:
         raise argparse.ArgumentTypeError("seconds must be a finite number >= 0 (0: no budget)")
+    if value > MAX_TIMEOUT:
+        raise argparse.ArgumentTypeError(f"{text} seconds is more than the maximum of {MAX_TIMEOUT:g} s "
+                                         "(0: no budget)")
     return value
 
 
@@ -51,8 +63,8 @@ def _timeout_option(parser: argparse.ArgumentParser, default: object) -> None:
     parser.add_argument(
         "--timeout", type=_seconds, default=default, metavar="SECONDS",
         help=f"time budget of the whole command, parse to written files (default "
-        f"{DEFAULT_TIMEOUT:g} s, audit {audit.AUDIT_TIMEOUT:g} s; 0: none); on expiry: exit 2 "
-        "naming the stage",
+        f"{DEFAULT_TIMEOUT:g} s, audit {audit.AUDIT_TIMEOUT:g} s; 0: none; at most "
+        f"{MAX_TIMEOUT:g} s); on expiry: exit 2 naming the stage",
     )
 
 
@@ -143,7 +155,7 @@ def run(args: argparse.Namespace, seconds: float | None) -> int:
     """Run the parsed command in this process under the time budget; the exit status."""
     budget.reset()
     try:
-        with budget.enforce(seconds), warnings.catch_warnings():
+        with worker.terminate_raises(), budget.enforce(seconds), warnings.catch_warnings():
             # overflow in a numeric scan is handled where it happens; it is no message for users
             warnings.simplefilter("ignore", RuntimeWarning)
             sys.set_int_max_str_digits(max(sys.get_int_max_str_digits(), INT_DIGITS))
@@ -156,7 +168,10 @@ def run(args: argparse.Namespace, seconds: float | None) -> int:
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("symrot: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    except worker.Terminated:
+        print("symrot: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except BrokenPipeError:
         return 0
     except RecursionError:

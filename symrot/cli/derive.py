@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import keyword
+import os
 import re
+import sys
+from pathlib import Path
 from typing import Any
 
 from .. import strict_json
@@ -11,7 +15,7 @@ from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
 from ..budget import stage
 from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
 from ..errors import SymrotError
-from .output import output_directory, write_file
+from .output import check_writable, write_files
 
 SCALAR_LABELS = {
     "p_prime": "p'",
@@ -22,6 +26,15 @@ SCALAR_LABELS = {
 }
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 TENSOR_LABELS = {"R": "R", "H": "H", "H_inverse": "H^-1", "G": "G", "K": "K"}
+NAME_LENGTH = 64
+"""The longest ``--name`` (the C header adds ``symrot_``/``.h``; file systems stop at 255 bytes)."""
+RESERVED_NAMES = frozenset({
+    "numpy", "scipy", "jax", "jaxlib", "torch", "sympy", "mpmath", "symrot", "functools", "math",
+    "lax", "typing", "conftest", "setup",
+})
+"""Module names ``--name`` may not take besides the standard library's: the numeric libraries,
+symrot itself and every module a generated file imports (a module of that name beside them would
+shadow it)."""
 
 
 def register(subparsers: Any) -> None:
@@ -65,16 +78,57 @@ def backend_names(text: str) -> list[str]:
 
 def _check_emit_options(args: argparse.Namespace) -> None:
     """Refuse a bad --name or --emit before any derivation is spent on them."""
-    if args.name is not None and not IDENTIFIER.fullmatch(args.name):
-        raise SymrotError(f"--name {args.name!r} is not a valid identifier")
+    if args.name is not None:
+        check_name(args.name)
     backend_names(args.emit)
+    check_writable(Path(args.out))
+
+
+def check_name(name: str) -> None:
+    """Refuse a ``--name`` that is no identifier, longer than :data:`NAME_LENGTH`, a keyword, a
+    dunder name or the name of a module the generated code or its user would import."""
+    if not IDENTIFIER.fullmatch(name):
+        raise SymrotError(f"--name {name[:NAME_LENGTH]!r} is not a valid identifier")
+    if len(name) > NAME_LENGTH:
+        raise SymrotError(f"--name has {len(name)} characters; at most {NAME_LENGTH}")
+    if keyword.iskeyword(name):
+        raise SymrotError(f"--name {name!r} is a Python keyword")
+    if name.startswith("__") and name.endswith("__"):
+        raise SymrotError(f"--name {name!r} is a special (dunder) name")
+    if name in RESERVED_NAMES or name in sys.stdlib_module_names:
+        raise SymrotError(f"--name {name!r} would shadow the module {name} (choose another name)")
+
+
+SCRATCH_PREFIX = "symrot-emit-"
+"""Scratch directories of ``--emit`` are ``$TMPDIR/symrot-emit-PID-RANDOM``."""
+
+
+def remove_stale_scratch() -> None:
+    """Remove the scratch directories that a killed ``--emit`` (SIGKILL) left behind: those of
+    this user whose process id no longer runs."""
+    import shutil
+    import tempfile
+
+    from ..atomic import process_running
+
+    try:
+        entries = list(Path(tempfile.gettempdir()).glob(f"{SCRATCH_PREFIX}*-*"))
+    except OSError:
+        return
+    for entry in entries:
+        pid = entry.name[len(SCRATCH_PREFIX):].split("-", 1)[0]
+        try:
+            if not pid.isdigit() or process_running(int(pid)) or entry.lstat().st_uid != os.getuid():
+                continue
+        except OSError:
+            continue
+        shutil.rmtree(entry, ignore_errors=True)
 
 
 def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
-    """Plan once, print with every backend of ``--emit`` into a scratch directory, then write the
-    files into ``--out`` (nothing is written when a backend fails)."""
+    """Plan once, print with every backend of ``--emit`` into a scratch directory, then replace
+    the files in ``--out`` all or none (nothing is written when a backend fails)."""
     import tempfile
-    from pathlib import Path
 
     from ..backends import emitter
     from ..plan import evaluation_plan
@@ -84,7 +138,7 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
     backends = backend_names(args.emit)
-    output_directory(Path(args.out))
+    out = Path(args.out)
     with stages(f"symrot: --emit {','.join(backends)}", 3) as progress:
         progress.start("validity range (Section 3.4)")
         with stage("validity analysis"):
@@ -96,15 +150,15 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
             else:
                 cached_plan(result.derivation, name)
         progress.start("printing")
-        with tempfile.TemporaryDirectory(prefix="symrot-emit-") as scratch:
-            printed: list[tuple[Path, Path]] = []
+        remove_stale_scratch()
+        with tempfile.TemporaryDirectory(prefix=f"{SCRATCH_PREFIX}{os.getpid()}-") as scratch:
+            printed: list[tuple[Path, str]] = []
             with stage("printing"):
                 for backend in backends:  # several: each into OUT/BACKEND (NumPy, JAX, PyTorch: NAME.py)
-                    target = Path(args.out) / backend if len(backends) > 1 else Path(args.out)
-                    printed += [(target, path) for path in
+                    target = out / backend if len(backends) > 1 else out
+                    printed += [(target / path.name, path.read_text(encoding="utf-8")) for path in
                                 emitter(backend)(result.derivation, name, Path(scratch) / backend)]
-            for target, path in printed:
-                write_file(target, path.name, path.read_text(encoding="utf-8"))
+            write_files(out, printed)  # all or none
     return 0
 
 

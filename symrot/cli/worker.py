@@ -7,6 +7,10 @@ expiry with the stage named), and the parent waits until the budget plus a short
 has passed, then kills the worker and names the stage the worker last published in shared
 memory. The worker inherits stdout and stderr, so its output passes through unchanged; argument
 parsing, ``--help`` and usage errors happen in the parent before the fork.
+
+SIGINT from a terminal reaches both processes; SIGTERM sent to ``symrot`` reaches the parent only,
+which passes it on to the worker and waits the grace period for it to clean up (temporary files,
+scratch directories) and exit 143; a worker that does not end by then is killed.
 """
 
 from __future__ import annotations
@@ -18,7 +22,8 @@ import select
 import signal
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager, suppress
 
 from .. import budget
 from ..forked import die_with_parent
@@ -36,6 +41,32 @@ exhaustion (exit 2); below it, it is a genuine crash (exit 70, signal named)."""
 
 EXIT_ERROR = 2
 EXIT_INTERNAL = 70
+EXIT_TERMINATED = 128 + signal.SIGTERM
+"""Exit status after SIGTERM (143), reported once the command has cleaned up."""
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived: raised in the main thread so that ``finally`` blocks and context managers
+    (temporary files, scratch directories) clean up as they do for ``KeyboardInterrupt``."""
+
+
+def _raise_terminated(number: int, frame: object) -> None:
+    raise Terminated
+
+
+@contextmanager
+def terminate_raises() -> Iterator[None]:
+    """Within the block, SIGTERM raises :class:`Terminated` (in the main thread only; elsewhere
+    the handler cannot be set and the block runs unchanged)."""
+    try:
+        previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def available() -> bool:
@@ -62,13 +93,21 @@ def run(command: Callable[[], int], seconds: float | None, memory: int = MEMORY_
         finally:
             os._exit(code)
     try:
-        status, peak = _wait(pid, None if not seconds else seconds + GRACE_SECONDS)
+        with terminate_raises():
+            status, peak = _wait(pid, None if not seconds else seconds + GRACE_SECONDS)
     except KeyboardInterrupt:  # the worker got the same SIGINT: let it report, briefly
         status, peak = _wait(pid, GRACE_SECONDS)
         if status is None:
             _kill(pid)
             print("symrot: interrupted", file=sys.stderr)
             return 130
+    except Terminated:  # SIGTERM reaches this process only: pass it on, let the worker clean up
+        _signal(pid, signal.SIGTERM)
+        status, peak = _wait(pid, GRACE_SECONDS)
+        if status is None:
+            _kill(pid)
+            print("symrot: terminated", file=sys.stderr)
+            return EXIT_TERMINATED
     if status is None:
         _kill(pid)
         assert seconds is not None
@@ -153,6 +192,11 @@ def _wait(pid: int, seconds: float | None) -> tuple[int | None, int]:
     finally:
         if handle is not None:
             os.close(handle)
+
+
+def _signal(pid: int, number: int) -> None:
+    with suppress(ProcessLookupError):
+        os.kill(pid, number)
 
 
 def _kill(pid: int) -> None:
