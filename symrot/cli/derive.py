@@ -55,8 +55,11 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--emit", metavar="BACKEND[,BACKEND...]",
                         help="write code with this backend (e.g. numpy); several, comma-separated (e.g. "
                         "c,numpy), or all, share one evaluation plan and write into OUT/BACKEND/")
-    parser.add_argument("--name", help="module name for --emit (default: registry name or 'rotation')")
-    parser.add_argument("--out", default=".", help="output directory for --emit (default: .)")
+    parser.add_argument("--name", help="module name for --emit (default: registry name or 'rotation'): "
+                        f"an identifier of at most {NAME_LENGTH} characters, no keyword, dunder or "
+                        "module name (numpy, math, ...)")
+    parser.add_argument("--out", default=".", help="output directory for --emit (default: .); checked "
+                        "before any work; no symbolic link inside it is followed")
     parser.add_argument("--no-cache", action="store_true",
                         help="compute the evaluation plan even when an earlier --emit of the same p "
                         "kept it (in $SYMROT_CACHE_DIR, default ~/.cache/symrot/plans)")
