@@ -358,5 +358,71 @@ def main(argv: list[str]) -> int:
     return 1 if bad else 0
 
 
+
+# OUTPUT (issue 55 items 3 and 5): options refused before any work, links inside --out not followed.
+
+OUTPUT_CASES: list[tuple[str, dict[str, str], list[str], str]] = [
+    ("timeout past the maximum", {}, ["--timeout", "1e10", "derive", "phi"], "maximum"),
+    ("timeout past the maximum, in-process", {"SYMROT_WORKER": "0"}, ["--timeout", "1e10", "derive", "phi"],
+     "maximum"),
+    ("timeout 1e300", {}, ["derive", "phi", "--timeout", "1e300"], "maximum"),
+    ("name of 250 characters", {}, ["derive", "phi", "--emit", "numpy", "--name", "x" * 250, "--out", "out"],
+     "--name"),
+    ("name numpy", {}, ["derive", "phi", "--emit", "numpy", "--name", "numpy", "--out", "out"], "shadow"),
+    ("name functools", {}, ["derive", "phi", "--emit", "c,numpy", "--name", "functools", "--out", "out"],
+     "shadow"),
+    ("name __main__", {}, ["derive", "phi", "--emit", "numpy", "--name", "__main__", "--out", "out"],
+     "dunder"),
+    ("name class", {}, ["derive", "phi", "--emit", "numpy", "--name", "class", "--out", "out"], "keyword"),
+    ("out below a file", {}, ["derive", "phi", "--emit", "numpy", "--out", "a_file/sub"], "cannot write"),
+    ("out in /proc", {}, ["derive", "phi", "--emit", "numpy", "--out", "/proc/symrot"], "cannot write"),
+    ("link to a file outside out", {}, ["derive", "phi", "--emit", "numpy", "--name", "rotation", "--out",
+                                        "linked"], "symbolic link"),
+    ("link to a directory outside out", {}, ["derive", "phi", "--emit", "c,numpy", "--name", "rotation",
+                                             "--out", "linked"], "outside"),
+]
+"""(what, extra environment, arguments, a word of the one-line error): each must exit 2 with one
+error line on stderr (argparse prints the usage above it), no traceback, and leave the files
+outside ``--out`` as they were. ``linked`` holds a link ``rotation.py`` to a file outside it and a
+link ``c`` to a directory outside it."""
+
+
+def _output_scratch(directory: Path) -> None:
+    (directory / "a_file").write_text("")
+    (directory / "outside").mkdir()
+    (directory / "outside.py").write_text("old\n")
+    (directory / "linked").mkdir()
+    (directory / "linked" / "rotation.py").symlink_to(directory / "outside.py")
+    (directory / "linked" / "c").symlink_to(directory / "outside")
+
+
+def run_output_cases(cases: list[tuple[str, dict[str, str], list[str], str]] | None = None) -> int:
+    """Run :data:`OUTPUT_CASES` (each in a fresh scratch directory), print one line each; the
+    number that misbehaved."""
+    bad = 0
+    for what, environment, args, word in OUTPUT_CASES if cases is None else cases:
+        with tempfile.TemporaryDirectory(prefix="symrot-hostile-output-") as scratch:
+            directory = Path(scratch)
+            _output_scratch(directory)
+            result = subprocess.run([sys.executable, "-m", "symrot", *args], capture_output=True, text=True,
+                                    cwd=directory, env={**os.environ, **environment}, check=False,
+                                    timeout=10 * MARGIN)
+            lines = [line for line in result.stderr.splitlines() if "error:" in line]  # after a usage
+            problems = [problem for problem, failed in [
+                (f"exit {result.returncode}", result.returncode != 2),
+                (f"{len(lines)} error lines", len(lines) != 1),
+                ("a traceback", "Traceback" in result.stderr),
+                (f"no {word!r} in the error", not any(word in line for line in lines)),
+                ("a file outside --out changed", (directory / "outside.py").read_text() != "old\n"
+                 or any((directory / "outside").iterdir())),
+            ] if failed]
+        bad += bool(problems)
+        print(f"{'FAIL' if problems else 'ok  '} {result.returncode:>3} {what:40} "
+              f"{'; '.join(problems) or (lines or [''])[-1][:80]}")
+    print(f"{len(OUTPUT_CASES if cases is None else cases)} output cases, {bad} failed")
+    return bad
+
+
 if __name__ == "__main__":
-    raise SystemExit(main(sys.argv[1:]))
+    code = main(sys.argv[1:])
+    raise SystemExit(1 if run_output_cases() else code)

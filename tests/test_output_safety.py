@@ -351,3 +351,13 @@ def test_a_read_only_out_is_refused_before_any_work(tmp_path: Path, monkeypatch:
     (tmp_path / "ro").mkdir(mode=0o500)
     monkeypatch.setattr(derive_command, "derive", lambda *a, **k: pytest.fail("derived anyway"))
     assert main(["derive", "phi", "--emit", "numpy", "--out", str(tmp_path / "ro" / "new")]) == 2
+
+
+def test_the_output_cases_of_the_hostile_bench(capsys: pytest.CaptureFixture[str]) -> None:
+    """``bench/hostile_cli.py``'s OUTPUT section: every case exits 2 with one error line, through
+    ``python -m symrot`` (the worker process included)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
+    import hostile_cli
+
+    bad = hostile_cli.run_output_cases()
+    assert bad == 0, capsys.readouterr().out
