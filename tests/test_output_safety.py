@@ -361,3 +361,18 @@ def test_the_output_cases_of_the_hostile_bench(capsys: pytest.CaptureFixture[str
 
     bad = hostile_cli.run_output_cases()
     assert bad == 0, capsys.readouterr().out
+
+
+def test_no_directory_is_created_through_a_link_out_of_out(tmp_path: Path) -> None:
+    (tmp_path / "elsewhere").mkdir()
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "numpy").symlink_to(tmp_path / "elsewhere")
+    with pytest.raises(SymrotError, match="outside"):
+        write_files(out, [(out / "numpy" / "deeper" / "rotation.py", "new")], announce=False)
+    assert list((tmp_path / "elsewhere").iterdir()) == []
+
+
+def test_a_new_out_is_created(tmp_path: Path) -> None:
+    write_files(tmp_path / "new" / "out", [(tmp_path / "new" / "out" / "c" / "a.h", "new")], announce=False)
+    assert (tmp_path / "new" / "out" / "c" / "a.h").read_text() == "new"

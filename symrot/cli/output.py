@@ -47,6 +47,12 @@ def output_directory(directory: Path, root: Path | None = None) -> Path:
     outside ``root`` through a symbolic link)."""
     with stage("writing"):
         try:
+            if root is not None:  # no directory is created through a link out of root
+                root.mkdir(parents=True, exist_ok=True)
+                existing = directory
+                while not os.path.lexists(existing) and existing != existing.parent:
+                    existing = existing.parent
+                _inside(root, existing, directory)
             directory.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise SymrotError(f"cannot create {directory}: {exc.strerror or exc}") from None
