@@ -238,7 +238,8 @@ CHILD = textwrap.dedent("""
 """ % FAST)
 
 
-def stop_while_writing(tmp_path: Path, mode: str, number: int, group: bool = False) -> tuple[int, Path]:
+def stop_while_writing(tmp_path: Path, mode: str, number: int, group: bool = False,
+                       worker: str = "1") -> tuple[int, Path]:
     """Run :data:`CHILD`, send ``number`` once it hangs in a write; (its exit status, out)."""
     out, scratch, ready = tmp_path / "out", tmp_path / "tmp", tmp_path / "ready"
     out.mkdir()
@@ -246,7 +247,7 @@ def stop_while_writing(tmp_path: Path, mode: str, number: int, group: bool = Fal
     for path in (out / "c" / f"symrot_{FAST}.h", out / "numpy" / f"{FAST}.py", out / "a.py"):
         path.parent.mkdir(exist_ok=True)
         path.write_text(OLD)
-    environment = {**os.environ, "TMPDIR": str(scratch), "SYMROT_WORKER": "1", "PYTHONPATH":
+    environment = {**os.environ, "TMPDIR": str(scratch), "SYMROT_WORKER": worker, "PYTHONPATH":
                    str(Path(__file__).resolve().parents[1])}
     child = subprocess.Popen([sys.executable, "-c", CHILD, str(ready), mode, str(out)],
                              env=environment, start_new_session=True)
@@ -268,11 +269,11 @@ def stop_while_writing(tmp_path: Path, mode: str, number: int, group: bool = Fal
     return status, out
 
 
-@pytest.mark.parametrize(("number", "status", "group"), [
-    (signal.SIGTERM, 143, False), (signal.SIGINT, 130, True)])
+@pytest.mark.parametrize(("number", "status", "group", "worker"), [
+    (signal.SIGTERM, 143, False, "1"), (signal.SIGINT, 130, True, "1"), (signal.SIGTERM, 143, False, "0")])
 def test_a_signal_during_an_emit_leaves_the_old_files_and_nothing_else(
-        tmp_path: Path, number: int, status: int, group: bool) -> None:
-    code, out = stop_while_writing(tmp_path, "emit", number, group)
+        tmp_path: Path, number: int, status: int, group: bool, worker: str) -> None:
+    code, out = stop_while_writing(tmp_path, "emit", number, group, worker)
     assert code == status
     assert (out / "c" / f"symrot_{FAST}.h").read_text() == OLD
     assert (out / "numpy" / f"{FAST}.py").read_text() == OLD
