@@ -13,6 +13,8 @@ worker process of :mod:`symrot.cli.worker`) in a scratch directory, two at a tim
 ``tests/test_hostile_cli.py`` runs :data:`QUICK` with a small budget and :data:`HEAVY` as a slow
 test; ``python bench/hostile_cli.py [BUDGET]`` runs those and :data:`EXTRA` with the default
 budget of 60 s and prints one line per input (status, seconds, the last line of stderr).
+``python bench/hostile_cli.py --cache`` runs the plan cache's cases instead (:func:`run_cache_cases`,
+the last section).
 
 :func:`run_all_preloaded` is the quick tier's runner: the same command line (``symrot.cli.main``
 on ``sys.argv``, its worker process and budget included), each input in a process forked from a
@@ -423,6 +425,121 @@ def run_output_cases(cases: list[tuple[str, dict[str, str], list[str], str]] | N
     return bad
 
 
+# --- The plan cache of --emit (issue 55, items 1, 2 and 7): ``python bench/hostile_cli.py --cache`` ---
+
+CACHE_PROBE = ([[0.3, -0.2, 0.5]], 0.95257673)
+"""tangent(p)[0, 0, 0] of phi's module at this p: what every emit must print, whatever the cache holds."""
+
+
+def _emit_phi(out: Path, environment: dict[str, str],
+              cwd: Path | None = None) -> tuple[int, float | None, str]:
+    """(exit status, tangent at :data:`CACHE_PROBE` of the module written, stderr's last line) of
+    ``symrot derive phi --emit numpy --out OUT``."""
+    import importlib.util
+
+    command = [sys.executable, "-m", "symrot", "derive", "phi", "--emit", "numpy", "--out", str(out)]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False, cwd=cwd,
+                            env={**os.environ, "SYMROT_NO_CACHE": "", **environment})
+    module_path = out / "rotation_vector.py"
+    value = None
+    if result.returncode == 0 and module_path.is_file():
+        spec = importlib.util.spec_from_file_location(f"phi_{abs(hash(str(out)))}", module_path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        value = float(module.tangent(CACHE_PROBE[0])[0, 0, 0])
+    return result.returncode, value, (result.stderr.strip().splitlines() or [""])[-1][:100]
+
+
+def _right(value: float | None) -> bool:
+    return value is not None and abs(value - CACHE_PROBE[1]) <= 1e-7 * CACHE_PROBE[1]
+
+
+_IN_PROCESS_FLIPS = """
+import json, os, sys
+os.environ.update(SYMROT_CACHE_DIR=sys.argv[1], SYMROT_NO_CACHE="")
+from symrot.api import derive
+from symrot.cli import plan_cache
+plan = plan_cache.evaluation_plan(derive("phi").derivation, "rotation_vector")
+path = plan_cache.directory() / plan_cache.entry_name(plan.p, plan.name)
+good = plan_cache.entry_bytes(plan, plan_cache.entry_key(plan.p, plan.name))
+path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+counts = {"miss": 0, "same plan": 0, "other plan": 0, "exception": 0}
+changes = [good[:i] + bytes([good[i] ^ (1 << i % 8)]) + good[i + 1:] for i in range(len(good))]
+changes += [good[:length] for length in range(len(good))]
+for content in changes:
+    path.write_bytes(content)
+    try:
+        loaded = plan_cache.load(plan.p, plan.name)
+    except Exception:
+        counts["exception"] += 1
+        continue
+    counts["miss" if loaded is None else "same plan" if loaded == plan else "other plan"] += 1
+print(json.dumps({"entry bytes": len(good), **counts}))
+"""
+
+
+def run_cache_cases() -> int:
+    """The cache cases of issue 55, each printed as one line; 1 if any went wrong."""
+    failures = 0
+
+    def report(ok: bool, case: str, detail: str) -> None:
+        nonlocal failures
+        failures += not ok
+        print(f"{'ok  ' if ok else 'FAIL'} {case:48} {detail}")
+
+    with tempfile.TemporaryDirectory(prefix="symrot-hostile-cache-") as scratch_name:
+        scratch = Path(scratch_name)
+        root = scratch / "user-cache"
+        root.mkdir()
+        own = [root / f"mine-{index}.pickle" for index in range(300)] + [root / "notes.json"]
+        for path in own:
+            path.write_text("the user's")
+        environment = {"SYMROT_CACHE_DIR": str(root)}
+        status, value, last = _emit_phi(scratch / "out0", environment)
+        report(status == 0 and _right(value), "first emit (stores phi's plan)",
+               f"exit {status}, tangent {value} {last}")
+        report(all(path.exists() for path in own), "300 *.pickle of the user's kept",
+               f"{sum(map(Path.exists, own))} of {len(own)} left")
+        entries = sorted((root / "symrot-plans-v1").glob("symrot-plan-*.json"))
+        report(len(entries) == 1, "one entry, in symrot's own subdirectory",
+               f"{[p.name[:24] for p in entries]}")
+        if entries:
+            good = entries[0].read_bytes()
+            for run, offset in enumerate((55, 66, 1902, 2254, len(good) // 2, len(good) - 2)):
+                offset = min(offset, len(good) - 1)
+                entries[0].write_bytes(good[:offset] + bytes([good[offset] ^ 0x10]) + good[offset + 1:])
+                status, value, last = _emit_phi(scratch / f"flip{run}", environment)
+                report(status == 0 and _right(value) and entries[0].read_bytes() == good,
+                       f"emit over a byte flipped at {offset}", f"exit {status}, tangent {value} {last}")
+            entries[0].chmod(0o400)
+            (root / "symrot-plans-v1").chmod(0o500)
+            try:
+                status, value, last = _emit_phi(scratch / "read-only", environment)
+            finally:
+                (root / "symrot-plans-v1").chmod(0o700)
+            report(status == 0 and _right(value) and entries[0].read_bytes() == good,
+                   "emit from a read-only cache", f"exit {status}, tangent {value} {last}")
+        homeless = scratch / "homeless"
+        homeless.mkdir()
+        existed = Path("/.cache/symrot").exists()
+        no_home = {"HOME": "", "XDG_CACHE_HOME": "", "SYMROT_CACHE_DIR": ""}
+        status, value, last = _emit_phi(homeless / "out", no_home, cwd=homeless)
+        report(status == 0 and _right(value) and [p.name for p in homeless.iterdir()] == ["out"]
+               and (existed or not Path("/.cache/symrot").exists()), "emit with HOME='' (no cache)",
+               f"exit {status}, tangent {value} {last}")
+        flips = subprocess.run([sys.executable, "-c", _IN_PROCESS_FLIPS, str(scratch / "flips")],
+                               capture_output=True, text=True, timeout=600, check=False,
+                               env={**os.environ, "PYTHONHASHSEED": "0"})
+        counts = json.loads(flips.stdout) if flips.returncode == 0 else {}
+        report(bool(counts) and counts["other plan"] == 0 and counts["exception"] == 0,
+               "every bit flip and truncation of phi's entry", f"{counts or flips.stderr[-200:]}")
+    print(f"plan cache: {failures} failed")
+    return 1 if failures else 0
+
+
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["--cache"]:
+        raise SystemExit(run_cache_cases())
     code = main(sys.argv[1:])
     raise SystemExit(1 if run_output_cases() else code)

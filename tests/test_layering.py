@@ -29,7 +29,7 @@ LAYER_OF_PREFIX: dict[str, str] = {
     "symrot.backends": "backends",
     **{f"symrot.{name}": "plan" for name in (
         "plan", "plan_ir", "algebraic", "newton_start", "quaternion_plan", "sincos_kernel", "evaluation",
-        "domain", "measurement", "pole", "angle_solve",
+        "domain", "measurement", "pole", "angle_solve", "plan_json",
     )},
     **{f"symrot.{name}": "core" for name in (
         "axial", "core", "errors", "functions", "operations", "parsing", "registry", "series",

@@ -6,23 +6,34 @@ any load. So it is stored under a key made of exactly those: p's ``srepr``, the 
 every file of the installed symrot package, and the versions of Python, SymPy, NumPy and mpmath.
 Any change of the code or of a library makes a new key; an entry is never stale, only unused.
 
-Location: ``$SYMROT_CACHE_DIR``, else ``$XDG_CACHE_HOME/symrot/plans``, else
-``~/.cache/symrot/plans``. ``--no-cache`` or ``SYMROT_NO_CACHE=1`` neither reads nor writes it, nor
-does a process without the commands' fixed hash seed (:func:`enabled`); deleting the directory is
-always safe. At most :data:`KEPT` plans are kept (the oldest go first).
+Location: a directory of symrot's own, :data:`SUBDIRECTORY` (versioned with the entry format),
+inside ``$SYMROT_CACHE_DIR``, else inside ``$XDG_CACHE_HOME/symrot`` (an absolute path), else inside
+``$HOME/.cache/symrot`` (an absolute ``HOME``); with none of them there is no cache (never one
+under ``/``). ``--no-cache`` or ``SYMROT_NO_CACHE=1`` neither reads nor writes it, nor does a
+process without the commands' fixed hash seed (:func:`enabled`); deleting the directory is always
+safe. Entries are named ``symrot-plan-<64 hex digits>.json`` (:data:`ENTRY_PATTERN`); at most
+:data:`KEPT` are kept (the least recently used go first), and pruning removes nothing else: no
+file of another name, nothing outside that directory.
 
-The files are pickles, and loading a pickle can run code: a file is read only when it and its
-directory belong to this user and nobody else may write them (POSIX permissions). The cache is an
-optimisation, so every failure (an unreadable, corrupt or foreign file; a read-only disk) is silent
-and the plan is computed instead.
+An entry is two lines of JSON (:func:`entry_bytes`): a header with the entry format, its version,
+the key and the SHA-256 of the payload, then the payload, the plan in the format of
+:mod:`symrot.plan_json`, which never runs code when read. Every check (the header, the checksum,
+the decoding, p and the name) is made before a plan is used, and any failure is a miss: the plan
+is computed again and the entry rewritten. The cache is an optimisation, so every failure (an
+unreadable, corrupt, truncated or foreign file; a read-only or full disk) is silent. A file is
+read only when it and its directory belong to this user and nobody else may write them (POSIX
+permissions): a forged plan would print a wrong kernel. A read-only cache directory is read, and
+not written.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import json
 import os
-import pickle
 import platform
+import re
 import stat
 import sys
 import tempfile
@@ -36,6 +47,7 @@ import sympy as sp
 from ..core import Derivation
 from ..plan import evaluation_plan, remember_plan
 from ..plan_ir import EvaluationPlan
+from ..plan_json import canonical_json, decode_plan, encode_plan
 
 COMMANDS_HASH_SEED = "0"
 """``symrot.entry.SEED``, the hash seed every command runs with (not imported: ``symrot.entry`` imports
@@ -44,8 +56,13 @@ KEPT = 256
 """Plans kept on disk; storing one more removes the least recently used."""
 DISABLE_VARIABLE = "SYMROT_NO_CACHE"
 DIRECTORY_VARIABLE = "SYMROT_CACHE_DIR"
-
-
+ENTRY_FORMAT = "symrot-plan-cache"
+ENTRY_VERSION = 1
+"""Version of the entry layout and of its directory: entries of another version are never read."""
+SUBDIRECTORY = f"symrot-plans-v{ENTRY_VERSION}"
+ENTRY_PATTERN = re.compile(r"symrot-plan-[0-9a-f]{64}\.json")
+"""The names of entries (matched whole): the only files pruning ever removes."""
+TEMPORARY_PREFIX = ".symrot-plan-"
 def enabled() -> bool:
     """Whether plans are read and stored: not when ``SYMROT_NO_CACHE`` is set to anything but empty
     or 0, and only in a process with the commands' hash seed (:mod:`symrot.entry`), whose plans are
@@ -54,13 +71,18 @@ def enabled() -> bool:
             and os.environ.get("PYTHONHASHSEED") == COMMANDS_HASH_SEED)
 
 
-def directory() -> Path:
-    """Where the plans are kept (see the module's docstring)."""
+def directory() -> Path | None:
+    """Where the plans are kept (see the module's docstring), or None: no place for a cache."""
     explicit = os.environ.get(DIRECTORY_VARIABLE)
     if explicit:
-        return Path(explicit)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "symrot" / "plans"
+        return Path(explicit) / SUBDIRECTORY
+    xdg = os.environ.get("XDG_CACHE_HOME", "")
+    if os.path.isabs(xdg):  # the XDG specification ignores a relative path
+        return Path(xdg) / "symrot" / SUBDIRECTORY
+    home = os.environ.get("HOME", "")
+    if os.path.isabs(home) and home.strip("/"):  # not unset, empty, relative or /
+        return Path(home) / ".cache" / "symrot" / SUBDIRECTORY
+    return None
 
 
 @lru_cache(maxsize=1)
@@ -79,12 +101,40 @@ def code_digest() -> str:
     return digest.hexdigest()
 
 
-def entry_name(p: sp.Expr, name: str) -> str:
-    """The file name of the plan of ``p`` named ``name`` for this code."""
+def entry_key(p: sp.Expr, name: str) -> str:
+    """The key (64 hex digits) of the plan of ``p`` named ``name`` for this code."""
     digest = hashlib.sha256()
     for text in (code_digest(), sp.srepr(p), name):
         digest.update(text.encode() + b"\0")
-    return digest.hexdigest() + ".pickle"
+    return digest.hexdigest()
+
+
+def entry_name(p: sp.Expr, name: str) -> str:
+    """The file name of the plan of ``p`` named ``name`` for this code (matches :data:`ENTRY_PATTERN`)."""
+    return f"symrot-plan-{entry_key(p, name)}.json"
+
+
+def entry_bytes(plan: EvaluationPlan, key: str) -> bytes:
+    """The file of ``plan`` stored under ``key``: the header line, then the payload line."""
+    payload = encode_plan(plan)
+    header = {"format": ENTRY_FORMAT, "version": ENTRY_VERSION, "key": key,
+              "sha256": hashlib.sha256(payload).hexdigest()}
+    return canonical_json(header) + b"\n" + payload + b"\n"
+
+
+def plan_of_entry(content: bytes, key: str) -> EvaluationPlan:
+    """The plan an entry's bytes hold; ValueError (or another exception of decoding) unless they
+    are exactly what :func:`entry_bytes` writes for ``key``."""
+    header_line, separator, rest = content.partition(b"\n")
+    if not separator or not rest.endswith(b"\n"):
+        raise ValueError("an entry is two lines")
+    payload = rest[:-1]
+    header = json.loads(header_line.decode("ascii"))
+    expected = {"format": ENTRY_FORMAT, "version": ENTRY_VERSION, "key": key,
+                "sha256": hashlib.sha256(payload).hexdigest()}
+    if header != expected or canonical_json(header) != header_line:
+        raise ValueError("another format, version or key, or a payload that does not match its checksum")
+    return decode_plan(payload)
 
 
 def _private(path: Path) -> bool:
@@ -97,45 +147,63 @@ def _private(path: Path) -> bool:
 
 def load(p: sp.Expr, name: str) -> EvaluationPlan | None:
     """The stored plan of ``p`` named ``name``, or None (absent, disabled or unusable)."""
-    if not enabled():
+    folder = directory() if enabled() else None
+    if folder is None:
         return None
-    folder = directory()
-    path = folder / entry_name(p, name)
+    key = entry_key(p, name)
+    path = folder / f"symrot-plan-{key}.json"
     try:
         if not (path.is_file() and _private(folder) and _private(path)):
             return None
-        with path.open("rb") as stream:
-            plan = pickle.load(stream)
+        plan = plan_of_entry(path.read_bytes(), key)
+        if plan.p != p or plan.name != name:
+            return None
+    except Exception:  # unreadable, corrupt, truncated, of another version or key: computed instead
+        return None
+    with contextlib.suppress(OSError):  # a read-only cache is still read
         os.utime(path)  # recently used: kept longest
-    except Exception:  # a corrupt or truncated entry (any unpickling error): computed instead
-        return None
-    if not isinstance(plan, EvaluationPlan) or plan.p != p or plan.name != name:
-        return None
     return plan
+
+
+def _prune(folder: Path) -> None:
+    """Remove the least recently used entries beyond :data:`KEPT`; only files named like entries."""
+    entries = []
+    for path in folder.iterdir():
+        if ENTRY_PATTERN.fullmatch(path.name):
+            try:
+                info = path.lstat()
+            except OSError:
+                continue
+            if stat.S_ISREG(info.st_mode):
+                entries.append((info.st_mtime, path))
+    entries.sort(key=lambda entry: entry[0], reverse=True)
+    for _, old in entries[KEPT:]:
+        old.unlink(missing_ok=True)
 
 
 def store(plan: EvaluationPlan) -> None:
     """Keep ``plan`` on disk (written to a temporary file and renamed: readers never see half a
-    file); then remove the least recently used plans beyond :data:`KEPT`."""
-    if not enabled():
+    file); then remove the least recently used entries beyond :data:`KEPT`."""
+    folder = directory() if enabled() else None
+    if folder is None:
         return
-    folder = directory()
     try:
+        content = entry_bytes(plan, entry_key(plan.p, plan.name))
         folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-        if not _private(folder):
-            return
-        handle, temporary = tempfile.mkstemp(dir=folder, prefix=".plan-", suffix=".tmp")
+        if not _private(folder) or not os.access(folder, os.W_OK):
+            return  # another's directory, or a read-only cache: read, never written
+        handle, temporary = tempfile.mkstemp(dir=folder, prefix=TEMPORARY_PREFIX, suffix=".tmp")
         try:
             with os.fdopen(handle, "wb") as stream:
-                pickle.dump(plan, stream, protocol=pickle.HIGHEST_PROTOCOL)
+                stream.write(content)
+                stream.flush()
+                os.fsync(stream.fileno())
             os.replace(temporary, folder / entry_name(plan.p, plan.name))
         finally:
             if os.path.exists(temporary):
                 os.unlink(temporary)
-        entries = sorted(folder.glob("*.pickle"), key=lambda path: path.stat().st_mtime, reverse=True)
-        for old in entries[KEPT:]:
-            old.unlink(missing_ok=True)
-    except Exception:  # a read-only or full disk, a plan pickle cannot write: computed next time
+        _prune(folder)
+    except Exception:  # a read-only or full disk, a plan outside the JSON form: computed next time
         return
 
 
