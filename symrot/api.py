@@ -13,8 +13,8 @@ import sympy as sp
 
 from .budget import stage
 from .core import SCALAR_NAMES, TENSOR_NAMES, Derivation, Tensor, derive_expression
-from .errors import SymrotError
-from .parsing import parse_expression
+from .errors import ParseError, SymrotError
+from .parsing import MAX_LENGTH, check_expression, parse_expression
 from .registry import NamedParameterization, find_by_expression, is_identifier, looks_like_a_name, lookup
 from .timeouts import time_limit
 from .validation import validate
@@ -25,12 +25,24 @@ COEFFICIENT_KEYS = ("I", "px", "px2")
 
 
 def resolve(expression: str | sp.Expr) -> tuple[sp.Expr, NamedParameterization | None]:
-    """A registry identifier or an expression (parsed safely) → (p(φ), registry entry)."""
-    if isinstance(expression, sp.Expr):
+    """A registry identifier or an expression (parsed safely) → (p(φ), registry entry).
+
+    Raises :class:`~symrot.errors.SymrotError` for anything else, in time bounded by the length
+    caps: a string longer than :data:`~symrot.parsing.MAX_LENGTH` is refused before it is read,
+    a SymPy expression is held to the parser's caps (:func:`~symrot.parsing.check_expression`).
+    """
+    if isinstance(expression, sp.Basic):
+        with stage("parse"):
+            checked = check_expression(expression)
         with stage("registry lookup"):
-            return expression, find_by_expression(expression)
-    text = expression.strip() if isinstance(expression, str) else expression
-    if isinstance(text, str) and (is_identifier(text) or looks_like_a_name(text)):
+            return checked, find_by_expression(checked)
+    if not isinstance(expression, str):
+        raise ParseError("expression must be a string or a SymPy expression, "
+                         f"got {type(expression).__name__}")
+    if len(expression) > MAX_LENGTH:
+        raise ParseError(f"expression is too long ({len(expression)} characters, at most {MAX_LENGTH})")
+    text = expression.strip()
+    if is_identifier(text) or looks_like_a_name(text):
         with stage("registry lookup"):
             entry = lookup(text)
         return entry.expression, entry
@@ -127,6 +139,8 @@ def derive(expression: str | sp.Expr, normalize: bool = False) -> DerivationResu
 
     Raises :class:`~symrot.errors.SymrotError` subclasses for invalid input; bounded in time.
     """
+    if not isinstance(normalize, bool):
+        raise SymrotError(f"normalize must be True or False, got {type(normalize).__name__}")
     expr, entry = resolve(expression)
     with time_limit(DERIVE_TIME_LIMIT, "derivation"):
         derivation = derive_expression(expr, normalize=normalize)

@@ -316,6 +316,90 @@ class _Builder:
 
 _ROOTS = {"sqrt": sp.Rational(1, 2), "cbrt": sp.Rational(1, 3)}
 
+_FUNCTION_CLASSES: dict[type, str] = {
+    function: name for name, function in FUNCTIONS.items() if isinstance(function, type)
+}
+"""The SymPy classes of the grammar's functions (``sqrt`` is a power in SymPy)."""
+_SYMPY_CONSTANTS = (sp.pi, sp.E)
+"""π, and e (``exp(1)`` evaluates to it)."""
+
+
+def check_expression(expr: object) -> sp.Expr:
+    """A SymPy expression given to the API, held to the caps of a parsed string: the grammar's
+    operations, functions and constants only, rational exponents, finite real numbers below
+    2**MAX_NUMBER_BITS, at most MAX_NODES nodes and MAX_DEPTH levels, and an expanded size within
+    :class:`Size`'s caps. Raises :class:`ParseError`; returns ``expr``.
+
+    ``sp.Integer(10)**10000 * phi`` was derived and then failed with Python's ValueError when its
+    result was printed (more than 4300 digits); ``sp.Float('1e400') * phi`` gave infinite kernels.
+    Symbols other than :data:`PHI` are left to :func:`symrot.validation.validate`'s message.
+    """
+    if not isinstance(expr, sp.Expr):
+        raise ParseError(f"expression must be a string or a SymPy expression, got {type(expr).__name__}")
+    for nodes, _ in enumerate(sp.preorder_traversal(expr), start=1):
+        if nodes > MAX_NODES:
+            raise ParseError(f"expression is too large (more than {MAX_NODES} nodes)")
+    _ExpressionCheck().size(expr, 0)
+    return expr
+
+
+class _ExpressionCheck:
+    """The :class:`Size` of a SymPy expression, checked node by node as :class:`_Builder` does."""
+
+    def __init__(self) -> None:
+        self.calls = 0
+
+    def size(self, expr: sp.Basic, depth: int) -> Size:
+        if depth > MAX_DEPTH:
+            raise ParseError(f"expression is nested too deeply (more than {MAX_DEPTH} levels)")
+        if expr.is_Symbol or expr in _SYMPY_CONSTANTS:
+            return _ATOM
+        if expr.is_Number:
+            return Size(1, 0, _number_bits(expr))
+        if isinstance(expr, sp.Add):
+            total = self.size(expr.args[0], depth + 1)
+            for arg in expr.args[1:]:
+                total = total.plus(self.size(arg, depth + 1)).check()
+            return total
+        if isinstance(expr, sp.Mul):
+            total = self.size(expr.args[0], depth + 1)
+            for arg in expr.args[1:]:
+                total = total.times(self.size(arg, depth + 1)).check()
+            return total
+        if isinstance(expr, sp.Pow):
+            base, exponent = expr.args
+            return self.size(base, depth + 1).power(_Builder._exponent(exponent)).check()
+        name = _FUNCTION_CLASSES.get(type(expr))
+        if name is None:
+            if expr.is_number and expr.has(sp.I):
+                raise ParseError("expression is not real")
+            raise ParseError(f"'{type(expr).__name__}' is not allowed in an expression "
+                             f"(allowed functions: {', '.join(FUNCTIONS)}; constants: pi, E)")
+        if len(expr.args) != 1:
+            raise ParseError(f"function '{name}' takes exactly one argument")
+        self.calls += 1
+        if self.calls > MAX_FUNCTION_NESTING:
+            raise ParseError(f"functions are nested more than {MAX_FUNCTION_NESTING} deep")
+        inner = self.size(expr.args[0], depth + 1)
+        self.calls -= 1
+        return inner.power(_ROOTS[name]).check() if name in _ROOTS else _ATOM
+
+
+def _number_bits(number: sp.Basic) -> int:
+    """Bits of a finite real SymPy number (numerator or denominator; a float's magnitude)."""
+    if number.is_Rational:
+        rational = sp.Rational(number)
+        bits = max(abs(rational.p).bit_length(), rational.q.bit_length())
+    elif number.is_Float and number.is_finite:
+        _, _, exponent, mantissa_bits = sp.Float(number)._mpf_  # |value| < 2**(exponent + bits)
+        bits = 0 if number.is_zero else abs(int(exponent) + int(mantissa_bits)) + 1
+    else:
+        raise ParseError(f"number {str(number)[:40]} is not a finite real number")
+    if bits > MAX_NUMBER_BITS:
+        raise ParseError(f"number {str(number)[:40] if bits < 10_000 else '(too long)'} is out of range "
+                         f"(at most {MAX_NUMBER_BITS} bits)")
+    return bits
+
 
 _BASES = {"0x": 16, "0o": 8, "0b": 2}
 

@@ -18,6 +18,8 @@ from .functions import RealCbrt
 from .parsing import FUNCTIONS, PHI
 
 MAX_FAMILY_ORDER = 1000
+MAX_SHOWN_NAME = 60
+"""An unknown name is quoted, and compared with the registry's, by its first characters only."""
 
 
 @dataclass(frozen=True)
@@ -115,12 +117,15 @@ def lookup(identifier: str) -> NamedParameterization:
 
 def unknown_name_message(identifier: str) -> str:
     """"unknown parameterization …", with the closest registry names and the list of all of them."""
-    order = re.search(r"([0-9]+)$", identifier)
-    families = [f"{family}_m{order.group(1) if order else 'N'}" for family in ("sine", "tangent", "cayley")]
-    close = difflib.get_close_matches(identifier.lower(), [*_FIXED, *families], n=3, cutoff=0.6)
+    shown = identifier[:MAX_SHOWN_NAME]
+    # Trailing digits by rstrip, in linear time: re.search(r"([0-9]+)$") retried every run of
+    # digits from each of its positions, quadratic ('a' + '9' * 200000 + 'b' ran for minutes).
+    order = shown[len(shown.rstrip("0123456789")):]
+    families = [f"{family}_m{order or 'N'}" for family in ("sine", "tangent", "cayley")]
+    close = difflib.get_close_matches(shown.lower(), [*_FIXED, *families], n=3, cutoff=0.6)
     hint = f"; did you mean {' or '.join(close)}?" if close else ""
     known = ", ".join([*_FIXED, "sine_mN", "tangent_mN", "cayley_mN"])
-    return f"unknown parameterization '{identifier[:60]}'{hint} (registry names: {known})"
+    return f"unknown parameterization '{shown}'{hint} (registry names: {known})"
 
 
 def is_identifier(text: str) -> bool:

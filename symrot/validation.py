@@ -48,8 +48,11 @@ def _evaluate_or_inf(expr: sp.Expr, angle: str) -> mpmath.mpf | mpmath.mpc:
 
 def validate(expr: sp.Expr) -> ValidatedFunction:
     """Check ``expr`` as a generating function and return it with κ and its Taylor series."""
-    if expr.free_symbols - {PHI}:
-        raise InvalidGeneratingFunction("p must depend on phi only")
+    others = expr.free_symbols - {PHI}
+    if others:
+        hint = ("; the angle is symrot.PHI, a real symbol (sympy.Symbol('phi', real=True))"
+                if any(str(symbol) == str(PHI) for symbol in others) else "")
+        raise InvalidGeneratingFunction(f"p must depend on phi only{hint}")
     if PHI not in expr.free_symbols:
         raise InvalidGeneratingFunction("p does not depend on phi")
     try:

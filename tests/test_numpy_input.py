@@ -44,3 +44,39 @@ def test_second_argument_shape_is_checked(wiener_milenkovic) -> None:  # type: i
 def test_integer_input_is_float64(wiener_milenkovic) -> None:  # type: ignore[no-untyped-def]
     assert wiener_milenkovic.rotation_matrix([1, 2, 3]).dtype == np.float64
     assert wiener_milenkovic.rotation_matrix(np.array([1, 2, 3], dtype=np.int8)).dtype == np.float64
+
+
+@pytest.mark.parametrize("order", [">", "<", "="])
+@pytest.mark.parametrize("bits", ["4", "8"])
+def test_any_byte_order_keeps_its_precision(wiener_milenkovic, order: str, bits: str) -> None:  # type: ignore[no-untyped-def]
+    """A big-endian float32 p was computed and returned in float64 (issue 55, item 7)."""
+    expected = np.float32 if bits == "4" else np.float64
+    p = np.array([[0.1, -0.2, 0.3], [0.0, 0.0, 0.0]], dtype=order + "f" + bits)
+    native = p.astype(expected)
+    for function in (wiener_milenkovic.rotation_matrix, wiener_milenkovic.angle,
+                     wiener_milenkovic.to_quaternion):
+        result = function(p)
+        assert result.dtype == expected, function.__name__
+        np.testing.assert_array_equal(result, function(native))
+    assert wiener_milenkovic.pdot(p, np.ones(3, dtype=order + "f" + bits)).dtype == expected
+
+
+def test_masked_arrays_are_refused(wiener_milenkovic) -> None:  # type: ignore[no-untyped-def]
+    """A numpy.ma masked array lost its mask silently (issue 55, item 7)."""
+    masked = np.ma.masked_array([[0.1, 0.2, 0.3]], mask=[[False, True, False]])
+    for function in (wiener_milenkovic.rotation_matrix, wiener_milenkovic.angle,
+                     wiener_milenkovic.to_quaternion):
+        with pytest.raises(ValueError, match="masked array"):
+            function(masked)
+    with pytest.raises(ValueError, match="masked array"):
+        wiener_milenkovic.pdot(np.zeros(3), masked)
+
+
+@pytest.mark.parametrize("name", ["cayley_gibbs_rodrigues", "rotation_vector", "sine_m4"])
+def test_other_modules_keep_big_endian_precision_and_refuse_masks(name: str) -> None:
+    module = load(GENERATED / f"{name}.py", f"input_{name}")
+    p = np.array([0.1, -0.2, 0.3], dtype=">f4")
+    assert module.rotation_matrix(p).dtype == np.float32
+    assert module.rotation_matrix(p.astype(">f8")).dtype == np.float64
+    with pytest.raises(ValueError, match="masked array"):
+        module.rotation_matrix(np.ma.masked_array(p.astype(np.float64), mask=[True, False, False]))

@@ -32,7 +32,7 @@ PAPER = {
 def test_paper_properties_give_eqs_31_to_35(prop: str) -> None:
     started = time.process_time()  # CPU time: the wall time of a loaded CI run measures the load
     solution = solve_property(prop)
-    assert time.process_time() - started < 10
+    assert time.process_time() - started < 60  # hang-catcher only (was 10 s)
     expected, constant = PAPER[prop]
     assert solution.expression is not None
     assert sp.expand(solution.expression) == sp.expand(expected)
@@ -47,7 +47,7 @@ def test_registry_entries_are_derived_from_their_property(name: str) -> None:
     assert entry.defining_property is not None
     started = time.process_time()
     solution = solve_property(entry.defining_property)
-    assert time.process_time() - started < 10
+    assert time.process_time() - started < 60  # hang-catcher only (was 10 s)
     assert solution.expression is not None
     assert sp.expand(solution.expression) == sp.expand(entry.expression)
 

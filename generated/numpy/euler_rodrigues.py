@@ -487,8 +487,15 @@ def _quiet(function):
 
 def _as_float(value, name, shape):
     """value as a float32 or float64 array of shape (..., *shape); ValueError for anything else
-    (complex, bool, object, string and datetime input is refused, never silently converted)."""
+    (complex, bool, object, string and datetime input is refused, never silently converted).
+    A masked array is refused (its mask would be lost); a non-native byte order keeps its
+    precision (>f4 is computed in float32, >f8 in float64)."""
+    if isinstance(value, numpy.ma.MaskedArray):
+        raise ValueError(f"{name} must not be a masked array (numpy.ma): its mask would be lost; "
+                         "pass value.filled(numpy.nan) or value.data")
     value = numpy.asarray(value)
+    if value.dtype.kind == "f" and not value.dtype.isnative and value.dtype.itemsize in (4, 8):
+        value = value.astype(value.dtype.newbyteorder("="))
     if value.dtype != numpy.float64 and value.dtype != numpy.float32:  # float input is never copied
         if value.dtype.kind not in "fiu":
             raise ValueError(f"{name} must be a real float or integer array, got dtype {value.dtype}")
