@@ -46,7 +46,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--out", default=".", help="output directory for --emit (default: .)")
     parser.add_argument("--no-cache", action="store_true",
                         help="compute the evaluation plan even when an earlier --emit of the same p "
-                        "kept it (in $SYMROT_CACHE_DIR, default ~/.cache/symrot/plans)")
+                        "kept it (in symrot-plans-v1 under $SYMROT_CACHE_DIR, else $XDG_CACHE_HOME/symrot, "
+                        "else ~/.cache/symrot; no cache without any of them)")
     parser.set_defaults(run=run)
 
 
