@@ -508,17 +508,21 @@ def run_cache_cases() -> int:
             good = entries[0].read_bytes()
             for run, offset in enumerate((55, 66, 1902, 2254, len(good) // 2, len(good) - 2)):
                 offset = min(offset, len(good) - 1)
-                entries[0].write_bytes(good[:offset] + bytes([good[offset] ^ 0x10]) + good[offset + 1:])
+                corrupted = good[:offset] + bytes([good[offset] ^ 0x10]) + good[offset + 1:]
+                entries[0].write_bytes(corrupted)
                 status, value, last = _emit_phi(scratch / f"flip{run}", environment)
-                report(status == 0 and _right(value) and entries[0].read_bytes() == good,
+                # rewritten; not compared with ``good``: a plan computed on a loaded machine (its
+                # time limits) may differ from the first and still print a right kernel
+                report(status == 0 and _right(value) and entries[0].read_bytes() != corrupted,
                        f"emit over a byte flipped at {offset}", f"exit {status}, tangent {value} {last}")
+            before = entries[0].read_bytes()
             entries[0].chmod(0o400)
             (root / "symrot-plans-v1").chmod(0o500)
             try:
                 status, value, last = _emit_phi(scratch / "read-only", environment)
             finally:
                 (root / "symrot-plans-v1").chmod(0o700)
-            report(status == 0 and _right(value) and entries[0].read_bytes() == good,
+            report(status == 0 and _right(value) and entries[0].read_bytes() == before,
                    "emit from a read-only cache", f"exit {status}, tangent {value} {last}")
         homeless = scratch / "homeless"
         homeless.mkdir()

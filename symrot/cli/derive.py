@@ -62,7 +62,8 @@ def register(subparsers: Any) -> None:
                         "before any work; no symbolic link inside it is followed")
     parser.add_argument("--no-cache", action="store_true",
                         help="compute the evaluation plan even when an earlier --emit of the same p "
-                        "kept it (in $SYMROT_CACHE_DIR, default ~/.cache/symrot/plans)")
+                        "kept it (in symrot-plans-v1 under $SYMROT_CACHE_DIR, else $XDG_CACHE_HOME/symrot, "
+                        "else ~/.cache/symrot; no cache without any of them)")
     parser.set_defaults(run=run)
 
 
