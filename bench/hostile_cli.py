@@ -111,6 +111,8 @@ BOMBS = [
     "-" * 5000 + "phi",
     "+".join(["phi"] * 500),
     "phi" + "*phi" * 200,
+    "a" + "9" * 100000 + "b",  # issue 55: the unknown-name message scanned this in quadratic time
+    "10**10000*phi",  # issue 55: raised ValueError in the API, not SymrotError
 ]
 
 INVALID = [
