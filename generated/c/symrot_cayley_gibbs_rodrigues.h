@@ -24,6 +24,13 @@
  * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
  * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
  *
+ * In place: any output array may be the same array as any input array (rotation_matrix(buf, buf)
+ * with buf of 9 numbers, to_quaternion(buf, buf), angular_acceleration(p, pdot, pddot, pdot)): every
+ * function reads all its inputs before it writes an output. A _batch kernel's output may start at
+ * the same address as its p (in place: it runs backward). Other partial overlaps between an input
+ * and an output, and outputs overlapping each other (compose_jacobians' J1 and J2), are not
+ * supported.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -107,15 +114,25 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[
     const double c_R_1 = 4/(x + 4);
     const double c_R_2 = 2/(x + 4);
     const double t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const double out0 = c_R_2*(p[0]*p[0]) + t;
+    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out4 = c_R_2*(p[1]*p[1]) + t;
+    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_batch: symrot_cayley_gibbs_rodrigues_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -126,9 +143,11 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -153,19 +172,22 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
             const double closed_R_2 = c_R_2_lanes[k];
             c_R_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -195,15 +217,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent(const double p[3], doub
     }
     const double c_H_across = 4/(x + 4);
     const double c_H_1 = 2/(x + 4);
-    H[0] = c_H_across;
-    H[1] = -c_H_1*p[2];
-    H[2] = c_H_1*p[1];
-    H[3] = c_H_1*p[2];
-    H[4] = c_H_across;
-    H[5] = -c_H_1*p[0];
-    H[6] = -c_H_1*p[1];
-    H[7] = c_H_1*p[0];
-    H[8] = c_H_across;
+    const double out0 = c_H_across;
+    const double out1 = -c_H_1*p[2];
+    const double out2 = c_H_1*p[1];
+    const double out3 = c_H_1*p[2];
+    const double out4 = c_H_across;
+    const double out5 = -c_H_1*p[0];
+    const double out6 = -c_H_1*p[1];
+    const double out7 = c_H_1*p[0];
+    const double out8 = c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_batch: symrot_cayley_gibbs_rodrigues_tangent for n vectors p[3*k..3*k+2] into
@@ -214,9 +246,11 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent(const double p[3], doub
 static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const double *p, double *H)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -241,18 +275,21 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_batch(size_t n, const d
             c_H_1_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_H_1;
             c_H_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : 0;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -280,15 +317,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[
         Hinv[8] = (double)NAN;
         return;
     }
-    Hinv[0] = (1.0/4.0)*(p[0]*p[0]) + 1;
-    Hinv[1] = (1.0/4.0)*p[0]*p[1] + (1.0/2.0)*p[2];
-    Hinv[2] = (1.0/4.0)*p[0]*p[2] - 1.0/2.0*p[1];
-    Hinv[3] = (1.0/4.0)*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = (1.0/4.0)*(p[1]*p[1]) + 1;
-    Hinv[5] = (1.0/2.0)*p[0] + (1.0/4.0)*p[1]*p[2];
-    Hinv[6] = (1.0/4.0)*p[0]*p[2] + (1.0/2.0)*p[1];
-    Hinv[7] = -1.0/2.0*p[0] + (1.0/4.0)*p[1]*p[2];
-    Hinv[8] = (1.0/4.0)*(p[2]*p[2]) + 1;
+    const double out0 = (1.0/4.0)*(p[0]*p[0]) + 1;
+    const double out1 = (1.0/4.0)*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out2 = (1.0/4.0)*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out3 = (1.0/4.0)*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out4 = (1.0/4.0)*(p[1]*p[1]) + 1;
+    const double out5 = (1.0/2.0)*p[0] + (1.0/4.0)*p[1]*p[2];
+    const double out6 = (1.0/4.0)*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out7 = -1.0/2.0*p[0] + (1.0/4.0)*p[1]*p[2];
+    const double out8 = (1.0/4.0)*(p[2]*p[2]) + 1;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_batch: symrot_cayley_gibbs_rodrigues_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -299,9 +346,11 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -317,18 +366,21 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_batch(size_t n,
             c_H_inverse_1_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : -1.0/2.0;
             c_H_inverse_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : 1.0/4.0;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -375,15 +427,25 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], 
     const double c_G_1 = 1.0/sqrt(x + 4);
     const double c_G_2 = 1.0/(x + 2*sqrt(x + 4) + 4);
     const double t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const double out0 = c_G_2*(p[0]*p[0]) + t;
+    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out4 = c_G_2*(p[1]*p[1]) + t;
+    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_batch: symrot_cayley_gibbs_rodrigues_root_matrix for n vectors p[3*k..3*k+2] into
@@ -395,9 +457,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], 
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, const double *p, double *G)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -434,19 +498,22 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
             const double closed_G_2 = c_G_2_lanes[k];
             c_G_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -477,15 +544,25 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3],
     const double c_K_across = 1.0/sqrt(x + 4);
     const double c_K_1 = 1.0/(x + 2*sqrt(x + 4) + 4);
     const double c_K_2 = -1/((x + 4)*(sqrt(x + 4) + 2));
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_batch: symrot_cayley_gibbs_rodrigues_root_tangent for n vectors p[3*k..3*k+2] into
@@ -497,9 +574,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3],
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, const double *p, double *K)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -539,18 +618,21 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
             const double closed_K_2 = c_K_2_lanes[k];
             c_K_2_lanes[k] = !(x < 4.149515568880993e+180) ? (double)NAN : closed_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -628,10 +710,15 @@ static inline void symrot_cayley_gibbs_rodrigues_to_quaternion(const double p[3]
     const double c_e_0 = 2/sqrt(x + 4);
     const double c_nu = 2/sqrt(x + 4);
     const double half_nu = (1.0/2.0)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const double out0 = c_e_0;
+    const double out1 = half_nu*p[0];
+    const double out2 = half_nu*p[1];
+    const double out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_cayley_gibbs_rodrigues__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
@@ -817,15 +904,25 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative(const doubl
     const double dw23 = a[0]*c_R_1;
     const double dw24 = dw11*p[0] - dw16;
     const double dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -882,15 +979,25 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative(c
     const double dw21 = a[0]*p[0];
     const double dw22 = a[0]*c_R_1;
     const double dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -937,15 +1044,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative(const double
     const double dw12 = a[0]*c_H_1;
     const double dw13 = c_H_1_x*(a[1]*p[0] - dw4);
     const double dw14 = 2*dw13;
-    D[0] = a[0]*c_H_0_x*dw0 + dw0*dw2;
-    D[1] = dw3 + dw4*dw5 + dw6*p[1];
-    D[2] = dw5*dw8 + dw6*p[2] - dw7;
-    D[3] = a[1]*dw5*p[0] + dw0*dw10 - dw3;
-    D[4] = a[1]*dw5*p[1] + dw11*p[1];
-    D[5] = dw1*dw5 + dw11*p[2] + dw12;
-    D[6] = dw0*dw13 + dw5*dw9 + dw7;
-    D[7] = a[2]*dw5*p[1] - dw12 + dw14*p[1];
-    D[8] = a[2]*dw5*p[2] + dw14*p[2];
+    const double out0 = a[0]*c_H_0_x*dw0 + dw0*dw2;
+    const double out1 = dw3 + dw4*dw5 + dw6*p[1];
+    const double out2 = dw5*dw8 + dw6*p[2] - dw7;
+    const double out3 = a[1]*dw5*p[0] + dw0*dw10 - dw3;
+    const double out4 = a[1]*dw5*p[1] + dw11*p[1];
+    const double out5 = dw1*dw5 + dw11*p[2] + dw12;
+    const double out6 = dw0*dw13 + dw5*dw9 + dw7;
+    const double out7 = a[2]*dw5*p[1] - dw12 + dw14*p[1];
+    const double out8 = a[2]*dw5*p[2] + dw14*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -989,15 +1106,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(co
     const double dw9 = a[0]*c_H_1;
     const double dw10 = c_H_1_x*(-a[0]*p[1] + a[1]*p[0]);
     const double dw11 = 2*dw10;
-    D[0] = a[0]*c_H_0_x*dw0 - dw0*dw1;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - dw2 - dw3*p[1];
-    D[2] = -dw3*p[2] + dw4 + dw5*dw6;
-    D[3] = a[1]*dw6*p[0] - dw0*dw7 + dw2;
-    D[4] = a[1]*dw6*p[1] - dw8*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - dw8*p[2] - dw9;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - dw0*dw10 - dw4;
-    D[7] = a[2]*dw6*p[1] - dw11*p[1] + dw9;
-    D[8] = a[2]*dw6*p[2] - dw11*p[2];
+    const double out0 = a[0]*c_H_0_x*dw0 - dw0*dw1;
+    const double out1 = 2*a[0]*c_H_0_x*p[1] - dw2 - dw3*p[1];
+    const double out2 = -dw3*p[2] + dw4 + dw5*dw6;
+    const double out3 = a[1]*dw6*p[0] - dw0*dw7 + dw2;
+    const double out4 = a[1]*dw6*p[1] - dw8*p[1];
+    const double out5 = 2*a[1]*c_H_0_x*p[2] - dw8*p[2] - dw9;
+    const double out6 = 2*a[2]*c_H_0_x*p[0] - dw0*dw10 - dw4;
+    const double out7 = a[2]*dw6*p[1] - dw11*p[1] + dw9;
+    const double out8 = a[2]*dw6*p[2] - dw11*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1035,15 +1162,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative(cons
     const double dw6 = (1.0/2.0)*a[1];
     const double dw7 = (1.0/4.0)*a[0];
     const double dw8 = dw7*p[0];
-    D[0] = dw0*p[0] + dw2 + dw4;
-    D[1] = dw1*p[0] - dw5;
-    D[2] = dw3*p[0] + dw6;
-    D[3] = dw5 + dw7*p[1];
-    D[4] = dw4 + dw6*p[1] + dw8;
-    D[5] = (1.0/4.0)*a[2]*p[1] - dw0;
-    D[6] = -dw6 + dw7*p[2];
-    D[7] = dw0 + dw1*p[2];
-    D[8] = dw2 + dw5*p[2] + dw8;
+    const double out0 = dw0*p[0] + dw2 + dw4;
+    const double out1 = dw1*p[0] - dw5;
+    const double out2 = dw3*p[0] + dw6;
+    const double out3 = dw5 + dw7*p[1];
+    const double out4 = dw4 + dw6*p[1] + dw8;
+    const double out5 = (1.0/4.0)*a[2]*p[1] - dw0;
+    const double out6 = -dw6 + dw7*p[2];
+    const double out7 = dw0 + dw1*p[2];
+    const double out8 = dw2 + dw5*p[2] + dw8;
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
@@ -1077,9 +1214,13 @@ static inline void symrot_cayley_gibbs_rodrigues_angular_acceleration(const doub
     const double dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
     const double dw1 = c_H_0_x*dw0;
     const double dw2 = c_H_1_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 + dw1*pdot[0] + dw2*(p[1]*pdot[2] - p[2]*pdot[1]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 + dw1*pdot[1] + dw2*(-p[0]*pdot[2] + p[2]*pdot[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 + dw1*pdot[2] + dw2*(p[0]*pdot[1] - p[1]*pdot[0]);
+    const double out0 = c_H_0*pddot[0] + c_H_1*w0 + dw1*pdot[0] + dw2*(p[1]*pdot[2] - p[2]*pdot[1]);
+    const double out1 = c_H_0*pddot[1] + c_H_1*w1 + dw1*pdot[1] + dw2*(-p[0]*pdot[2] + p[2]*pdot[0]);
+    const double out2 = c_H_0*pddot[2] + c_H_1*w2 + dw1*pdot[2] + dw2*(p[0]*pdot[1] - p[1]*pdot[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_cayley_gibbs_rodrigues_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
@@ -1262,15 +1403,25 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p
     const float c_R_1 = 4/(x + 4);
     const float c_R_2 = 2/(x + 4);
     const float t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const float out0 = c_R_2*(p[0]*p[0]) + t;
+    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out4 = c_R_2*(p[1]*p[1]) + t;
+    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch: symrot_cayley_gibbs_rodrigues_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1281,9 +1432,11 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p
 static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1308,19 +1461,22 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
             const float closed_R_2 = c_R_2_lanes[k];
             c_R_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1350,15 +1506,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f(const float p[3], flo
     }
     const float c_H_across = 4/(x + 4);
     const float c_H_1 = 2/(x + 4);
-    H[0] = c_H_across;
-    H[1] = -c_H_1*p[2];
-    H[2] = c_H_1*p[1];
-    H[3] = c_H_1*p[2];
-    H[4] = c_H_across;
-    H[5] = -c_H_1*p[0];
-    H[6] = -c_H_1*p[1];
-    H[7] = c_H_1*p[0];
-    H[8] = c_H_across;
+    const float out0 = c_H_across;
+    const float out1 = -c_H_1*p[2];
+    const float out2 = c_H_1*p[1];
+    const float out3 = c_H_1*p[2];
+    const float out4 = c_H_across;
+    const float out5 = -c_H_1*p[0];
+    const float out6 = -c_H_1*p[1];
+    const float out7 = c_H_1*p[0];
+    const float out8 = c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_f_batch: symrot_cayley_gibbs_rodrigues_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1369,9 +1535,11 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f(const float p[3], flo
 static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const float *p, float *H)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1396,18 +1564,21 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f_batch(size_t n, const
             c_H_1_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_H_1;
             c_H_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : 0;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -1435,15 +1606,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p
         Hinv[8] = NAN;
         return;
     }
-    Hinv[0] = (1.0F/4.0F)*(p[0]*p[0]) + 1;
-    Hinv[1] = (1.0F/4.0F)*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    Hinv[2] = (1.0F/4.0F)*p[0]*p[2] - 1.0F/2.0F*p[1];
-    Hinv[3] = (1.0F/4.0F)*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = (1.0F/4.0F)*(p[1]*p[1]) + 1;
-    Hinv[5] = (1.0F/2.0F)*p[0] + (1.0F/4.0F)*p[1]*p[2];
-    Hinv[6] = (1.0F/4.0F)*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    Hinv[7] = -1.0F/2.0F*p[0] + (1.0F/4.0F)*p[1]*p[2];
-    Hinv[8] = (1.0F/4.0F)*(p[2]*p[2]) + 1;
+    const float out0 = (1.0F/4.0F)*(p[0]*p[0]) + 1;
+    const float out1 = (1.0F/4.0F)*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out2 = (1.0F/4.0F)*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out3 = (1.0F/4.0F)*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out4 = (1.0F/4.0F)*(p[1]*p[1]) + 1;
+    const float out5 = (1.0F/2.0F)*p[0] + (1.0F/4.0F)*p[1]*p[2];
+    const float out6 = (1.0F/4.0F)*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out7 = -1.0F/2.0F*p[0] + (1.0F/4.0F)*p[1]*p[2];
+    const float out8 = (1.0F/4.0F)*(p[2]*p[2]) + 1;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch: symrot_cayley_gibbs_rodrigues_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1454,9 +1635,11 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p
 static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1472,18 +1655,21 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f_batch(size_t 
             c_H_inverse_1_lanes[k] = !(x < 3.8685626e+25F) ? NAN : -1.0F/2.0F;
             c_H_inverse_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : 1.0F/4.0F;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1530,15 +1716,25 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3],
     const float c_G_1 = 1.0F/sqrtf(x + 4);
     const float c_G_2 = 1.0F/(x + 2*sqrtf(x + 4) + 4);
     const float t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const float out0 = c_G_2*(p[0]*p[0]) + t;
+    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out4 = c_G_2*(p[1]*p[1]) + t;
+    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_f_batch: symrot_cayley_gibbs_rodrigues_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1550,9 +1746,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3],
 static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1589,19 +1787,22 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
             const float closed_G_2 = c_G_2_lanes[k];
             c_G_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1632,15 +1833,25 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3]
     const float c_K_across = 1.0F/sqrtf(x + 4);
     const float c_K_1 = 1.0F/(x + 2*sqrtf(x + 4) + 4);
     const float c_K_2 = -1/((x + 4)*(sqrtf(x + 4) + 2));
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_f_batch: symrot_cayley_gibbs_rodrigues_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1652,9 +1863,11 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3]
 static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1694,18 +1907,21 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
             const float closed_K_2 = c_K_2_lanes[k];
             c_K_2_lanes[k] = !(x < 3.8685626e+25F) ? NAN : closed_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -1783,10 +1999,15 @@ static inline void symrot_cayley_gibbs_rodrigues_to_quaternion_f(const float p[3
     const float c_e_0 = 2/sqrtf(x + 4);
     const float c_nu = 2/sqrtf(x + 4);
     const float half_nu = (1.0F/2.0F)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const float out0 = c_e_0;
+    const float out1 = half_nu*p[0];
+    const float out2 = half_nu*p[1];
+    const float out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_cayley_gibbs_rodrigues__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
@@ -1972,15 +2193,25 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative_f(const flo
     const float dw23 = a[0]*c_R_1;
     const float dw24 = dw11*p[0] - dw16;
     const float dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2037,15 +2268,25 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f
     const float dw21 = a[0]*p[0];
     const float dw22 = a[0]*c_R_1;
     const float dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2092,15 +2333,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative_f(const floa
     const float dw12 = a[0]*c_H_1;
     const float dw13 = c_H_1_x*(a[1]*p[0] - dw4);
     const float dw14 = 2*dw13;
-    D[0] = a[0]*c_H_0_x*dw0 + dw0*dw2;
-    D[1] = dw3 + dw4*dw5 + dw6*p[1];
-    D[2] = dw5*dw8 + dw6*p[2] - dw7;
-    D[3] = a[1]*dw5*p[0] + dw0*dw10 - dw3;
-    D[4] = a[1]*dw5*p[1] + dw11*p[1];
-    D[5] = dw1*dw5 + dw11*p[2] + dw12;
-    D[6] = dw0*dw13 + dw5*dw9 + dw7;
-    D[7] = a[2]*dw5*p[1] - dw12 + dw14*p[1];
-    D[8] = a[2]*dw5*p[2] + dw14*p[2];
+    const float out0 = a[0]*c_H_0_x*dw0 + dw0*dw2;
+    const float out1 = dw3 + dw4*dw5 + dw6*p[1];
+    const float out2 = dw5*dw8 + dw6*p[2] - dw7;
+    const float out3 = a[1]*dw5*p[0] + dw0*dw10 - dw3;
+    const float out4 = a[1]*dw5*p[1] + dw11*p[1];
+    const float out5 = dw1*dw5 + dw11*p[2] + dw12;
+    const float out6 = dw0*dw13 + dw5*dw9 + dw7;
+    const float out7 = a[2]*dw5*p[1] - dw12 + dw14*p[1];
+    const float out8 = a[2]*dw5*p[2] + dw14*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2144,15 +2395,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(
     const float dw9 = a[0]*c_H_1;
     const float dw10 = c_H_1_x*(-a[0]*p[1] + a[1]*p[0]);
     const float dw11 = 2*dw10;
-    D[0] = a[0]*c_H_0_x*dw0 - dw0*dw1;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - dw2 - dw3*p[1];
-    D[2] = -dw3*p[2] + dw4 + dw5*dw6;
-    D[3] = a[1]*dw6*p[0] - dw0*dw7 + dw2;
-    D[4] = a[1]*dw6*p[1] - dw8*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - dw8*p[2] - dw9;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - dw0*dw10 - dw4;
-    D[7] = a[2]*dw6*p[1] - dw11*p[1] + dw9;
-    D[8] = a[2]*dw6*p[2] - dw11*p[2];
+    const float out0 = a[0]*c_H_0_x*dw0 - dw0*dw1;
+    const float out1 = 2*a[0]*c_H_0_x*p[1] - dw2 - dw3*p[1];
+    const float out2 = -dw3*p[2] + dw4 + dw5*dw6;
+    const float out3 = a[1]*dw6*p[0] - dw0*dw7 + dw2;
+    const float out4 = a[1]*dw6*p[1] - dw8*p[1];
+    const float out5 = 2*a[1]*c_H_0_x*p[2] - dw8*p[2] - dw9;
+    const float out6 = 2*a[2]*c_H_0_x*p[0] - dw0*dw10 - dw4;
+    const float out7 = a[2]*dw6*p[1] - dw11*p[1] + dw9;
+    const float out8 = a[2]*dw6*p[2] - dw11*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2190,15 +2451,25 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative_f(co
     const float dw6 = (1.0F/2.0F)*a[1];
     const float dw7 = (1.0F/4.0F)*a[0];
     const float dw8 = dw7*p[0];
-    D[0] = dw0*p[0] + dw2 + dw4;
-    D[1] = dw1*p[0] - dw5;
-    D[2] = dw3*p[0] + dw6;
-    D[3] = dw5 + dw7*p[1];
-    D[4] = dw4 + dw6*p[1] + dw8;
-    D[5] = (1.0F/4.0F)*a[2]*p[1] - dw0;
-    D[6] = -dw6 + dw7*p[2];
-    D[7] = dw0 + dw1*p[2];
-    D[8] = dw2 + dw5*p[2] + dw8;
+    const float out0 = dw0*p[0] + dw2 + dw4;
+    const float out1 = dw1*p[0] - dw5;
+    const float out2 = dw3*p[0] + dw6;
+    const float out3 = dw5 + dw7*p[1];
+    const float out4 = dw4 + dw6*p[1] + dw8;
+    const float out5 = (1.0F/4.0F)*a[2]*p[1] - dw0;
+    const float out6 = -dw6 + dw7*p[2];
+    const float out7 = dw0 + dw1*p[2];
+    const float out8 = dw2 + dw5*p[2] + dw8;
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_cayley_gibbs_rodrigues_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
@@ -2232,9 +2503,13 @@ static inline void symrot_cayley_gibbs_rodrigues_angular_acceleration_f(const fl
     const float dw0 = 2*p[0]*pdot[0] + 2*p[1]*pdot[1] + 2*p[2]*pdot[2];
     const float dw1 = c_H_0_x*dw0;
     const float dw2 = c_H_1_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 + dw1*pdot[0] + dw2*(p[1]*pdot[2] - p[2]*pdot[1]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 + dw1*pdot[1] + dw2*(-p[0]*pdot[2] + p[2]*pdot[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 + dw1*pdot[2] + dw2*(p[0]*pdot[1] - p[1]*pdot[0]);
+    const float out0 = c_H_0*pddot[0] + c_H_1*w0 + dw1*pdot[0] + dw2*(p[1]*pdot[2] - p[2]*pdot[1]);
+    const float out1 = c_H_0*pddot[1] + c_H_1*w1 + dw1*pdot[1] + dw2*(-p[0]*pdot[2] + p[2]*pdot[0]);
+    const float out2 = c_H_0*pddot[2] + c_H_1*w2 + dw1*pdot[2] + dw2*(p[0]*pdot[1] - p[1]*pdot[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_cayley_gibbs_rodrigues_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).

@@ -24,6 +24,13 @@
  * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
  * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
  *
+ * In place: any output array may be the same array as any input array (rotation_matrix(buf, buf)
+ * with buf of 9 numbers, to_quaternion(buf, buf), angular_acceleration(p, pdot, pddot, pdot)): every
+ * function reads all its inputs before it writes an output. A _batch kernel's output may start at
+ * the same address as its p (in place: it runs backward). Other partial overlaps between an input
+ * and an output, and outputs overlapping each other (compose_jacobians' J1 and J2), are not
+ * supported.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -129,15 +136,25 @@ static inline void symrot_euler_rodrigues_rotation_matrix(const double p[3], dou
     }
     const double c_R_1 = (1.0/2.0)*sqrt(d);
     const double t = 1 - 1.0/2.0*x;
-    R[0] = (1.0/2.0)*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + (1.0/2.0)*p[0]*p[1];
-    R[2] = c_R_1*p[1] + (1.0/2.0)*p[0]*p[2];
-    R[3] = c_R_1*p[2] + (1.0/2.0)*p[0]*p[1];
-    R[4] = (1.0/2.0)*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + (1.0/2.0)*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + (1.0/2.0)*p[0]*p[2];
-    R[7] = c_R_1*p[0] + (1.0/2.0)*p[1]*p[2];
-    R[8] = (1.0/2.0)*(p[2]*p[2]) + t;
+    const double out0 = (1.0/2.0)*(p[0]*p[0]) + t;
+    const double out1 = -c_R_1*p[2] + (1.0/2.0)*p[0]*p[1];
+    const double out2 = c_R_1*p[1] + (1.0/2.0)*p[0]*p[2];
+    const double out3 = c_R_1*p[2] + (1.0/2.0)*p[0]*p[1];
+    const double out4 = (1.0/2.0)*(p[1]*p[1]) + t;
+    const double out5 = -c_R_1*p[0] + (1.0/2.0)*p[1]*p[2];
+    const double out6 = -c_R_1*p[1] + (1.0/2.0)*p[0]*p[2];
+    const double out7 = c_R_1*p[0] + (1.0/2.0)*p[1]*p[2];
+    const double out8 = (1.0/2.0)*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_euler_rodrigues_rotation_matrix_batch: symrot_euler_rodrigues_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -149,9 +166,11 @@ static inline void symrot_euler_rodrigues_rotation_matrix(const double p[3], dou
 static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -181,19 +200,22 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
             c_R_1_lanes[k] = !(x < 4.0) ? (double)NAN : closed_R_1;
             c_R_2_lanes[k] = !(x < 4.0) ? (double)NAN : 1.0/2.0;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -222,15 +244,25 @@ static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9]
     }
     const double c_H_across = (1.0/2.0)*sqrt(d);
     const double c_H_2 = (1.0/2.0)/sqrt(d);
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = c_H_2*p[0]*p[1] - 1.0/2.0*p[2];
-    H[2] = c_H_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    H[3] = c_H_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = c_H_2*p[1]*p[2] - 1.0/2.0*p[0];
-    H[6] = c_H_2*p[0]*p[2] - 1.0/2.0*p[1];
-    H[7] = c_H_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const double out1 = c_H_2*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out2 = c_H_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out3 = c_H_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const double out5 = c_H_2*p[1]*p[2] - 1.0/2.0*p[0];
+    const double out6 = c_H_2*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out7 = c_H_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_batch: symrot_euler_rodrigues_tangent for n vectors p[3*k..3*k+2] into
@@ -242,9 +274,11 @@ static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9]
 static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *p, double *H)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -281,18 +315,21 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
             const double closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 4.0) ? (double)NAN : closed_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -320,15 +357,25 @@ static inline void symrot_euler_rodrigues_tangent_inverse(const double p[3], dou
         return;
     }
     const double c_H_inverse_across = (1.0/2.0)*sqrt(d);
-    Hinv[0] = c_H_inverse_across;
-    Hinv[1] = (1.0/2.0)*p[2];
-    Hinv[2] = -1.0/2.0*p[1];
-    Hinv[3] = -1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_across;
-    Hinv[5] = (1.0/2.0)*p[0];
-    Hinv[6] = (1.0/2.0)*p[1];
-    Hinv[7] = -1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_across;
+    const double out0 = c_H_inverse_across;
+    const double out1 = (1.0/2.0)*p[2];
+    const double out2 = -1.0/2.0*p[1];
+    const double out3 = -1.0/2.0*p[2];
+    const double out4 = c_H_inverse_across;
+    const double out5 = (1.0/2.0)*p[0];
+    const double out6 = (1.0/2.0)*p[1];
+    const double out7 = -1.0/2.0*p[0];
+    const double out8 = c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_batch: symrot_euler_rodrigues_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -340,9 +387,11 @@ static inline void symrot_euler_rodrigues_tangent_inverse(const double p[3], dou
 static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -372,18 +421,21 @@ static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const 
             c_H_inverse_1_lanes[k] = !(x < 4.0) ? (double)NAN : -1.0/2.0;
             c_H_inverse_2_lanes[k] = !(x < 4.0) ? (double)NAN : 0;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -427,15 +479,25 @@ static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double 
     }
     const double c_G_2 = (1.0/2.0)/(sqrt(d) + 2);
     const double t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = c_G_2*p[0]*p[1] - 1.0/2.0*p[2];
-    G[2] = c_G_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    G[3] = c_G_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = c_G_2*p[1]*p[2] - 1.0/2.0*p[0];
-    G[6] = c_G_2*p[0]*p[2] - 1.0/2.0*p[1];
-    G[7] = c_G_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const double out0 = c_G_2*(p[0]*p[0]) + t;
+    const double out1 = c_G_2*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out2 = c_G_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out3 = c_G_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out4 = c_G_2*(p[1]*p[1]) + t;
+    const double out5 = c_G_2*p[1]*p[2] - 1.0/2.0*p[0];
+    const double out6 = c_G_2*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out7 = c_G_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    const double out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_euler_rodrigues_root_matrix_batch: symrot_euler_rodrigues_root_matrix for n vectors p[3*k..3*k+2] into
@@ -447,9 +509,11 @@ static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double 
 static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const double *p, double *G)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -479,19 +543,22 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
             const double closed_G_2 = c_G_2_lanes[k];
             c_G_2_lanes[k] = !(x < 4.0) ? (double)NAN : closed_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -526,15 +593,25 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
         const double w0 = sqrt(d);
         c_K_2 = (1.0/4.0)/(w0*((1.0/2.0)*w0 + 1));
     }
-    K[0] = c_K_2*(p[0]*p[0]) + 1.0/2.0;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + 1.0/2.0;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + 1.0/2.0;
+    const double out0 = c_K_2*(p[0]*p[0]) + 1.0/2.0;
+    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out4 = c_K_2*(p[1]*p[1]) + 1.0/2.0;
+    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out8 = c_K_2*(p[2]*p[2]) + 1.0/2.0;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_euler_rodrigues_root_tangent_batch: symrot_euler_rodrigues_root_tangent for n vectors p[3*k..3*k+2] into
@@ -546,9 +623,11 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
 static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const double *p, double *K)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -589,18 +668,21 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
             const double v_K_2 = x < 9.99999999999999e-15 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.0) ? (double)NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -675,10 +757,15 @@ static inline void symrot_euler_rodrigues_to_quaternion(const double p[3], doubl
     }
     const double c_e_0 = (1.0/2.0)*sqrt(d);
     const double half_nu = 1.0/2.0;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const double out0 = c_e_0;
+    const double out1 = half_nu*p[0];
+    const double out2 = half_nu*p[1];
+    const double out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_euler_rodrigues__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
@@ -854,15 +941,25 @@ static inline void symrot_euler_rodrigues_rotation_derivative(const double p[3],
     const double dw16 = a[0]*c_R_1;
     const double dw17 = -dw12 - dw8;
     const double dw18 = dw17*dw5;
-    D[0] = dw0 + dw1 + dw6*p[0];
-    D[1] = dw6*p[1] + dw7 - dw8 + (1.0/2.0)*dw9;
-    D[2] = (1.0/2.0)*a[2]*p[0] + 2*c_R_1_x*dw4*p[2] - dw10 - dw11;
-    D[3] = dw12 + dw14*p[0] - dw7 + (1.0/2.0)*dw8;
-    D[4] = dw1 + dw14*p[1] + dw15;
-    D[5] = dw14*p[2] + dw16 - dw2 + (1.0/2.0)*dw3;
-    D[6] = (1.0/2.0)*dw10 + dw11 + dw13 + dw18*p[0];
-    D[7] = (1.0/2.0)*a[1]*p[2] + 2*c_R_1_x*dw17*p[1] - dw16 - dw3;
-    D[8] = dw0 + dw15 + dw18*p[2];
+    const double out0 = dw0 + dw1 + dw6*p[0];
+    const double out1 = dw6*p[1] + dw7 - dw8 + (1.0/2.0)*dw9;
+    const double out2 = (1.0/2.0)*a[2]*p[0] + 2*c_R_1_x*dw4*p[2] - dw10 - dw11;
+    const double out3 = dw12 + dw14*p[0] - dw7 + (1.0/2.0)*dw8;
+    const double out4 = dw1 + dw14*p[1] + dw15;
+    const double out5 = dw14*p[2] + dw16 - dw2 + (1.0/2.0)*dw3;
+    const double out6 = (1.0/2.0)*dw10 + dw11 + dw13 + dw18*p[0];
+    const double out7 = (1.0/2.0)*a[1]*p[2] + 2*c_R_1_x*dw17*p[1] - dw16 - dw3;
+    const double out8 = dw0 + dw15 + dw18*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -908,15 +1005,25 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative(const do
     const double dw13 = (1.0/2.0)*a[0]*p[0];
     const double dw14 = a[0]*c_R_1;
     const double dw15 = dw4*(-dw10 - dw6);
-    D[0] = dw0 + dw1 - dw5*p[0];
-    D[1] = (1.0/2.0)*a[1]*p[0] - dw5*p[1] - dw6 - dw7;
-    D[2] = (1.0/2.0)*a[2]*p[0] - dw5*p[2] - dw8 + dw9;
-    D[3] = dw10 - dw12*p[0] + (1.0/2.0)*dw6 + dw7;
-    D[4] = dw1 - dw12*p[1] + dw13;
-    D[5] = (1.0/2.0)*a[2]*p[1] - dw12*p[2] - dw14 - dw2;
-    D[6] = (1.0/2.0)*a[0]*p[2] - dw11 - dw15*p[0] - dw9;
-    D[7] = dw14 - dw15*p[1] + (1.0/2.0)*dw2 + dw3;
-    D[8] = dw0 + dw13 - dw15*p[2];
+    const double out0 = dw0 + dw1 - dw5*p[0];
+    const double out1 = (1.0/2.0)*a[1]*p[0] - dw5*p[1] - dw6 - dw7;
+    const double out2 = (1.0/2.0)*a[2]*p[0] - dw5*p[2] - dw8 + dw9;
+    const double out3 = dw10 - dw12*p[0] + (1.0/2.0)*dw6 + dw7;
+    const double out4 = dw1 - dw12*p[1] + dw13;
+    const double out5 = (1.0/2.0)*a[2]*p[1] - dw12*p[2] - dw14 - dw2;
+    const double out6 = (1.0/2.0)*a[0]*p[2] - dw11 - dw15*p[0] - dw9;
+    const double out7 = dw14 - dw15*p[1] + (1.0/2.0)*dw2 + dw3;
+    const double out8 = dw0 + dw13 - dw15*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -970,15 +1077,25 @@ static inline void symrot_euler_rodrigues_tangent_derivative(const double p[3], 
     const double dw20 = (1.0/2.0)*a[0];
     const double dw21 = -dw17*p[1] + dw9*p[0];
     const double dw22 = dw11*dw21;
-    D[0] = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw12*p[1] + dw13;
-    D[2] = 2*a[0]*c_H_0_x*p[2] - c_H_2*dw7 - c_H_2*dw9 + 2*c_H_2_x*dw10*p[2] - dw14;
-    D[3] = 2*a[1]*c_H_0_x*p[0] - a[1]*c_H_2*p[0] - c_H_2*dw6 + 2*c_H_2_x*dw18*p[0] - dw13;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw19*p[1];
-    D[5] = -c_H_2*dw15 - c_H_2*dw16 + dw1*dw15 + dw19*p[2] + dw20;
-    D[6] = -c_H_2*dw8 + c_H_2*dw9 + dw1*dw8 + dw14 + dw22*p[0];
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] - c_H_2*dw17 + 2*c_H_2_x*dw21*p[1] - dw20;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw22*p[2];
+    const double out0 = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const double out1 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw12*p[1] + dw13;
+    const double out2 = 2*a[0]*c_H_0_x*p[2] - c_H_2*dw7 - c_H_2*dw9 + 2*c_H_2_x*dw10*p[2] - dw14;
+    const double out3 = 2*a[1]*c_H_0_x*p[0] - a[1]*c_H_2*p[0] - c_H_2*dw6 + 2*c_H_2_x*dw18*p[0] - dw13;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw19*p[1];
+    const double out5 = -c_H_2*dw15 - c_H_2*dw16 + dw1*dw15 + dw19*p[2] + dw20;
+    const double out6 = -c_H_2*dw8 + c_H_2*dw9 + dw1*dw8 + dw14 + dw22*p[0];
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] - c_H_2*dw17 + 2*c_H_2_x*dw21*p[1] - dw20;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw22*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1034,15 +1151,25 @@ static inline void symrot_euler_rodrigues_tangent_transpose_derivative(const dou
     const double dw22 = -dw18*p[1] + dw9*p[0];
     const double dw23 = a[2]*p[1];
     const double dw24 = dw11*dw22;
-    D[0] = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw10*p[1] - dw13;
-    D[2] = -c_H_2*dw7 - c_H_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
-    D[3] = -c_H_2*dw15 - c_H_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw16 - c_H_2*dw17 + 2*c_H_2_x*dw19*p[2] - dw21;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw8 + c_H_2*dw9 + 2*c_H_2_x*dw22*p[0] - dw14;
-    D[7] = -c_H_2*dw18 - c_H_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    const double out0 = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw10*p[1] - dw13;
+    const double out2 = -c_H_2*dw7 - c_H_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    const double out3 = -c_H_2*dw15 - c_H_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw16 - c_H_2*dw17 + 2*c_H_2_x*dw19*p[2] - dw21;
+    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw8 + c_H_2*dw9 + 2*c_H_2_x*dw22*p[0] - dw14;
+    const double out7 = -c_H_2*dw18 - c_H_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1078,15 +1205,25 @@ static inline void symrot_euler_rodrigues_tangent_inverse_derivative(const doubl
     const double dw4 = a[1]*dw0;
     const double dw5 = (1.0/2.0)*a[0];
     const double dw6 = a[2]*dw0;
-    D[0] = dw1*p[0];
-    D[1] = dw1*p[1] - dw2;
-    D[2] = dw1*p[2] + dw3;
-    D[3] = dw2 + dw4*p[0];
-    D[4] = dw4*p[1];
-    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - dw5;
-    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - dw3;
-    D[7] = dw5 + dw6*p[1];
-    D[8] = dw6*p[2];
+    const double out0 = dw1*p[0];
+    const double out1 = dw1*p[1] - dw2;
+    const double out2 = dw1*p[2] + dw3;
+    const double out3 = dw2 + dw4*p[0];
+    const double out4 = dw4*p[1];
+    const double out5 = 2*a[1]*c_H_inverse_0_x*p[2] - dw5;
+    const double out6 = 2*a[2]*c_H_inverse_0_x*p[0] - dw3;
+    const double out7 = dw5 + dw6*p[1];
+    const double out8 = dw6*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
@@ -1122,9 +1259,13 @@ static inline void symrot_euler_rodrigues_angular_acceleration(const double p[3]
     const double dw3 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double dw4 = c_H_2_x*dw0;
     const double dw5 = p[1]*pdot[2] - p[2]*pdot[1];
-    alpha[0] = c_H_0*pddot[0] - c_H_2*(-dw2*pdot[1] + dw3*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw4*(dw2*p[1] - dw3*p[2]) + (1.0/2.0)*w0;
-    alpha[1] = c_H_0*pddot[1] - c_H_2*(dw2*pdot[0] - dw5*pdot[2]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw4*(-dw2*p[0] + dw5*p[2]) + (1.0/2.0)*w1;
-    alpha[2] = c_H_0*pddot[2] - c_H_2*(-dw3*pdot[0] + dw5*pdot[1]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw4*(dw3*p[0] - dw5*p[1]) + (1.0/2.0)*w2;
+    const double out0 = c_H_0*pddot[0] - c_H_2*(-dw2*pdot[1] + dw3*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw4*(dw2*p[1] - dw3*p[2]) + (1.0/2.0)*w0;
+    const double out1 = c_H_0*pddot[1] - c_H_2*(dw2*pdot[0] - dw5*pdot[2]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw4*(-dw2*p[0] + dw5*p[2]) + (1.0/2.0)*w1;
+    const double out2 = c_H_0*pddot[2] - c_H_2*(-dw3*pdot[0] + dw5*pdot[1]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw4*(dw3*p[0] - dw5*p[1]) + (1.0/2.0)*w2;
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_euler_rodrigues_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
@@ -1329,15 +1470,25 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f(const float p[3], fl
     }
     const float c_R_1 = (1.0F/2.0F)*sqrtf(d);
     const float t = 1 - 1.0F/2.0F*x;
-    R[0] = (1.0F/2.0F)*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + (1.0F/2.0F)*p[0]*p[1];
-    R[2] = c_R_1*p[1] + (1.0F/2.0F)*p[0]*p[2];
-    R[3] = c_R_1*p[2] + (1.0F/2.0F)*p[0]*p[1];
-    R[4] = (1.0F/2.0F)*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + (1.0F/2.0F)*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + (1.0F/2.0F)*p[0]*p[2];
-    R[7] = c_R_1*p[0] + (1.0F/2.0F)*p[1]*p[2];
-    R[8] = (1.0F/2.0F)*(p[2]*p[2]) + t;
+    const float out0 = (1.0F/2.0F)*(p[0]*p[0]) + t;
+    const float out1 = -c_R_1*p[2] + (1.0F/2.0F)*p[0]*p[1];
+    const float out2 = c_R_1*p[1] + (1.0F/2.0F)*p[0]*p[2];
+    const float out3 = c_R_1*p[2] + (1.0F/2.0F)*p[0]*p[1];
+    const float out4 = (1.0F/2.0F)*(p[1]*p[1]) + t;
+    const float out5 = -c_R_1*p[0] + (1.0F/2.0F)*p[1]*p[2];
+    const float out6 = -c_R_1*p[1] + (1.0F/2.0F)*p[0]*p[2];
+    const float out7 = c_R_1*p[0] + (1.0F/2.0F)*p[1]*p[2];
+    const float out8 = (1.0F/2.0F)*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_euler_rodrigues_rotation_matrix_f_batch: symrot_euler_rodrigues_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1349,9 +1500,11 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f(const float p[3], fl
 static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1381,19 +1534,22 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
             c_R_1_lanes[k] = !(x < 4.0F) ? NAN : closed_R_1;
             c_R_2_lanes[k] = !(x < 4.0F) ? NAN : 1.0F/2.0F;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1422,15 +1578,25 @@ static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9]
     }
     const float c_H_across = (1.0F/2.0F)*sqrtf(d);
     const float c_H_2 = (1.0F/2.0F)/sqrtf(d);
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = c_H_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    H[2] = c_H_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    H[3] = c_H_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = c_H_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    H[6] = c_H_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    H[7] = c_H_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const float out1 = c_H_2*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out2 = c_H_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out3 = c_H_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const float out5 = c_H_2*p[1]*p[2] - 1.0F/2.0F*p[0];
+    const float out6 = c_H_2*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out7 = c_H_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
+    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_f_batch: symrot_euler_rodrigues_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1442,9 +1608,11 @@ static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9]
 static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float *p, float *H)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1481,18 +1649,21 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
             const float closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 4.0F) ? NAN : closed_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -1520,15 +1691,25 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f(const float p[3], fl
         return;
     }
     const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(d);
-    Hinv[0] = c_H_inverse_across;
-    Hinv[1] = (1.0F/2.0F)*p[2];
-    Hinv[2] = -1.0F/2.0F*p[1];
-    Hinv[3] = -1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_across;
-    Hinv[5] = (1.0F/2.0F)*p[0];
-    Hinv[6] = (1.0F/2.0F)*p[1];
-    Hinv[7] = -1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_across;
+    const float out0 = c_H_inverse_across;
+    const float out1 = (1.0F/2.0F)*p[2];
+    const float out2 = -1.0F/2.0F*p[1];
+    const float out3 = -1.0F/2.0F*p[2];
+    const float out4 = c_H_inverse_across;
+    const float out5 = (1.0F/2.0F)*p[0];
+    const float out6 = (1.0F/2.0F)*p[1];
+    const float out7 = -1.0F/2.0F*p[0];
+    const float out8 = c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_f_batch: symrot_euler_rodrigues_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1540,9 +1721,11 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f(const float p[3], fl
 static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1572,18 +1755,21 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, cons
             c_H_inverse_1_lanes[k] = !(x < 4.0F) ? NAN : -1.0F/2.0F;
             c_H_inverse_2_lanes[k] = !(x < 4.0F) ? NAN : 0;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1627,15 +1813,25 @@ static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float 
     }
     const float c_G_2 = (1.0F/2.0F)/(sqrtf(d) + 2);
     const float t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = c_G_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    G[2] = c_G_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    G[3] = c_G_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = c_G_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    G[6] = c_G_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    G[7] = c_G_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const float out0 = c_G_2*(p[0]*p[0]) + t;
+    const float out1 = c_G_2*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out2 = c_G_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out3 = c_G_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out4 = c_G_2*(p[1]*p[1]) + t;
+    const float out5 = c_G_2*p[1]*p[2] - 1.0F/2.0F*p[0];
+    const float out6 = c_G_2*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out7 = c_G_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
+    const float out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_euler_rodrigues_root_matrix_f_batch: symrot_euler_rodrigues_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1647,9 +1843,11 @@ static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float 
 static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1679,19 +1877,22 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
             const float closed_G_2 = c_G_2_lanes[k];
             c_G_2_lanes[k] = !(x < 4.0F) ? NAN : closed_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1726,15 +1927,25 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
         const float w0 = sqrtf(d);
         c_K_2 = (1.0F/4.0F)/(w0*((1.0F/2.0F)*w0 + 1));
     }
-    K[0] = c_K_2*(p[0]*p[0]) + 1.0F/2.0F;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + 1.0F/2.0F;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + 1.0F/2.0F;
+    const float out0 = c_K_2*(p[0]*p[0]) + 1.0F/2.0F;
+    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out4 = c_K_2*(p[1]*p[1]) + 1.0F/2.0F;
+    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out8 = c_K_2*(p[2]*p[2]) + 1.0F/2.0F;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_euler_rodrigues_root_tangent_f_batch: symrot_euler_rodrigues_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1746,9 +1957,11 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
 static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1788,18 +2001,21 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
             const float v_K_2 = x < 1e-14F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 4.0F) ? NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -1874,10 +2090,15 @@ static inline void symrot_euler_rodrigues_to_quaternion_f(const float p[3], floa
     }
     const float c_e_0 = (1.0F/2.0F)*sqrtf(d);
     const float half_nu = 1.0F/2.0F;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const float out0 = c_e_0;
+    const float out1 = half_nu*p[0];
+    const float out2 = half_nu*p[1];
+    const float out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_euler_rodrigues__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
@@ -2053,15 +2274,25 @@ static inline void symrot_euler_rodrigues_rotation_derivative_f(const float p[3]
     const float dw16 = a[0]*c_R_1;
     const float dw17 = -dw12 - dw8;
     const float dw18 = dw17*dw5;
-    D[0] = dw0 + dw1 + dw6*p[0];
-    D[1] = dw6*p[1] + dw7 - dw8 + (1.0F/2.0F)*dw9;
-    D[2] = (1.0F/2.0F)*a[2]*p[0] + 2*c_R_1_x*dw4*p[2] - dw10 - dw11;
-    D[3] = dw12 + dw14*p[0] - dw7 + (1.0F/2.0F)*dw8;
-    D[4] = dw1 + dw14*p[1] + dw15;
-    D[5] = dw14*p[2] + dw16 - dw2 + (1.0F/2.0F)*dw3;
-    D[6] = (1.0F/2.0F)*dw10 + dw11 + dw13 + dw18*p[0];
-    D[7] = (1.0F/2.0F)*a[1]*p[2] + 2*c_R_1_x*dw17*p[1] - dw16 - dw3;
-    D[8] = dw0 + dw15 + dw18*p[2];
+    const float out0 = dw0 + dw1 + dw6*p[0];
+    const float out1 = dw6*p[1] + dw7 - dw8 + (1.0F/2.0F)*dw9;
+    const float out2 = (1.0F/2.0F)*a[2]*p[0] + 2*c_R_1_x*dw4*p[2] - dw10 - dw11;
+    const float out3 = dw12 + dw14*p[0] - dw7 + (1.0F/2.0F)*dw8;
+    const float out4 = dw1 + dw14*p[1] + dw15;
+    const float out5 = dw14*p[2] + dw16 - dw2 + (1.0F/2.0F)*dw3;
+    const float out6 = (1.0F/2.0F)*dw10 + dw11 + dw13 + dw18*p[0];
+    const float out7 = (1.0F/2.0F)*a[1]*p[2] + 2*c_R_1_x*dw17*p[1] - dw16 - dw3;
+    const float out8 = dw0 + dw15 + dw18*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2107,15 +2338,25 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative_f(const 
     const float dw13 = (1.0F/2.0F)*a[0]*p[0];
     const float dw14 = a[0]*c_R_1;
     const float dw15 = dw4*(-dw10 - dw6);
-    D[0] = dw0 + dw1 - dw5*p[0];
-    D[1] = (1.0F/2.0F)*a[1]*p[0] - dw5*p[1] - dw6 - dw7;
-    D[2] = (1.0F/2.0F)*a[2]*p[0] - dw5*p[2] - dw8 + dw9;
-    D[3] = dw10 - dw12*p[0] + (1.0F/2.0F)*dw6 + dw7;
-    D[4] = dw1 - dw12*p[1] + dw13;
-    D[5] = (1.0F/2.0F)*a[2]*p[1] - dw12*p[2] - dw14 - dw2;
-    D[6] = (1.0F/2.0F)*a[0]*p[2] - dw11 - dw15*p[0] - dw9;
-    D[7] = dw14 - dw15*p[1] + (1.0F/2.0F)*dw2 + dw3;
-    D[8] = dw0 + dw13 - dw15*p[2];
+    const float out0 = dw0 + dw1 - dw5*p[0];
+    const float out1 = (1.0F/2.0F)*a[1]*p[0] - dw5*p[1] - dw6 - dw7;
+    const float out2 = (1.0F/2.0F)*a[2]*p[0] - dw5*p[2] - dw8 + dw9;
+    const float out3 = dw10 - dw12*p[0] + (1.0F/2.0F)*dw6 + dw7;
+    const float out4 = dw1 - dw12*p[1] + dw13;
+    const float out5 = (1.0F/2.0F)*a[2]*p[1] - dw12*p[2] - dw14 - dw2;
+    const float out6 = (1.0F/2.0F)*a[0]*p[2] - dw11 - dw15*p[0] - dw9;
+    const float out7 = dw14 - dw15*p[1] + (1.0F/2.0F)*dw2 + dw3;
+    const float out8 = dw0 + dw13 - dw15*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2169,15 +2410,25 @@ static inline void symrot_euler_rodrigues_tangent_derivative_f(const float p[3],
     const float dw20 = (1.0F/2.0F)*a[0];
     const float dw21 = -dw17*p[1] + dw9*p[0];
     const float dw22 = dw11*dw21;
-    D[0] = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw12*p[1] + dw13;
-    D[2] = 2*a[0]*c_H_0_x*p[2] - c_H_2*dw7 - c_H_2*dw9 + 2*c_H_2_x*dw10*p[2] - dw14;
-    D[3] = 2*a[1]*c_H_0_x*p[0] - a[1]*c_H_2*p[0] - c_H_2*dw6 + 2*c_H_2_x*dw18*p[0] - dw13;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw19*p[1];
-    D[5] = -c_H_2*dw15 - c_H_2*dw16 + dw1*dw15 + dw19*p[2] + dw20;
-    D[6] = -c_H_2*dw8 + c_H_2*dw9 + dw1*dw8 + dw14 + dw22*p[0];
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] - c_H_2*dw17 + 2*c_H_2_x*dw21*p[1] - dw20;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw22*p[2];
+    const float out0 = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const float out1 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw12*p[1] + dw13;
+    const float out2 = 2*a[0]*c_H_0_x*p[2] - c_H_2*dw7 - c_H_2*dw9 + 2*c_H_2_x*dw10*p[2] - dw14;
+    const float out3 = 2*a[1]*c_H_0_x*p[0] - a[1]*c_H_2*p[0] - c_H_2*dw6 + 2*c_H_2_x*dw18*p[0] - dw13;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw19*p[1];
+    const float out5 = -c_H_2*dw15 - c_H_2*dw16 + dw1*dw15 + dw19*p[2] + dw20;
+    const float out6 = -c_H_2*dw8 + c_H_2*dw9 + dw1*dw8 + dw14 + dw22*p[0];
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] - c_H_2*dw17 + 2*c_H_2_x*dw21*p[1] - dw20;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw22*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2233,15 +2484,25 @@ static inline void symrot_euler_rodrigues_tangent_transpose_derivative_f(const f
     const float dw22 = -dw18*p[1] + dw9*p[0];
     const float dw23 = a[2]*p[1];
     const float dw24 = dw11*dw22;
-    D[0] = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw10*p[1] - dw13;
-    D[2] = -c_H_2*dw7 - c_H_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
-    D[3] = -c_H_2*dw15 - c_H_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw16 - c_H_2*dw17 + 2*c_H_2_x*dw19*p[2] - dw21;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw8 + c_H_2*dw9 + 2*c_H_2_x*dw22*p[0] - dw14;
-    D[7] = -c_H_2*dw18 - c_H_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    const float out0 = -c_H_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw10*p[1] - dw13;
+    const float out2 = -c_H_2*dw7 - c_H_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    const float out3 = -c_H_2*dw15 - c_H_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw16 - c_H_2*dw17 + 2*c_H_2_x*dw19*p[2] - dw21;
+    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw8 + c_H_2*dw9 + 2*c_H_2_x*dw22*p[0] - dw14;
+    const float out7 = -c_H_2*dw18 - c_H_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2277,15 +2538,25 @@ static inline void symrot_euler_rodrigues_tangent_inverse_derivative_f(const flo
     const float dw4 = a[1]*dw0;
     const float dw5 = (1.0F/2.0F)*a[0];
     const float dw6 = a[2]*dw0;
-    D[0] = dw1*p[0];
-    D[1] = dw1*p[1] - dw2;
-    D[2] = dw1*p[2] + dw3;
-    D[3] = dw2 + dw4*p[0];
-    D[4] = dw4*p[1];
-    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - dw5;
-    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - dw3;
-    D[7] = dw5 + dw6*p[1];
-    D[8] = dw6*p[2];
+    const float out0 = dw1*p[0];
+    const float out1 = dw1*p[1] - dw2;
+    const float out2 = dw1*p[2] + dw3;
+    const float out3 = dw2 + dw4*p[0];
+    const float out4 = dw4*p[1];
+    const float out5 = 2*a[1]*c_H_inverse_0_x*p[2] - dw5;
+    const float out6 = 2*a[2]*c_H_inverse_0_x*p[0] - dw3;
+    const float out7 = dw5 + dw6*p[1];
+    const float out8 = dw6*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_euler_rodrigues_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
@@ -2321,9 +2592,13 @@ static inline void symrot_euler_rodrigues_angular_acceleration_f(const float p[3
     const float dw3 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float dw4 = c_H_2_x*dw0;
     const float dw5 = p[1]*pdot[2] - p[2]*pdot[1];
-    alpha[0] = c_H_0*pddot[0] - c_H_2*(-dw2*pdot[1] + dw3*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw4*(dw2*p[1] - dw3*p[2]) + (1.0F/2.0F)*w0;
-    alpha[1] = c_H_0*pddot[1] - c_H_2*(dw2*pdot[0] - dw5*pdot[2]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw4*(-dw2*p[0] + dw5*p[2]) + (1.0F/2.0F)*w1;
-    alpha[2] = c_H_0*pddot[2] - c_H_2*(-dw3*pdot[0] + dw5*pdot[1]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw4*(dw3*p[0] - dw5*p[1]) + (1.0F/2.0F)*w2;
+    const float out0 = c_H_0*pddot[0] - c_H_2*(-dw2*pdot[1] + dw3*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw4*(dw2*p[1] - dw3*p[2]) + (1.0F/2.0F)*w0;
+    const float out1 = c_H_0*pddot[1] - c_H_2*(dw2*pdot[0] - dw5*pdot[2]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw4*(-dw2*p[0] + dw5*p[2]) + (1.0F/2.0F)*w1;
+    const float out2 = c_H_0*pddot[2] - c_H_2*(-dw3*pdot[0] + dw5*pdot[1]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw4*(dw3*p[0] - dw5*p[1]) + (1.0F/2.0F)*w2;
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_euler_rodrigues_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).

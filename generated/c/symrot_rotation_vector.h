@@ -24,6 +24,13 @@
  * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
  * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
  *
+ * In place: any output array may be the same array as any input array (rotation_matrix(buf, buf)
+ * with buf of 9 numbers, to_quaternion(buf, buf), angular_acceleration(p, pdot, pddot, pdot)): every
+ * function reads all its inputs before it writes an output. A _batch kernel's output may start at
+ * the same address as its p (in place: it runs backward). Other partial overlaps between an input
+ * and an output, and outputs overlapping each other (compose_jacobians' J1 and J2), are not
+ * supported.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -131,15 +138,25 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
         c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*(w1*w1)/(phi*phi);
     }
     const double t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const double out0 = c_R_2*(p[0]*p[0]) + t;
+    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out4 = c_R_2*(p[1]*p[1]) + t;
+    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_rotation_vector_rotation_matrix_batch: symrot_rotation_vector_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -152,9 +169,11 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
 static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -205,19 +224,22 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double v_R_2 = x < 5.028297529613116e-13 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -253,15 +275,25 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
         c_H_2 = (phi - sin(phi))/(phi*phi*phi);
     }
     const double t = -c_H_2*x + 1;
-    H[0] = c_H_2*(p[0]*p[0]) + t;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + t;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + t;
+    const double out0 = c_H_2*(p[0]*p[0]) + t;
+    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out4 = c_H_2*(p[1]*p[1]) + t;
+    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out8 = c_H_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_batch: symrot_rotation_vector_tangent for n vectors p[3*k..3*k+2] into
@@ -274,9 +306,11 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
 static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *p, double *H)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -335,19 +369,22 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double v_H_2 = x < 0.7851233626304374 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_H_0_lanes[k] - c_H_2_lanes[k]*x_lanes[k];
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_H_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -382,15 +419,25 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
         c_H_inverse_2 = (-w0*cos(w0)/sin(w0) + 1)/(phi*phi);
     }
     const double t = -c_H_inverse_2*x + 1;
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + t;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + t;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + t;
+    const double out0 = c_H_inverse_2*(p[0]*p[0]) + t;
+    const double out1 = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out2 = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out3 = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out4 = c_H_inverse_2*(p[1]*p[1]) + t;
+    const double out5 = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    const double out6 = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out7 = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
+    const double out8 = c_H_inverse_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_inverse_batch: symrot_rotation_vector_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -403,9 +450,11 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
 static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -451,19 +500,22 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
             const double v_H_inverse_2 = x < 5.5673482008975155 ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*x_lanes[k];
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -519,15 +571,25 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
         c_G_2 = x < 2.897865491219683 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
     }
     const double t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const double out0 = c_G_2*(p[0]*p[0]) + t;
+    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out4 = c_G_2*(p[1]*p[1]) + t;
+    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_rotation_vector_root_matrix_batch: symrot_rotation_vector_root_matrix for n vectors p[3*k..3*k+2] into
@@ -540,9 +602,11 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
 static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const double *p, double *G)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -601,19 +665,22 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double v_G_2 = x < 1.8559287093218047e-12 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -649,15 +716,25 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : (1.0/2.0)*(phi - 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
     }
     const double t = -c_K_2*x + 1.0/2.0;
-    K[0] = c_K_2*(p[0]*p[0]) + t;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + t;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + t;
+    const double out0 = c_K_2*(p[0]*p[0]) + t;
+    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out4 = c_K_2*(p[1]*p[1]) + t;
+    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out8 = c_K_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_rotation_vector_root_tangent_batch: symrot_rotation_vector_root_tangent for n vectors p[3*k..3*k+2] into
@@ -670,9 +747,11 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
 static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const double *p, double *K)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -731,19 +810,22 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double v_K_2 = x < 5.5673482008975155 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x <= 39.47841760435743) ? (double)NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_K_0_lanes[k] - c_K_2_lanes[k]*x_lanes[k];
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_K_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -841,10 +923,15 @@ static inline void symrot_rotation_vector_to_quaternion(const double p[3], doubl
         c_nu = 2*sin(w0)/phi;
     }
     const double half_nu = (1.0/2.0)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const double out0 = c_e_0;
+    const double out1 = half_nu*p[0];
+    const double out2 = half_nu*p[1];
+    const double out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_rotation_vector__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
@@ -1044,15 +1131,25 @@ static inline void symrot_rotation_vector_rotation_derivative(const double p[3],
     const double dw23 = a[0]*c_R_1;
     const double dw24 = dw11*p[0] - dw16;
     const double dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1122,15 +1219,25 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative(const do
     const double dw21 = a[0]*p[0];
     const double dw22 = a[0]*c_R_1;
     const double dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1202,15 +1309,25 @@ static inline void symrot_rotation_vector_tangent_derivative(const double p[3], 
     const double dw23 = a[0]*c_H_1;
     const double dw24 = dw11*p[0] - dw16;
     const double dw25 = c_H_2_x*dw24;
-    D[0] = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
-    D[4] = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
-    D[8] = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const double out0 = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1280,15 +1397,25 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative(const dou
     const double dw21 = a[0]*p[0];
     const double dw22 = a[0]*c_H_1;
     const double dw23 = -dw15 + dw18;
-    D[0] = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
-    D[1] = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double out0 = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
+    const double out1 = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const double out2 = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const double out3 = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const double out4 = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const double out5 = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const double out6 = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const double out7 = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const double out8 = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1347,15 +1474,25 @@ static inline void symrot_rotation_vector_tangent_inverse_derivative(const doubl
     const double dw15 = a[0]*p[0];
     const double dw16 = (1.0/2.0)*a[0];
     const double dw17 = -dw13*p[1] + dw7*p[0];
-    D[0] = -c_H_inverse_2*(-dw0 - dw1) + 2*c_H_inverse_2_x*dw8*p[0];
-    D[1] = -c_H_inverse_2*dw2 - c_H_inverse_2*dw3 + 2*c_H_inverse_2_x*dw8*p[1] - dw9;
-    D[2] = -c_H_inverse_2*dw5 - c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw8*p[2] + dw10;
-    D[3] = -a[1]*c_H_inverse_2*p[0] - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw14*p[0] + dw9;
-    D[4] = -c_H_inverse_2*(-dw1 - dw15) + 2*c_H_inverse_2_x*dw14*p[1];
-    D[5] = -c_H_inverse_2*dw11 - c_H_inverse_2*dw12 + 2*c_H_inverse_2_x*dw14*p[2] - dw16;
-    D[6] = -c_H_inverse_2*dw6 + c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw17*p[0] - dw10;
-    D[7] = -a[2]*c_H_inverse_2*p[1] - c_H_inverse_2*dw13 + 2*c_H_inverse_2_x*dw17*p[1] + dw16;
-    D[8] = -c_H_inverse_2*(-dw0 - dw15) + 2*c_H_inverse_2_x*dw17*p[2];
+    const double out0 = -c_H_inverse_2*(-dw0 - dw1) + 2*c_H_inverse_2_x*dw8*p[0];
+    const double out1 = -c_H_inverse_2*dw2 - c_H_inverse_2*dw3 + 2*c_H_inverse_2_x*dw8*p[1] - dw9;
+    const double out2 = -c_H_inverse_2*dw5 - c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw8*p[2] + dw10;
+    const double out3 = -a[1]*c_H_inverse_2*p[0] - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw14*p[0] + dw9;
+    const double out4 = -c_H_inverse_2*(-dw1 - dw15) + 2*c_H_inverse_2_x*dw14*p[1];
+    const double out5 = -c_H_inverse_2*dw11 - c_H_inverse_2*dw12 + 2*c_H_inverse_2_x*dw14*p[2] - dw16;
+    const double out6 = -c_H_inverse_2*dw6 + c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw17*p[0] - dw10;
+    const double out7 = -a[2]*c_H_inverse_2*p[1] - c_H_inverse_2*dw13 + 2*c_H_inverse_2_x*dw17*p[1] + dw16;
+    const double out8 = -c_H_inverse_2*(-dw0 - dw15) + 2*c_H_inverse_2_x*dw17*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
@@ -1405,9 +1542,13 @@ static inline void symrot_rotation_vector_angular_acceleration(const double p[3]
     const double dw3 = p[0]*pdot[1] - p[1]*pdot[0];
     const double dw4 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double dw5 = c_H_2_x*dw1;
-    alpha[0] = c_H_1*w0 - c_H_2*(-dw3*pdot[1] + dw4*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw0*dw2 + dw5*(dw3*p[1] - dw4*p[2]) + pddot[0];
-    alpha[1] = c_H_1*w1 - c_H_2*(-dw0*pdot[2] + dw3*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw2*dw4 + dw5*(dw0*p[2] - dw3*p[0]) + pddot[1];
-    alpha[2] = c_H_1*w2 - c_H_2*(dw0*pdot[1] - dw4*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw2*dw3 + dw5*(-dw0*p[1] + dw4*p[0]) + pddot[2];
+    const double out0 = c_H_1*w0 - c_H_2*(-dw3*pdot[1] + dw4*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw0*dw2 + dw5*(dw3*p[1] - dw4*p[2]) + pddot[0];
+    const double out1 = c_H_1*w1 - c_H_2*(-dw0*pdot[2] + dw3*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw2*dw4 + dw5*(dw0*p[2] - dw3*p[0]) + pddot[1];
+    const double out2 = c_H_1*w2 - c_H_2*(dw0*pdot[1] - dw4*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw2*dw3 + dw5*(-dw0*p[1] + dw4*p[0]) + pddot[2];
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_rotation_vector_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
@@ -1595,15 +1736,25 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
         c_R_2 = 2*(w1*w1)/(phi*phi);
     }
     const float t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const float out0 = c_R_2*(p[0]*p[0]) + t;
+    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out4 = c_R_2*(p[1]*p[1]) + t;
+    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_rotation_vector_rotation_matrix_f_batch: symrot_rotation_vector_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1616,9 +1767,11 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
 static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1668,19 +1821,22 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             const float v_R_2 = x < 5.028297e-13F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1716,15 +1872,25 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
         c_H_2 = (phi - sinf(phi))/(phi*phi*phi);
     }
     const float t = -c_H_2*x + 1;
-    H[0] = c_H_2*(p[0]*p[0]) + t;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + t;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + t;
+    const float out0 = c_H_2*(p[0]*p[0]) + t;
+    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out4 = c_H_2*(p[1]*p[1]) + t;
+    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out8 = c_H_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_f_batch: symrot_rotation_vector_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1737,9 +1903,11 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
 static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float *p, float *H)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1798,19 +1966,22 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             const float v_H_2 = x < 1.5083706F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_H_0_lanes[k] - c_H_2_lanes[k]*x_lanes[k];
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_H_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1845,15 +2016,25 @@ static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], fl
         c_H_inverse_2 = (-w0*cosf(w0)/sinf(w0) + 1)/(phi*phi);
     }
     const float t = -c_H_inverse_2*x + 1;
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + t;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + t;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + t;
+    const float out0 = c_H_inverse_2*(p[0]*p[0]) + t;
+    const float out1 = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out2 = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out3 = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out4 = c_H_inverse_2*(p[1]*p[1]) + t;
+    const float out5 = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
+    const float out6 = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out7 = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
+    const float out8 = c_H_inverse_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_inverse_f_batch: symrot_rotation_vector_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1866,9 +2047,11 @@ static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], fl
 static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1914,19 +2097,22 @@ static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, cons
             const float v_H_inverse_2 = x < 5.567348F ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_H_inverse_0_lanes[k] - c_H_inverse_2_lanes[k]*x_lanes[k];
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1982,15 +2168,25 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
     }
     const float t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const float out0 = c_G_2*(p[0]*p[0]) + t;
+    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out4 = c_G_2*(p[1]*p[1]) + t;
+    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_rotation_vector_root_matrix_f_batch: symrot_rotation_vector_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2003,9 +2199,11 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
 static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2063,19 +2261,22 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             const float v_G_2 = x < 1.8559286e-12F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -2111,15 +2312,25 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
         c_K_2 = (1.0F/2.0F)*(phi - 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
     }
     const float t = -c_K_2*x + 1.0F/2.0F;
-    K[0] = c_K_2*(p[0]*p[0]) + t;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + t;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + t;
+    const float out0 = c_K_2*(p[0]*p[0]) + t;
+    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out4 = c_K_2*(p[1]*p[1]) + t;
+    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out8 = c_K_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_rotation_vector_root_tangent_f_batch: symrot_rotation_vector_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2132,9 +2343,11 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
 static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2193,19 +2406,22 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             const float v_K_2 = x < 5.567348F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x <= 39.478416F) ? NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_K_0_lanes[k] - c_K_2_lanes[k]*x_lanes[k];
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_K_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -2303,10 +2519,15 @@ static inline void symrot_rotation_vector_to_quaternion_f(const float p[3], floa
         c_nu = 2*sinf(w0)/phi;
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const float out0 = c_e_0;
+    const float out1 = half_nu*p[0];
+    const float out2 = half_nu*p[1];
+    const float out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_rotation_vector__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
@@ -2508,15 +2729,25 @@ static inline void symrot_rotation_vector_rotation_derivative_f(const float p[3]
     const float dw23 = a[0]*c_R_1;
     const float dw24 = dw11*p[0] - dw16;
     const float dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2588,15 +2819,25 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative_f(const 
     const float dw21 = a[0]*p[0];
     const float dw22 = a[0]*c_R_1;
     const float dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2669,15 +2910,25 @@ static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3],
     const float dw23 = a[0]*c_H_1;
     const float dw24 = dw11*p[0] - dw16;
     const float dw25 = c_H_2_x*dw24;
-    D[0] = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
-    D[4] = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
-    D[8] = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const float out0 = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2748,15 +2999,25 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const f
     const float dw21 = a[0]*p[0];
     const float dw22 = a[0]*c_H_1;
     const float dw23 = -dw15 + dw18;
-    D[0] = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
-    D[1] = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float out0 = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
+    const float out1 = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const float out2 = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const float out3 = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const float out4 = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const float out5 = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const float out6 = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const float out7 = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const float out8 = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2815,15 +3076,25 @@ static inline void symrot_rotation_vector_tangent_inverse_derivative_f(const flo
     const float dw15 = a[0]*p[0];
     const float dw16 = (1.0F/2.0F)*a[0];
     const float dw17 = -dw13*p[1] + dw7*p[0];
-    D[0] = -c_H_inverse_2*(-dw0 - dw1) + 2*c_H_inverse_2_x*dw8*p[0];
-    D[1] = -c_H_inverse_2*dw2 - c_H_inverse_2*dw3 + 2*c_H_inverse_2_x*dw8*p[1] - dw9;
-    D[2] = -c_H_inverse_2*dw5 - c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw8*p[2] + dw10;
-    D[3] = -a[1]*c_H_inverse_2*p[0] - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw14*p[0] + dw9;
-    D[4] = -c_H_inverse_2*(-dw1 - dw15) + 2*c_H_inverse_2_x*dw14*p[1];
-    D[5] = -c_H_inverse_2*dw11 - c_H_inverse_2*dw12 + 2*c_H_inverse_2_x*dw14*p[2] - dw16;
-    D[6] = -c_H_inverse_2*dw6 + c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw17*p[0] - dw10;
-    D[7] = -a[2]*c_H_inverse_2*p[1] - c_H_inverse_2*dw13 + 2*c_H_inverse_2_x*dw17*p[1] + dw16;
-    D[8] = -c_H_inverse_2*(-dw0 - dw15) + 2*c_H_inverse_2_x*dw17*p[2];
+    const float out0 = -c_H_inverse_2*(-dw0 - dw1) + 2*c_H_inverse_2_x*dw8*p[0];
+    const float out1 = -c_H_inverse_2*dw2 - c_H_inverse_2*dw3 + 2*c_H_inverse_2_x*dw8*p[1] - dw9;
+    const float out2 = -c_H_inverse_2*dw5 - c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw8*p[2] + dw10;
+    const float out3 = -a[1]*c_H_inverse_2*p[0] - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw14*p[0] + dw9;
+    const float out4 = -c_H_inverse_2*(-dw1 - dw15) + 2*c_H_inverse_2_x*dw14*p[1];
+    const float out5 = -c_H_inverse_2*dw11 - c_H_inverse_2*dw12 + 2*c_H_inverse_2_x*dw14*p[2] - dw16;
+    const float out6 = -c_H_inverse_2*dw6 + c_H_inverse_2*dw7 + 2*c_H_inverse_2_x*dw17*p[0] - dw10;
+    const float out7 = -a[2]*c_H_inverse_2*p[1] - c_H_inverse_2*dw13 + 2*c_H_inverse_2_x*dw17*p[1] + dw16;
+    const float out8 = -c_H_inverse_2*(-dw0 - dw15) + 2*c_H_inverse_2_x*dw17*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_rotation_vector_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
@@ -2874,9 +3145,13 @@ static inline void symrot_rotation_vector_angular_acceleration_f(const float p[3
     const float dw3 = p[0]*pdot[1] - p[1]*pdot[0];
     const float dw4 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float dw5 = c_H_2_x*dw1;
-    alpha[0] = c_H_1*w0 - c_H_2*(-dw3*pdot[1] + dw4*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw0*dw2 + dw5*(dw3*p[1] - dw4*p[2]) + pddot[0];
-    alpha[1] = c_H_1*w1 - c_H_2*(-dw0*pdot[2] + dw3*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw2*dw4 + dw5*(dw0*p[2] - dw3*p[0]) + pddot[1];
-    alpha[2] = c_H_1*w2 - c_H_2*(dw0*pdot[1] - dw4*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw2*dw3 + dw5*(-dw0*p[1] + dw4*p[0]) + pddot[2];
+    const float out0 = c_H_1*w0 - c_H_2*(-dw3*pdot[1] + dw4*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw0*dw2 + dw5*(dw3*p[1] - dw4*p[2]) + pddot[0];
+    const float out1 = c_H_1*w1 - c_H_2*(-dw0*pdot[2] + dw3*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw2*dw4 + dw5*(dw0*p[2] - dw3*p[0]) + pddot[1];
+    const float out2 = c_H_1*w2 - c_H_2*(dw0*pdot[1] - dw4*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw2*dw3 + dw5*(-dw0*p[1] + dw4*p[0]) + pddot[2];
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_rotation_vector_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).

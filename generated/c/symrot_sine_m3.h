@@ -24,6 +24,13 @@
  * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
  * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
  *
+ * In place: any output array may be the same array as any input array (rotation_matrix(buf, buf)
+ * with buf of 9 numbers, to_quaternion(buf, buf), angular_acceleration(p, pdot, pddot, pdot)): every
+ * function reads all its inputs before it writes an output. A _batch kernel's output may start at
+ * the same address as its p (in place: it runs backward). Other partial overlaps between an input
+ * and an output, and outputs overlapping each other (compose_jacobians' J1 and J2), are not
+ * supported.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -155,15 +162,25 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
         c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const double out0 = c_R_2*(p[0]*p[0]) + t;
+    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out4 = c_R_2*(p[1]*p[1]) + t;
+    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_sine_m3_rotation_matrix_batch: symrot_sine_m3_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -176,9 +193,11 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
 static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -225,19 +244,22 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double v_R_2 = x < 0.1294709423110197 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0) ? (double)NAN : v_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -276,15 +298,25 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
         c_H_1 = w0*w1;
         c_H_2 = w0*(w1 + 4*pow(sin((1.0/6.0)*phi), 2))/sqrt(d);
     }
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_batch: symrot_sine_m3_tangent for n vectors p[3*k..3*k+2] into
@@ -297,9 +329,11 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
 static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, double *H)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -368,18 +402,21 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double v_H_2 = x < 0.1294709423110197 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 9.0) ? (double)NAN : v_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -414,15 +451,25 @@ static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv
         const double w0 = sqrt(d);
         c_H_inverse_across = (1.0/3.0)*w0 + (1.0/6.0)*x*(2*w0 + 9)/(-9*w0 + 2*x - 27);
     }
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    const double out0 = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
+    const double out1 = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out2 = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out3 = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out4 = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
+    const double out5 = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    const double out6 = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out7 = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
+    const double out8 = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_inverse_batch: symrot_sine_m3_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -434,9 +481,11 @@ static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv
 static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -473,18 +522,21 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.0) ? (double)NAN : closed_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -543,15 +595,25 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
         c_G_2 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const double out0 = c_G_2*(p[0]*p[0]) + t;
+    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out4 = c_G_2*(p[1]*p[1]) + t;
+    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_sine_m3_root_matrix_batch: symrot_sine_m3_root_matrix for n vectors p[3*k..3*k+2] into
@@ -564,9 +626,11 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
 static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, double *G)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -630,19 +694,22 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double v_G_2 = x < 0.8648056668462011 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.0) ? (double)NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -682,15 +749,25 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
         c_K_1 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
         c_K_2 = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*(-6*w0 + 9/sqrt(d))/(s*s);
     }
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_sine_m3_root_tangent_batch: symrot_sine_m3_root_tangent for n vectors p[3*k..3*k+2] into
@@ -703,9 +780,11 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
 static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, double *K)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -780,18 +859,21 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double v_K_2 = x < 1.595363771286421 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 9.0) ? (double)NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -892,10 +974,15 @@ static inline void symrot_sine_m3_to_quaternion(const double p[3], double e[4])
         c_nu = (1.0/3.0)*((2.0/3.0)*sqrt(d) + 1)/cos((1.0/6.0)*phi);
     }
     const double half_nu = (1.0/2.0)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const double out0 = c_e_0;
+    const double out1 = half_nu*p[0];
+    const double out2 = half_nu*p[1];
+    const double out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_sine_m3__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
@@ -1089,15 +1176,25 @@ static inline void symrot_sine_m3_rotation_derivative(const double p[3], const d
     const double dw20 = a[0]*p[0];
     const double dw21 = a[0]*c_R_1;
     const double dw22 = -dw15 + dw17;
-    D[0] = -c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0] - 8.0/27.0*dw4*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] + dw14 - 8.0/27.0*dw15;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16 - 8.0/27.0*dw4*p[2];
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw19*p[0] - dw14 - 8.0/27.0*dw17;
-    D[4] = -c_R_2*(-dw1 - dw20) + 2*c_R_2_x*dw19*p[1] - 8.0/27.0*dw11*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw19*p[2] - 8.0/27.0*dw12 + dw21;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] + dw16 - 8.0/27.0*dw18;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw22*p[1] - dw21 - 8.0/27.0*dw8;
-    D[8] = -c_R_2*(-dw0 - dw20) + 2*c_R_2_x*dw22*p[2] - 8.0/27.0*dw7*p[2];
+    const double out0 = -c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0] - 8.0/27.0*dw4*p[0];
+    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] + dw14 - 8.0/27.0*dw15;
+    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16 - 8.0/27.0*dw4*p[2];
+    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw19*p[0] - dw14 - 8.0/27.0*dw17;
+    const double out4 = -c_R_2*(-dw1 - dw20) + 2*c_R_2_x*dw19*p[1] - 8.0/27.0*dw11*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw19*p[2] - 8.0/27.0*dw12 + dw21;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] + dw16 - 8.0/27.0*dw18;
+    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw22*p[1] - dw21 - 8.0/27.0*dw8;
+    const double out8 = -c_R_2*(-dw0 - dw20) + 2*c_R_2_x*dw22*p[2] - 8.0/27.0*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1164,15 +1261,25 @@ static inline void symrot_sine_m3_rotation_transpose_derivative(const double p[3
     const double dw21 = a[0]*c_R_1;
     const double dw22 = dw17 - dw2*p[1];
     const double dw23 = dw13*dw22;
-    D[0] = -c_R_2*(-dw3 - dw4) + dw14*p[0] + (8.0/27.0)*dw2*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw12*p[1] - dw15 + (8.0/27.0)*dw2*p[1];
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + dw14*p[2] + dw16 + (8.0/27.0)*dw2*p[2];
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + dw15 + (8.0/27.0)*dw17 + dw19*p[0];
-    D[4] = -c_R_2*(-dw20 - dw4) + (8.0/27.0)*dw11*p[1] + dw19*p[1];
-    D[5] = -c_R_2*dw0 - c_R_2*dw1 + 2*c_R_2_x*dw18*p[2] + (8.0/27.0)*dw11*p[2] - dw21;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] - dw16 + (8.0/27.0)*dw7*p[0];
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw2 + dw21 + dw23*p[1] + (8.0/27.0)*dw8;
-    D[8] = -c_R_2*(-dw20 - dw3) + dw23*p[2] + (8.0/27.0)*dw7*p[2];
+    const double out0 = -c_R_2*(-dw3 - dw4) + dw14*p[0] + (8.0/27.0)*dw2*p[0];
+    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw12*p[1] - dw15 + (8.0/27.0)*dw2*p[1];
+    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + dw14*p[2] + dw16 + (8.0/27.0)*dw2*p[2];
+    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + dw15 + (8.0/27.0)*dw17 + dw19*p[0];
+    const double out4 = -c_R_2*(-dw20 - dw4) + (8.0/27.0)*dw11*p[1] + dw19*p[1];
+    const double out5 = -c_R_2*dw0 - c_R_2*dw1 + 2*c_R_2_x*dw18*p[2] + (8.0/27.0)*dw11*p[2] - dw21;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] - dw16 + (8.0/27.0)*dw7*p[0];
+    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw2 + dw21 + dw23*p[1] + (8.0/27.0)*dw8;
+    const double out8 = -c_R_2*(-dw20 - dw3) + dw23*p[2] + (8.0/27.0)*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1255,15 +1362,25 @@ static inline void symrot_sine_m3_tangent_derivative(const double p[3], const do
     const double dw26 = a[0]*c_H_1;
     const double dw27 = -dw17 + dw22;
     const double dw28 = c_H_2_x*dw27;
-    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    const double out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1348,15 +1465,25 @@ static inline void symrot_sine_m3_tangent_transpose_derivative(const double p[3]
     const double dw28 = -dw19 + dw23;
     const double dw29 = a[2]*p[1];
     const double dw30 = 2*c_H_2_x*dw28;
-    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    const double out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    const double out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    const double out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1412,15 +1539,25 @@ static inline void symrot_sine_m3_tangent_inverse_derivative(const double p[3], 
     const double dw22 = -dw18*p[1] + dw9*p[0];
     const double dw23 = a[2]*p[1];
     const double dw24 = dw11*dw22;
-    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
-    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
-    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
-    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
-    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
-    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
-    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
-    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    const double out0 = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const double out1 = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    const double out2 = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    const double out3 = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    const double out4 = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    const double out5 = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    const double out6 = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    const double out7 = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    const double out8 = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
@@ -1480,9 +1617,13 @@ static inline void symrot_sine_m3_angular_acceleration(const double p[3], const 
     const double dw4 = p[0]*pdot[1] - p[1]*pdot[0];
     const double dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double dw6 = c_H_2_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    const double out0 = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    const double out1 = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    const double out2 = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_sine_m3_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
@@ -1694,15 +1835,25 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
         c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     const float t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const float out0 = c_R_2*(p[0]*p[0]) + t;
+    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out4 = c_R_2*(p[1]*p[1]) + t;
+    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_sine_m3_rotation_matrix_f_batch: symrot_sine_m3_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1715,9 +1866,11 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
 static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1764,19 +1917,22 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float v_R_2 = x < 0.03594455F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 9.0F) ? NAN : v_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1816,15 +1972,25 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
         c_H_1 = w0*w1;
         c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w0*(w1 - 2.0F/3.0F*w2 + 2)/w2;
     }
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_f_batch: symrot_sine_m3_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1837,9 +2003,11 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
 static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1903,18 +2071,21 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float v_H_2 = x < 2.8627653F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 9.0F) ? NAN : v_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -1949,15 +2120,25 @@ static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv
         const float w0 = sqrtf(d);
         c_H_inverse_across = (1.0F/3.0F)*w0 + (1.0F/6.0F)*x*(2*w0 + 9)/(-9*w0 + 2*x - 27);
     }
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    const float out0 = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
+    const float out1 = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out2 = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out3 = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out4 = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
+    const float out5 = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
+    const float out6 = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out7 = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
+    const float out8 = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_inverse_f_batch: symrot_sine_m3_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1969,9 +2150,11 @@ static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv
 static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2008,18 +2191,21 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.0F) ? NAN : closed_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -2078,15 +2264,25 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const float out0 = c_G_2*(p[0]*p[0]) + t;
+    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out4 = c_G_2*(p[1]*p[1]) + t;
+    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_sine_m3_root_matrix_f_batch: symrot_sine_m3_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2099,9 +2295,11 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
 static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2165,19 +2363,22 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float v_G_2 = x < 0.24508163F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.0F) ? NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -2217,15 +2418,25 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (-w0 + (3.0F/2.0F)/sqrtf(d))/(s*s);
     }
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_sine_m3_root_tangent_f_batch: symrot_sine_m3_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2238,9 +2449,11 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
 static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2315,18 +2528,21 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float v_K_2 = x < 2.8627653F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 9.0F) ? NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -2428,10 +2644,15 @@ static inline void symrot_sine_m3_to_quaternion_f(const float p[3], float e[4])
         c_nu = (1.0F/3.0F)*((2.0F/3.0F)*sqrtf(d) + 1)/cosf((1.0F/6.0F)*phi);
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const float out0 = c_e_0;
+    const float out1 = half_nu*p[0];
+    const float out2 = half_nu*p[1];
+    const float out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_sine_m3__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
@@ -2625,15 +2846,25 @@ static inline void symrot_sine_m3_rotation_derivative_f(const float p[3], const 
     const float dw20 = a[0]*p[0];
     const float dw21 = a[0]*c_R_1;
     const float dw22 = -dw15 + dw17;
-    D[0] = -c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0] - 8.0F/27.0F*dw4*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] + dw14 - 8.0F/27.0F*dw15;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16 - 8.0F/27.0F*dw4*p[2];
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw19*p[0] - dw14 - 8.0F/27.0F*dw17;
-    D[4] = -c_R_2*(-dw1 - dw20) + 2*c_R_2_x*dw19*p[1] - 8.0F/27.0F*dw11*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw19*p[2] - 8.0F/27.0F*dw12 + dw21;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] + dw16 - 8.0F/27.0F*dw18;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw22*p[1] - dw21 - 8.0F/27.0F*dw8;
-    D[8] = -c_R_2*(-dw0 - dw20) + 2*c_R_2_x*dw22*p[2] - 8.0F/27.0F*dw7*p[2];
+    const float out0 = -c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0] - 8.0F/27.0F*dw4*p[0];
+    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] + dw14 - 8.0F/27.0F*dw15;
+    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16 - 8.0F/27.0F*dw4*p[2];
+    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw19*p[0] - dw14 - 8.0F/27.0F*dw17;
+    const float out4 = -c_R_2*(-dw1 - dw20) + 2*c_R_2_x*dw19*p[1] - 8.0F/27.0F*dw11*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw19*p[2] - 8.0F/27.0F*dw12 + dw21;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] + dw16 - 8.0F/27.0F*dw18;
+    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw22*p[1] - dw21 - 8.0F/27.0F*dw8;
+    const float out8 = -c_R_2*(-dw0 - dw20) + 2*c_R_2_x*dw22*p[2] - 8.0F/27.0F*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2700,15 +2931,25 @@ static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[
     const float dw21 = a[0]*c_R_1;
     const float dw22 = dw17 - dw2*p[1];
     const float dw23 = dw13*dw22;
-    D[0] = -c_R_2*(-dw3 - dw4) + dw14*p[0] + (8.0F/27.0F)*dw2*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw12*p[1] - dw15 + (8.0F/27.0F)*dw2*p[1];
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + dw14*p[2] + dw16 + (8.0F/27.0F)*dw2*p[2];
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + dw15 + (8.0F/27.0F)*dw17 + dw19*p[0];
-    D[4] = -c_R_2*(-dw20 - dw4) + (8.0F/27.0F)*dw11*p[1] + dw19*p[1];
-    D[5] = -c_R_2*dw0 - c_R_2*dw1 + 2*c_R_2_x*dw18*p[2] + (8.0F/27.0F)*dw11*p[2] - dw21;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] - dw16 + (8.0F/27.0F)*dw7*p[0];
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw2 + dw21 + dw23*p[1] + (8.0F/27.0F)*dw8;
-    D[8] = -c_R_2*(-dw20 - dw3) + dw23*p[2] + (8.0F/27.0F)*dw7*p[2];
+    const float out0 = -c_R_2*(-dw3 - dw4) + dw14*p[0] + (8.0F/27.0F)*dw2*p[0];
+    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw12*p[1] - dw15 + (8.0F/27.0F)*dw2*p[1];
+    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + dw14*p[2] + dw16 + (8.0F/27.0F)*dw2*p[2];
+    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + dw15 + (8.0F/27.0F)*dw17 + dw19*p[0];
+    const float out4 = -c_R_2*(-dw20 - dw4) + (8.0F/27.0F)*dw11*p[1] + dw19*p[1];
+    const float out5 = -c_R_2*dw0 - c_R_2*dw1 + 2*c_R_2_x*dw18*p[2] + (8.0F/27.0F)*dw11*p[2] - dw21;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw22*p[0] - dw16 + (8.0F/27.0F)*dw7*p[0];
+    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw2 + dw21 + dw23*p[1] + (8.0F/27.0F)*dw8;
+    const float out8 = -c_R_2*(-dw20 - dw3) + dw23*p[2] + (8.0F/27.0F)*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2791,15 +3032,25 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
     const float dw26 = a[0]*c_H_1;
     const float dw27 = -dw17 + dw22;
     const float dw28 = c_H_2_x*dw27;
-    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    const float out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2884,15 +3135,25 @@ static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3
     const float dw28 = -dw19 + dw23;
     const float dw29 = a[2]*p[1];
     const float dw30 = 2*c_H_2_x*dw28;
-    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    const float out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    const float out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    const float out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2948,15 +3209,25 @@ static inline void symrot_sine_m3_tangent_inverse_derivative_f(const float p[3],
     const float dw22 = -dw18*p[1] + dw9*p[0];
     const float dw23 = a[2]*p[1];
     const float dw24 = dw11*dw22;
-    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
-    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
-    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
-    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
-    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
-    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
-    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
-    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    const float out0 = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const float out1 = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    const float out2 = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    const float out3 = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    const float out4 = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    const float out5 = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    const float out6 = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    const float out7 = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    const float out8 = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m3_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
@@ -3016,9 +3287,13 @@ static inline void symrot_sine_m3_angular_acceleration_f(const float p[3], const
     const float dw4 = p[0]*pdot[1] - p[1]*pdot[0];
     const float dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float dw6 = c_H_2_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    const float out0 = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    const float out1 = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    const float out2 = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_sine_m3_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).

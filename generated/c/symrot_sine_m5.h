@@ -24,6 +24,13 @@
  * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
  * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
  *
+ * In place: any output array may be the same array as any input array (rotation_matrix(buf, buf)
+ * with buf of 9 numbers, to_quaternion(buf, buf), angular_acceleration(p, pdot, pddot, pdot)): every
+ * function reads all its inputs before it writes an output. A _batch kernel's output may start at
+ * the same address as its p (in place: it runs backward). Other partial overlaps between an input
+ * and an output, and outputs overlapping each other (compose_jacobians' J1 and J2), are not
+ * supported.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -128,15 +135,25 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
         c_R_2 = (1 - cos(phi))/x;
     }
     const double t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const double out0 = c_R_2*(p[0]*p[0]) + t;
+    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out4 = c_R_2*(p[1]*p[1]) + t;
+    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_sine_m5_rotation_matrix_batch: symrot_sine_m5_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -149,9 +166,11 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
 static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -198,19 +217,22 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double v_R_2 = x < 0.4064433613155127 ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -250,15 +272,25 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
         c_H_1 = 2*w0*(w2*w2);
         c_H_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0 : w0*(1.0/cos((1.0/5.0)*phi) - 2*w2*cos(w1)/s);
     }
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_batch: symrot_sine_m5_tangent for n vectors p[3*k..3*k+2] into
@@ -271,9 +303,11 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
 static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, double *H)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -342,18 +376,21 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double v_H_2 = x < 2.787613413593369 ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -395,15 +432,25 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
         c_H_inverse_across = w0/(s*((w0*w0)*w1 + 4*w1*(w3*w3*w3*w3)));
         c_H_inverse_2 = x < 2.787613413593369 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0 : (1.0/25.0)*(cos(w4) - 5.0/2.0*w5*cos(w2)/w3)/(w5*w5);
     }
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    const double out0 = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
+    const double out1 = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out2 = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out3 = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out4 = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
+    const double out5 = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    const double out6 = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out7 = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
+    const double out8 = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_inverse_batch: symrot_sine_m5_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -416,9 +463,11 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
 static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -496,18 +545,21 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double v_H_inverse_2 = x < 2.787613413593369 ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -562,15 +614,25 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const double out0 = c_G_2*(p[0]*p[0]) + t;
+    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out4 = c_G_2*(p[1]*p[1]) + t;
+    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_sine_m5_root_matrix_batch: symrot_sine_m5_root_matrix for n vectors p[3*k..3*k+2] into
@@ -583,9 +645,11 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
 static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, double *G)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -641,19 +705,22 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double v_G_2 = x < 4.692488584147999e-09 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -691,15 +758,25 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
         c_K_2 = x < 5.166154456090205 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0 : (1.0/250.0)*(5/cos(w0) - 2*sin((1.0/2.0)*phi)/w1)/(w1*w1);
     }
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_sine_m5_root_tangent_batch: symrot_sine_m5_root_tangent for n vectors p[3*k..3*k+2] into
@@ -712,9 +789,11 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
 static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, double *K)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -797,18 +876,21 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double v_K_2 = x < 5.166154456090205 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 22.612712429686844) ? (double)NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -909,10 +991,15 @@ static inline void symrot_sine_m5_to_quaternion(const double p[3], double e[4])
     const double c_e_0 = -1.0/250.0*sqrt(10)*sqrt(sqrt(25 - x) + 5)*(4*x + 10*sqrt(25 - x) - 75);
     const double c_nu = -1.0/125.0*sqrt(10)*(4*x - 10*sqrt(25 - x) - 75)/sqrt(sqrt(25 - x) + 5);
     const double half_nu = (1.0/2.0)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const double out0 = c_e_0;
+    const double out1 = half_nu*p[0];
+    const double out2 = half_nu*p[1];
+    const double out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_sine_m5__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
@@ -1108,15 +1195,25 @@ static inline void symrot_sine_m5_rotation_derivative(const double p[3], const d
     const double dw23 = a[0]*c_R_1;
     const double dw24 = dw11*p[0] - dw16;
     const double dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1182,15 +1279,25 @@ static inline void symrot_sine_m5_rotation_transpose_derivative(const double p[3
     const double dw21 = a[0]*p[0];
     const double dw22 = a[0]*c_R_1;
     const double dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1273,15 +1380,25 @@ static inline void symrot_sine_m5_tangent_derivative(const double p[3], const do
     const double dw26 = a[0]*c_H_1;
     const double dw27 = -dw17 + dw22;
     const double dw28 = c_H_2_x*dw27;
-    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    const double out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1366,15 +1483,25 @@ static inline void symrot_sine_m5_tangent_transpose_derivative(const double p[3]
     const double dw28 = -dw19 + dw23;
     const double dw29 = a[2]*p[1];
     const double dw30 = 2*c_H_2_x*dw28;
-    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    const double out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    const double out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    const double out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1446,15 +1573,25 @@ static inline void symrot_sine_m5_tangent_inverse_derivative(const double p[3], 
     const double dw22 = -dw18*p[1] + dw9*p[0];
     const double dw23 = a[2]*p[1];
     const double dw24 = dw11*dw22;
-    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
-    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
-    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
-    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
-    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
-    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
-    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
-    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    const double out0 = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const double out1 = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    const double out2 = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    const double out3 = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    const double out4 = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    const double out5 = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    const double out6 = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    const double out7 = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    const double out8 = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
@@ -1514,9 +1651,13 @@ static inline void symrot_sine_m5_angular_acceleration(const double p[3], const 
     const double dw4 = p[0]*pdot[1] - p[1]*pdot[0];
     const double dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double dw6 = c_H_2_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    const double out0 = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    const double out1 = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    const double out2 = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_sine_m5_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
@@ -1701,15 +1842,25 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
         c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     const float t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const float out0 = c_R_2*(p[0]*p[0]) + t;
+    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out4 = c_R_2*(p[1]*p[1]) + t;
+    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_sine_m5_rotation_matrix_f_batch: symrot_sine_m5_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1722,9 +1873,11 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
 static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1770,19 +1923,22 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float v_R_2 = x < 0.0022018803F ? poly_R_2 : closed_R_2;
             c_R_2_lanes[k] = !(x < 22.612713F) ? NAN : v_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1822,15 +1978,25 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
         c_H_1 = 2*w0*(w2*w2);
         c_H_2 = w0*(1.0F/cosf((1.0F/5.0F)*phi) - 2*w2*cosf(w1)/s);
     }
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_f_batch: symrot_sine_m5_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1843,9 +2009,11 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
 static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1914,18 +2082,21 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float v_H_2 = x < 2.7876132F ? poly_H_2 : closed_H_2;
             c_H_2_lanes[k] = !(x < 22.612713F) ? NAN : v_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -1964,15 +2135,25 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
         c_H_inverse_across = (5.0F/2.0F)*w2*sinf(w0);
         c_H_inverse_2 = x < 5.1661544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F : (-1.0F/2.0F*s*w2 + cosf(w0))/x;
     }
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    const float out0 = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
+    const float out1 = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out2 = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out3 = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out4 = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
+    const float out5 = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
+    const float out6 = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out7 = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
+    const float out8 = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_inverse_f_batch: symrot_sine_m5_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1985,9 +2166,11 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
 static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2055,18 +2238,21 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
             const float v_H_inverse_2 = x < 5.1661544F ? poly_H_inverse_2 : closed_H_inverse_2;
             c_H_inverse_2_lanes[k] = !(x < 22.612713F) ? NAN : v_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -2121,15 +2307,25 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const float out0 = c_G_2*(p[0]*p[0]) + t;
+    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out4 = c_G_2*(p[1]*p[1]) + t;
+    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_sine_m5_root_matrix_f_batch: symrot_sine_m5_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2142,9 +2338,11 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
 static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2200,19 +2398,22 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             const float v_G_2 = x < 0.008126427F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 22.612713F) ? NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -2250,15 +2451,25 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = (1.0F/250.0F)*(5/cosf(w0) - 2*sinf((1.0F/2.0F)*phi)/w1)/(w1*w1);
     }
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_sine_m5_root_tangent_f_batch: symrot_sine_m5_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2271,9 +2482,11 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
 static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2356,18 +2569,21 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float v_K_2 = x < 5.1661544F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 22.612713F) ? NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -2465,10 +2681,15 @@ static inline void symrot_sine_m5_to_quaternion_f(const float p[3], float e[4])
     const float c_e_0 = -1.0F/250.0F*sqrtf(10)*sqrtf(sqrtf(25 - x) + 5)*(4*x + 10*sqrtf(25 - x) - 75);
     const float c_nu = -1.0F/125.0F*sqrtf(10)*(4*x - 10*sqrtf(25 - x) - 75)/sqrtf(sqrtf(25 - x) + 5);
     const float half_nu = (1.0F/2.0F)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const float out0 = c_e_0;
+    const float out1 = half_nu*p[0];
+    const float out2 = half_nu*p[1];
+    const float out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_sine_m5__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
@@ -2662,15 +2883,25 @@ static inline void symrot_sine_m5_rotation_derivative_f(const float p[3], const 
     const float dw23 = a[0]*c_R_1;
     const float dw24 = dw11*p[0] - dw16;
     const float dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2734,15 +2965,25 @@ static inline void symrot_sine_m5_rotation_transpose_derivative_f(const float p[
     const float dw21 = a[0]*p[0];
     const float dw22 = a[0]*c_R_1;
     const float dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2824,15 +3065,25 @@ static inline void symrot_sine_m5_tangent_derivative_f(const float p[3], const f
     const float dw26 = a[0]*c_H_1;
     const float dw27 = -dw17 + dw22;
     const float dw28 = c_H_2_x*dw27;
-    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    const float out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2916,15 +3167,25 @@ static inline void symrot_sine_m5_tangent_transpose_derivative_f(const float p[3
     const float dw28 = -dw19 + dw23;
     const float dw29 = a[2]*p[1];
     const float dw30 = 2*c_H_2_x*dw28;
-    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    const float out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    const float out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    const float out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2997,15 +3258,25 @@ static inline void symrot_sine_m5_tangent_inverse_derivative_f(const float p[3],
     const float dw22 = -dw18*p[1] + dw9*p[0];
     const float dw23 = a[2]*p[1];
     const float dw24 = dw11*dw22;
-    D[0] = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
-    D[1] = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
-    D[2] = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
-    D[3] = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
-    D[4] = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
-    D[5] = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
-    D[6] = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
-    D[7] = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
-    D[8] = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    const float out0 = -c_H_inverse_2*(-dw2 - dw3) + dw0*dw1 + dw12*p[0];
+    const float out1 = 2*a[0]*c_H_inverse_0_x*p[1] - c_H_inverse_2*dw4 - c_H_inverse_2*dw5 + 2*c_H_inverse_2_x*dw10*p[1] - dw13;
+    const float out2 = -c_H_inverse_2*dw7 - c_H_inverse_2*dw9 + dw1*dw7 + dw12*p[2] + dw14;
+    const float out3 = -c_H_inverse_2*dw15 - c_H_inverse_2*dw6 + dw1*dw15 + dw13 + dw20*p[0];
+    const float out4 = -c_H_inverse_2*(-dw0 - dw3) + dw1*dw2 + dw20*p[1];
+    const float out5 = 2*a[1]*c_H_inverse_0_x*p[2] - c_H_inverse_2*dw16 - c_H_inverse_2*dw17 + 2*c_H_inverse_2_x*dw19*p[2] - dw21;
+    const float out6 = 2*a[2]*c_H_inverse_0_x*p[0] - c_H_inverse_2*dw8 + c_H_inverse_2*dw9 + 2*c_H_inverse_2_x*dw22*p[0] - dw14;
+    const float out7 = -c_H_inverse_2*dw18 - c_H_inverse_2*dw23 + dw1*dw23 + dw21 + dw24*p[1];
+    const float out8 = -c_H_inverse_2*(-dw0 - dw2) + dw1*dw3 + dw24*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_sine_m5_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
@@ -3064,9 +3335,13 @@ static inline void symrot_sine_m5_angular_acceleration_f(const float p[3], const
     const float dw4 = p[0]*pdot[1] - p[1]*pdot[0];
     const float dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float dw6 = c_H_2_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    const float out0 = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    const float out1 = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    const float out2 = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_sine_m5_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).

@@ -24,6 +24,13 @@
  * fixed a, D[3*i + j] = d(T a)_i/dp_j), angular_acceleration (H pddot + Hdot pdot),
  * compose_jacobians (dp3/dp1, dp3/dp2) and rescale_jacobian.
  *
+ * In place: any output array may be the same array as any input array (rotation_matrix(buf, buf)
+ * with buf of 9 numbers, to_quaternion(buf, buf), angular_acceleration(p, pdot, pddot, pdot)): every
+ * function reads all its inputs before it writes an output. A _batch kernel's output may start at
+ * the same address as its p (in place: it runs backward). Other partial overlaps between an input
+ * and an output, and outputs overlapping each other (compose_jacobians' J1 and J2), are not
+ * supported.
+ *
  * Tensors are evaluated as T = c0 I + c1 (p x) + c2 (p x)^2 with scalar coefficients c(x) of
  * x = |p|^2 from the evaluation plan: the float64 and float32 plans of symrot.plan, closed inverse for phi
  */
@@ -126,15 +133,25 @@ static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R
     const double c_R_1 = 1.0/sqrt(x + 1);
     const double c_R_2 = 1.0/(x + sqrt(x + 1) + 1);
     const double t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const double out0 = c_R_2*(p[0]*p[0]) + t;
+    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const double out4 = c_R_2*(p[1]*p[1]) + t;
+    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const double out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_tangent_m1_rotation_matrix_batch: symrot_tangent_m1_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -146,9 +163,11 @@ static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R
 static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -185,19 +204,22 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
             const double closed_R_2 = c_R_2_lanes[k];
             c_R_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -228,15 +250,25 @@ static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
     const double c_H_across = 1.0/sqrt(x + 1);
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
     const double c_H_2 = -1/((x + 1)*(sqrt(x + 1) + 1));
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_batch: symrot_tangent_m1_tangent for n vectors p[3*k..3*k+2] into
@@ -248,9 +280,11 @@ static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
 static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, double *H)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -290,18 +324,21 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
             const double closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -331,15 +368,25 @@ static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double H
     }
     const double c_H_inverse_across = (1.0/2.0)*sqrt(x + 1) + 1.0/2.0;
     const double c_H_inverse_2 = (1.0/2.0)*(2*sqrt(x + 1) + 1)/(sqrt(x + 1) + 1);
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    const double out0 = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
+    const double out1 = c_H_inverse_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out2 = c_H_inverse_2*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out3 = c_H_inverse_2*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out4 = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
+    const double out5 = c_H_inverse_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    const double out6 = c_H_inverse_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out7 = c_H_inverse_2*p[1]*p[2] - 1.0/2.0*p[0];
+    const double out8 = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_inverse_batch: symrot_tangent_m1_tangent_inverse for n vectors p[3*k..3*k+2] into
@@ -351,9 +398,11 @@ static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double H
 static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -384,18 +433,21 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
             const double closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : closed_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -448,15 +500,25 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const double out0 = c_G_2*(p[0]*p[0]) + t;
+    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const double out4 = c_G_2*(p[1]*p[1]) + t;
+    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const double out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_tangent_m1_root_matrix_batch: symrot_tangent_m1_root_matrix for n vectors p[3*k..3*k+2] into
@@ -469,9 +531,11 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
 static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p, double *G)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -527,19 +591,22 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
             const double v_G_2 = x < 7.889013259849922e-06 ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -582,15 +649,25 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
         c_K_2 = x < 0.13182630716008584 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0 : w0*w3*((1.0/2.0)*w3 - w1*w2*sin((1.0/2.0)*phi)/s)/(s*s);
     }
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_tangent_m1_root_tangent_batch: symrot_tangent_m1_root_tangent for n vectors p[3*k..3*k+2] into
@@ -603,9 +680,11 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
 static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *p, double *K)
 {
     double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], u2_lanes[SYMROT_BATCH_BLOCK], u3_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -692,18 +771,21 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double v_K_2 = x < 0.13182630716008584 ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 6.703903964971299e+153) ? (double)NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
+            const double p0 = pk[0];
+            const double p1 = pk[1];
+            const double p2 = pk[2];
             double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -791,10 +873,15 @@ static inline void symrot_tangent_m1_to_quaternion(const double p[3], double e[4
         c_e_0 = cos((1.0/2.0)*phi);
     }
     const double half_nu = (1.0/2.0)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const double out0 = c_e_0;
+    const double out1 = half_nu*p[0];
+    const double out2 = half_nu*p[1];
+    const double out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_tangent_m1__from_quaternion: internal: p from a quaternion of any norm and sign (eq 75).
@@ -980,15 +1067,25 @@ static inline void symrot_tangent_m1_rotation_derivative(const double p[3], cons
     const double dw23 = a[0]*c_R_1;
     const double dw24 = dw11*p[0] - dw16;
     const double dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1045,15 +1142,25 @@ static inline void symrot_tangent_m1_rotation_transpose_derivative(const double 
     const double dw21 = a[0]*p[0];
     const double dw22 = a[0]*c_R_1;
     const double dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1116,15 +1223,25 @@ static inline void symrot_tangent_m1_tangent_derivative(const double p[3], const
     const double dw26 = a[0]*c_H_1;
     const double dw27 = -dw17 + dw22;
     const double dw28 = c_H_2_x*dw27;
-    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    const double out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1189,15 +1306,25 @@ static inline void symrot_tangent_m1_tangent_transpose_derivative(const double p
     const double dw28 = -dw19 + dw23;
     const double dw29 = a[2]*p[1];
     const double dw30 = 2*c_H_2_x*dw28;
-    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    const double out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    const double out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    const double out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1252,15 +1379,25 @@ static inline void symrot_tangent_m1_tangent_inverse_derivative(const double p[3
     const double dw21 = -dw17*p[1] + dw8*p[0];
     const double dw22 = a[2]*p[1];
     const double dw23 = dw10*dw21;
-    D[0] = -c_H_inverse_2*(-dw1 - dw2) + 2*dw0 + dw11*p[0];
-    D[1] = 2*a[0]*p[1] - c_H_inverse_2*dw3 - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw9*p[1] - dw12;
-    D[2] = -c_H_inverse_2*dw6 - c_H_inverse_2*dw8 + dw11*p[2] + dw13 + 2*dw6;
-    D[3] = -c_H_inverse_2*dw14 - c_H_inverse_2*dw5 + dw12 + 2*dw14 + dw19*p[0];
-    D[4] = -c_H_inverse_2*(-dw0 - dw2) + 2*dw1 + dw19*p[1];
-    D[5] = 2*a[1]*p[2] - c_H_inverse_2*dw15 - c_H_inverse_2*dw16 + 2*c_H_inverse_2_x*dw18*p[2] - dw20;
-    D[6] = 2*a[2]*p[0] - c_H_inverse_2*dw7 + c_H_inverse_2*dw8 + 2*c_H_inverse_2_x*dw21*p[0] - dw13;
-    D[7] = -c_H_inverse_2*dw17 - c_H_inverse_2*dw22 + dw20 + 2*dw22 + dw23*p[1];
-    D[8] = -c_H_inverse_2*(-dw0 - dw1) + 2*dw2 + dw23*p[2];
+    const double out0 = -c_H_inverse_2*(-dw1 - dw2) + 2*dw0 + dw11*p[0];
+    const double out1 = 2*a[0]*p[1] - c_H_inverse_2*dw3 - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw9*p[1] - dw12;
+    const double out2 = -c_H_inverse_2*dw6 - c_H_inverse_2*dw8 + dw11*p[2] + dw13 + 2*dw6;
+    const double out3 = -c_H_inverse_2*dw14 - c_H_inverse_2*dw5 + dw12 + 2*dw14 + dw19*p[0];
+    const double out4 = -c_H_inverse_2*(-dw0 - dw2) + 2*dw1 + dw19*p[1];
+    const double out5 = 2*a[1]*p[2] - c_H_inverse_2*dw15 - c_H_inverse_2*dw16 + 2*c_H_inverse_2_x*dw18*p[2] - dw20;
+    const double out6 = 2*a[2]*p[0] - c_H_inverse_2*dw7 + c_H_inverse_2*dw8 + 2*c_H_inverse_2_x*dw21*p[0] - dw13;
+    const double out7 = -c_H_inverse_2*dw17 - c_H_inverse_2*dw22 + dw20 + 2*dw22 + dw23*p[1];
+    const double out8 = -c_H_inverse_2*(-dw0 - dw1) + 2*dw2 + dw23*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_angular_acceleration: angular acceleration (eq D1-D5 of the sheet).
@@ -1300,9 +1437,13 @@ static inline void symrot_tangent_m1_angular_acceleration(const double p[3], con
     const double dw4 = p[0]*pdot[1] - p[1]*pdot[0];
     const double dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
     const double dw6 = c_H_2_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    const double out0 = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    const double out1 = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    const double out2 = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_tangent_m1_compose_jacobians: Jacobians of compose (eq D1-D5 of the sheet).
@@ -1485,15 +1626,25 @@ static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R
     const float c_R_1 = 1.0F/sqrtf(x + 1);
     const float c_R_2 = 1.0F/(x + sqrtf(x + 1) + 1);
     const float t = -c_R_2*x + 1;
-    R[0] = c_R_2*(p[0]*p[0]) + t;
-    R[1] = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[2] = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[3] = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    R[4] = c_R_2*(p[1]*p[1]) + t;
-    R[5] = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[6] = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    R[7] = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    R[8] = c_R_2*(p[2]*p[2]) + t;
+    const float out0 = c_R_2*(p[0]*p[0]) + t;
+    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
+    const float out4 = c_R_2*(p[1]*p[1]) + t;
+    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
+    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
+    const float out8 = c_R_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    R[0] = out0;
+    R[1] = out1;
+    R[2] = out2;
+    R[3] = out3;
+    R[4] = out4;
+    R[5] = out5;
+    R[6] = out6;
+    R[7] = out7;
+    R[8] = out8;
 }
 
 /* symrot_tangent_m1_rotation_matrix_f_batch: symrot_tangent_m1_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1505,9 +1656,11 @@ static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R
 static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1544,19 +1697,22 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
             const float closed_R_2 = c_R_2_lanes[k];
             c_R_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_R_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
             float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_R_1_lanes[k]*pk[2] + c_R_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_R_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_R_1_lanes[k]*pk[1] + c_R_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_R_1_lanes[k]*pk[0] + c_R_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_R_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
+            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
+            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
+            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1587,15 +1743,25 @@ static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
     const float c_H_across = 1.0F/sqrtf(x + 1);
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
     const float c_H_2 = -1/((x + 1)*(sqrtf(x + 1) + 1));
-    H[0] = c_H_2*(p[0]*p[0]) + c_H_across;
-    H[1] = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[2] = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[3] = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    H[4] = c_H_2*(p[1]*p[1]) + c_H_across;
-    H[5] = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[6] = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    H[7] = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    H[8] = c_H_2*(p[2]*p[2]) + c_H_across;
+    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
+    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
+    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
+    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
+    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
+    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
+    /* stored last: an output may be the same array as an input */
+    H[0] = out0;
+    H[1] = out1;
+    H[2] = out2;
+    H[3] = out3;
+    H[4] = out4;
+    H[5] = out5;
+    H[6] = out6;
+    H[7] = out7;
+    H[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_f_batch: symrot_tangent_m1_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1607,9 +1773,11 @@ static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
 static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, float *H)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1649,18 +1817,21 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
             const float closed_H_2 = c_H_2_lanes[k];
             c_H_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(pk[0]*pk[0]) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_1_lanes[k]*pk[2] + c_H_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_2_lanes[k]*(pk[1]*pk[1]) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_1_lanes[k]*pk[1] + c_H_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_1_lanes[k]*pk[0] + c_H_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_2_lanes[k]*(pk[2]*pk[2]) + c_H_across_lanes[k];
+            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
+            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
+            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
+            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
+            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
+            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
         }
     }
 }
@@ -1690,15 +1861,25 @@ static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float H
     }
     const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(x + 1) + 1.0F/2.0F;
     const float c_H_inverse_2 = (1.0F/2.0F)*(2*sqrtf(x + 1) + 1)/(sqrtf(x + 1) + 1);
-    Hinv[0] = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
-    Hinv[1] = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    Hinv[2] = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    Hinv[3] = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    Hinv[4] = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
-    Hinv[5] = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    Hinv[6] = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    Hinv[7] = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    Hinv[8] = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    const float out0 = c_H_inverse_2*(p[0]*p[0]) + c_H_inverse_across;
+    const float out1 = c_H_inverse_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out2 = c_H_inverse_2*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out3 = c_H_inverse_2*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out4 = c_H_inverse_2*(p[1]*p[1]) + c_H_inverse_across;
+    const float out5 = c_H_inverse_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
+    const float out6 = c_H_inverse_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out7 = c_H_inverse_2*p[1]*p[2] - 1.0F/2.0F*p[0];
+    const float out8 = c_H_inverse_2*(p[2]*p[2]) + c_H_inverse_across;
+    /* stored last: an output may be the same array as an input */
+    Hinv[0] = out0;
+    Hinv[1] = out1;
+    Hinv[2] = out2;
+    Hinv[3] = out3;
+    Hinv[4] = out4;
+    Hinv[5] = out5;
+    Hinv[6] = out6;
+    Hinv[7] = out7;
+    Hinv[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_inverse_f_batch: symrot_tangent_m1_tangent_inverse_f for n vectors p[3*k..3*k+2] into
@@ -1710,9 +1891,11 @@ static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float H
 static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1743,18 +1926,21 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
             const float closed_H_inverse_2 = c_H_inverse_2_lanes[k];
             c_H_inverse_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : closed_H_inverse_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = Hinv + 9 * (start + k);
-            out[0] = c_H_inverse_2_lanes[k]*(pk[0]*pk[0]) + c_H_inverse_across_lanes[k];
-            out[1] = -c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_H_inverse_1_lanes[k]*pk[2] + c_H_inverse_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_H_inverse_2_lanes[k]*(pk[1]*pk[1]) + c_H_inverse_across_lanes[k];
-            out[5] = -c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_H_inverse_1_lanes[k]*pk[1] + c_H_inverse_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_H_inverse_1_lanes[k]*pk[0] + c_H_inverse_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_H_inverse_2_lanes[k]*(pk[2]*pk[2]) + c_H_inverse_across_lanes[k];
+            out[0] = c_H_inverse_2_lanes[k]*(p0*p0) + c_H_inverse_across_lanes[k];
+            out[1] = -c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[2] = c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[3] = c_H_inverse_1_lanes[k]*p2 + c_H_inverse_2_lanes[k]*p0*p1;
+            out[4] = c_H_inverse_2_lanes[k]*(p1*p1) + c_H_inverse_across_lanes[k];
+            out[5] = -c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[6] = -c_H_inverse_1_lanes[k]*p1 + c_H_inverse_2_lanes[k]*p0*p2;
+            out[7] = c_H_inverse_1_lanes[k]*p0 + c_H_inverse_2_lanes[k]*p1*p2;
+            out[8] = c_H_inverse_2_lanes[k]*(p2*p2) + c_H_inverse_across_lanes[k];
         }
     }
 }
@@ -1807,15 +1993,25 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
-    G[0] = c_G_2*(p[0]*p[0]) + t;
-    G[1] = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[2] = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[3] = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    G[4] = c_G_2*(p[1]*p[1]) + t;
-    G[5] = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[6] = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    G[7] = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    G[8] = c_G_2*(p[2]*p[2]) + t;
+    const float out0 = c_G_2*(p[0]*p[0]) + t;
+    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
+    const float out4 = c_G_2*(p[1]*p[1]) + t;
+    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
+    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
+    const float out8 = c_G_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    G[0] = out0;
+    G[1] = out1;
+    G[2] = out2;
+    G[3] = out3;
+    G[4] = out4;
+    G[5] = out5;
+    G[6] = out6;
+    G[7] = out7;
+    G[8] = out8;
 }
 
 /* symrot_tangent_m1_root_matrix_f_batch: symrot_tangent_m1_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1828,9 +2024,11 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
 static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -1886,19 +2084,22 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             const float v_G_2 = x < 0.0009788593F ? poly_G_2 : closed_G_2;
             c_G_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_G_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
             float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(pk[0]*pk[0]) + t;
-            out[1] = -c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_G_1_lanes[k]*pk[2] + c_G_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_G_2_lanes[k]*(pk[1]*pk[1]) + t;
-            out[5] = -c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_G_1_lanes[k]*pk[1] + c_G_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_G_1_lanes[k]*pk[0] + c_G_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_G_2_lanes[k]*(pk[2]*pk[2]) + t;
+            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
+            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
+            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
+            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
+            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
+            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
         }
     }
 }
@@ -1938,15 +2139,25 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
         c_K_1 = 2*w0*powf(sinf((1.0F/4.0F)*phi), 2);
         c_K_2 = x < 0.2589544F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F : w0*((1.0F/2.0F)/(x + 1) - sinf((1.0F/2.0F)*phi)/s);
     }
-    K[0] = c_K_2*(p[0]*p[0]) + c_K_across;
-    K[1] = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[2] = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[3] = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    K[4] = c_K_2*(p[1]*p[1]) + c_K_across;
-    K[5] = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[6] = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    K[7] = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    K[8] = c_K_2*(p[2]*p[2]) + c_K_across;
+    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
+    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
+    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
+    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
+    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
+    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
+    /* stored last: an output may be the same array as an input */
+    K[0] = out0;
+    K[1] = out1;
+    K[2] = out2;
+    K[3] = out3;
+    K[4] = out4;
+    K[5] = out5;
+    K[6] = out6;
+    K[7] = out7;
+    K[8] = out8;
 }
 
 /* symrot_tangent_m1_root_tangent_f_batch: symrot_tangent_m1_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1959,9 +2170,11 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
 static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
     float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
-    size_t start, k;
-    for (start = 0; start < n; start += SYMROT_BATCH_BLOCK) {
-        const size_t m = n - start < SYMROT_BATCH_BLOCK ? n - start : SYMROT_BATCH_BLOCK;
+    size_t end, start, k;
+    /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
+    for (end = n; end > 0; end = start) {
+        start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
+        const size_t m = end - start;
         for (k = 0; k < m; ++k) {
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
@@ -2037,18 +2250,21 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float v_K_2 = x < 0.2589544F ? poly_K_2 : closed_K_2;
             c_K_2_lanes[k] = !(x < 9.223372e+18F) ? NAN : v_K_2;
         }
-        for (k = 0; k < m; ++k) {
+        for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
+            const float p0 = pk[0];
+            const float p1 = pk[1];
+            const float p2 = pk[2];
             float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(pk[0]*pk[0]) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[2] = c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[3] = c_K_1_lanes[k]*pk[2] + c_K_2_lanes[k]*pk[0]*pk[1];
-            out[4] = c_K_2_lanes[k]*(pk[1]*pk[1]) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[6] = -c_K_1_lanes[k]*pk[1] + c_K_2_lanes[k]*pk[0]*pk[2];
-            out[7] = c_K_1_lanes[k]*pk[0] + c_K_2_lanes[k]*pk[1]*pk[2];
-            out[8] = c_K_2_lanes[k]*(pk[2]*pk[2]) + c_K_across_lanes[k];
+            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
+            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
+            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
+            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
+            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
+            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
         }
     }
 }
@@ -2136,10 +2352,15 @@ static inline void symrot_tangent_m1_to_quaternion_f(const float p[3], float e[4
         c_e_0 = cosf((1.0F/2.0F)*phi);
     }
     const float half_nu = (1.0F/2.0F)*c_nu;
-    e[0] = c_e_0;
-    e[1] = half_nu*p[0];
-    e[2] = half_nu*p[1];
-    e[3] = half_nu*p[2];
+    const float out0 = c_e_0;
+    const float out1 = half_nu*p[0];
+    const float out2 = half_nu*p[1];
+    const float out3 = half_nu*p[2];
+    /* stored last: an output may be the same array as an input */
+    e[0] = out0;
+    e[1] = out1;
+    e[2] = out2;
+    e[3] = out3;
 }
 
 /* symrot_tangent_m1__from_quaternion_f: internal: p from a quaternion of any norm and sign (eq 75).
@@ -2325,15 +2546,25 @@ static inline void symrot_tangent_m1_rotation_derivative_f(const float p[3], con
     const float dw23 = a[0]*c_R_1;
     const float dw24 = dw11*p[0] - dw16;
     const float dw25 = c_R_2_x*dw24;
-    D[0] = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    D[1] = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    D[2] = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    D[3] = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    D[4] = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    D[7] = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    D[8] = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2390,15 +2621,25 @@ static inline void symrot_tangent_m1_rotation_transpose_derivative_f(const float
     const float dw21 = a[0]*p[0];
     const float dw22 = a[0]*c_R_1;
     const float dw23 = -dw15 + dw18;
-    D[0] = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    D[1] = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    D[2] = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    D[3] = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    D[4] = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    D[5] = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    D[6] = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    D[7] = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    D[8] = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
+    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
+    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
+    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
+    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
+    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
+    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2461,15 +2702,25 @@ static inline void symrot_tangent_m1_tangent_derivative_f(const float p[3], cons
     const float dw26 = a[0]*c_H_1;
     const float dw27 = -dw17 + dw22;
     const float dw28 = c_H_2_x*dw27;
-    D[0] = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    D[1] = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    D[2] = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    D[3] = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    D[5] = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    D[6] = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    D[7] = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    const float out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2534,15 +2785,25 @@ static inline void symrot_tangent_m1_tangent_transpose_derivative_f(const float 
     const float dw28 = -dw19 + dw23;
     const float dw29 = a[2]*p[1];
     const float dw30 = 2*c_H_2_x*dw28;
-    D[0] = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    D[1] = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    D[2] = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    D[3] = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    D[4] = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    D[5] = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    D[6] = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    D[7] = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    D[8] = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    const float out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
+    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
+    const float out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
+    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
+    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
+    const float out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2597,15 +2858,25 @@ static inline void symrot_tangent_m1_tangent_inverse_derivative_f(const float p[
     const float dw21 = -dw17*p[1] + dw8*p[0];
     const float dw22 = a[2]*p[1];
     const float dw23 = dw10*dw21;
-    D[0] = -c_H_inverse_2*(-dw1 - dw2) + 2*dw0 + dw11*p[0];
-    D[1] = 2*a[0]*p[1] - c_H_inverse_2*dw3 - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw9*p[1] - dw12;
-    D[2] = -c_H_inverse_2*dw6 - c_H_inverse_2*dw8 + dw11*p[2] + dw13 + 2*dw6;
-    D[3] = -c_H_inverse_2*dw14 - c_H_inverse_2*dw5 + dw12 + 2*dw14 + dw19*p[0];
-    D[4] = -c_H_inverse_2*(-dw0 - dw2) + 2*dw1 + dw19*p[1];
-    D[5] = 2*a[1]*p[2] - c_H_inverse_2*dw15 - c_H_inverse_2*dw16 + 2*c_H_inverse_2_x*dw18*p[2] - dw20;
-    D[6] = 2*a[2]*p[0] - c_H_inverse_2*dw7 + c_H_inverse_2*dw8 + 2*c_H_inverse_2_x*dw21*p[0] - dw13;
-    D[7] = -c_H_inverse_2*dw17 - c_H_inverse_2*dw22 + dw20 + 2*dw22 + dw23*p[1];
-    D[8] = -c_H_inverse_2*(-dw0 - dw1) + 2*dw2 + dw23*p[2];
+    const float out0 = -c_H_inverse_2*(-dw1 - dw2) + 2*dw0 + dw11*p[0];
+    const float out1 = 2*a[0]*p[1] - c_H_inverse_2*dw3 - c_H_inverse_2*dw4 + 2*c_H_inverse_2_x*dw9*p[1] - dw12;
+    const float out2 = -c_H_inverse_2*dw6 - c_H_inverse_2*dw8 + dw11*p[2] + dw13 + 2*dw6;
+    const float out3 = -c_H_inverse_2*dw14 - c_H_inverse_2*dw5 + dw12 + 2*dw14 + dw19*p[0];
+    const float out4 = -c_H_inverse_2*(-dw0 - dw2) + 2*dw1 + dw19*p[1];
+    const float out5 = 2*a[1]*p[2] - c_H_inverse_2*dw15 - c_H_inverse_2*dw16 + 2*c_H_inverse_2_x*dw18*p[2] - dw20;
+    const float out6 = 2*a[2]*p[0] - c_H_inverse_2*dw7 + c_H_inverse_2*dw8 + 2*c_H_inverse_2_x*dw21*p[0] - dw13;
+    const float out7 = -c_H_inverse_2*dw17 - c_H_inverse_2*dw22 + dw20 + 2*dw22 + dw23*p[1];
+    const float out8 = -c_H_inverse_2*(-dw0 - dw1) + 2*dw2 + dw23*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
 }
 
 /* symrot_tangent_m1_angular_acceleration_f: angular acceleration (eq D1-D5 of the sheet).
@@ -2645,9 +2916,13 @@ static inline void symrot_tangent_m1_angular_acceleration_f(const float p[3], co
     const float dw4 = p[0]*pdot[1] - p[1]*pdot[0];
     const float dw5 = -p[0]*pdot[2] + p[2]*pdot[0];
     const float dw6 = c_H_2_x*dw0;
-    alpha[0] = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
-    alpha[1] = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
-    alpha[2] = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    const float out0 = c_H_0*pddot[0] + c_H_1*w0 - c_H_2*(-dw4*pdot[1] + dw5*pdot[2]) + c_H_2*(p[1]*w2 - p[2]*w1) + dw1*pdot[0] + dw2*dw3 + dw6*(dw4*p[1] - dw5*p[2]);
+    const float out1 = c_H_0*pddot[1] + c_H_1*w1 - c_H_2*(-dw2*pdot[2] + dw4*pdot[0]) + c_H_2*(-p[0]*w2 + p[2]*w0) + dw1*pdot[1] + dw3*dw5 + dw6*(dw2*p[2] - dw4*p[0]);
+    const float out2 = c_H_0*pddot[2] + c_H_1*w2 - c_H_2*(dw2*pdot[1] - dw5*pdot[0]) + c_H_2*(p[0]*w1 - p[1]*w0) + dw1*pdot[2] + dw3*dw4 + dw6*(-dw2*p[1] + dw5*p[0]);
+    /* stored last: an output may be the same array as an input */
+    alpha[0] = out0;
+    alpha[1] = out1;
+    alpha[2] = out2;
 }
 
 /* symrot_tangent_m1_compose_jacobians_f: Jacobians of compose (eq D1-D5 of the sheet).

@@ -27,6 +27,7 @@ from ..forked import first_here_others_in_children
 from ..plan import evaluation_plan
 from ..plan_ir import ClosedAngle, EvaluationPlan
 from ..registry import NAMED, find_by_expression, lookup
+from .c_aliasing import stored_last
 from .c_batch import DEFAULT_BLOCK, BatchWriter
 from .c_derivatives import DerivativeWriter
 from .c_functions import FUNCTIONS, CFunction
@@ -74,7 +75,8 @@ def _uses_nearest(functions: list[dict[str, Any]]) -> bool:
 
 def _precision_functions(plan: EvaluationPlan, name: str, precision: Precision) -> list[dict[str, Any]]:
     """The functions of one precision, in header order: angle, public functions with their batch
-    kernels, operations, derivatives."""
+    kernels, operations, derivatives; each stores its outputs after reading its inputs
+    (:func:`~symrot.backends.c_aliasing.stored_last`)."""
     writer = FunctionWriter(plan, name, precision)
     batch = BatchWriter(writer)
     functions = []
@@ -89,7 +91,7 @@ def _precision_functions(plan: EvaluationPlan, name: str, precision: Precision) 
     functions += public
     functions += OperationWriter(plan, name, precision).all()
     functions += DerivativeWriter(plan, name, precision).all()
-    return functions
+    return [stored_last(function) for function in functions]  # outputs may alias inputs
 
 
 def angle_kind(plan: EvaluationPlan) -> str:

@@ -24,6 +24,10 @@ and four passes, so that the two expensive middle ones have no branch and no lib
    is moved up to skip library calls.
 4. **assembly** (k < block length): T = c0 I + c1 (p×) + c2 (p×)² entry by entry, as the single call.
 
+The blocks, and the vectors of the assembly, run backward: with the output at the address of p
+(in place, :mod:`symrot.backends.c_aliasing`) vector k's entries out[9k..9k+8] overwrite only the
+p of vectors already done, or its own, read into locals first.
+
 The values differ from the single call only by the rounding of the sin/cos kernel (≤ 1.5 ulp
 where libm's is about 0.5); both are tested against mpmath. Lanes whose result is discarded may
 raise floating-point exception flags (a 0/0 in the closed form below its threshold, for example);
@@ -58,6 +62,8 @@ BLOCK = "SYMROT_BATCH_BLOCK"
 DEFAULT_BLOCK = 32
 """Vectors per block: 8 (AVX2) or 4 (AVX-512) vector iterations per loop, 2–3 KB of stack."""
 LANE = sp.Symbol("pk[0]"), sp.Symbol("pk[1]"), sp.Symbol("pk[2]")
+VALUE = sp.Symbol("p0", real=True), sp.Symbol("p1", real=True), sp.Symbol("p2", real=True)
+"""p of a vector read before its entries are written (in place, vector 0's p is out[0..2])."""
 
 
 @dataclass
@@ -152,16 +158,18 @@ class BatchWriter:
         ] if candidate_body else []
         return [
             {"kind": "declare", "type": self.t, "names": arrays},
-            {"kind": "declare", "type": "size_t", "names": ["start", "k"]},
-            {"kind": "loop", "header": f"start = 0; start < n; start += {BLOCK}", "times": 1, "body": [
-                {"kind": "let", "type": "size_t", "name": "m",
-                 "value": f"n - start < {BLOCK} ? n - start : {BLOCK}"},
+            {"kind": "declare", "type": "size_t", "names": ["end", "start", "k"]},
+            {"kind": "comment", "text": "the last block first, its last vector first: in place "
+                                        "(the output at p), no entries overwrite a p not yet read"},
+            {"kind": "loop", "header": "end = n; end > 0; end = start", "times": 1, "body": [
+                {"kind": "set", "name": "start", "value": f"(end - 1) / {BLOCK} * {BLOCK}"},
+                {"kind": "let", "type": "size_t", "name": "m", "value": "end - start"},
                 *self.scalar_pass(lanes, inputs, self.polynomial_below(plan, closed, inputs)),
                 *candidates,
                 {"kind": "comment", "text": "select: polynomial below the threshold, NaN outside the range"},
                 {"kind": "loop", "header": f"k = 0; k < {BLOCK}; ++k", "times": 1,
                  "body": self.select_pass(plan)},
-                {"kind": "loop", "header": "k = 0; k < m; ++k", "times": 1,
+                {"kind": "loop", "header": "k = m; k-- > 0;", "times": 1,
                  "body": self.assembly(spec, names)},
             ]},
         ], notes
@@ -228,10 +236,13 @@ class BatchWriter:
         if t_value != first:
             across.append({"kind": "let", "type": self.t, "name": "t", "value": self.c(t_value)})
             t_value = sp.Symbol("t", real=True)
-        entries = [entry.xreplace(dict(zip(P, LANE, strict=True))) for entry in tensor_entries(t_value, b, c)]
+        values = dict(zip(P, VALUE, strict=True))
+        entries = [entry.xreplace(values) for entry in tensor_entries(t_value, b, c)]
         output = OUTPUT_NAMES[spec.name]
         return [
             {"kind": "let", "type": f"{self.t} *const", "name": "pk", "value": "p + 3 * (start + k)"},
+            *({"kind": "let", "type": self.t, "name": str(v), "value": str(lane)}  # vector 0: out = pk
+              for v, lane in zip(VALUE, LANE, strict=True)),
             *across,
             {"kind": "declare", "type": f"{self.t} *const", "names": [f"out = {output} + 9 * (start + k)"]},
             *({"kind": "set", "name": f"out[{i}]", "value": self.c(entry)}
