@@ -544,8 +544,60 @@ def run_cache_cases() -> int:
     return 1 if failures else 0
 
 
+# -- The Python API (issue 55, item 6) ---------------------------------------------------------
+
+API_CASES: list[tuple[str, str]] = [
+    ("long unknown name", "'a' + '9' * 200000 + 'b'"),
+    ("long digits", "'9' * 200000"),
+    ("long blank tail", "'phi' + ' ' * 200000"),
+    ("a million letters", "'x' * 10**6"),
+    ("huge integer", "sympy.Integer(10)**10000 * PHI"),
+    ("huge float", "sympy.Float('1e400') * PHI"),
+    ("NaN", "sympy.nan * PHI"),
+    ("other symbol", "sympy.Symbol('x') * PHI"),
+    ("plain phi symbol", "sympy.Symbol('phi')"),
+    ("function outside the grammar", "sympy.Abs(PHI)"),
+    ("None", "None"),
+    ("bytes", "b'phi'"),
+]
+"""``symrot.derive`` on each (a Python expression with ``sympy`` and ``PHI`` in scope): every one
+must end in a SymrotError within the budget (the long strings had run for minutes, the huge
+integer was Python's ValueError)."""
+
+
+def run_api_case(source: str, budget: float) -> Outcome:
+    """``symrot.derive(<source>)`` in a fresh interpreter; exit 2 for a SymrotError, 0 for a
+    result, 1 (with a traceback) for anything else; killed after ``budget + 10 * MARGIN``."""
+    script = ("import sympy, symrot\nfrom symrot.parsing import PHI\n"
+              f"try:\n    symrot.derive({source})\n"
+              "except symrot.SymrotError as exc:\n    print(exc)\n    raise SystemExit(2)\n")
+    started = time.monotonic()
+    try:
+        result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                                timeout=budget + 10 * MARGIN, check=False)
+        status, stderr = result.returncode, result.stderr
+    except subprocess.TimeoutExpired as exc:
+        status, stderr = -9, str(exc.stderr or "")
+    return Outcome(("derive", source), status, time.monotonic() - started, stderr)
+
+
+def api_main(budget: float = 60.0) -> int:
+    """Every :data:`API_CASES` entry; 1 when one misbehaves (see :meth:`Outcome.problems`)."""
+    bad = 0
+    for label, source in API_CASES:
+        outcome = run_api_case(source, budget)
+        problems = outcome.problems(budget)
+        if outcome.status == 0:
+            problems.append("accepted")
+        bad += bool(problems)
+        print(f"{'FAIL' if problems else 'ok  '} {outcome.status:>3} {outcome.seconds:6.1f} s  "
+              f"{label:30} {', '.join(problems)}")
+    print(f"{len(API_CASES)} API inputs, {bad} failed")
+    return 1 if bad else 0
+
+
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--cache"]:
         raise SystemExit(run_cache_cases())
-    code = main(sys.argv[1:])
-    raise SystemExit(1 if run_output_cases() else code)
+    codes = [main(sys.argv[1:]), run_output_cases(), api_main()]
+    raise SystemExit(1 if any(codes) else 0)

@@ -190,3 +190,16 @@ EXPRESSIONS = st.recursive(_LEAVES, _extend, max_leaves=8)
 @given(EXPRESSIONS)
 def test_any_sympy_expression_is_a_result_or_a_symrot_error(expression: sp.Expr) -> None:
     _derive_or_refuse(expression)
+
+
+def test_the_bench_api_cases_are_symrot_errors() -> None:
+    """``bench/hostile_cli.py``'s API section, in this process (the bench runs each in its own)."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    import hostile_cli
+
+    assert len(hostile_cli.API_CASES) >= 10
+    for label, source in hostile_cli.API_CASES:
+        value = eval(source, {"sympy": sp, "PHI": PHI})  # the bench's own, fixed sources
+        with pytest.raises(SymrotError):
+            derive(value)
+        assert label

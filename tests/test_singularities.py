@@ -109,7 +109,7 @@ def test_the_edge_of_the_real_domain_is_a_singularity(text: str, edge: sp.Expr, 
     p_events = [s for s in result.singularities if s.quantity == "p"]
     assert p_events and p_events[0].phi == edge and p_events[0].limit == limit
     assert (result.p_max_float == float("inf")) == (limit == "oo")
-    assert time.monotonic() - started < 20
+    assert time.monotonic() - started < 120  # hang-catcher: 2x DERIVE_TIME_LIMIT (was 20 s)
 
 
 def test_solveset_is_tried_on_one_frequency_or_on_sines_and_cosines_only() -> None:
@@ -207,7 +207,7 @@ def test_inverse_functions_in_p_prime_are_left_to_the_numeric_scan() -> None:
     found = validity(derive_expression(parse_expression(text)))
     assert found.phi_max == sp.Rational(3, 2) and found.numeric_only
     assert {("p", "edge"), ("p_prime", "oo")} <= {(s.quantity, s.limit) for s in found.singularities}
-    assert time.monotonic() - started < 20
+    assert time.monotonic() - started < 120  # hang-catcher: 2x DERIVE_TIME_LIMIT (was 20 s)
 
 
 def test_a_jump_of_p_itself_ends_the_range() -> None:
