@@ -6,7 +6,7 @@ TEST_JOBS ?= auto
 SYMFORCE_VENV ?= /tmp/symforce_venv
 
 .DEFAULT_GOAL := help
-.PHONY: audit help setup setup-bench setup-system setup-python test lint typecheck pytest generate check-generated bench clean
+.PHONY: audit help setup setup-bench setup-system setup-python test lint typecheck pytest generate check-generated mutations bench clean
 
 help: ## List the targets with what they do
 	@grep -E '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-16s %s\n", $$1, $$2}'
@@ -56,9 +56,12 @@ generate: ## Rewrite generated/ for the named parameterizations (deterministic)
 check-generated: ## Fail with a diff when generated/ is stale
 	$(PYTHON) -m symrot.generate --check generated
 
+mutations: ## Mutation check: every fault of bench/mutation_list.py must fail a test of make test; writes docs/mutations.md
+	$(PYTHON) bench/mutations.py --out docs/mutations.md
+
 bench: ## Benchmarks (accuracy and speed); writes docs/*.md
 	$(PYTHON) -m symrot.generate --list >/dev/null
-	@for script in bench/*.py; do echo "== $$script"; \
+	@for script in $(filter-out bench/mutation_list.py,$(wildcard bench/*.py)); do echo "== $$script"; \
 	  SYMROT_SYMFORCE_PYTHON=$$(test -x $(SYMFORCE_VENV)/bin/python && echo $(SYMFORCE_VENV)/bin/python || echo $(PYTHON)) \
 	  $(PYTHON) $$script || exit 1; done
 
