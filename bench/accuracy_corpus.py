@@ -39,9 +39,12 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
-from accuracy import DTYPES, TARGET_ULP, Worst, _ulp, condition, load_module, sweep  # noqa: E402
+from accuracy import DTYPES, load_module, sweep  # noqa: E402
 
 from tests.corpus import CORPUS  # noqa: E402
+from tests.measure import TARGET_ULP, Worst, condition  # noqa: E402
+from tests.measure import scale as _scale  # noqa: E402
+from tests.measure import ulp as _ulp  # noqa: E402
 from tests.reference import GeneratingFunction, Reference, State  # noqa: E402
 
 MATRICES = {"rotation_matrix": "R", "tangent": "H", "tangent_inverse": "H_inverse", "root_matrix": "G",
@@ -261,12 +264,7 @@ class Measurement:
                   e: list[Any], guess: float | None, tiny: float) -> dict[str, float]:
         """κ of ``function`` (and, for the kinematic ones, of all of them at once)."""
         def scale(ref: Any, matrix: bool) -> float:
-            values = [ref[i, j] for i in range(ref.rows) for j in range(ref.cols)] \
-                if isinstance(ref, mpmath.matrix) else list(ref)
-            if any(mpmath.isnan(v) for v in values):
-                return 0.0
-            biggest = max(float(abs(v)) for v in values)
-            return max(1.0, biggest) if matrix else max(tiny, biggest)
+            return _scale(ref, matrix, tiny)
 
         if function in KINEMATIC:
             base = {f: refs[f] for f in KINEMATIC}
