@@ -67,6 +67,11 @@ NUMPY_NAMED = ("rotation_vector", "cayley_gibbs_rodrigues", "euler_rodrigues", "
 DERIVATIVES = {"rotation_derivative": "R", "rotation_transpose_derivative": "R_T",
                "tangent_derivative": "H", "tangent_transpose_derivative": "H_T",
                "tangent_inverse_derivative": "H_inverse", "angular_acceleration": "alpha"}
+WORKING_DIGITS = 60
+"""The ambient precision of every reference call: tests/reference.py rounds what it returns from
+products done outside its own precision blocks (H⁻¹ w, H w, the quaternion product of compose) to
+the ambient precision, and κ perturbs inputs by 10⁻³⁰ (at 15 digits compose's reference was 10⁻¹⁶
+off and its κ read 10¹⁴)."""
 BATCH = 16
 """The rows of every Python call (:func:`python_values`): at least the longest sweep."""
 DERIVATIVE_ULP = 8.0
@@ -150,18 +155,23 @@ class Family:
             rows["r"].append(np.array(r).astype(dtype))
             rows["e"].append((np.array(e) * (-1.0 if rng.random() < 0.5 else 1.0)).astype(dtype))
         arrays = {k: np.array(v, dtype=np.float64 if k == "angle" else dtype) for k, v in rows.items()}
-        # compose(p, p2) with p2 another point of the sweep (its reference state is there already)
-        arrays["p2"] = np.roll(arrays["p"], -5, axis=0)
-        refs = [self._references(i, arrays) for i in range(len(arrays["angle"]))]
+        # compose(p, p2) with p2 another point of the sweep (its reference state is there already),
+        # one well inside the range: next to a fold or pole p2 would make compose's κ ~1e14 and hide
+        # a compose with its factors swapped
+        inner = np.flatnonzero((arrays["angle"] > 0) & (arrays["angle"] <= 0.8 * phi_max))
+        second = inner[(np.arange(len(arrays["angle"])) + 3) % len(inner)]
+        arrays["p2"] = arrays["p"][second]
+        with mpmath.workdps(WORKING_DIGITS):
+            refs = [self._references(i, arrays, second) for i in range(len(arrays["angle"]))]
         return Points(refs=refs, **arrays)
 
-    def _references(self, i: int, arrays: dict[str, np.ndarray]) -> dict[str, Any]:
+    def _references(self, i: int, arrays: dict[str, np.ndarray], second: np.ndarray) -> dict[str, Any]:
         p, p2, w, e = (_mp(arrays[k][i]) for k in ("p", "p2", "w", "e"))
         guess = float(arrays["angle"][i]) or None
         out = kinematic(self.reference.state(p, guess), w)
         out["from_quaternion"] = self.reference.from_quaternion(e)
         out["rescale"] = self.reference.rescale(p, guess)
-        other = float(np.roll(arrays["angle"], -5)[i]) or None
+        other = float(arrays["angle"][second[i]])
         out["compose"] = self.reference.compose(p, p2, (guess, other))
         out["from_rotation_matrix"] = self._from_rotation_matrix(_mp(arrays["r"][i]))
         return out
@@ -181,12 +191,12 @@ class Family:
             guess = float(points.angle[i]) or None
             if function == "from_rotation_matrix":
                 ref = points.refs[i][function]
-                with mpmath.workdps(60):
+                with mpmath.workdps(WORKING_DIGITS):
                     found = condition(lambda x: {"f": self._from_rotation_matrix(x)}, _mp(points.r[i]),
                                       {"f": ref}, {"f": scale(ref, False, tiny)})
                 self._kappa[key] = found["f"]
                 return self._kappa[key]
-            with mpmath.workdps(60):
+            with mpmath.workdps(WORKING_DIGITS):
                 found = condition_of(self.reference, function, points.refs[i],
                                      lambda x: kinematic(self.reference.state(x, guess), w), p, p2, e, guess,
                                      tiny)
@@ -200,7 +210,8 @@ class Family:
         if key not in self._derivatives:
             points = self.points(label)
             p, w, v = (_mp(getattr(points, k)[i]) for k in ("p", "w", "v"))
-            self._derivatives[key] = self._derivatives_at(p, w, v)
+            with mpmath.workdps(WORKING_DIGITS):
+                self._derivatives[key] = self._derivatives_at(p, w, v)
         return self._derivatives[key]
 
     def _derivatives_at(self, p: list[Any], w: list[Any], v: list[Any]) -> dict[str, Any]:
@@ -223,7 +234,7 @@ class Family:
 
         inputs = p + w + (v if function == "angular_acceleration" else [])
         tiny = float(np.finfo(DTYPES[label]).tiny)
-        with mpmath.workdps(60):
+        with mpmath.workdps(WORKING_DIGITS):
             return condition(at, inputs, base, {function: scale(base[function], False, tiny)})[function]
 
 

@@ -59,7 +59,12 @@ WM_EDGE = 2 * math.pi - 1e-6
 """The last angle of the Wiener–Milenkovic sweep (φ_max = 2π, the pole of 4 tan(φ/4))."""
 JAX_FLUSHES = ("XLA on the CPU flushes float32 subnormals to zero: at |φ| = 1.18e-38 (the smallest "
                "normal) the components of p are subnormal and read as 0")
-KNOWN_MISSES: dict[tuple[str, str, str, str], tuple[float, str]] = {
+TANGENT_M1_COMPOSE = (
+    "C compose with p1 next to the pole (|p1| = 12.7 and 63.7, φ = 0.95 and 0.99 φ_max): 11.5 and 37.8 ulp "
+    "(κ 1.16 and 2.18); the double function at the same inputs is 10.6 and 12.8 ulp off. φ3 from atan2 and "
+    "then p3 = tan φ3 amplifies φ3's rounding by φ3/(sin φ3 cos φ3) (3.7 and 14 here), which κ of the inputs "
+    "does not: the pole compresses p1's rounding")
+KNOWN_MISSES: dict[tuple[str, str, str, str], tuple[float | tuple[float, ...], str]] = {
     **{(name, "jax", "float32", "angle"): (FLOAT32_TINY, JAX_FLUSHES + ": angle 0, 8.39e6 ulp")
        for name in NUMPY_NAMED},
     **{(name, "jax", "float32", "from_quaternion"): (FLOAT32_TINY, JAX_FLUSHES + ": p 0, 5.5e6-8.1e6 ulp")
@@ -74,9 +79,18 @@ KNOWN_MISSES: dict[tuple[str, str, str, str], tuple[float, str]] = {
         WM_EDGE, "2.63e3 ulp (κ 4.19) at |p| = 1.6e7 (φ = 2π − 1e-6), where the entries are ~1e-21; "
                  "float64 at the same input 1.1 ulp, JAX and PyTorch float32 within 8")
        for f in ("tangent_derivative", "tangent_transpose_derivative")},
+    ("tangent_m1", "c-gcc-O2-nofma", "float32", "compose"): (
+        (0.95 * (math.pi / 2), 0.99 * (math.pi / 2)), TANGENT_M1_COMPOSE),
+    ("tangent_m1", "c-gcc-O2-fma", "float32", "compose"): (0.95 * (math.pi / 2), TANGENT_M1_COMPOSE),
 }
-"""(family, backend, precision, function) → (the angle of the point that misses, the measured miss):
-that point is left out of the strict test and is an xfail(strict=True) of test_known_miss."""
+"""(family, backend, precision, function) → (the angle, or angles, of the points that miss, the measured
+miss): those points are left out of the strict test and are an xfail(strict=True) of test_known_miss."""
+
+
+def _known(key: tuple[str, str, str, str]) -> tuple[float, ...]:
+    """The angles of KNOWN_MISSES[key] (none when it has no entry)."""
+    angles = KNOWN_MISSES.get(key, ((), ""))[0]
+    return angles if isinstance(angles, tuple) else (angles,)
 
 
 @cache
@@ -190,8 +204,8 @@ def test_value_against_the_independent_reference(name: str, backend: str, label:
     points = family(name).points(label)
     assert len(points.angle) >= 8, "the sweep lost its points"
     assert values.dtype == DTYPES[label], values.dtype
-    known = KNOWN_MISSES.get((name, backend, label, function))
-    misses = errors(family(name), label, function, values, lambda angle: known is None or angle != known[0])
+    known = _known((name, backend, label, function))
+    misses = errors(family(name), label, function, values, lambda angle: angle not in known)
     assert not misses, f"{name} {backend} {label} {function}: " + "; ".join(misses)
 
 
@@ -199,11 +213,11 @@ def test_value_against_the_independent_reference(name: str, backend: str, label:
     pytest.param(*key, marks=pytest.mark.xfail(strict=True, reason=reason), id="-".join(key))
     for key, (_angle, reason) in KNOWN_MISSES.items()])
 def test_known_miss(name: str, backend: str, label: str, function: str) -> None:
-    """The one point of KNOWN_MISSES, held to the same target (it fails; strict: a fix shows)."""
-    angle = KNOWN_MISSES[name, backend, label, function][0]
+    """The points of KNOWN_MISSES, held to the same target (they fail; strict: a fix shows)."""
+    known = _known((name, backend, label, function))
     values = _outputs(name, backend, label)[function]
-    assert angle in family(name).points(label).angle
-    misses = errors(family(name), label, function, values, lambda a: a == angle)
+    assert set(known) <= set(family(name).points(label).angle)
+    misses = errors(family(name), label, function, values, lambda a: a in known)
     assert not misses, "; ".join(misses)
 
 
