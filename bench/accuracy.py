@@ -20,8 +20,6 @@ import importlib.util
 import sys
 import tempfile
 import warnings
-from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -38,6 +36,17 @@ from symrot.parsing import PHI
 from symrot.plan import EvaluationPlan, evaluation_plan
 from symrot.registry import NAMED
 
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:  # run as a script: tests/ is beside bench/
+    sys.path.insert(0, str(ROOT))
+
+from tests.measure import TARGET_ULP, Worst, condition  # noqa: E402
+from tests.measure import scale as _scale  # noqa: E402
+from tests.measure import ulp as _ulp  # noqa: E402
+
+__all__ = ["DIGITS", "DTYPES", "TARGET_ULP", "Reference", "Worst", "condition", "load_module", "measure",
+           "subject", "sweep"]
+
 TENSORS = {"rotation_matrix": "R", "tangent": "H", "tangent_inverse": "H_inverse", "root_matrix": "G",
            "root_tangent": "K"}
 VECTORS = {"pdot": "H_inverse", "omega": "H"}
@@ -46,7 +55,6 @@ FUNCTIONS = (*TENSORS, *VECTORS, *SCALARS)
 DTYPES = {"float64": np.float64, "float32": np.float32}
 SERIES_TERMS = 24
 DIGITS = 50
-TARGET_ULP = 4.0
 
 
 def default_parameterizations() -> list[str]:
@@ -121,75 +129,6 @@ def _tensor(c: dict[str, Any], name: str, p: list[Any]) -> mpmath.matrix:
             outer[i, j] = p[i] * p[j]
     return (c[name + "_0"] - c[name + "_2"] * x) * mpmath.eye(3) + c[name + "_1"] * cross + \
         c[name + "_2"] * outer
-
-
-def _ulp(value: np.ndarray, reference: Any, epsilon: float, matrix: bool, tiny: float) -> float:
-    ref = np.array([[float(reference[i, j]) for j in range(3)] for i in range(3)]) if matrix else \
-        np.array([float(v) for v in reference])
-    # subnormal results cannot carry 4 eps relative accuracy: scale by at least the smallest normal
-    scale = max(1.0, float(np.max(np.abs(ref)))) if matrix else max(tiny, float(np.max(np.abs(ref))))
-    error = float(np.max(np.abs(value.astype(np.float64) - ref)))
-    if not np.isfinite(error):
-        return float("inf")
-    if scale == 0:
-        return 0.0 if error == 0 else float("inf")
-    return error / (scale * epsilon)
-
-
-@dataclass
-class Worst:
-    """The worst point of one (function, precision, kind) over the sweep."""
-
-    ulp: float = 0.0
-    at: float = 0.0
-    kappa: float = 1.0
-    excess: float = 0.0
-    """max over points of ulp / max(1, κ): ≤ 4 means at most the error of a 4 ε relative input change."""
-    excess_at: float = 0.0
-    """The angle of that worst ulp/κ: a miss is there, not always at ``at`` (p = φ − φ³/6 + φ⁵/120:
-    10¹² ulp at its fold, within κ, but 9·10⁵ κ ulp at φ = 0.1)."""
-
-    def add(self, ulp: float, at: float, kappa: float) -> None:
-        ulp = float("inf") if np.isnan(ulp) else ulp
-        if ulp > self.ulp or (ulp == self.ulp == 0 and at == 0):
-            self.ulp, self.at, self.kappa = ulp, at, kappa
-        excess = ulp / max(1.0, kappa)
-        if excess > self.excess:
-            self.excess, self.excess_at = excess, at
-
-
-def condition(reference: Callable[[list[Any]], dict[str, Any]], inputs: list[Any],
-              base: dict[str, Any], scales: dict[str, float]) -> dict[str, float]:
-    """κ_f = max over output entries of Σ_i |∂f/∂x_i| |x_i| / scale_f (50-digit differences).
-
-    The relative condition number of each output with respect to componentwise relative changes of
-    the input: an algorithm whose error is ≤ 4 κ ulp is as accurate as a 4 ε change of its input.
-    """
-    delta = mpmath.mpf(10) ** -30
-    totals: dict[str, np.ndarray] = {}
-    for i, value in enumerate(inputs):
-        if value == 0:
-            continue
-        moved = list(inputs)
-        moved[i] = value * (1 + delta)
-        other = reference(moved)
-        for f, ref in base.items():
-            pairs = zip(_entries(other[f]), _entries(ref), strict=True)
-            diff = np.array([float(abs(a - b)) for a, b in pairs])
-            totals[f] = totals.get(f, 0) + diff / float(delta)
-    return {f: float(np.max(totals[f])) / scales[f] if f in totals and scales[f] > 0 else 0.0
-            for f in base}
-
-
-def _entries(value: Any) -> list[Any]:
-    if isinstance(value, mpmath.matrix):
-        return [value[i, j] for i in range(value.rows) for j in range(value.cols)]
-    return list(value)
-
-
-def _scale(ref: Any, matrix: bool, tiny: float) -> float:
-    biggest = max(float(abs(v)) for v in _entries(ref))
-    return max(1.0, biggest) if matrix else max(tiny, biggest)
 
 
 def sweep(phi_max: float, points: int, edge: float = 1e-6) -> np.ndarray:

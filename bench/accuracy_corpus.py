@@ -39,9 +39,12 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
-from accuracy import DTYPES, TARGET_ULP, Worst, _ulp, condition, load_module, sweep  # noqa: E402
+from accuracy import DTYPES, load_module, sweep  # noqa: E402
 
 from tests.corpus import CORPUS  # noqa: E402
+from tests.measure import TARGET_ULP, Worst, condition  # noqa: E402
+from tests.measure import scale as _scale  # noqa: E402
+from tests.measure import ulp as _ulp  # noqa: E402
 from tests.reference import GeneratingFunction, Reference, State  # noqa: E402
 
 MATRICES = {"rotation_matrix": "R", "tangent": "H", "tangent_inverse": "H_inverse", "root_matrix": "G",
@@ -102,6 +105,38 @@ C_OPERATIONS: dict[str, tuple[tuple[str, ...], int]] = {
 and number of outputs. tests/c_harness.py wraps only the nine kinematic functions."""
 
 
+def operation_wrappers(headers: list[str],
+                       operations: dict[str, tuple[tuple[str, ...], int]] = C_OPERATIONS) -> str:
+    """C source of one wrapper ``o_HEADER_NAME[_f](inputs..., out)`` per operation (default
+    C_OPERATIONS: name → (inputs, number of outputs)), header and precision (the status is dropped:
+    NaN says the same)."""
+    lines = [f'#include "symrot_{header}.h"' for header in headers]
+    for header in headers:
+        for ctype, suffix in (("double", ""), ("float", "_f")):
+            for name, (inputs, _width) in operations.items():
+                parameters = ", ".join([*(f"const {ctype} *{i}" for i in inputs), f"{ctype} *out"])
+                signature = f"void o_{header}_{name}{suffix}({parameters})"
+                call = f"symrot_{header}_{name}{suffix}({', '.join(inputs)}, out)"
+                lines += [f"{signature};", f"{signature} {{ (void){call}; }}"]
+    return "\n".join(lines) + "\n"
+
+
+def call_operation(dll: ctypes.CDLL, header: str, name: str, dtype: Any, *arrays: np.ndarray,
+                   operations: dict[str, tuple[tuple[str, ...], int]] = C_OPERATIONS) -> np.ndarray:
+    """Operation ``name`` of ``header`` (wrapped by :func:`operation_wrappers`) for one input (each
+    array one vector), in ``dtype``."""
+    inputs, width = operations[name]
+    ctype = ctypes.c_double if dtype == np.float64 else ctypes.c_float
+    pointer = ctypes.POINTER(ctype)
+    values = [np.ascontiguousarray(a, dtype=dtype) for a in arrays]
+    out = np.empty(width, dtype=dtype)
+    function = getattr(dll, f"o_{header}_{name}" + ("" if dtype == np.float64 else "_f"))
+    function.argtypes = [pointer] * (len(inputs) + 1)
+    function.restype = None
+    function(*[v.ctypes.data_as(pointer) for v in values], out.ctypes.data_as(pointer))
+    return out
+
+
 class COperations:
     """The quaternion operations of a compiled C header, called through ctypes (gcc -O2
     -ffp-contract=off, the configuration of the kinematic wrappers)."""
@@ -109,31 +144,16 @@ class COperations:
     def __init__(self, directory: Path, header: str) -> None:
         from tests.c_harness import build_config, compile_one
 
-        lines = [f'#include "symrot_{header}.h"']
-        for ctype, suffix in (("double", ""), ("float", "_f")):
-            for name, (inputs, _width) in C_OPERATIONS.items():
-                parameters = ", ".join([*(f"const {ctype} *{i}" for i in inputs), f"{ctype} *out"])
-                signature = f"void o_{name}{suffix}({parameters})"
-                call = f"symrot_{header}_{name}{suffix}({', '.join(inputs)}, out)"
-                lines += [f"{signature};", f"{signature} {{ (void){call}; }}"]
+        self.header = header
         out_dir = directory / "operations"
         out_dir.mkdir()
         source = out_dir / "operations.c"
-        source.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        source.write_text(operation_wrappers([header]), encoding="utf-8")
         self.dll = ctypes.CDLL(str(compile_one(build_config("gcc-O2-nofma"), source, directory, out_dir)))
 
     def call(self, name: str, dtype: Any, *arrays: np.ndarray) -> np.ndarray:
         """``name``'s outputs for one input (each array one vector), in ``dtype``."""
-        inputs, width = C_OPERATIONS[name]
-        ctype = ctypes.c_double if dtype == np.float64 else ctypes.c_float
-        pointer = ctypes.POINTER(ctype)
-        values = [np.ascontiguousarray(a, dtype=dtype) for a in arrays]
-        out = np.empty(width, dtype=dtype)
-        function = getattr(self.dll, f"o_{name}" + ("" if dtype == np.float64 else "_f"))
-        function.argtypes = [pointer] * (len(inputs) + 1)
-        function.restype = None
-        function(*[v.ctypes.data_as(pointer) for v in values], out.ctypes.data_as(pointer))
-        return out
+        return call_operation(self.dll, self.header, name, dtype, *arrays)
 
 
 def _is_nan_reference(ref: Any) -> bool:
@@ -260,28 +280,31 @@ class Measurement:
                   kinematic_at: Callable[[list[Any]], dict[str, Any]], p: list[Any], p2: list[Any],
                   e: list[Any], guess: float | None, tiny: float) -> dict[str, float]:
         """κ of ``function`` (and, for the kinematic ones, of all of them at once)."""
-        def scale(ref: Any, matrix: bool) -> float:
-            values = [ref[i, j] for i in range(ref.rows) for j in range(ref.cols)] \
-                if isinstance(ref, mpmath.matrix) else list(ref)
-            if any(mpmath.isnan(v) for v in values):
-                return 0.0
-            biggest = max(float(abs(v)) for v in values)
-            return max(1.0, biggest) if matrix else max(tiny, biggest)
+        return condition_of(self.reference, function, refs, kinematic_at, p, p2, e, guess, tiny)
 
-        if function in KINEMATIC:
-            base = {f: refs[f] for f in KINEMATIC}
-            return condition(kinematic_at, p, base, {f: scale(r, f in MATRICES) for f, r in base.items()})
-        ref = self.reference
-        exact: dict[str, tuple[Callable[[list[Any]], dict[str, Any]], list[Any]]] = {
-            "from_quaternion": (lambda x: {"f": ref.from_quaternion(x)}, e),
-            "rescale": (lambda x: {"f": ref.rescale(x, guess)}, p),
-            "compose": (lambda x: {"f": ref.compose(x[:3], x[3:], (guess, guess))}, p + p2),
-        }
-        evaluate, inputs = exact[function]
-        s = scale(refs[function], False)
-        if s == 0:
-            return {function: 0.0}
-        return {function: condition(evaluate, inputs, {"f": refs[function]}, {"f": s})["f"]}
+
+def condition_of(ref: Reference, function: str, refs: dict[str, Any],
+                 kinematic_at: Callable[[list[Any]], dict[str, Any]], p: list[Any], p2: list[Any],
+                 e: list[Any], guess: float | None, tiny: float) -> dict[str, float]:
+    """κ of ``function`` at p (p2 for compose, e for from_quaternion), against ``ref``: for a
+    kinematic function that of all of them at once (``kinematic_at(p)`` gives their references, as
+    :func:`kinematic`), for an operation its own; ``refs`` the values at the unperturbed inputs."""
+    def scale(value: Any, matrix: bool) -> float:
+        return _scale(value, matrix, tiny)
+
+    if function in KINEMATIC:
+        base = {f: refs[f] for f in KINEMATIC}
+        return condition(kinematic_at, p, base, {f: scale(r, f in MATRICES) for f, r in base.items()})
+    exact: dict[str, tuple[Callable[[list[Any]], dict[str, Any]], list[Any]]] = {
+        "from_quaternion": (lambda x: {"f": ref.from_quaternion(x)}, e),
+        "rescale": (lambda x: {"f": ref.rescale(x, guess)}, p),
+        "compose": (lambda x: {"f": ref.compose(x[:3], x[3:], (guess, guess))}, p + p2),
+    }
+    evaluate, inputs = exact[function]
+    s = scale(refs[function], False)
+    if s == 0:
+        return {function: 0.0}
+    return {function: condition(evaluate, inputs, {"f": refs[function]}, {"f": s})["f"]}
 
 
 def emit(expression: str, name: str) -> tuple[Any, str, float]:

@@ -81,15 +81,16 @@ def missing_compilers() -> list[str]:
     return [name for name in ("gcc", "g++", "clang") if shutil.which(name) is None]
 
 
-def wrapper_names(headers: Sequence[str]) -> list[tuple[str, str, CFunction, bool]]:
-    """(wrapper symbol, precision, function, is_batch) in the driver's output order."""
+def wrapper_names(headers: Sequence[str], batches: bool = True) -> list[tuple[str, str, CFunction, bool]]:
+    """(wrapper symbol, precision, function, is_batch) in the driver's output order (without the
+    batch kernels' wrappers when not ``batches``)."""
     names = []
     for header in headers:
         for precision in ("double", "float"):
             for function in FUNCTIONS:
                 base = f"{header}_{function.name}{SUFFIX[precision]}"
                 names.append((f"t_{base}", precision, function, False))
-                if function.kind == "matrix":
+                if batches and function.kind == "matrix":
                     names.append((f"t_{base}_batch", precision, function, True))
     return names
 
@@ -108,13 +109,14 @@ def _call(header: str, function: CFunction, precision: str, batch: bool) -> str:
     return f"size_t i; for (i = 0; i < n; ++i) {{ {call} }}"
 
 
-def translation_unit(headers: Sequence[str]) -> str:
-    """The test source: the headers, the wrappers and (under SYMROT_TEST_MAIN) the driver."""
+def translation_unit(headers: Sequence[str], batches: bool = True) -> str:
+    """The test source: the headers, the wrappers and (under SYMROT_TEST_MAIN) the driver; without
+    the batch kernels' wrappers when not ``batches`` (they are most of the compile time)."""
     lines = ["#include <stddef.h>"]
     lines += [f'#include "symrot_{header}.h"' for header in headers]
     lines += ["#ifdef __cplusplus", 'extern "C" {', "#endif"]
     entries = {"double": [], "float": []}
-    for symbol, precision, function, batch in wrapper_names(headers):
+    for symbol, precision, function, batch in wrapper_names(headers, batches):
         header = symbol[2:].split(f"_{function.name}")[0]
         ctype = precision
         lines.append(f"void {symbol}(size_t n, const {ctype} *p, const {ctype} *v, {ctype} *out);")

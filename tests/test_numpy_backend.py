@@ -7,6 +7,7 @@ import subprocess
 import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -90,27 +91,63 @@ def test_cli_rejects_unknown_backend(tmp_path: Path, capsys) -> None:
     assert "unknown backend" in capsys.readouterr().err
 
 
+FOLD = {"euler_rodrigues": ("2*sin(phi/2)", "pi"), "sine_m3": ("3*sin(phi/3)", "3*pi/2"),
+        "det_h_one": ("cbrt(6*(phi - sin(phi)))", "2*pi")}
+"""p(φ) and φ_max (the fold of m sin(φ/m) at mπ/2; eq 35 folds at 2π) from the paper, not the plan."""
+
+
+def _independent_sweep(name: str, points: int) -> dict[tuple[str, str], Any]:
+    """{(function, precision): Worst} of the module ``name`` (generated/numpy, or emitted when it has
+    none) against tests/reference.py (φ by Newton on p(φ), R from eq 1, H from ω = H ṗ), on the sweep
+    of bench/accuracy_corpus.py: accuracy.sweep(φ_max, points) (φ_max − 10⁻ᵏ, k = 1…6) plus 1e-30,
+    1e-8, 1e-3, 0.1 and 1, random axes; φ_max and p_max from the reference."""
+    from types import SimpleNamespace
+
+    from accuracy import load_module
+    from accuracy_corpus import Measurement
+
+    from symrot.api import derive
+    from symrot.plan import evaluation_plan
+    from tests.reference import GeneratingFunction
+
+    function = GeneratingFunction(FOLD[name][0], phi_max_text=FOLD[name][1])
+    path = ROOT / "generated" / "numpy" / f"{name}.py"
+    if path.exists():
+        module = load(path, f"gen_{name}_independent")
+    else:
+        import tempfile
+
+        module = load_module(evaluation_plan(derive(name).derivation, name), Path(tempfile.mkdtemp()))
+    edge = SimpleNamespace(phi_max=function.phi_max, p_max=function.p_max())
+    measurement = Measurement(function, edge, module, None, None, points)
+    measurement.run()
+    assert not measurement.errors, measurement.errors
+    assert all(t.nonfinite == 0 for t in measurement.tallies.values())
+    return {(f, label): t.worst for (f, label, _backend), t in measurement.tallies.items()}
+
+
 @pytest.mark.parametrize("name", ["euler_rodrigues", "sine_m3"])
 def test_accuracy_up_to_the_fold(name: str) -> None:
-    """Up to φ_max − 10⁻⁶, where p′ → 0: every kernel within 4 ulp of mpmath (the fold complement
-    d = k² − |p|² is computed with compensated arithmetic; without it the error was 10¹² ulp)."""
-    from accuracy import measure
-
-    worst = measure(name, 8)
+    """Up to φ_max − 10⁻⁶, where p′ → 0: every kernel within 4 ulp of the independent reference (the
+    fold complement d = k² − |p|² is computed with compensated arithmetic; without it the error was
+    10¹² ulp)."""
+    worst = _independent_sweep(name, 8)
     vectors = ("pdot", "omega")  # a v + b p×v + c p×(p×v): a and c x cancel as μ → ∞ (κ ~ 1e12)
-    # float32 may exceed 4 ulp only where the input is ill-conditioned (κ in the hundreds at 0.98 φ_max)
-    misses = {k: (v.ulp, v.at, v.kappa) for k, v in worst.items() if k[2] == "plan"
-              and (v.excess > 4 if k[0] in vectors or k[1] == "float32" else v.ulp > 4)}
+    # float32, and the operations (compose's result, from_quaternion's e, rescale's flip next to π),
+    # may exceed 4 ulp only where the input is ill-conditioned (κ in the hundreds at 0.98 φ_max)
+    operations = ("compose", "from_quaternion", "rescale")
+    misses = {k: (v.ulp, v.at, v.kappa) for k, v in worst.items()
+              if (v.excess > 4 if k[0] in vectors + operations or k[1] == "float32" else v.ulp > 4)}
     assert not misses, misses
+    assert {"rotation_matrix", "tangent", "tangent_inverse", "pdot", "omega", "angle",
+            "tangent_det"} <= {k[0] for k in worst}
 
 
 def test_accuracy_is_backward_stable_without_closed_inverse() -> None:
     """eq 35 (Newton angle, triple fold at 2π): errors may exceed 4 ulp only where the input is
     ill-conditioned, and never by more than 4 κ ulp (κ: condition number w.r.t. the input p)."""
-    from accuracy import measure
-
-    worst = measure("det_h_one", 8)
-    misses = {k: (v.ulp, v.at, v.kappa) for k, v in worst.items() if k[2] == "plan" and v.excess > 4}
+    worst = _independent_sweep("det_h_one", 8)
+    misses = {k: (v.ulp, v.at, v.kappa) for k, v in worst.items() if v.excess > 4}
     assert not misses, misses
 
 
