@@ -98,13 +98,14 @@ def edge(expression: str) -> Edge:
     return Edge(expression, function, p_max)
 
 
-def documented_x_limit(documentation: Path, dtype: type) -> float:
+def documented_x_limit(documentation: Path, dtype: type, function: str = "angle") -> float:
     """The x_limit that a NumPy module's docstring ("|p|^2 < 2^K (2^L in float32)") or a C header's
-    comment of its ``angle`` (``angle_f`` in float: "Valid for every p with |p|^2 < 2^K") documents."""
+    comment of ``function`` (``function_f`` in float: "Valid for every p with |p|^2 < 2^K") documents."""
     text = documentation.read_text(encoding="utf-8")
     if documentation.suffix == ".h":
         suffix = "_f" if dtype == np.float32 else ""
-        found = re.search(rf"_angle{suffix}: [^\n]*\n \* Valid for every p with \|p\|\^2 < 2\^(\d+)", text)
+        found = re.search(rf"_{function}{suffix}: [^\n]*\n(?: \* [^\n]*\n)*? \* Valid for every p with "
+                          r"\|p\|\^2 < 2\^(\d+)", text)
         exponent = found.group(1) if found else None
     else:
         found = re.search(r"\|p\|\^2 < 2\^(\d+) \(2\^(\d+) in float32\)", text)

@@ -27,6 +27,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+import mpmath
 import numpy as np
 import pytest
 
@@ -41,6 +42,7 @@ from .edges import (
     accuracy_probes,
     documented_x_limit,
     edge,
+    ladder,
     probes,
 )
 from .test_array_backends import framework, load
@@ -241,6 +243,27 @@ def test_c_edge(name: str, named_c: ctypes.CDLL) -> None:
         found = family_probes(FAMILIES[name], dtype, header(name))
         results, status = c_evaluate(named_c, name, as_rows(found, dtype))
         wrong += failures(FAMILIES[name], found, results, dtype, status)
+    assert not wrong
+
+
+@pytest.mark.parametrize("name", ["tangent_m1", "tangent_m3"])
+def test_c_derivatives_end_at_their_own_documented_limit(name: str, named_c: ctypes.CDLL) -> None:
+    """Where a header documents a narrower x_limit for the derivatives (2^32 for tan φ and 3 tan(φ/3),
+    against 2^511 for the others), they are NaN from the first |p|² at or above it on (ladder probes,
+    ±3 ulps) and finite below, while every other function stays finite on both sides."""
+    wrong = []
+    for dtype in DTYPES:
+        limits = {documented_x_limit(header(name), dtype, f) for f in sorted(DERIVATIVES)}
+        assert len(limits) == 1 and limits.pop() < documented_x_limit(header(name), dtype) / 2**16
+        found = tuple(ladder(mpmath.mpf(documented_x_limit(header(name), dtype, "rotation_derivative")),
+                             dtype, "derivative limit"))
+        results, _ = c_evaluate(named_c, name, as_rows(found, dtype))
+        for row, probe in enumerate(found):
+            for label, values in results.items():
+                answer = _answer([v[row] for v in values])
+                expected = "nan" if label in DERIVATIVES and not probe.inside else "value"
+                if answer != expected and label.split("(")[0] not in PAIRS:
+                    wrong.append(f"{label} {np.dtype(dtype).name} {answer} at {probe.step:+d} {probe.p}")
     assert not wrong
 
 
