@@ -44,6 +44,7 @@ from symrot.singularities import Validity, validity
 
 from . import c_harness
 from .c_harness import Reference, build_configs, compile_all, ulp_errors
+from .edges import FAMILIES, documented_x_limit, edge, probes
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated" / "c"
@@ -81,14 +82,13 @@ def phi_max(name: str) -> float:
 
 
 def accepted_x(name: str, precision: str) -> float:
-    """The bound on x = |p|² of the header's ``angle`` (p_max², inclusive or not, or the plan's
-    x_limit where p is unbounded), read off the generated header (tests/test_generated.py keeps
-    it current) instead of re-planning 14 parameterizations (about 90 s)."""
-    text = (GENERATED / f"symrot_{name}.h").read_text(encoding="utf-8")
-    start = text.index(f"symrot_{name}_angle{c_harness.SUFFIX[precision]}(const")
-    found = re.search(r"if \(!\(x <=? ([-+.e0-9]+)F?\)\)", text[start:])
-    assert found, (name, precision)
-    return float(found.group(1))
+    """The bound on x = |p|² of the range, independent of the header under test: p_max² from
+    tests/reference.py (φ_max by its own scan of p(φ)), or where p is unbounded the x_limit that
+    the header's comment of ``angle`` documents."""
+    found = edge(FAMILIES[name])
+    if found.bounded:
+        return float(found.p_max_squared)
+    return documented_x_limit(GENERATED / f"symrot_{name}.h", c_harness.DTYPES[precision])
 
 
 def make_grid(name: str, precision: str, seed: int = 5) -> Grid:
@@ -100,7 +100,7 @@ def make_grid(name: str, precision: str, seed: int = 5) -> Grid:
     top = phi_max(name)
     angles = [0.0, *np.geomspace(TINY[precision], 1e-3, 5), *np.geomspace(1e-3, top * 0.9, 11)[1:],
               *(top * (1 - np.geomspace(0.05, 1e-6, 5)))]
-    p_max = limits(name).p_max_float
+    p_max = float(edge(FAMILIES[name]).p_max)
     x_limit = accepted_x(name, precision)
     rows, vs = [], []
     for angle in angles:
@@ -337,11 +337,19 @@ def test_double_and_float_agree_with_the_numpy_backend(name: str, builds: dict) 
 
 @pytest.mark.parametrize("name", ["wiener_milenkovic", "rotation_vector", "det_h_one"])
 def test_outside_the_validity_range_every_output_is_nan(name: str, builds: dict) -> None:
-    p_max = limits(name).p_max_float
-    beyond = [[p_max * 1.5, 0.0, 0.0]] if math.isfinite(p_max) else [[1e200, 0.0, 0.0]]
+    """NaN from the first floats outside the range on (tests/edges.py: p_max from tests/reference.py,
+    or the documented x_limit; axis and |p|² ladder probes one ulp outside), and for non-finite p."""
     library = builds["gcc-O2-fma"].load()
-    p = np.array([*beyond, [np.inf, 0, 0], [np.nan, 0, 0], [0, -np.inf, 1]])
-    for precision in ("double", "float"):
+    for precision, dtype in (("double", np.float64), ("float", np.float32)):
+        expression, header = FAMILIES[name], GENERATED / f"symrot_{name}.h"
+        limit = None if edge(expression).bounded else documented_x_limit(header, dtype)
+        outside = [probe for probe in probes(expression, dtype, limit) if probe.inside is False
+                   and probe.kind in ("axis", "ladder", "limit")]
+        nearest = {kind: min(probe.step for probe in outside if probe.kind == kind)
+                   for kind in {probe.kind for probe in outside}}
+        beyond = [probe.p for probe in outside if probe.step == nearest[probe.kind]]
+        assert beyond and all(abs(step) <= 1 for step in nearest.values()), nearest
+        p = np.array([*beyond, [np.inf, 0, 0], [np.nan, 0, 0], [0, -np.inf, 1]], dtype=dtype)
         for function in FUNCTIONS:
             values = library.call(name, function, precision, p, np.ones_like(p))
             assert np.all(np.isnan(values)), (name, precision, function.name, values)

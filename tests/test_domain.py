@@ -18,6 +18,8 @@ import sympy as sp
 from symrot.api import derive
 from symrot.core import tensor_definitions
 from symrot.plan import evaluation_plan
+from tests.edges import documented_x_limit
+from tests.edges import ladder as edges_ladder
 from tests.helpers import axial_matrix
 from tests.test_numpy_backend import load
 
@@ -44,20 +46,26 @@ def _closed_inverse(name: str, s: mpmath.mpf) -> mpmath.mpf:
 
 @pytest.mark.parametrize("name", UNBOUNDED)
 def test_numpy_module_is_right_below_x_limit_and_nan_beyond(name: str) -> None:
-    module = load(ROOT / "generated" / "numpy" / f"{name}.py", f"domain_{name}")
-    plan = evaluation_plan(derive(name).derivation, name)
+    """The documented x_limit ("|p|^2 < 2^K (2^L in float32)" in the module's docstring, not the
+    plan's): NaN from the first |p|² at or above it (tests/edges.py's ladder: every float from 3 ulps
+    below to 3 ulps above it), finite below, and right at |p| = √x_limit/2."""
+    path = ROOT / "generated" / "numpy" / f"{name}.py"
+    module = load(path, f"domain_{name}")
     axis = np.array([0.6, 0.8, 0.0])
-    for label, dtype in (("float64", np.float64), ("float32", np.float32)):
-        limit = plan.precisions[label].x_limit
+    for dtype in (np.float64, np.float32):
+        limit = documented_x_limit(path, dtype)
+        ladder = edges_ladder(mpmath.mpf(limit), dtype, "limit")
+        p = np.array([probe.p for probe in ladder], dtype=dtype)
+        inside = np.array([probe.inside for probe in ladder])
         eps = float(np.finfo(dtype).eps)
-        inside = axis * math.sqrt(limit) * 0.5
-        outside = axis * math.sqrt(limit) * 1.01
+        for function in FUNCTIONS:
+            got = getattr(module, function)(p)
+            assert np.isnan(got[~inside]).all() and np.isfinite(got[inside]).all(), (function, dtype)
+        half = (axis * math.sqrt(limit) * 0.5).astype(dtype)
         for function, tensor in FUNCTIONS.items():
-            got = getattr(module, function)(inside.astype(dtype)).astype(np.float64)
-            exact = _reference(name, tensor, inside.astype(dtype).astype(np.float64))
-            assert np.all(np.isfinite(got)), (function, label)
-            assert np.max(np.abs(got - exact)) <= 64 * eps * np.max(np.abs(exact)), (function, label)
-            assert np.all(np.isnan(getattr(module, function)(outside.astype(dtype)))), (function, label)
+            got = getattr(module, function)(half).astype(np.float64)
+            exact = _reference(name, tensor, half.astype(np.float64))
+            assert np.max(np.abs(got - exact)) <= 64 * eps * np.max(np.abs(exact)), (function, dtype)
 
 
 def test_the_reported_wiener_milenkovic_tangent_is_nan_not_wrong() -> None:

@@ -14,6 +14,8 @@ import pytest
 
 from symrot.cli import main
 
+from .edges import FAMILIES, axis_probes, edge
+
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
@@ -55,13 +57,21 @@ def test_identities_without_warnings(module, dtype) -> None:
 
 
 def test_outside_validity_is_nan() -> None:
+    """One ulp either side of p_max = cbrt(12π) (from tests/reference.py, not the module), along
+    an axis where |p|² is one rounding of s²: NaN outside, finite inside."""
     module = load(ROOT / "generated" / "numpy" / "det_h_one.py", "gen_det_h_one_nan")
-    p = np.array([[3.4, 0, 0], [0.1, 0, 0]])  # |p| < cbrt(12 pi) = 3.353... is valid
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        r = module.rotation_matrix(p)
-    assert np.isnan(r[0]).all() and np.isfinite(r[1]).all()
-    assert np.isnan(module.angle(p)[0])
+    for dtype in (np.float64, np.float32):
+        found = axis_probes(edge(FAMILIES["det_h_one"]), dtype)
+        decided = [probe for probe in found if probe.inside is not None]
+        outside = min((probe for probe in decided if not probe.inside), key=lambda probe: probe.step)
+        inside = max((probe for probe in decided if probe.inside), key=lambda probe: probe.step)
+        assert outside.step - inside.step <= 2, (outside, inside)
+        p = np.array([outside.p, inside.p, [0.1, 0, 0]], dtype=dtype)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            r = module.rotation_matrix(p)
+        assert np.isnan(r[0]).all() and np.isfinite(r[1:]).all(), dtype
+        assert np.isnan(module.angle(p)[0]) and np.isfinite(module.angle(p)[1:]).all(), dtype
 
 
 def test_tiny_rotation_keeps_its_digits() -> None:
