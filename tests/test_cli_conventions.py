@@ -56,8 +56,14 @@ def test_json_is_strict_for_an_unbounded_p() -> None:
 
 
 def test_generated_derivations_are_strict_json() -> None:
-    for path in (Path(__file__).resolve().parent.parent / "generated" / "derivations").glob("*.json"):
-        json.loads(path.read_text(encoding="utf-8"), parse_constant=_no_non_finite)
+    """One derivation per generated NumPy module (an empty or missing folder fails), each strict JSON."""
+    generated = Path(__file__).resolve().parent.parent / "generated"
+    paths = sorted((generated / "derivations").glob("*.json"))
+    assert [p.stem for p in paths] == sorted(p.stem for p in (generated / "numpy").glob("*.py"))
+    assert len(paths) >= 7
+    for path in paths:
+        data = json.loads(path.read_text(encoding="utf-8"), parse_constant=_no_non_finite)
+        assert isinstance(data, dict) and data, path.name
 
 
 def test_strict_json_replaces_every_non_finite_number() -> None:
