@@ -2,8 +2,9 @@
 
 Functions under test: ``to_quaternion``, ``from_quaternion``, ``from_rotation_matrix``, ``compose``
 and ``rescale``, for rotation_vector, wiener_milenkovic, cayley_gibbs_rodrigues, linear, det_h_one
-and the user expression ``cbrt(6*(phi-sin(phi)))`` (eq 35 again, built through ``module_source``),
-plus euler_rodrigues for the 180° edge.
+the user expression ``cbrt(6*(phi-sin(phi)))`` (eq 35 again, built through ``module_source``) and two
+user functions of tests/corpus.py (``phi + phi**5/120``, ``4*atanh(phi/4)``), plus euler_rodrigues for
+the 180° edge.
 
 Tolerances. Every operation is a short, fixed chain of correctly rounded operations on unit
 quaternions (to_quaternion: coefficients of x = |p|² within 4 ε each (issue 4); a Hamilton product:
@@ -39,6 +40,7 @@ from types import ModuleType
 import mpmath
 import numpy as np
 import pytest
+import sympy as sp
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
@@ -46,6 +48,9 @@ from scipy.spatial.transform import Rotation
 from symrot.api import derive
 from symrot.backends.numpy_backend import module_source
 from symrot.plan import evaluation_plan
+
+from .corpus import by_expression
+from .reference import PHI, parse
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated" / "numpy"
@@ -85,6 +90,22 @@ def _det_h_one_prime(phi: np.ndarray) -> np.ndarray:
     return np.where(np.abs(phi) < 1e-4, 1.0, value)
 
 
+def _corpus(expression: str) -> Parameterization:
+    """A user function of tests/corpus.py: p and p′ lambdified from tests/reference.py's parse (not
+    symrot's), φ_max the corpus's declared one."""
+    expr = parse(expression)
+    p, dp = (sp.lambdify(PHI, e, modules="numpy") for e in (expr, sp.diff(expr, PHI)))
+
+    def quiet(function: Callable[[np.ndarray], np.ndarray]) -> Callable[[np.ndarray], np.ndarray]:
+        def evaluate(phi: np.ndarray) -> np.ndarray:
+            with np.errstate(divide="ignore"):  # p(φ_max) = inf at a pole: the end of the range
+                return function(phi)
+        return evaluate
+
+    phi_max = float(by_expression(expression).declared_phi_max())
+    return Parameterization(expression, quiet(p), quiet(dp), phi_max)
+
+
 PARAMETERIZATIONS: dict[str, Parameterization] = {
     "rotation_vector": Parameterization("rotation_vector", lambda t: t, np.ones_like, 2 * math.pi),
     "wiener_milenkovic": Parameterization("wiener_milenkovic", lambda t: 4 * np.tan(t / 4),
@@ -94,8 +115,12 @@ PARAMETERIZATIONS: dict[str, Parameterization] = {
     "linear": Parameterization("linear", np.sin, np.cos, math.pi / 2),
     "det_h_one": Parameterization("det_h_one", _det_h_one, _det_h_one_prime, 2 * math.pi),
     "user_eq35": Parameterization(USER_EXPRESSION, _det_h_one, _det_h_one_prime, 2 * math.pi),
+    "corpus_quintic": _corpus("phi + phi**5/120"),
+    "corpus_atanh": _corpus("4*atanh(phi/4)"),
 }
-"""user_eq35 is det_h_one entered as an expression: the module comes from module_source."""
+"""user_eq35 is det_h_one entered as an expression: the module comes from module_source; so do the
+two user functions of the corpus, beyond the named families: φ + φ⁵/120 (no closed inverse: a
+Newton angle; ν → 0 at 2π) and 4 atanh(φ/4) (a pole at φ = 4: p unbounded)."""
 
 Case = tuple[str, ModuleType, Parameterization]
 Rotations = tuple[np.ndarray, np.ndarray]
@@ -108,7 +133,7 @@ def build_module(name: str, directory: Path) -> ModuleType:
     """The generated module for ``name``: generated/numpy/NAME.py when it already has the
     operations of issue 6, else (and always for the user expression) built by module_source."""
     path = GENERATED / f"{name}.py"
-    user = name in PARAMETERIZATIONS and PARAMETERIZATIONS[name].source == USER_EXPRESSION
+    user = name in PARAMETERIZATIONS and PARAMETERIZATIONS[name].source != name
     if user or not path.exists() or "def compose(" not in path.read_text(encoding="utf-8"):
         source = {**PARAMETERIZATIONS, **EXTRA}[name].source
         path = directory / f"{name}.py"
