@@ -441,22 +441,25 @@ def test_compose_and_rescale_jacobians(adapter: Adapter) -> None:
     pairs = {"kept": (0.3 * rng.normal(size=3), 0.3 * rng.normal(size=3)),
              # φ1 + φ2 ≈ 5 > π about nearly the same axis: compose rescales
              "rescaled": (half_turn * axis, half_turn * (axis + 0.01 * rng.normal(size=3)))}
+    # 4 ε of the largest entry (was 1e-13 against autodiff, 16 ε against NumPy): measured 2.4 ε
+    # (rescaled pair, closed vs autodiff, JAX and PyTorch) and 0.8 ε (PyTorch vs NumPy)
+    limit = 4 * np.finfo(float).eps
     for case, (p1, p2) in pairs.items():
         closed = [adapter.numpy(j) for j in module.compose_jacobians(adapter.array(p1), adapter.array(p2))]
         automatic = transforms.jacfwd(module.compose, argnums=(0, 1))(adapter.array(p1), adapter.array(p2))
         reference = numpy_module.compose_jacobians(p1, p2)
         for k in range(2):
             scale = np.max(np.abs(reference[k]))
-            assert np.max(np.abs(closed[k] - adapter.numpy(automatic[k]))) <= 1e-13 * scale, (case, k)
-            assert np.max(np.abs(closed[k] - reference[k])) <= 16 * np.finfo(float).eps * scale, (case, k)
+            assert np.max(np.abs(closed[k] - adapter.numpy(automatic[k]))) <= limit * scale, (case, k)
+            assert np.max(np.abs(closed[k] - reference[k])) <= limit * scale, (case, k)
     for size in (1.0, 4.0):  # kept (identity) and rescaled (|φ| > π)
         p = 4 * np.tan(size / 4) * axis
         closed = adapter.numpy(module.rescale_jacobian(adapter.array(p)))
         automatic = adapter.numpy(transforms.jacfwd(module.rescale)(adapter.array(p)))
         reference = numpy_module.rescale_jacobian(p)
         scale = np.max(np.abs(reference))
-        assert np.max(np.abs(closed - automatic)) <= 1e-13 * scale, size
-        assert np.max(np.abs(closed - reference)) <= 16 * np.finfo(float).eps * scale, size
+        assert np.max(np.abs(closed - automatic)) <= limit * scale, size
+        assert np.max(np.abs(closed - reference)) <= limit * scale, size
     assert np.array_equal(numpy_module.rescale_jacobian(0.5 * axis), np.eye(3))
     outside = adapter.numpy(module.rescale_jacobian(adapter.array(np.array([1e300, 0.0, 0.0]))))
     assert np.isnan(outside).all()
