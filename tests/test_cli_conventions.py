@@ -150,3 +150,8 @@ def test_every_bench_driver_answers_help_without_running(driver: str) -> None:
     assert result.returncode == 0, result.stderr[-2000:]
     assert "Traceback" not in result.stderr
     assert result.stdout.startswith("usage: ") or "accuracy.py" in result.stdout, result.stdout[:500]
+
+
+def test_the_bench_drivers_are_found() -> None:
+    """The parametrization above is not empty: a moved bench/ or a changed guard would skip it all."""
+    assert len(BENCH_DRIVERS) >= 10 and "accuracy.py" in BENCH_DRIVERS, BENCH_DRIVERS
