@@ -242,8 +242,9 @@ def test_sanitizer_builds_run_clean_and_accurate(label: str, builds: dict, grids
 def test_batch_kernels_agree_with_single_calls_for_every_block_shape(count: int, builds: dict) -> None:
     """n below, at and above the block of 32 vectors, with lanes outside the range (NaN, inf,
     beyond p_max) among valid ones: the same NaN lanes as the single call, and elsewhere the
-    same values to within twice the accuracy target, 4 ε · (1 + |p|/p′(φ)) (both evaluate through
-    x = |p|², whose rounding the angle amplifies by |p|/p′; see the NumPy comparison below)."""
+    same values to within the accuracy target, 4 ε · (1 + |p|/p′(φ)) (both evaluate through x = |p|²,
+    whose rounding the angle amplifies by |p|/p′; see the NumPy comparison below). Measured 2.6
+    (tangent_m3 float rotation_matrix, n = 32); it was twice the target."""
     library = builds["gcc-O2-fma"].load()
     rng = np.random.default_rng(count)
     angle = next(f for f in FUNCTIONS if f.name == "angle")
@@ -276,7 +277,7 @@ def test_batch_kernels_agree_with_single_calls_for_every_block_shape(count: int,
                 scale = np.maximum(1.0, np.abs(single[valid]).max(axis=(1, 2), initial=0.0))
                 error = np.abs(batch[valid] - single[valid]).max(axis=(1, 2), initial=0.0) / scale / eps
                 error /= condition[valid]
-                assert error.max(initial=0.0) <= 2 * TARGET_ULP, (label, float(error.max()))
+                assert error.max(initial=0.0) <= TARGET_ULP, (label, float(error.max()))
 
 
 @cache
