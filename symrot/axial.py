@@ -67,10 +67,6 @@ class AxialTensor:
         re, im = self.planar
         return sp.Matrix([[self.a, 0, 0], [0, re, -im], [0, im, re]])
 
-    def eigenvalues(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
-        re, im = self.planar
-        return self.a, re + sp.I * im, re - sp.I * im
-
     def in_p_basis(self, p: sp.Expr) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         """Coefficients on I, (p×), (p×)² for p = p(φ) u."""
         return self.a, self.b / p, self.c / p**2
@@ -87,11 +83,3 @@ def skew(vector: sp.Matrix) -> sp.Matrix:
     """(v×) as a 3×3 matrix."""
     x, y, z = vector
     return sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-
-
-def matrix_from_p_coefficients(
-    coefficients: tuple[sp.Expr, sp.Expr, sp.Expr], p_vector: sp.Matrix
-) -> sp.Matrix:
-    """c0 I + c1 (p×) + c2 (p×)² as an explicit 3×3 matrix."""
-    px = skew(p_vector)
-    return coefficients[0] * sp.eye(3) + coefficients[1] * px + coefficients[2] * px * px

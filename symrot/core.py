@@ -169,10 +169,6 @@ class Derivation:
             values[SLOPES[k]] = self.simplified_form(slope_name(name))
         return values
 
-    def simplified_planned(self) -> dict[str, sp.Expr]:
-        """Simplified forms of :meth:`planned_expressions` (see :meth:`simplified_form`)."""
-        return {name: self.simplified_form(name) for name in self.planned_expressions()}
-
     def simplified_form(self, name: str) -> sp.Expr:
         """The simplified form of one planned expression; a slope is the derivative of its parent's
         simplified form over dx/dφ = 2 p p′ with common factors pulled out (``factor_terms``): no

@@ -74,11 +74,3 @@ def paper_rescaling_claims() -> list[RescalingClaim]:
         nu = scalar_definitions(p)["nu"]
         claims.append(RescalingClaim(equation, p, printed(nu), rescale_factor(p)))
     return claims
-
-
-def quaternion_product(e2: tuple[sp.Expr, sp.Matrix], e1: tuple[sp.Expr, sp.Matrix]
-                       ) -> tuple[sp.Expr, sp.Matrix]:
-    """e₂ ∘ e₁ (eq 53): the quaternion of R₂ R₁."""
-    a0, a = e1
-    b0, b = e2
-    return a0 * b0 - a.dot(b), a0 * b + b0 * a - a.cross(b)

@@ -45,7 +45,10 @@ from .helpers import mp_function
 EXPRESSION = "2*cosh(3*phi/2)*tanh(phi/4) + 3*cosh(3*phi/2)*tanh(phi/3)/2"
 CLOSED = "2*sinh(3*phi/2)/3"
 ANGLES = ("6.2831", "6.28318", "6.2831852")
-TARGET = {"float64": 4.5, "float32": 4.0}
+TARGET = {"float64": 4.1, "float32": 4.0}
+"""Worst sin φ error in ulp over max(1, its condition number κ). Measured: float64 C 4.02 at
+φ = 6.2831 (gcc -O2, libm's sin), NumPy 3.90 at 6.2831852; float32 below 10⁻⁴. Hence 4.1, not the
+claim's 4, for float64 (it was 4.5)."""
 FORMATS = {"float64": (np.float64, ctypes.c_double, ""), "float32": (np.float32, ctypes.c_float, "_f")}
 CASES = [(EXPRESSION, label, backend) for label in FORMATS for backend in ("numpy", "c")] + [
     (CLOSED, "float32", "numpy")]

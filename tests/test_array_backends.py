@@ -334,19 +334,28 @@ def test_float32_gradients(adapter: Adapter, name: str) -> None:
         assert ulp_error(value, expected, np.float32) <= 8.0, float(phi)
 
 
+IDENTITY_ORDERS = [(dtype, order) for dtype in (np.float64, np.float32) for order in ("jacobian", "forward")]
+
+
 @pytest.mark.parametrize("name", NAMED)
 def test_identity_gradient_is_the_exact_cross_form(adapter: Adapter, name: str) -> None:
-    """∂R/∂p_k = (e_k×) at p = 0, exactly, in both modes and both precisions."""
-    if adapter.kind == "jax" and name != "sine_m4":
-        pytest.skip("JAX: sampled (compile time)")
+    """∂R/∂p_k = (e_k×) at p = 0, exactly, in both modes and both precisions. JAX: sine_m4 in all
+    four (compiled); every other module in one of them, eagerly (a compile per module and mode costs
+    2–14 s, the eager call 0.5–5 s): the i-th module of NAMED takes IDENTITY_ORDERS[i mod 4], so
+    the sample covers every mode, precision and module, the same on every run."""
     exact = np.zeros((3, 3, 3))
     for k in range(3):
         e = np.eye(3)[k]
         exact[:, :, k] = [[0, -e[2], e[1]], [e[2], 0, -e[0]], [-e[1], e[0], 0]]
     module = generated(adapter.kind, name)
-    for dtype in (np.float64, np.float32):
-        for order in ("jacobian", "forward"):
-            assert np.array_equal(adapter(module, "rotation_matrix", order, np.zeros(3, dtype)), exact)
+    if adapter.kind == "jax" and name != "sine_m4":
+        dtype, order = IDENTITY_ORDERS[NAMED.index(name) % len(IDENTITY_ORDERS)]
+        transform = adapter.fw.jacrev if order == "jacobian" else adapter.fw.jacfwd
+        value = adapter.numpy(transform(module.rotation_matrix)(adapter.array(np.zeros(3, dtype))))
+        assert value.dtype == dtype and np.array_equal(value, exact), (dtype, order)
+        return
+    for dtype, order in IDENTITY_ORDERS:
+        assert np.array_equal(adapter(module, "rotation_matrix", order, np.zeros(3, dtype)), exact)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -432,22 +441,25 @@ def test_compose_and_rescale_jacobians(adapter: Adapter) -> None:
     pairs = {"kept": (0.3 * rng.normal(size=3), 0.3 * rng.normal(size=3)),
              # φ1 + φ2 ≈ 5 > π about nearly the same axis: compose rescales
              "rescaled": (half_turn * axis, half_turn * (axis + 0.01 * rng.normal(size=3)))}
+    # 4 ε of the largest entry (was 1e-13 against autodiff, 16 ε against NumPy): measured 2.4 ε
+    # (rescaled pair, closed vs autodiff, JAX and PyTorch) and 0.8 ε (PyTorch vs NumPy)
+    limit = 4 * np.finfo(float).eps
     for case, (p1, p2) in pairs.items():
         closed = [adapter.numpy(j) for j in module.compose_jacobians(adapter.array(p1), adapter.array(p2))]
         automatic = transforms.jacfwd(module.compose, argnums=(0, 1))(adapter.array(p1), adapter.array(p2))
         reference = numpy_module.compose_jacobians(p1, p2)
         for k in range(2):
             scale = np.max(np.abs(reference[k]))
-            assert np.max(np.abs(closed[k] - adapter.numpy(automatic[k]))) <= 1e-13 * scale, (case, k)
-            assert np.max(np.abs(closed[k] - reference[k])) <= 16 * np.finfo(float).eps * scale, (case, k)
+            assert np.max(np.abs(closed[k] - adapter.numpy(automatic[k]))) <= limit * scale, (case, k)
+            assert np.max(np.abs(closed[k] - reference[k])) <= limit * scale, (case, k)
     for size in (1.0, 4.0):  # kept (identity) and rescaled (|φ| > π)
         p = 4 * np.tan(size / 4) * axis
         closed = adapter.numpy(module.rescale_jacobian(adapter.array(p)))
         automatic = adapter.numpy(transforms.jacfwd(module.rescale)(adapter.array(p)))
         reference = numpy_module.rescale_jacobian(p)
         scale = np.max(np.abs(reference))
-        assert np.max(np.abs(closed - automatic)) <= 1e-13 * scale, size
-        assert np.max(np.abs(closed - reference)) <= 16 * np.finfo(float).eps * scale, size
+        assert np.max(np.abs(closed - automatic)) <= limit * scale, size
+        assert np.max(np.abs(closed - reference)) <= limit * scale, size
     assert np.array_equal(numpy_module.rescale_jacobian(0.5 * axis), np.eye(3))
     outside = adapter.numpy(module.rescale_jacobian(adapter.array(np.array([1e300, 0.0, 0.0]))))
     assert np.isnan(outside).all()

@@ -100,7 +100,8 @@ def test_numpy_float32_tangent_of_a_small_scale_is_finite_inside_the_range(tmp_p
         double = getattr(module, name)(p).reshape(len(p), -1)
         assert np.isfinite(single).all(), (name, phi[~np.isfinite(single).all(-1)])
         error = np.abs(single - double).max(-1) / np.abs(double).max(-1)
-        assert (error <= 64 * float(np.finfo(np.float32).eps)).all(), (name, error.max())
+        # the claim, 4 ε (was 64 ε): measured 3.5 (rotation_matrix), 2.5 (tangent)
+        assert (error <= 4 * float(np.finfo(np.float32).eps)).all(), (name, error.max())
 
 
 @pytest.mark.slow
@@ -131,5 +132,4 @@ def test_numpy_closed_form_in_x_on_mixed_batches(tmp_path: Path) -> None:
             assert np.isfinite(batch).all(), (name, dtype)
             for k in (0, 150, 299):
                 single = getattr(module, name)(p[k].astype(dtype))
-                scale = 16 * float(np.finfo(dtype).eps) * float(np.abs(single).max())
-                np.testing.assert_allclose(batch[k], single, rtol=0, atol=scale)
+                np.testing.assert_array_equal(batch[k], single)  # the same arithmetic: equal (was 16 ε)

@@ -6,6 +6,7 @@ import json
 import resource
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -79,3 +80,24 @@ def test_usage_errors_exit_two() -> None:
     result = run_cli("derive")
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert run_cli("frobnicate").returncode == 2
+
+
+def emit_marker(derivation: object, name: str, out_dir: Path) -> list[Path]:
+    """A backend for :func:`test_a_registered_backend_is_used_by_emit`: one file with p(φ)."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    path = out_dir / f"{name}.marker"
+    path.write_text(str(derivation.p), encoding="utf-8")  # type: ignore[attr-defined]
+    return [path]
+
+
+def test_a_registered_backend_is_used_by_emit(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``register_emitter`` (the documented way to add a backend, docs/architecture.md) makes
+    ``derive --emit NAME`` call it, and nothing else is written."""
+    from symrot import backends
+
+    monkeypatch.setattr(backends, "EMITTERS", dict(backends.EMITTERS))
+    backends.register_emitter("marker", f"{__name__}:emit_marker")
+    assert main(["derive", "2*tan(phi/2)", "--name", "user_marker", "--emit", "marker",
+                 "--out", str(tmp_path)]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == ["user_marker.marker"]
+    assert (tmp_path / "user_marker.marker").read_text(encoding="utf-8") == "2*tan(phi/2)"

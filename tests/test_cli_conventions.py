@@ -56,8 +56,14 @@ def test_json_is_strict_for_an_unbounded_p() -> None:
 
 
 def test_generated_derivations_are_strict_json() -> None:
-    for path in (Path(__file__).resolve().parent.parent / "generated" / "derivations").glob("*.json"):
-        json.loads(path.read_text(encoding="utf-8"), parse_constant=_no_non_finite)
+    """One derivation per generated NumPy module (an empty or missing folder fails), each strict JSON."""
+    generated = Path(__file__).resolve().parent.parent / "generated"
+    paths = sorted((generated / "derivations").glob("*.json"))
+    assert [p.stem for p in paths] == sorted(p.stem for p in (generated / "numpy").glob("*.py"))
+    assert len(paths) >= 7
+    for path in paths:
+        data = json.loads(path.read_text(encoding="utf-8"), parse_constant=_no_non_finite)
+        assert isinstance(data, dict) and data, path.name
 
 
 def test_strict_json_replaces_every_non_finite_number() -> None:
@@ -144,3 +150,8 @@ def test_every_bench_driver_answers_help_without_running(driver: str) -> None:
     assert result.returncode == 0, result.stderr[-2000:]
     assert "Traceback" not in result.stderr
     assert result.stdout.startswith("usage: ") or "accuracy.py" in result.stdout, result.stdout[:500]
+
+
+def test_the_bench_drivers_are_found() -> None:
+    """The parametrization above is not empty: a moved bench/ or a changed guard would skip it all."""
+    assert len(BENCH_DRIVERS) >= 10 and "accuracy.py" in BENCH_DRIVERS, BENCH_DRIVERS

@@ -28,6 +28,11 @@ def load(path: Path, name: str):
     return module
 
 
+PAPER_P = {"det_h_one": "cbrt(6*(phi - sin(phi)))", "cayley_gibbs_rodrigues": "2*tan(phi/2)",
+           "euler_rodrigues": "2*sin(phi/2)"}
+"""p(φ) of the modules of :func:`module` (Table 1 and eq 35), for tests/reference.py."""
+
+
 @pytest.fixture(scope="module", params=["det_h_one", "cayley_gibbs_rodrigues", "euler_rodrigues"])
 def module(request):
     return load(ROOT / "generated" / "numpy" / f"{request.param}.py", f"gen_{request.param}")
@@ -52,7 +57,13 @@ def test_identities_without_warnings(module, dtype) -> None:
     assert np.allclose(h @ h_inverse, np.eye(3), atol=tolerance)
     assert np.allclose(g @ g, r, atol=tolerance)
     assert np.allclose(back, w, atol=tolerance)
-    assert np.allclose(det, np.linalg.det(h.astype(np.float64)), rtol=1e-5)
+    from tests.reference import GeneratingFunction, Reference
+
+    function = GeneratingFunction(PAPER_P[module.__name__.removeprefix("gen_")])
+    reference = Reference(function)
+    exact = np.array([float(reference.state([float(v) for v in q]).det_H) for q in p.reshape(-1, 3)])
+    det_ulp = np.abs(det.reshape(-1).astype(np.float64) - exact) / (np.abs(exact) * np.finfo(dtype).eps)
+    assert det_ulp.max() <= 4, det_ulp.max()  # det H against tests/reference.py (measured ≤ 1.0 ulp)
     assert np.array_equal(r[:, 0], np.broadcast_to(np.eye(3, dtype=dtype), (2, 3, 3)))
 
 
@@ -88,7 +99,12 @@ def test_cli_emits_a_ruff_clean_module(tmp_path: Path) -> None:
     assert code == 0
     path = tmp_path / "user_eq35.py"
     module = load(path, "user_eq35")
-    assert module.angle(np.array([0.3, 0.4, 0.0])) == pytest.approx(0.5015, abs=2e-3)
+    from tests.reference import GeneratingFunction, Reference
+
+    p = [0.3, 0.4, 0.0]
+    exact = float(Reference(GeneratingFunction("cbrt(6*(phi - sin(phi)))", cancels=True)).state(p).angle)
+    angle = float(module.angle(np.array(p)))
+    assert abs(angle - exact) <= 4 * np.spacing(exact), (angle, exact)  # measured: 0 ulp
     ruff = subprocess.run([sys.executable, "-m", "ruff", "check", "--no-cache", "--isolated",
                            "--line-length", "110",
                            "--select", "E,F,W,B,UP,SIM,RUF", "--ignore", "RUF001,RUF002,RUF003", str(path)],

@@ -90,13 +90,6 @@ def rotation(phi: mpmath.mpf, u: Vector) -> mpmath.matrix:
     return mpmath.eye(3) + mpmath.sin(phi) * k + (1 - mpmath.cos(phi)) * k * k
 
 
-def angle_axis(r: mpmath.matrix) -> tuple[mpmath.mpf, Vector]:
-    """(φ, u) with φ ∈ [0, π] of a rotation tensor (cos φ from the trace, sin φ u = axial R)."""
-    s = axial(r)
-    phi = mpmath.atan2(mpmath.norm(s), (r[0, 0] + r[1, 1] + r[2, 2] - 1) / 2)
-    return phi, unit(s)
-
-
 def size(m: mpmath.matrix | mpmath.mpf) -> mpmath.mpf:
     """Largest absolute entry."""
     if isinstance(m, mpmath.matrix):

@@ -69,11 +69,6 @@ def core_tensor(name: str) -> sp.Matrix:
     return generic(t.a) * EYE + generic(t.b) * U_CROSS + generic(t.c) * U_CROSS**2
 
 
-def axial_tensor(a: sp.Expr, b: sp.Expr, c: sp.Expr, u: sp.Matrix = U_CANONICAL) -> sp.Matrix:
-    """a I + b (u×) + c (u×)²."""
-    return a * EYE + b * u + c * u * u
-
-
 def p_cross(magnitude: sp.Expr = P) -> sp.Matrix:
     """(p×) = p (u×) at u = e₁."""
     return magnitude * U_CANONICAL
