@@ -330,9 +330,6 @@ def test_corpus_edge(kind: str, backend: str, dtype: type,
 JAX_SKIP = (*sorted(DERIVATIVES - {"angular_acceleration"}), "rescale_jacobian")
 """Not run in JAX (forward-mode derivatives of the kernels checked here, 1–1.5 s a family eagerly;
 the same template's PyTorch modules run them)."""
-ARRAY_MISS = ("angular_acceleration returns 0 (finite), not NaN, outside the range in every JAX and "
-              "PyTorch module, both precisions (measured: [0, 0, 0] at p = (0, 6.283185307179587, 0), "
-              "rotation_vector float64): its jvp tangent is not masked like _jacobian's")
 
 
 @cache
@@ -348,20 +345,9 @@ def array_results(name: str, kind: str, dtype: type) -> tuple[tuple[Probe, ...],
 @pytest.mark.parametrize("kind", ["jax", "torch"])
 @pytest.mark.parametrize("name", NAMED)
 def test_array_backend_edge(name: str, kind: str) -> None:
-    """Every function but angular_acceleration (below) as the NumPy modules are checked."""
+    """Every function as the NumPy modules are checked."""
     wrong = []
     for dtype in DTYPES:
         found, results = array_results(name, kind, dtype)
-        checked = {label: values for label, values in results.items() if label != "angular_acceleration"}
-        wrong += failures(FAMILIES[name], found, checked, dtype)
+        wrong += failures(FAMILIES[name], found, results, dtype)
     assert not wrong
-
-
-@pytest.mark.xfail(strict=True, reason=ARRAY_MISS)
-@pytest.mark.parametrize("kind", ["jax", "torch"])
-@pytest.mark.parametrize("name", NAMED)
-def test_array_backend_angular_acceleration_is_nan_outside(name: str, kind: str) -> None:
-    for dtype in DTYPES:
-        found, results = array_results(name, kind, dtype)
-        outside = [row for row, probe in enumerate(found) if probe.inside is False]
-        assert np.isnan(results["angular_acceleration"][0][outside]).all(), (name, kind, dtype)

@@ -785,7 +785,8 @@ def angular_acceleration(p, pdot, pddot):
     """d omega/dt = H pddot + (dH/dt) pdot for omega = H pdot (eq 20)."""
     p, rate = _vectors(p, pdot)
     acceleration = _vectors(p, pddot)[1]
-    return _jvp(lambda q, v: omega(q, v), (p, rate), (rate, acceleration))[1]
+    value, derivative = _jvp(lambda q, v: omega(q, v), (p, rate), (rate, acceleration))
+    return _where(_xp.isnan(value).any(-1)[..., None], math.nan, derivative)  # NaN outside, as _jacobian
 
 
 def compose_jacobians(p1, p2):
