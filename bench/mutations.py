@@ -237,7 +237,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.baseline:
         tests = tuple(dict.fromkeys(t for m in chosen for t in m.tests))
         clean = run(Mutation("baseline", "-", "none", (), tests), args.jobs, not args.no_tests)
-        print(f"baseline {clean.seconds:6.0f} s  {clean.status} {clean.detail}", flush=True)
+        print(f"baseline {clean.seconds:6.0f} s  {clean.status} {clean.detail} {' '.join(clean.killers)}",
+              flush=True)
         if clean.status not in ("survived", "applies"):
             print("error: the unmutated copy does not pass the tests of the list", file=sys.stderr)
             return 2
