@@ -34,7 +34,8 @@ from symrot.core.derivation import Derivation
 from symrot.core.functions import mpmath_namespace
 from symrot.core.parsing import PHI
 from symrot.core.registry import NAMED
-from symrot.plan.builder import EvaluationPlan, evaluation_plan
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.ir import EvaluationPlan
 
 ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:  # run as a script: tests/ is beside bench/

@@ -54,7 +54,8 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "numpy-validity-widened", "runtime",
         "NumPy validity test `x <= 1.02 * P_MAX_SQUARED` (template and the modules of generated/numpy)",
-        (Edit("symrot/backends/templates/numpy_module.py.j2", '}} P_MAX_SQUARED{%', '}} 1.02 * P_MAX_SQUARED{%'),
+        (Edit("symrot/backends/templates/numpy_module.py.j2", '}} P_MAX_SQUARED{%',
+              '}} 1.02 * P_MAX_SQUARED{%'),
          Edit("symrot/backends/templates/numpy_module.py.j2", "    return x < _X_LIMIT[suffix]\n",
               "    return x < 1.02 * _X_LIMIT[suffix]\n"),
          Edit(NUMPY, "    return x <= P_MAX_SQUARED\n", "    return x <= 1.02 * P_MAX_SQUARED\n", 0),
@@ -72,9 +73,9 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "plan-switches-4x", "plan",
         "every series/closed-form switch 4× higher, same polynomial (rotation_vector regenerated)",
-        (Edit("symrot/plan/builder.py", "    return Branch(threshold, tuple(series[:degree]), closed, ",
+        (Edit("symrot/plan/branches.py", "    return Branch(threshold, tuple(series[:degree]), closed, ",
               "    return Branch(4 * threshold, tuple(series[:degree]), closed, "),
-         Edit("symrot/plan/builder.py", "best, edge,\n                  accurate_threshold, accurate_terms)",
+         Edit("symrot/plan/branches.py", "best, edge,\n                  accurate_threshold, accurate_terms)",
               "best, edge,\n                  4 * accurate_threshold, accurate_terms)")),
         (VALUES, "tests/test_numpy_backend.py", "tests/test_generated.py"),
         (("numpy", "rotation_vector"),)),
@@ -128,7 +129,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "plan-horner-short", "plan",
         "every Horner polynomial one term shorter than the plan chose (rotation_vector regenerated)",
-        (Edit("symrot/plan/builder.py", "    return Branch(threshold, tuple(series[:degree]), closed,",
+        (Edit("symrot/plan/branches.py", "    return Branch(threshold, tuple(series[:degree]), closed,",
               "    return Branch(threshold, tuple(series[:max(1, degree - 1)]), closed,"),),
         (VALUES, "tests/test_numpy_backend.py"),
         (("numpy", "rotation_vector"),)),
@@ -136,7 +137,7 @@ MUTATIONS: tuple[Mutation, ...] = (
         "plan-newton-steps-dropped", "plan",
         "no Newton step after the angle's start (det_h_one regenerated; one step of the six already "
         "meets 4 ulp, the start alone is 1.6e4 ulp off)",
-        (Edit("symrot/plan/builder.py", "float(np.finfo(dtype).eps)), count.steps)\n",
+        (Edit("symrot/plan/angles.py", "float(np.finfo(dtype).eps)), count.steps)\n",
               "float(np.finfo(dtype).eps)), count.steps) * 0\n"),),
         (VALUES, "tests/test_newton_edge.py", "tests/test_numpy_backend.py"),
         (("numpy", "det_h_one"),)),

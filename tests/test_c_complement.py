@@ -24,7 +24,7 @@ from symrot.api import derive
 from symrot.backends.c_backend import COVERED
 from symrot.core.singularities import validity
 from symrot.plan.algebraic import fold_complement
-from symrot.plan.builder import closed_inverse
+from symrot.plan.forms import closed_inverse
 
 from . import c_harness
 from .test_c_backend import GENERATED

@@ -2,7 +2,7 @@
 
 ``symrot derive cayley_m1000 --emit c`` (also ``cayley_m800``, ``'1e-8*phi'``) used to write
 ``(inf.0F)*x + 1.1106829e+37F``: a float32 Horner coefficient beyond 3.4e38. The plan now keeps
-only the leading Horner terms that are finite in the format (symrot.plan.builder._branch_for, ``top``),
+only the leading Horner terms that are finite in the format (symrot.plan.branches._branch_for, ``top``),
 and the printer refuses any non-finite constant with a one-line SymrotError (exit 2). Each
 ``--emit c`` here must exit 0 with a header that gcc compiles with -std=c99 -Wall -Wextra
 -Wpedantic -Werror (and the embedded warnings), or exit 2 with one line.

@@ -87,7 +87,8 @@ def test_every_module_has_a_layer() -> None:
 def test_the_top_of_the_package_is_only_the_public_face() -> None:
     top = {path.stem for path in PACKAGE.glob("*.py")}
     assert top == TOP_LEVEL and len(top) <= 8
-    folders = {path.name for path in PACKAGE.iterdir() if path.is_dir() and not path.name.startswith(("_", "."))}
+    folders = {path.name for path in PACKAGE.iterdir()
+               if path.is_dir() and not path.name.startswith(("_", "."))}
     assert folders == set(LAYER_OF_FOLDER)
 
 

@@ -9,18 +9,11 @@ import sympy as sp
 
 from symrot.api import derive
 from symrot.core.parsing import PHI
-from symrot.plan.algebraic import S
-from symrot.plan.builder import (
-    CHEAP_TERMS,
-    Algebraic,
-    Branch,
-    ClosedAngle,
-    Constant,
-    NewtonAngle,
-    X,
-    evaluation_plan,
-    near_half_turn,
-)
+from symrot.plan.algebraic import S, X
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import near_half_turn
+from symrot.plan.ir import Algebraic, Branch, ClosedAngle, Constant, NewtonAngle
+from symrot.plan.targets import CHEAP_TERMS
 
 from .reference import GeneratingFunction, Reference
 
@@ -237,7 +230,7 @@ def test_the_half_angle_form_through_x_is_a_candidate_when_p_is_a_sum_of_cosines
     cancels at small phi. The planned form recomputed p from the rounded angle (9 ulp of G in
     float32 at 6.18); 2 sin^2(phi/4)/x must be measured."""
     from symrot.core.parsing import parse_expression
-    from symrot.plan.builder import candidate_forms
+    from symrot.plan.branches import candidate_forms
 
     p = parse_expression("3*phi*cos(phi/3)/5 + 2*sqrt(2*phi**2 + 1)*sinh(phi)/5")
     closed = 25 * (1 - sp.cos(PHI / 2)) / (3 * PHI * sp.cos(PHI / 3)
@@ -251,7 +244,9 @@ def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
     to 1/8 its form in phi (sinh amplifies the float32 angle's rounding 4 times, 6 ulp of G_2 x)
     would tie with 2 sin^2(phi/4)/x; measured relative to |G| / |p|^2 it must lose."""
     from symrot.core.singularities import validity
-    from symrot.plan.builder import MAX_TERMS, closed_inverse, plan_branch, tensor_part
+    from symrot.plan.branches import plan_branch, tensor_part
+    from symrot.plan.forms import closed_inverse
+    from symrot.plan.targets import MAX_TERMS
 
     derivation = derive("sinh(phi)*cosh(phi)").derivation
     phi_max = float(validity(derivation).phi_max_float)
@@ -326,7 +321,9 @@ def test_hyperbolic_inverses_are_inverse_hyperbolic_functions(text: str, expecte
     """sp.solve writes φ(s) for sinh φ = s as log(s + √(s² + 1)), which loses every digit for small s:
     the plan took the Newton angle, and cosh(φ) = √(1 + x) was never found for H₀ = 1/p′."""
     from symrot.core.parsing import PHI
-    from symrot.plan.builder import ANGLE_TOLERANCE_ULP, S, closed_angle_error, closed_inverse
+    from symrot.plan.algebraic import S
+    from symrot.plan.forms import closed_angle_error, closed_inverse
+    from symrot.plan.targets import ANGLE_TOLERANCE_ULP
 
     p = sp.sympify(text, locals={"phi": PHI})
     inverse = closed_inverse(p, sp.Integer(1))
@@ -356,6 +353,7 @@ def test_one_plus_cosine_is_written_through_the_half_angle_next_to_a_half_turn()
 def test_every_branch_measures_candidate_forms_computed_before_the_precisions(monkeypatch) -> None:
     """The candidate forms of every branch in x are computed once, half in a forked child, before
     the precisions part (plan._prepare_shared_work), and equal those computed in place."""
+    import symrot.plan.branches as branches
     import symrot.plan.builder as plan
     from symrot.core.derivation import derive_expression
     from symrot.core.parsing import parse_expression
@@ -378,6 +376,7 @@ def test_every_branch_measures_candidate_forms_computed_before_the_precisions(mo
             in_precision = False
 
     monkeypatch.setattr(plan, "_candidate_forms", forms)
+    monkeypatch.setattr(branches, "_candidate_forms", forms)
     monkeypatch.setattr(plan, "_precision_plan", precision)
     derivation = derive_expression(parse_expression("2*asinh(phi/2)"))  # a p no other test plans
     result = plan.evaluation_plan(derivation, "two_asinh_half")
@@ -392,7 +391,7 @@ def test_hyperbolic_complement_is_the_same_function_without_cancellation() -> No
     """k − k tanh²(u) in a sum becomes k/cosh²(u) (the forms through φ = 4 tanh(s/4) of 4 atanh(φ/4));
     other sums are left alone; the value is unchanged (40 digits at a large u, where the old form
     has lost every digit in float64)."""
-    from symrot.plan.builder import hyperbolic_complement
+    from symrot.plan.forms import hyperbolic_complement
     from symrot.plan.measurement import S
 
     form = 16 - 16 * sp.tanh(S / 4) ** 2 + PHI

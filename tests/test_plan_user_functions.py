@@ -10,14 +10,10 @@ import sympy as sp
 
 from symrot.api import derive
 from symrot.core.parsing import PHI, parse_expression
-from symrot.plan.builder import (
-    ClosedAngle,
-    S,
-    closed_angle_error,
-    closed_inverse,
-    evaluation_plan,
-    half_angle_sums,
-)
+from symrot.plan.algebraic import S
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import closed_angle_error, closed_inverse, half_angle_sums
+from symrot.plan.ir import ClosedAngle
 
 
 def test_a_solver_that_raises_means_no_closed_inverse() -> None:
@@ -83,7 +79,7 @@ def test_p_cubic_in_its_one_function_is_not_solved() -> None:
     """asinh³φ + asinh φ = s: sp.solve wrote sinh of Cardano's root and spent its whole bound on it,
     and ``--emit`` ran out of its 60 s budget (61.8 s). A cubic or higher in the one call is not
     handed to the solver (the Newton angle serves it); a quadratic or linear one still is."""
-    from symrot.plan.builder import _solvable_shape
+    from symrot.plan.forms import _solvable_shape
 
     assert not _solvable_shape(sp.asinh(PHI) ** 3 + sp.asinh(PHI))
     assert not _solvable_shape(sp.tan(PHI) ** 3 / 3 + sp.tan(PHI))
@@ -204,7 +200,7 @@ def test_newton_next_to_a_pole_steps_on_the_reciprocal_below_the_pole() -> None:
 
     from symrot.backends.numpy_backend import _angle_lines, _branch_lines
     from symrot.core.singularities import validity
-    from symrot.plan.builder import _bracket_top, _newton_angle
+    from symrot.plan.angles import _bracket_top, _newton_angle
 
     expression = "3*tan(2*phi/3)/(2*(3*phi**2/4 + 1))"
     derivation = derive(expression).derivation
@@ -238,7 +234,8 @@ def test_an_arcsine_of_tanh_inverse_is_offered_as_the_arctangent_of_sinh(dtype: 
     asin(tanh s), which loses the digits of π/2 − φ where tanh s rounds next to 1; the Newton angle
     that replaced it converged below |p| = 5.02 only, and the range ended there (φ = 1.5576 of π/2).
     atan(sinh s), the same function, is offered next and measures within the tolerance."""
-    from symrot.plan.builder import ANGLE_TOLERANCE_ULP, angle_forms
+    from symrot.plan.forms import angle_forms
+    from symrot.plan.targets import ANGLE_TOLERANCE_ULP
 
     p = sp.atanh(sp.sin(PHI))
     inverse = closed_inverse(p, sp.Integer(1))
@@ -255,7 +252,7 @@ def test_the_quaternion_scale_of_atanh_sin_is_measured_as_asinh_tan(dtype: type)
     """σ = p(φ)/sin(φ/2) of p = atanh(sin φ): 1 − sin φ from the rounded φ keeps none of its digits
     next to π/2, and from_quaternion was 1.4·10¹⁰ (float64) and 3.4·10⁶ (float32) ulp off at
     π/2 − 10⁻⁶; asinh(tan φ), the same function there, is a candidate and the plan takes it."""
-    from symrot.plan.builder import _quaternion_scale
+    from symrot.plan.angles import _quaternion_scale
 
     scale = _quaternion_scale(sp.atanh(sp.sin(PHI)), float(np.pi) / 2, dtype)
     assert scale.algebraic is None and scale.branch is not None
@@ -267,7 +264,8 @@ def test_a_closed_inverse_that_cancels_is_rejected_not_crashed() -> None:
     cancel for small s. They were judged against their own value at 40 digits, which is 0 (or a
     division by zero, and the emit ended in an internal error) at s = 10⁻³⁰⁰; the reference is now
     the angle refined by Newton on p itself, and both forms are rejected (float64 gives 0 there)."""
-    from symrot.plan.builder import ANGLE_TOLERANCE_ULP, angle_forms
+    from symrot.plan.forms import angle_forms
+    from symrot.plan.targets import ANGLE_TOLERANCE_ULP
 
     p = PHI * sp.sqrt(1 + PHI**2)
     inverse = closed_inverse(p, sp.Integer(1))
@@ -492,7 +490,8 @@ def test_a_polynomial_is_measured_below_its_switch_not_only_estimated() -> None:
     after its first term (every later term zero): the estimate then says 1 is exact everywhere,
     and only the measurement against the reference moves the switch down to where 1 is within
     POLYNOMIAL_TOLERANCE_ULP of sin φ/p = 1 − x³/5040 + …"""
-    from symrot.plan.builder import POLYNOMIAL_TOLERANCE_ULP, plan_branch
+    from symrot.plan.branches import plan_branch
+    from symrot.plan.targets import POLYNOMIAL_TOLERANCE_ULP
 
     p = PHI - PHI**3 / 6 + PHI**5 / 120
     wrong_series = [sp.Integer(1)] + [sp.Integer(0)] * 10

@@ -42,18 +42,10 @@ from symrot.backends.subexpressions import common_subexpressions
 from symrot.backends.templating import render
 from symrot.core.atomic import write_atomic
 from symrot.core.parsing import PHI
-from symrot.plan.algebraic import D, X
-from symrot.plan.builder import (
-    Algebraic,
-    Branch,
-    ClosedAngle,
-    Constant,
-    EvaluationPlan,
-    NewtonAngle,
-    S,
-    evaluation_plan,
-    half_angle,
-)
+from symrot.plan.algebraic import D, S, X
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import half_angle
+from symrot.plan.ir import Algebraic, Branch, ClosedAngle, Constant, EvaluationPlan, NewtonAngle
 from symrot.plan.newton_start import FarStart
 from symrot.plan.quaternion import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 

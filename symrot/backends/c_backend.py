@@ -61,7 +61,7 @@ def header_source(plan: EvaluationPlan, name: str, expression: str | None = None
         "c/header.h.j2", name=name, expression=text, title=identifier,
         command=f"symrot derive '{text}' --name {name} --emit c --out DIR",
         validity=FunctionWriter(plan, name, "double").validity_notes()[0],
-        plan_note=f"the float64 and float32 plans of symrot.plan.builder, {angle_kind(plan)} for phi",
+        plan_note=f"the float64 and float32 plans of symrot.plan, {angle_kind(plan)} for phi",
         guard=f"SYMROT_{name.upper()}_H", functions=functions, block=DEFAULT_BLOCK,
         nearest=_uses_nearest(functions),
     )

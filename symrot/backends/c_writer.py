@@ -9,9 +9,9 @@ and the operations (:mod:`symrot.backends.c_operations`) build on it. How a plan
   x_limit, at most 2^600, 2^100 in float) when p is unbounded, which also catches inf and NaN)
   every output is NaN; for the sine family also d = p_max² − x with fma-exact products and TwoSum
   (``__complement``), which the plan's expressions use instead of k² − x;
-* coefficients: a :class:`~symrot.plan.builder.Constant` is folded into the output expressions, an
-  :class:`~symrot.plan.builder.Algebraic` one is a single expression in x (no branch, no trig); the
-  :class:`~symrot.plan.builder.Branch` ones of a function share one ``if (x < smallest threshold)``:
+* coefficients: a :class:`~symrot.plan.ir.Constant` is folded into the output expressions, an
+  :class:`~symrot.plan.ir.Algebraic` one is a single expression in x (no branch, no trig); the
+  :class:`~symrot.plan.ir.Branch` ones of a function share one ``if (x < smallest threshold)``:
   below it every coefficient is its Horner polynomial, above it φ is computed once, the closed
   forms share common subexpressions (``sympy.cse``, inside that branch only, where x > 0) and a
   coefficient whose own threshold is larger still takes its polynomial (sin and cos are libm's
@@ -53,7 +53,7 @@ from symrot.backends.subexpressions import common_subexpressions
 from symrot.core.errors import NonFiniteLiteral
 from symrot.core.parsing import PHI
 from symrot.plan.algebraic import S, X
-from symrot.plan.builder import half_angle
+from symrot.plan.forms import half_angle
 from symrot.plan.ir import (
     ANGLE_CORRECTION_GROWTH,
     ANGLE_CORRECTION_LIMIT,
@@ -365,7 +365,7 @@ class FunctionWriter:
     def half_angle_corrected(self, expr: sp.Expr) -> sp.Expr:
         """``expr`` with sin(φ/2) → sin(φ/2) + (λ/2) cos(φ/2) and cos(φ/2) → cos(φ/2) − (λ/2) sin(φ/2)
         where the angle is a Newton iteration (see ``EvaluationPlan.angle_correction``), sin φ and
-        cos φ written through them first (:func:`symrot.plan.builder.half_angle`)."""
+        cos φ written through them first (:func:`symrot.plan.forms.half_angle`)."""
         if not self.corrects_angle:
             return expr
         sine, cosine = sp.sin(PHI_SYMBOL / 2), sp.cos(PHI_SYMBOL / 2)

@@ -11,7 +11,7 @@ from typing import Any
 
 from symrot.backends.array_backend import emit_framework
 from symrot.backends.array_backend import module_source as array_module_source
-from symrot.plan.builder import EvaluationPlan
+from symrot.plan.ir import EvaluationPlan
 
 
 def module_source(plan: EvaluationPlan) -> str:

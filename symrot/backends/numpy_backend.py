@@ -33,19 +33,19 @@ from symrot.backends.subexpressions import common_subexpressions
 from symrot.backends.templating import render
 from symrot.core.atomic import write_atomic
 from symrot.core.parsing import PHI
-from symrot.plan.algebraic import D, X
-from symrot.plan.builder import (
+from symrot.plan.algebraic import D, S, X
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import half_angle
+from symrot.plan.ir import (
+    ANGLE_CORRECTION_GROWTH,
     Algebraic,
     Branch,
     ClosedAngle,
     Constant,
     EvaluationPlan,
     NewtonAngle,
-    S,
-    evaluation_plan,
-    half_angle,
+    uses_angle,
 )
-from symrot.plan.ir import ANGLE_CORRECTION_GROWTH, uses_angle
 from symrot.plan.newton_start import FarStart, edge_floor, edge_step
 from symrot.plan.quaternion import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 
@@ -114,7 +114,7 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
     block whose lanes are all inside the range (None otherwise, see the template's _span) lets a
     block on one side of the switch take its branch on all lanes, without masks or indexing.
     ``corrected``: the angle's half-angle sine and cosine carry λ (``EvaluationPlan.angle_correction``),
-    and sin φ, cos φ are printed through them (:func:`symrot.plan.builder.half_angle`)."""
+    and sin φ, cos φ are printed through them (:func:`symrot.plan.forms.half_angle`)."""
     threshold, horner = branch.smallest_switch
     closed = half_angle(branch.closed) if corrected else branch.closed
     if half_angles:  # sin(φ/2), cos(φ/2) come precomputed, shared by the coefficients of a tensor

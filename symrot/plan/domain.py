@@ -86,7 +86,7 @@ def _floors(exact: Callable[[mpmath.mpf], dict[str, mpmath.mpf]], references: Ma
     Then det H = μν² → 0 with ν at 2π, where it is ill conditioned in s (its form from φ̂ was 91 ulp
     off at φ = 6.24 for √(φ²/2 + 1) sinh(2φ)/2, an imprecise result, not a wrong one, and the range
     ended there, every output NaN up to 2π); the plan measures it against the same floor
-    (:data:`symrot.plan.builder.OWN_SCALE`). Next to a pole (p unbounded) it keeps its relative accuracy."""
+    (:data:`symrot.plan.branches.OWN_SCALE`). Next to a pole (p unbounded) it keeps its relative accuracy."""
     if not bounded or "det_H" not in references:
         return {}
     with mpmath.workdps(40):

@@ -4,7 +4,7 @@ The grid of angles (log-spaced towards 0, plus points approaching φ_max), the i
 have there (x = |p|² rounded, s = √x, the angle φ̂ they compute from s, the fold complement d),
 the exact angle θ of each rounded input, and the 60-digit reference values of a coefficient at
 those angles. Forms are evaluated on these inputs by :mod:`symrot.plan.evaluation`; the error model
-that turns the errors into switches and degrees is :func:`symrot.plan.builder.plan_branch`.
+that turns the errors into switches and degrees is :func:`symrot.plan.branches.plan_branch`.
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ writes f, and every sum in a form that is a polynomial multiple of f, through it
 factor (:class:`symrot.core.functions.BoundedPower`: SymPy would merge (φ/s)³ with the form's other
 powers of s into φ³/s⁵, which overflows float32 next to the pole while the value does not). The
 call atanh(u) or asin(u) itself, whose slope is infinite at the edge, becomes (s − A)/B. The plan
-measures those forms beside the others (:func:`symrot.plan.builder.plan_branch`) and takes them where they
+measures those forms beside the others (:func:`symrot.plan.branches.plan_branch`) and takes them where they
 are more accurate.
 """
 
