@@ -30,11 +30,12 @@ import sympy as sp
 
 from symrot.api import derive
 from symrot.backends.numpy_backend import module_source, numpy_function
-from symrot.core import Derivation
-from symrot.functions import mpmath_namespace
-from symrot.parsing import PHI
-from symrot.plan import EvaluationPlan, evaluation_plan
-from symrot.registry import NAMED
+from symrot.core.derivation import Derivation
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
+from symrot.core.registry import NAMED
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.ir import EvaluationPlan
 
 ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:  # run as a script: tests/ is beside bench/

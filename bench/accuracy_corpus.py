@@ -311,7 +311,7 @@ def emit(expression: str, name: str) -> tuple[Any, str, float]:
     """(plan, NumPy module source, seconds) through the public API, as ``--emit numpy`` does."""
     from symrot.api import derive
     from symrot.backends.numpy_backend import module_source
-    from symrot.plan import evaluation_plan
+    from symrot.plan.builder import evaluation_plan
 
     start = time.perf_counter()
     plan = evaluation_plan(derive(expression).derivation, name)

@@ -41,8 +41,8 @@ import sympy as sp
 from machine import description  # bench/, next to this script
 
 from symrot.api import derive, validity_dict
-from symrot.functions import mpmath_namespace
-from symrot.parsing import PHI
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
 
 ROOT = Path(__file__).resolve().parent.parent
 HEADERS = ROOT / "generated" / "c"

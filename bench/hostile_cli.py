@@ -568,7 +568,7 @@ integer was Python's ValueError)."""
 def run_api_case(source: str, budget: float) -> Outcome:
     """``symrot.derive(<source>)`` in a fresh interpreter; exit 2 for a SymrotError, 0 for a
     result, 1 (with a traceback) for anything else; killed after ``budget + 10 * MARGIN``."""
-    script = ("import sympy, symrot\nfrom symrot.parsing import PHI\n"
+    script = ("import sympy, symrot\nfrom symrot.core.parsing import PHI\n"
               f"try:\n    symrot.derive({source})\n"
               "except symrot.SymrotError as exc:\n    print(exc)\n    raise SystemExit(2)\n")
     started = time.monotonic()

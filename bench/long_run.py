@@ -67,7 +67,7 @@ if str(ROOT) not in sys.path:
 
 from symrot.api import derive  # noqa: E402
 from symrot.cli import main as symrot_main  # noqa: E402
-from symrot.parsing import PHI  # noqa: E402
+from symrot.core.parsing import PHI  # noqa: E402
 
 GENERATED = ROOT / "generated" / "c"
 USER_EXPRESSION = "cbrt(6*(phi-sin(phi)))"

@@ -3,7 +3,7 @@
 The first six are the issue's: a validity test widened by 2 %, a constant of a committed module
 37 ulp off, every series/closed-form switch moved up 4×, one Taylor coefficient scaled by 1.001,
 compose's order swapped, a sign of the quaternion product flipped (the issue's target,
-``symrot.operations.quaternion_product``, had no caller and is removed, so the same fault goes
+``symrot.core.operations.quaternion_product``, had no caller and is removed, so the same fault goes
 into the product every C ``compose`` computes). The others cover the rest of the layers: the core's
 definitions and derivatives, the validity analysis, the plan's polynomial degrees and Newton
 counts, each printer, the C batch and in-place code, the NumPy and array runtimes, LaTeX, input
@@ -54,8 +54,9 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "numpy-validity-widened", "runtime",
         "NumPy validity test `x <= 1.02 * P_MAX_SQUARED` (template and the modules of generated/numpy)",
-        (Edit("symrot/templates/numpy_module.py.j2", '}} P_MAX_SQUARED{%', '}} 1.02 * P_MAX_SQUARED{%'),
-         Edit("symrot/templates/numpy_module.py.j2", "    return x < _X_LIMIT[suffix]\n",
+        (Edit("symrot/backends/templates/numpy_module.py.j2", '}} P_MAX_SQUARED{%',
+              '}} 1.02 * P_MAX_SQUARED{%'),
+         Edit("symrot/backends/templates/numpy_module.py.j2", "    return x < _X_LIMIT[suffix]\n",
               "    return x < 1.02 * _X_LIMIT[suffix]\n"),
          Edit(NUMPY, "    return x <= P_MAX_SQUARED\n", "    return x <= 1.02 * P_MAX_SQUARED\n", 0),
          Edit(NUMPY, "    return x < P_MAX_SQUARED\n", "    return x < 1.02 * P_MAX_SQUARED\n", 0),
@@ -72,16 +73,16 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "plan-switches-4x", "plan",
         "every series/closed-form switch 4× higher, same polynomial (rotation_vector regenerated)",
-        (Edit("symrot/plan.py", "    return Branch(threshold, tuple(series[:degree]), closed, ",
+        (Edit("symrot/plan/branches.py", "    return Branch(threshold, tuple(series[:degree]), closed, ",
               "    return Branch(4 * threshold, tuple(series[:degree]), closed, "),
-         Edit("symrot/plan.py", "best, edge,\n                  accurate_threshold, accurate_terms)",
+         Edit("symrot/plan/branches.py", "best, edge,\n                  accurate_threshold, accurate_terms)",
               "best, edge,\n                  4 * accurate_threshold, accurate_terms)")),
         (VALUES, "tests/test_numpy_backend.py", "tests/test_generated.py"),
         (("numpy", "rotation_vector"),)),
     Mutation(
         "series-coefficient-1.001", "core",
         "the φ¹⁰ coefficient of every Taylor series scaled by 1.001 (rotation_vector regenerated)",
-        (Edit("symrot/series.py",
+        (Edit("symrot/core/series.py",
               "    return [exact_number(domain.to_sympy(c)) if domain == EX else domain.to_sympy(c)\n"
               "            for c in series.coefficients(start, stop)]",
               "    return [(exact_number(domain.to_sympy(c)) if domain == EX else domain.to_sympy(c))\n"
@@ -92,7 +93,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "numpy-compose-swapped", "runtime",
         "NumPy compose computes R(p1) R(p2) instead of R(p2) R(p1) (cross product order)",
-        (Edit("symrot/templates/numpy_module.py.j2", "b0[..., None] * a + _cross(b, a)",
+        (Edit("symrot/backends/templates/numpy_module.py.j2", "b0[..., None] * a + _cross(b, a)",
               "b0[..., None] * a + _cross(a, b)"),
          Edit(NUMPY, "b0[..., None] * a + _cross(b, a)", "b0[..., None] * a + _cross(a, b)")),
         ("tests/test_operations_numpy.py", VALUES)),
@@ -106,28 +107,29 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "core-epsilon-halved", "core",
         "ε = tan(φ/2)/p instead of 2 tan(φ/2)/p (eq 16), in every fresh derivation",
-        (Edit("symrot/core.py", "    epsilon = 2 * sp.tan(PHI / 2) / p\n",
+        (Edit("symrot/core/derivation.py", "    epsilon = 2 * sp.tan(PHI / 2) / p\n",
               "    epsilon = sp.tan(PHI / 2) / p\n"),),
         ("tests/test_core.py", "tests/test_validation.py", "tests/test_operations.py")),
     Mutation(
         "derivative-slope-series", "core",
         "the series of the slopes dc/dx shifted by one factor: j·d_(j+1) instead of (j+1)·d_(j+1) "
         "(rotation_vector regenerated)",
-        (Edit("symrot/derivatives.py", "    return [(j + 1) * parent_series[j + 1] for j in range(n_terms)]",
+        (Edit("symrot/core/derivatives.py",
+              "    return [(j + 1) * parent_series[j + 1] for j in range(n_terms)]",
               "    return [max(j, 1) * parent_series[j + 1] for j in range(n_terms)]"),),
         ("tests/test_derivatives.py", "tests/test_derivatives_core.py", VALUES),
         (("numpy", "rotation_vector"),)),
     Mutation(
         "validity-p-max-high", "core",
         "|p| at the edge of the validity range taken 1e-4 too large",
-        (Edit("symrot/singularities.py", "        return abs(float(value))\n",
+        (Edit("symrot/core/singularities.py", "        return abs(float(value))\n",
               "        return abs(float(value)) * 1.0001\n"),),
         ("tests/test_singularities.py", EDGES, "tests/test_domain.py"),
         (("numpy", "det_h_one"),)),
     Mutation(
         "plan-horner-short", "plan",
         "every Horner polynomial one term shorter than the plan chose (rotation_vector regenerated)",
-        (Edit("symrot/plan.py", "    return Branch(threshold, tuple(series[:degree]), closed,",
+        (Edit("symrot/plan/branches.py", "    return Branch(threshold, tuple(series[:degree]), closed,",
               "    return Branch(threshold, tuple(series[:max(1, degree - 1)]), closed,"),),
         (VALUES, "tests/test_numpy_backend.py"),
         (("numpy", "rotation_vector"),)),
@@ -135,7 +137,7 @@ MUTATIONS: tuple[Mutation, ...] = (
         "plan-newton-steps-dropped", "plan",
         "no Newton step after the angle's start (det_h_one regenerated; one step of the six already "
         "meets 4 ulp, the start alone is 1.6e4 ulp off)",
-        (Edit("symrot/plan.py", "float(np.finfo(dtype).eps)), count.steps)\n",
+        (Edit("symrot/plan/angles.py", "float(np.finfo(dtype).eps)), count.steps)\n",
               "float(np.finfo(dtype).eps)), count.steps) * 0\n"),),
         (VALUES, "tests/test_newton_edge.py", "tests/test_numpy_backend.py"),
         (("numpy", "det_h_one"),)),
@@ -168,7 +170,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "numpy-apply-transposed", "runtime",
         "NumPy omega/pdot apply the transpose: (v×p) for (p×v) (template and generated/numpy)",
-        (Edit("symrot/templates/numpy_module.py.j2", "    p_cross_v = _cross(p, v)\n",
+        (Edit("symrot/backends/templates/numpy_module.py.j2", "    p_cross_v = _cross(p, v)\n",
               "    p_cross_v = _cross(v, p)\n"),
          Edit(NUMPY, "    p_cross_v = _cross(p, v)\n", "    p_cross_v = _cross(v, p)\n")),
         (VALUES, "tests/test_numpy_backend.py")),
@@ -182,7 +184,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "array-compose-swapped", "runtime",
         "JAX/PyTorch compose computes R(p1) R(p2) (template and generated/jax, generated/torch)",
-        (Edit("symrot/templates/array_module.py.j2", "b0[..., None] * a + _cross(b, a)",
+        (Edit("symrot/backends/templates/array_module.py.j2", "b0[..., None] * a + _cross(b, a)",
               "b0[..., None] * a + _cross(a, b)"),
          Edit(ARRAYS, "b0[..., None] * a + _cross(b, a)", "b0[..., None] * a + _cross(a, b)")),
         ("tests/test_array_backends.py", VALUES)),
@@ -211,7 +213,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         "atomic-no-rollback", "cli",
         "replace_all does not undo the renames done when a later one fails",
-        (Edit("symrot/atomic.py", "        for target, backup in reversed(done):",
+        (Edit("symrot/core/atomic.py", "        for target, backup in reversed(done):",
               "        for target, backup in reversed(done[:0]):"),),
         ("tests/test_output_safety.py",)),
 )

@@ -45,7 +45,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 from mutation_list import MUTATIONS, Mutation  # noqa: E402
 
-from symrot.atomic import write_atomic  # noqa: E402
+from symrot.core.atomic import write_atomic  # noqa: E402
 
 NOT_COUNTED = ("tests/test_generated.py::test_generated_files_are_current",)
 """Byte comparisons with a fresh generation: they see any edit of generated/, never its effect."""
@@ -54,7 +54,7 @@ IGNORED = (".git", "__pycache__", ".mypy_cache", ".ruff_cache", ".pytest_cache",
 REGENERATE = """
 import sys
 from pathlib import Path
-from symrot.atomic import write_atomic
+from symrot.core.atomic import write_atomic
 from symrot.generate import render
 for relative, content in render(sys.argv[1], 1, sys.argv[2] or None).items():
     write_atomic(Path("generated") / relative, content.encode() if isinstance(content, str) else content)

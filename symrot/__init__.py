@@ -16,10 +16,10 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from .api import DerivationResult, derive
-    from .errors import SymrotError
-    from .parsing import PHI, parse_expression
-    from .registry import lookup
+    from symrot.api import DerivationResult, derive
+    from symrot.core.errors import SymrotError
+    from symrot.core.parsing import PHI, parse_expression
+    from symrot.core.registry import lookup
 
 __all__ = ["PHI", "DerivationResult", "SymrotError", "derive", "lookup", "parse_expression"]
 __version__ = "0.1.0"

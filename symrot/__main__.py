@@ -1,5 +1,5 @@
 """``python -m symrot`` is the ``symrot`` command."""
 
-from .entry import command
+from symrot.entry import command
 
 raise SystemExit(command())

@@ -1,6 +1,6 @@
 """The Python API: ``symrot.derive('4*tan(phi/4)')`` mirrors ``symrot derive``.
 
-:class:`DerivationResult` wraps the symbolic core's :class:`~symrot.core.Derivation` with the
+:class:`DerivationResult` wraps the symbolic core's :class:`~symrot.core.derivation.Derivation` with the
 registry identity, a JSON-ready dictionary and a LaTeX display for Jupyter (``_repr_latex_``).
 """
 
@@ -11,13 +11,19 @@ from typing import Any
 
 import sympy as sp
 
-from .budget import stage
-from .core import SCALAR_NAMES, TENSOR_NAMES, Derivation, Tensor, derive_expression
-from .errors import ParseError, SymrotError
-from .parsing import MAX_LENGTH, check_expression, parse_expression
-from .registry import NamedParameterization, find_by_expression, is_identifier, looks_like_a_name, lookup
-from .timeouts import time_limit
-from .validation import validate
+from symrot.core.budget import stage
+from symrot.core.derivation import SCALAR_NAMES, TENSOR_NAMES, Derivation, Tensor, derive_expression
+from symrot.core.errors import ParseError, SymrotError
+from symrot.core.parsing import MAX_LENGTH, check_expression, parse_expression
+from symrot.core.registry import (
+    NamedParameterization,
+    find_by_expression,
+    is_identifier,
+    looks_like_a_name,
+    lookup,
+)
+from symrot.core.timeouts import time_limit
+from symrot.core.validation import validate
 
 DERIVE_TIME_LIMIT = 60.0
 DEFAULT_SERIES_TERMS = 6
@@ -27,9 +33,9 @@ COEFFICIENT_KEYS = ("I", "px", "px2")
 def resolve(expression: str | sp.Expr) -> tuple[sp.Expr, NamedParameterization | None]:
     """A registry identifier or an expression (parsed safely) → (p(φ), registry entry).
 
-    Raises :class:`~symrot.errors.SymrotError` for anything else, in time bounded by the length
-    caps: a string longer than :data:`~symrot.parsing.MAX_LENGTH` is refused before it is read,
-    a SymPy expression is held to the parser's caps (:func:`~symrot.parsing.check_expression`).
+    Raises :class:`~symrot.core.errors.SymrotError` for anything else, in time bounded by the length
+    caps: a string longer than :data:`~symrot.core.parsing.MAX_LENGTH` is refused before it is read,
+    a SymPy expression is held to the parser's caps (:func:`~symrot.core.parsing.check_expression`).
     """
     if isinstance(expression, sp.Basic):
         with stage("parse"):
@@ -106,14 +112,14 @@ class DerivationResult:
         return out
 
     def _repr_latex_(self) -> str:
-        from .backends.latex import derivation_display
+        from symrot.backends.latex import derivation_display
 
         return derivation_display(self)
 
 
 def validity_dict(derivation: Derivation) -> dict[str, Any]:
     """The validity range and singular angles (Section 3.4) as JSON-ready data."""
-    from .singularities import validity
+    from symrot.core.singularities import validity
 
     result = validity(derivation)
     return {
@@ -137,7 +143,7 @@ def _canonical_dict(tensor: Tensor) -> dict[str, str]:
 def derive(expression: str | sp.Expr, normalize: bool = False) -> DerivationResult:
     """Derive everything for a generating function (expression or registry identifier).
 
-    Raises :class:`~symrot.errors.SymrotError` subclasses for invalid input; bounded in time.
+    Raises :class:`~symrot.core.errors.SymrotError` subclasses for invalid input; bounded in time.
     """
     if not isinstance(normalize, bool):
         raise SymrotError(f"normalize must be True or False, got {type(normalize).__name__}")

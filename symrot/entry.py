@@ -5,7 +5,7 @@ and their forms (the sign arrangement of a sum, which common factor is pulled ou
 order. It depends on two per-process random values: Python's string hashes (``PYTHONHASHSEED``)
 and the base number of SymPy's ``Dummy`` symbols. The plan measures the candidate forms' rounding,
 and equally accurate forms are ranked by their order, so ``symrot derive 'sinh(phi)' --emit
-numpy`` wrote four different (equally accurate) modules in 16 runs. :mod:`symrot.parsing` fixes
+numpy`` wrote four different (equally accurate) modules in 16 runs. :mod:`symrot.core.parsing` fixes
 the Dummy base when symrot is imported; the commands (``symrot``, ``python -m symrot``,
 ``python -m symrot.generate``) re-execute themselves once with ``PYTHONHASHSEED=0`` before SymPy
 is imported. A program that calls the Python API gets the same forms when it is started with
@@ -34,6 +34,6 @@ def run_with_fixed_hash_seed(module: str) -> None:
 def command() -> int:
     """The ``symrot`` command (console script and ``python -m symrot``)."""
     run_with_fixed_hash_seed("symrot")
-    from .cli import main
+    from symrot.cli import main
 
     return main()

@@ -16,12 +16,12 @@ from collections.abc import Callable, Iterable
 from functools import lru_cache, partial
 from pathlib import Path
 
-from . import strict_json
-from .api import derive
-from .atomic import write_atomic
-from .forked import in_child
-from .registry import NAMED
-from .timeouts import deterministic
+from symrot.api import derive
+from symrot.cli import strict_json
+from symrot.core.atomic import write_atomic
+from symrot.core.forked import in_child
+from symrot.core.registry import NAMED
+from symrot.core.timeouts import deterministic
 
 Producer = Callable[[], dict[str, str | bytes]]
 Content = str | bytes
@@ -40,8 +40,8 @@ def derivation_json() -> dict[str, str | bytes]:
 def latex_documents() -> dict[str, str | bytes]:
     """generated/latex/: Table 1 and the derivation sheets of the named parameterizations,
     each as a fragment (NAME.tex) and a complete document (NAME_standalone.tex)."""
-    from .backends.latex import sheet, standalone, table
-    from .registry import PAPER_TABLE_1_VALIDITY, TABLE_1
+    from symrot.backends.latex import sheet, standalone, table
+    from symrot.core.registry import PAPER_TABLE_1_VALIDITY, TABLE_1
 
     out: dict[str, str | bytes] = {}
     rows = table([derive(name) for name in TABLE_1], (), PAPER_TABLE_1_VALIDITY)
@@ -57,7 +57,7 @@ def latex_documents() -> dict[str, str | bytes]:
 def renderings() -> dict[str, str | bytes]:
     """generated/renderings/: the pages of Table 1 and of every derivation sheet as 100 dpi PNG
     (pdflatex, then pdftoppm; byte-reproducible), to read them without a TeX installation."""
-    from .backends.typeset import page_pngs
+    from symrot.backends.typeset import page_pngs
 
     out: dict[str, str | bytes] = {}
     for name, source in latex_documents().items():
@@ -71,24 +71,24 @@ def renderings() -> dict[str, str | bytes]:
 
 def figures() -> dict[str, str | bytes]:
     """generated/figures/: the paper's Figures 1–4, as PDF (for papers) and PNG."""
-    from .backends.figures import FIGURES
-    from .backends.figures import render as render_figure
+    from symrot.backends.figures import FIGURES
+    from symrot.backends.figures import render as render_figure
 
     return {f"figures/figure{n}.{fmt}": render_figure(n, fmt) for n in FIGURES for fmt in ("pdf", "png")}
 
 
 def numpy_modules(names: Iterable[str] | None = None) -> dict[str, str | bytes]:
     """generated/numpy/NAME.py: the NumPy kernels of every named parameterization (or ``names``)."""
-    from .backends.numpy_backend import module_source
-    from .plan import evaluation_plan
+    from symrot.backends.numpy_backend import module_source
+    from symrot.plan.builder import evaluation_plan
 
     return {f"numpy/{name}.py": module_source(evaluation_plan(derive(name).derivation, name))
             for name in (NAMED if names is None else names)}
 
 
 def _array_modules(framework: str, names: Iterable[str] | None = None) -> dict[str, str | bytes]:
-    from .backends.array_backend import module_source
-    from .plan import evaluation_plan
+    from symrot.backends.array_backend import module_source
+    from symrot.plan.builder import evaluation_plan
 
     return {f"{framework}/{name}.py": module_source(evaluation_plan(derive(name).derivation, name), framework)
             for name in (NAMED if names is None else names)}
@@ -107,7 +107,7 @@ def torch_modules(names: Iterable[str] | None = None) -> dict[str, str | bytes]:
 def c_headers(names: Iterable[str] | None = None) -> dict[str, str | bytes]:
     """generated/c/symrot_NAME.h: the C99 headers (Table 1, eq 35, sine/tangent m <= 6), or those
     of ``names``."""
-    from .backends.c_backend import generated_headers
+    from symrot.backends.c_backend import generated_headers
 
     return dict(generated_headers(None if names is None else tuple(names)))
 
@@ -134,7 +134,7 @@ def tasks(selected: list[str]) -> list[tuple[str, ...]]:
     derive every named parameterization (the documents of :data:`SHARED_DERIVATIONS` as one task, the
     figures), then ("names", name) for the per-name producers (the tangent and sine families of the C
     headers first)."""
-    from .backends.c_backend import COVERED
+    from symrot.backends.c_backend import COVERED
 
     names = [*COVERED] if "c/" in selected else []
     array_prefixes = ("numpy/", "jax/", "torch/")
@@ -153,7 +153,7 @@ def _run_task(task: tuple[str, ...], selected: tuple[str, ...]) -> dict[str, Con
             for prefix in task:
                 made.update(dict(producers())[prefix]())
             return made
-        from .backends.c_backend import COVERED
+        from symrot.backends.c_backend import COVERED
 
         name = task[1]
         out: dict[str, Content] = {}
@@ -170,7 +170,7 @@ def _run_task(task: tuple[str, ...], selected: tuple[str, ...]) -> dict[str, Con
 
 def names_of(prefix: str) -> tuple[str, ...]:
     """The parameterizations that have a file under the per-name ``prefix`` (:data:`PER_NAME`)."""
-    from .backends.c_backend import COVERED
+    from symrot.backends.c_backend import COVERED
 
     return tuple(COVERED) if prefix == "c/" else tuple(NAMED)
 
@@ -203,14 +203,14 @@ BACKEND_MODULES = ("numpy_backend", "array_backend", "c_backend", "latex", "type
 def warm_shared_state() -> None:
     """Do once, before the tasks fork, the work every task would repeat that depends on no
     parameterization: import the backends, compile every template, and derive the p-free algebra of
-    :mod:`symrot.derivatives` (∂(T a)/∂p and Ṫ ṗ on their bases). Each task inherits it. The state is
+    :mod:`symrot.core.derivatives` (∂(T a)/∂p and Ṫ ṗ on their bases). Each task inherits it. The state is
     the same in every run and for every split of the work (``--name`` and ``--only`` too: every
     backend is imported even when only one is selected, about 0.6 s for matplotlib), so what a task
     prints still depends only on its own work."""
     import importlib
 
-    from .backends.templating import environment
-    from .derivatives import rate_vector, tensor_derivative
+    from symrot.backends.templating import environment
+    from symrot.core.derivatives import rate_vector, tensor_derivative
 
     for module in BACKEND_MODULES:
         importlib.import_module(f".backends.{module}", __package__)
@@ -230,7 +230,7 @@ def render(only: str | None = None, jobs: int = 1, name: str | None = None) -> d
     that parameterization's files of the per-name producers (one task)."""
     import multiprocessing
 
-    from .cli.progress import each
+    from symrot.cli.progress import each
 
     files: dict[str, Content] = {}
     selected = selected_prefixes(only)
@@ -350,7 +350,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from .entry import run_with_fixed_hash_seed
+    from symrot.entry import run_with_fixed_hash_seed
 
     run_with_fixed_hash_seed("symrot.generate")  # the same files on every run (symrot.entry)
     raise SystemExit(main())

@@ -29,9 +29,9 @@ import numpy as np
 import sympy as sp
 
 from symrot.backends.c_backend import FUNCTIONS, CFunction
-from symrot.core import Derivation
-from symrot.functions import mpmath_namespace
-from symrot.parsing import PHI
+from symrot.core.derivation import Derivation
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
 
 EMBEDDED_WARNINGS = ("-Wdouble-promotion", "-Wconversion", "-Wshadow")
 """What embedded users add (a silent float → double promotion is a software-emulated double

@@ -12,9 +12,9 @@ from pathlib import Path
 import mpmath
 import sympy as sp
 
-from symrot.axial import AxialTensor
-from symrot.functions import mpmath_namespace
-from symrot.parsing import PHI
+from symrot.core.axial import AxialTensor
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
 
 DIGITS = 50
 

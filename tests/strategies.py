@@ -86,8 +86,8 @@ def sampled_expression(seed: int, index: int, max_terms: int = 3) -> str:
     ``random.Random(seed * 10007 + index)`` until κ > 0, φ_max ≥ MIN_PHI_MAX and p is no named
     parameterization (φ, sin φ, 2 tan(φ/2), …); the same expression on every run and version.
     Each index is drawn on its own, so a test of one function pays for that one only."""
-    from symrot.parsing import parse_expression
-    from symrot.registry import find_by_expression
+    from symrot.core.parsing import parse_expression
+    from symrot.core.registry import find_by_expression
 
     rng = random.Random(seed * 10007 + index)
     while True:

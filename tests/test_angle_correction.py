@@ -36,8 +36,8 @@ import sympy as sp
 from symrot.api import derive
 from symrot.backends.c_backend import header_source
 from symrot.backends.numpy_backend import module_source
-from symrot.parsing import PHI, parse_expression
-from symrot.plan import evaluation_plan
+from symrot.core.parsing import PHI, parse_expression
+from symrot.plan.builder import evaluation_plan
 
 from .c_harness import STRICT_C
 from .helpers import mp_function

@@ -1,4 +1,4 @@
-"""symrot.angle_solve: the reference angle φ(s) against closed inverses, at the precisions the domain
+"""symrot.plan.angle_solve: the reference angle φ(s) against closed inverses, at the precisions the domain
 sweep (up to 240 digits) and the Newton start (30 digits) use, with far fewer evaluations of p than
 bisection's one per bit."""
 
@@ -11,8 +11,8 @@ import mpmath
 import pytest
 import sympy as sp
 
-from symrot.angle_solve import angle_of_length
-from symrot.parsing import PHI
+from symrot.core.parsing import PHI
+from symrot.plan.angle_solve import angle_of_length
 
 # p, its closed inverse φ(s), φ_max: a pole (tan, 1/cos), a fold (2 sin(φ/2): p′ = 0 at π), and
 # the identity-like rotation vector

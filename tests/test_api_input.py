@@ -21,10 +21,10 @@ from hypothesis import strategies as st
 
 import symrot
 from symrot.api import DERIVE_TIME_LIMIT, DerivationResult, derive
-from symrot.errors import InvalidGeneratingFunction, ParseError, SymrotError, UnknownName
-from symrot.functions import RealCbrt
-from symrot.parsing import MAX_LENGTH, MAX_NUMBER_BITS, PHI
-from symrot.registry import unknown_name_message
+from symrot.core.errors import InvalidGeneratingFunction, ParseError, SymrotError, UnknownName
+from symrot.core.functions import RealCbrt
+from symrot.core.parsing import MAX_LENGTH, MAX_NUMBER_BITS, PHI
+from symrot.core.registry import unknown_name_message
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -46,8 +46,8 @@ def test_long_strings_are_answered_by_a_process_within_its_budget() -> None:
     """The cases of the issue, in a fresh process whose only limit is a hang-catcher."""
     script = textwrap.dedent("""
         import symrot
-        from symrot.errors import ParseError
-        from symrot.registry import unknown_name_message
+        from symrot.core.errors import ParseError
+        from symrot.core.registry import unknown_name_message
         for text in ("a" + "9" * 200000 + "b", "9" * 200000, "phi" + " " * 200000, "x" * 10**6):
             try:
                 symrot.derive(text)

@@ -67,7 +67,7 @@ def generated(kind: str, name: str) -> ModuleType:
 def user_module(kind: str, expression: str) -> ModuleType:
     from symrot.api import derive
     from symrot.backends.array_backend import module_source
-    from symrot.plan import evaluation_plan
+    from symrot.plan.builder import evaluation_plan
 
     plan = evaluation_plan(derive(expression).derivation, "user")
     source = module_source(plan, kind)

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from symrot import budget
 from symrot.cli import main, run, worker
+from symrot.core import budget
 
 TOWER = "tan(" * 4 + "phi" + ")" * 4
 """The deepest nesting the parser accepts; its derivation takes longer than the 1 s budgets below."""

@@ -37,10 +37,10 @@ from symrot.api import derive
 from symrot.backends import c_backend
 from symrot.backends.c_backend import FUNCTIONS
 from symrot.backends.c_derivatives import DERIVATIVES
-from symrot.functions import mpmath_namespace
-from symrot.parsing import PHI
-from symrot.registry import NAMED
-from symrot.singularities import Validity, validity
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
+from symrot.core.registry import NAMED
+from symrot.core.singularities import Validity, validity
 
 from . import c_harness
 from .c_harness import Reference, build_configs, compile_all, ulp_errors

@@ -1,6 +1,6 @@
 """The vectorizable batch kernels of the C backend (symrot.backends.c_batch).
 
-* the branch-free sin/cos kernel (symrot.sincos_kernel), printed exactly as the batch kernels print it,
+* the branch-free sin/cos kernel (symrot.plan.sincos_kernel), printed exactly as the batch kernels print it,
   is within 1.5 ulp of 50-digit mpmath in double and float, with and without FMA contraction, on
   arguments from 0 and 1e-300 up to far beyond the 3π/2 the headers need, and right next to
   multiples of π/2 where the reduction cancels;

@@ -20,11 +20,11 @@ import mpmath
 import numpy as np
 import pytest
 
-from symrot.algebraic import fold_complement
 from symrot.api import derive
 from symrot.backends.c_backend import COVERED
-from symrot.plan import closed_inverse
-from symrot.singularities import validity
+from symrot.core.singularities import validity
+from symrot.plan.algebraic import fold_complement
+from symrot.plan.forms import closed_inverse
 
 from . import c_harness
 from .test_c_backend import GENERATED
@@ -133,7 +133,7 @@ def test_a_fold_whose_p_max_squared_is_no_float(dtype: type, tmp_path: Path) -> 
     p_max² − |p|² up to 10⁻¹⁶ from the fold, as for the named families; the angle
     (4/3) atan2(s, √d) stays within 2 ulp of (4/3) asin(3s/4)."""
     from symrot.backends.c_backend import header_source
-    from symrot.plan import evaluation_plan
+    from symrot.plan.builder import evaluation_plan
 
     plan = evaluation_plan(derive("4*sin(3*phi/4)/3").derivation, "sin_three_quarters")
     assert plan.complement == Fraction(16, 9)
@@ -182,7 +182,7 @@ def test_numpy_complement_of_a_p_max_squared_that_is_no_float() -> None:
     ulp of the exact p_max² − |p|² next to the fold (with the float64 of 16/9 alone, 9.9·10⁻¹⁷ off,
     the worst was 2.2·10¹⁴ ulp of d)."""
     from symrot.backends.numpy_backend import module_source
-    from symrot.plan import evaluation_plan
+    from symrot.plan.builder import evaluation_plan
 
     namespace: dict[str, object] = {}
     plan = evaluation_plan(derive("4*sin(3*phi/4)/3").derivation, "sin_three_quarters")

@@ -2,7 +2,7 @@
 
 ``symrot derive cayley_m1000 --emit c`` (also ``cayley_m800``, ``'1e-8*phi'``) used to write
 ``(inf.0F)*x + 1.1106829e+37F``: a float32 Horner coefficient beyond 3.4e38. The plan now keeps
-only the leading Horner terms that are finite in the format (symrot.plan._branch_for, ``top``),
+only the leading Horner terms that are finite in the format (symrot.plan.branches._branch_for, ``top``),
 and the printer refuses any non-finite constant with a one-line SymrotError (exit 2). Each
 ``--emit c`` here must exit 0 with a header that gcc compiles with -std=c99 -Wall -Wextra
 -Wpedantic -Werror (and the embedded warnings), or exit 2 with one line.
@@ -21,8 +21,8 @@ import pytest
 
 from symrot.api import derive
 from symrot.backends.c_printer import MANTISSA_BITS
-from symrot.plan import evaluation_plan
-from symrot.plan_ir import Branch
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.ir import Branch
 
 from .c_harness import STRICT_C
 
@@ -32,7 +32,7 @@ LARGEST = {"float64": 1.7976931348623157e308, "float32": 3.4028234663852886e38}
 def emit(expression: str, out: Path) -> tuple[int, str]:
     """``symrot derive EXPR --emit c`` as a user runs it, in a fresh process (in the test process,
     after the JAX tests, a time bound once landed in JAX's garbage-collector callback and was lost;
-    symrot.timeouts now repeats the expiry, tests/test_timeouts.py checks it)."""
+    symrot.core.timeouts now repeats the expiry, tests/test_timeouts.py checks it)."""
     command = [sys.executable, "-m", "symrot", "derive", expression, "--name", "t", "--emit", "c",
                "--out", str(out)]
     result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symrot.backends.c_printer import SymrotCPrinter, print_c
-from symrot.functions import RealCbrt
+from symrot.core.functions import RealCbrt
 
 X, Y = sp.symbols("x y", real=True)
 
@@ -119,7 +119,7 @@ NON_FINITE = [(sp.Float("1.1253368e42"), "float"), (sp.Integer(10) ** 39, "float
 def test_non_finite_literal_is_refused_in_one_line(value: sp.Expr, precision: str) -> None:
     """A constant that is ±inf or NaN in the type would print as ``inf.0F`` (gcc: 'inf' undeclared):
     a SymrotError (exit 2 at the CLI) naming the constant and the type instead."""
-    from symrot.errors import NonFiniteLiteral, SymrotError
+    from symrot.core.errors import NonFiniteLiteral, SymrotError
 
     with pytest.raises(NonFiniteLiteral) as caught:
         print_c(value * X, precision)  # type: ignore[arg-type]

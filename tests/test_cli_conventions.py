@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from symrot import __version__
-from symrot.strict_json import dumps, strict
+from symrot.cli.strict_json import dumps, strict
 
 
 def run_cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:

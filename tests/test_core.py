@@ -9,11 +9,11 @@ import mpmath
 import pytest
 import sympy as sp
 
-from symrot.axial import AxialTensor
-from symrot.core import derive_expression, tensor_definitions
-from symrot.parsing import PHI
-from symrot.registry import NAMED, TABLE_1, family_member, lookup
-from symrot.simplify import base_angle_reduction, simplest
+from symrot.core.axial import AxialTensor
+from symrot.core.derivation import derive_expression, tensor_definitions
+from symrot.core.parsing import PHI
+from symrot.core.registry import NAMED, TABLE_1, family_member, lookup
+from symrot.core.simplify import base_angle_reduction, simplest
 
 from .helpers import DIGITS, axial_matrix, max_abs, mp_function, random_axis, skew
 
@@ -212,7 +212,7 @@ def test_tensors_are_simplified_only_when_asked() -> None:
     """A figure or the validity analysis needs the scalars and a few coefficients; the canonical
     forms and the other tensors' coefficients are simplified on first use (a figure of 11 curves
     spent 13 of its 25 s simplifying tensors it never drew)."""
-    from symrot.singularities import validity
+    from symrot.core.singularities import validity
 
     derivation = derive_expression(3 * sp.sin(PHI / 3) + sp.sin(PHI) / 7)
     validity(derivation)

@@ -24,9 +24,9 @@ import mpmath
 import pytest
 import sympy as sp
 
-from symrot.parsing import parse_expression
-from symrot.registry import find_by_expression
-from symrot.timeouts import time_limit
+from symrot.core.parsing import parse_expression
+from symrot.core.registry import find_by_expression
+from symrot.core.timeouts import time_limit
 
 from .corpus import CORPUS, by_expression
 from .reference import PHI, GeneratingFunction, Reference, State, skew, validity_edge
@@ -245,7 +245,7 @@ SAMPLE: dict[str, str | None] = {
     # root_matrix 6 ulp (float64) and 8.7 ulp (float32), float32 omega 61 ulp at 6.27-6.28 before
     # the across-axis part t = c0 - c2 |p|^2 was planned and forms in x found inside sums
     "sin(phi)/2 + sinh(phi)/2": None,
-    # a pole at 2*pi: NaN in every output from |p|^2 = 2^32 before symrot/pole.py (126 NaN/Inf)
+    # a pole at 2*pi: NaN in every output from |p|^2 = 2^32 before symrot/plan/pole.py (126 NaN/Inf)
     "phi/cos(phi/4)": None,
     # NaN in every output for |p| > 1.11415 (phi > 0.99995) before Newton in sqrt(1 - phi)
     "4*phi/5 + asin(phi)/5": None,
@@ -320,7 +320,7 @@ def test_a_logarithmic_pole_meets_the_target() -> None:
     """3 cosh(2φ) atanh(φ/3), the hypothesis sample's function until it was replaced by the seeded
     one, missed next to its logarithmic pole at φ = 3 (float64 rotation_matrix 9.4·10¹⁶ ulp) until
     p⁻¹ = 1/(3 cosh(2φ) atanh(φ/3)) in the coefficients was written as 1/s
-    (:func:`symrot.measurement.with_length` on products)."""
+    (:func:`symrot.plan.measurement.with_length` on products)."""
     missed = misses(measure(GeneratingFunction("3*cosh(2*phi)*atanh(phi/3)"), "log_pole", SAFETY_LIMIT))
     assert not missed, missed
 

@@ -25,7 +25,7 @@ import pytest
 
 from symrot.api import derive
 from symrot.backends.numpy_backend import module_source
-from symrot.plan import evaluation_plan
+from symrot.plan.builder import evaluation_plan
 
 from .corpus import by_expression
 from .reference import GeneratingFunction, Reference

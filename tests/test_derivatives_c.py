@@ -29,7 +29,7 @@ import pytest
 
 from symrot.api import derive
 from symrot.backends.c_backend import header_source
-from symrot.plan import evaluation_plan
+from symrot.plan.builder import evaluation_plan
 
 from . import c_harness
 from .corpus import by_expression

@@ -1,4 +1,4 @@
-"""The symbolic core of issue 19 (symrot/derivatives.py): ∂(T a)/∂p derived, and the slopes dc/dx.
+"""The symbolic core of issue 19 (symrot/core/derivatives.py): ∂(T a)/∂p derived, and the slopes dc/dx.
 
 * the core's form of ∂(T a)/∂p is SymPy's Jacobian (a polynomial identity in p, a, c_k, c_k′) and its
   basis is independent, so the form is determined;
@@ -18,7 +18,7 @@ import pytest
 import sympy as sp
 
 from symrot.api import derive
-from symrot.derivatives import (
+from symrot.core.derivatives import (
     SLOPES,
     VALUES,
     basis,
@@ -27,8 +27,8 @@ from symrot.derivatives import (
     slope_name,
     tensor_derivative,
 )
-from symrot.functions import mpmath_namespace
-from symrot.parsing import PHI
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
 
 from .reference import GeneratingFunction, skew
 

@@ -2,7 +2,7 @@
 
 Wiener–Milenkovic's tangent was 1.6e-159·I for p = (6e79, 8e79, 0) (exact first row
 [-4.48e-160, 1.536e-159, 1.024e-238]) because 128/(x + 16)² overflowed; the plan's x_limit
-(symrot/domain.py) now ends the domain before any printed form goes wrong, and the C header and the
+(symrot/plan/domain.py) now ends the domain before any printed form goes wrong, and the C header and the
 NumPy module both print it."""
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ import pytest
 import sympy as sp
 
 from symrot.api import derive
-from symrot.core import tensor_definitions
-from symrot.plan import evaluation_plan
+from symrot.core.derivation import tensor_definitions
+from symrot.plan.builder import evaluation_plan
 from tests.edges import documented_x_limit
 from tests.edges import ladder as edges_ladder
 from tests.helpers import axial_matrix
@@ -80,7 +80,7 @@ def test_float32_reaches_the_last_representable_angle(name: str) -> None:
     """Every float32 angle below φ_max is inside the float32 domain and meets the 4-ulp target.
 
     Wiener–Milenkovic's float32 module was NaN from φ = 2π − 7.6·10⁻⁶ (x = 2^42): det H =
-    4096/(x + 16)³ overflowed in its denominator (symrot.algebraic.bounded_powers)."""
+    4096/(x + 16)³ overflowed in its denominator (symrot.plan.algebraic.bounded_powers)."""
     module = load(ROOT / "generated" / "numpy" / f"{name}.py", f"domain32_{name}")
     m = 4 if name == "wiener_milenkovic" else 2
     phi_max = m * math.pi / 2  # p = m tan(φ/m) → ∞
@@ -108,12 +108,12 @@ def test_c_header_prints_the_same_limit() -> None:
 
 
 def test_bounded_powers_keep_the_value_and_do_not_overflow_first() -> None:
-    """symrot.algebraic.bounded_powers: the same rational function, evaluated without overflow in
+    """symrot.plan.algebraic.bounded_powers: the same rational function, evaluated without overflow in
     float32 where the expanded denominator (x + a)^n overflows, and printed as a power of the ratio."""
-    from symrot.algebraic import X, bounded_powers
     from symrot.backends.c_printer import SymrotCPrinter
-    from symrot.evaluation import model_function
-    from symrot.functions import BoundedPower
+    from symrot.core.functions import BoundedPower
+    from symrot.plan.algebraic import X, bounded_powers
+    from symrot.plan.evaluation import model_function
 
     forms = [4096 / (X + 16) ** 3, 128 / (X + 16) ** 2, -16 * (X - 16) / (X + 16) ** 2,
              32 * (X - 16) / (X + 16) ** 3 - 16 / (X + 16) ** 2, 3 * (X + 1) / (2 * X + 9) ** 4]
@@ -144,7 +144,7 @@ def test_a_pole_at_pi_keeps_the_domain_open_past_the_measured_range() -> None:
     e₀ relative to itself ("e_0" read as coefficient 0 of a tensor "e") instead of against the
     unit quaternion, and ended the domain at x = 2^32, |p| = 65536 (φ = π − 3·10⁻⁵): every output
     was NaN next to the pole. Measured: 2^107 in float64 (φ̂ rounds to π beyond), 2^63 in float32."""
-    from symrot.domain import _weight_and_scale
+    from symrot.plan.domain import _weight_and_scale
 
     values = {"e_0": mpmath.mpf("1e-5"), "R_0": mpmath.mpf(1), "R_1": mpmath.mpf(0), "R_2": mpmath.mpf(0)}
     assert _weight_and_scale("e_0", values, mpmath.mpf(10) ** 5) == (1, 1.0)
@@ -159,8 +159,8 @@ def test_an_ill_conditioned_det_h_of_a_bounded_p_does_not_end_the_range() -> Non
     took for a wrong result and ended the range at 2³⁶ (every output NaN from φ = 6.06). Judged as
     the plan measures it, against det H(0) when p is bounded, it is right up to the edge (relative
     to itself, as next to a pole, the limit is 2³⁶ < p_max², measured)."""
-    from symrot.domain import _floors, domain_limit
-    from symrot.singularities import validity
+    from symrot.core.singularities import validity
+    from symrot.plan.domain import _floors, domain_limit
 
     derivation = derive("sqrt(phi**2/2 + 1)*sinh(2*phi)/2").derivation
     limits = validity(derivation)
@@ -175,15 +175,15 @@ def test_an_ill_conditioned_det_h_of_a_bounded_p_does_not_end_the_range() -> Non
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_the_sweep_in_chunks_ends_where_the_sweep_point_by_point_ends(
         dtype: type, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The domain sweep evaluates each model once per chunk of points (symrot.domain.CHUNK) instead
+    """The domain sweep evaluates each model once per chunk of points (symrot.plan.domain.CHUNK) instead
     of once per point. Wiener–Milenkovic's H₀ = 16/(x + 16) written 16x(x + 17)/(x³ + 33x² + 272x)
     goes to 0 where x³ overflows, inside a chunk of the sweep (x ≈ 2^341 in float64, 2^43 in
     float32), and a chunk's first point is wrong when x² + 33x + 272 is the denominator (2^512,
     2^64): sweeping one point at a time ends the domain at the same power of two, below the
     overflow."""
-    from symrot import domain
-    from symrot.algebraic import S, X
-    from symrot.singularities import validity
+    from symrot.core.singularities import validity
+    from symrot.plan import domain
+    from symrot.plan.algebraic import S, X
 
     derivation = derive("wiener_milenkovic").derivation
     limits = validity(derivation)

@@ -12,8 +12,8 @@ import pytest
 
 from symrot.backends.figures import DPI, FAMILY_ORDERS, FIGURES, STYLES, build_figure, pi_label, render
 from symrot.cli import main
-from symrot.core import derive_expression
-from symrot.registry import family_member, lookup
+from symrot.core.derivation import derive_expression
+from symrot.core.registry import family_member, lookup
 
 from .helpers import mp_function
 

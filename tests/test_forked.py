@@ -1,4 +1,4 @@
-"""symrot.forked: a function run in a forked child, its value or exception taken back."""
+"""symrot.core.forked: a function run in a forked child, its value or exception taken back."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from symrot.errors import InvalidGeneratingFunction
-from symrot.forked import ForkedChildError, in_child
+from symrot.core.errors import InvalidGeneratingFunction
+from symrot.core.forked import ForkedChildError, in_child
 
 
 def test_the_value_comes_from_another_process() -> None:
@@ -62,7 +62,7 @@ def test_an_exception_that_does_not_unpickle_is_named() -> None:
 
 
 class _TwoArguments(Exception):
-    """Like symrot.budget.BudgetExceeded: its args (the message) do not rebuild it."""
+    """Like symrot.core.budget.BudgetExceeded: its args (the message) do not rebuild it."""
 
     def __init__(self, seconds: float, stage: str) -> None:
         super().__init__(f"{seconds} s in {stage}")

@@ -13,7 +13,7 @@ import symrot
 from symrot.backends.latex import cause_latex, latex, sheet, standalone, table
 from symrot.backends.typeset import typeset
 from symrot.cli import main
-from symrot.registry import NAMED, PAPER_TABLE_1_VALIDITY, TABLE_1
+from symrot.core.registry import NAMED, PAPER_TABLE_1_VALIDITY, TABLE_1
 
 pytestmark = pytest.mark.skipif(
     any(shutil.which(tool) is None for tool in ("pdflatex", "pdftotext", "pdftohtml", "pdftoppm")),
@@ -99,7 +99,7 @@ def test_cli_table_any_columns_stays_at_body_size(columns: str, tmp_path: Path) 
 
 
 def test_causes_are_those_derive_lists() -> None:
-    from symrot.singularities import validity
+    from symrot.core.singularities import validity
 
     for item in ("3*tan(phi/3)", "linear", "det_h_one"):
         result = symrot.derive(item)

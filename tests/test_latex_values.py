@@ -21,9 +21,9 @@ import mpmath
 import pytest
 
 import symrot
-import symrot.parsing
+import symrot.core.parsing
 from symrot.backends.latex import sheet
-from symrot.registry import NAMED, TABLE_1
+from symrot.core.registry import NAMED, TABLE_1
 
 from .corpus import by_expression
 from .latex_reader import LatexSyntaxError, read
@@ -251,7 +251,7 @@ def test_printer_values(expression: str) -> None:
     from symrot.backends.latex import latex
 
     expr = parse(expression)
-    text = latex(expr.subs(PHI, symrot.parsing.PHI))
+    text = latex(expr.subs(PHI, symrot.core.parsing.PHI))
     direct = mp_function(expr)
     for angle in ANGLES:
         with mpmath.workdps(DIGITS):

@@ -1,6 +1,7 @@
 """Imports run one way: core → plan → backends → API/CLI, with the audit beside plan and backends.
 
-Every module of ``symrot`` is assigned a layer (see docs/architecture.md). The test reads each
+Every module of ``symrot`` belongs to the layer of its folder (symrot/core, plan, backends, audit,
+cli; the few modules at the top are the public face; see docs/architecture.md). The test reads each
 module's source with :mod:`ast`, so it sees every import: at the top, inside functions (lazy) and
 under ``if TYPE_CHECKING:``. It fails when a module imports from a layer its own layer may not
 use, when an import cycle joins modules of different layers and, stricter, on any import cycle.
@@ -17,26 +18,16 @@ import symrot
 
 PACKAGE = Path(symrot.__file__).parent
 
-LAYER_OF_PREFIX: dict[str, str] = {
-    # longest prefix wins; a prefix names a module or a package and everything under it
-    "symrot": "app",
-    "symrot.__main__": "app",
-    "symrot.api": "app",
-    "symrot.cli": "app",
-    "symrot.entry": "app",
-    "symrot.generate": "app",
-    "symrot.audit": "audit",
-    "symrot.backends": "backends",
-    **{f"symrot.{name}": "plan" for name in (
-        "plan", "plan_ir", "algebraic", "newton_start", "quaternion_plan", "sincos_kernel", "evaluation",
-        "domain", "measurement", "pole", "angle_solve", "plan_json",
-    )},
-    **{f"symrot.{name}": "core" for name in (
-        "axial", "core", "errors", "functions", "operations", "parsing", "registry", "series",
-        "series_engine", "simplify", "singularities", "solve", "timeouts", "validation", "budget", "forked",
-        "two_processes", "derivatives", "atomic",
-    )},
+LAYER_OF_FOLDER: dict[str, str] = {
+    # the folder of symrot/ a module lives in is its layer; the top of the package is the public face
+    "core": "core",
+    "plan": "plan",
+    "backends": "backends",
+    "audit": "audit",
+    "cli": "app",
 }
+TOP_LEVEL = {"__init__", "__main__", "api", "entry", "generate"}
+"""The public face: the only modules directly in symrot/ (issue 56: at most 8)."""
 MAY_IMPORT: dict[str, set[str]] = {
     "core": {"core"},
     "plan": {"core", "plan"},
@@ -57,10 +48,13 @@ MODULES: dict[str, Path] = {module_name(path): path for path in sorted(PACKAGE.r
 
 
 def layer(module: str) -> str:
-    prefixes = [p for p in LAYER_OF_PREFIX if module == p or module.startswith(p + ".")]
-    if not prefixes:
-        raise AssertionError(f"{module} has no layer: add it to LAYER_OF_PREFIX")
-    return LAYER_OF_PREFIX[max(prefixes, key=len)]
+    """The layer of a module: the folder of symrot/ it lives in (app at the top)."""
+    parts = module.split(".")
+    if len(parts) == 1 or (len(parts) == 2 and parts[1] in TOP_LEVEL):
+        return "app"
+    if parts[1] not in LAYER_OF_FOLDER:
+        raise AssertionError(f"{module} is in no layer's folder: {sorted(LAYER_OF_FOLDER)} or the top")
+    return LAYER_OF_FOLDER[parts[1]]
 
 
 def imports(module: str) -> set[str]:
@@ -88,6 +82,21 @@ GRAPH: dict[str, set[str]] = {module: imports(module) for module in MODULES}
 def test_every_module_has_a_layer() -> None:
     for module in MODULES:
         assert layer(module) in MAY_IMPORT
+
+
+def test_the_top_of_the_package_is_only_the_public_face() -> None:
+    top = {path.stem for path in PACKAGE.glob("*.py")}
+    assert top == TOP_LEVEL and len(top) <= 8
+    folders = {path.name for path in PACKAGE.iterdir()
+               if path.is_dir() and not path.name.startswith(("_", "."))}
+    assert folders == set(LAYER_OF_FOLDER)
+
+
+def test_no_module_is_too_long_to_read_in_one_sitting() -> None:
+    """Issue 56: no module over ~500 lines (600 at most)."""
+    long = {module: lines for module, path in MODULES.items()
+            if (lines := len(path.read_text(encoding="utf-8").splitlines())) > 600}
+    assert not long, long
 
 
 def test_no_module_imports_a_layer_above_it() -> None:

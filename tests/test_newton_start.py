@@ -1,4 +1,4 @@
-"""The plan's count of Newton steps (symrot.newton_start.measured_iterations) runs the printed
+"""The plan's count of Newton steps (symrot.plan.newton_start.measured_iterations) runs the printed
 iteration, and names the sizes whose angle the steps do not reach, so that the range ends there;
 next to a fold or an asin edge the steps are Newton's in w = (φ_max − φ)^k (edge_step)."""
 
@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symrot.newton_start import (
+from symrot.core.parsing import PHI
+from symrot.plan.newton_start import (
     CHANGE,
     EDGE_STEP,
     MAX_ITERATIONS,
@@ -23,7 +24,6 @@ from symrot.newton_start import (
     measured_iterations,
     newton_lanes,
 )
-from symrot.parsing import PHI
 
 SERIES_ONLY = FarStart(kind="linear", scale=1.0, order=1, chebyshev=(0.0,), switch=math.inf, measured=0.0)
 """A far start never used: every lane starts from the reverted series φ ≈ s."""

@@ -133,7 +133,7 @@ def _independent_sweep(name: str, points: int) -> dict[tuple[str, str], Any]:
     from accuracy_corpus import Measurement
 
     from symrot.api import derive
-    from symrot.plan import evaluation_plan
+    from symrot.plan.builder import evaluation_plan
     from tests.reference import GeneratingFunction
 
     function = GeneratingFunction(FOLD[name][0], phi_max_text=FOLD[name][1])

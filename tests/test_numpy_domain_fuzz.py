@@ -13,7 +13,7 @@ Issue 17, generated-code half, for the 7 modules under ``generated/numpy/`` in f
 * the operations return either NaN or a vector inside that same test (``angle`` of it is finite):
   ``from_quaternion`` of Cayley–Gibbs–Rodrigues and Wiener–Milenkovic near e₀ → 0 included;
 * ``from_rotation_matrix`` refuses what is not a rotation (max |RᵀR − I| > tol or det R ≤ 0, tol =
-  2⁻²⁶ in float64, 2⁻¹¹ in float32: ``symrot.quaternion_plan.ROTATION_TOLERANCE_POWER``) and
+  2⁻²⁶ in float64, 2⁻¹¹ in float32: ``symrot.plan.quaternion.ROTATION_TOLERANCE_POWER``) and
   accepts rotations perturbed within tol.
 """
 
@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from symrot.quaternion_plan import ROTATION_TOLERANCE_POWER
+from symrot.plan.quaternion import ROTATION_TOLERANCE_POWER
 
 from .edges import FAMILIES, documented_x_limit, edge
 from .reference import GeneratingFunction, Reference

@@ -8,16 +8,16 @@ import mpmath
 import pytest
 import sympy as sp
 
-from symrot.core import derive_expression
-from symrot.operations import (
+from symrot.core.derivation import derive_expression
+from symrot.core.operations import (
     from_quaternion_scale,
     from_quaternion_series,
     paper_rescaling_claims,
     quaternion_coefficients,
     rescale_factor,
 )
-from symrot.parsing import PHI
-from symrot.registry import lookup
+from symrot.core.parsing import PHI
+from symrot.core.registry import lookup
 
 from .helpers import DIGITS, axial_matrix, max_abs, mp_function, random_axis
 
@@ -117,8 +117,8 @@ def test_the_scale_is_reduced_to_e0_only_for_trigonometric_p(monkeypatch: pytest
     """σ = p/sin(φ/2) becomes algebraic in e₀ = cos(φ/2) (eq 74) for trigonometric p, and the
     reduction's simplification (up to 3.2 s) is not run where another call of φ would leave a
     transcendental function of acos e₀ (sinh, asin, atan, the real cube root of eq 35)."""
-    from symrot import quaternion_plan
-    from symrot.parsing import parse_expression
+    from symrot.core.parsing import parse_expression
+    from symrot.plan import quaternion as quaternion_plan
 
     e0 = quaternion_plan.E0
     assert sp.simplify(quaternion_plan.scale_in_e0(4 * sp.tan(PHI / 4)) - 4 / (e0 + 1)) == 0

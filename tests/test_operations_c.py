@@ -315,7 +315,7 @@ def test_from_rotation_matrix_refuses_non_rotations(library: ctypes.CDLL, case: 
                                                     precision: str) -> None:
     """Status 1 and NaN unless max |RᵀR − I| ≤ tol and det R > 0 (tol = 2^-26, 2^-11 in float);
     rotations perturbed by up to tol/8 per entry are accepted, scaled by 1 + 4 tol refused."""
-    from symrot.quaternion_plan import ROTATION_TOLERANCE_POWER
+    from symrot.plan.quaternion import ROTATION_TOLERANCE_POWER
 
     name, module = case
     dtype = DTYPE[precision]

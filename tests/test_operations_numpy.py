@@ -47,7 +47,7 @@ from scipy.spatial.transform import Rotation
 
 from symrot.api import derive
 from symrot.backends.numpy_backend import module_source
-from symrot.plan import evaluation_plan
+from symrot.plan.builder import evaluation_plan
 
 from .corpus import by_expression
 from .reference import PHI, parse
@@ -644,7 +644,7 @@ def test_infinite_p_gives_nan_without_warning(module_dir: Path) -> None:
 
 
 def test_huge_unbounded_vector_is_documented_out_of_range(module_dir: Path) -> None:
-    """|p|² ≥ x_limit (2^341 for Wiener–Milenkovic in float64, symrot/domain.py) is outside the
+    """|p|² ≥ x_limit (2^341 for Wiener–Milenkovic in float64, symrot/plan/domain.py) is outside the
     documented range of p_max = ∞ parameterizations: NaN, never the unrescaled p (φ = 4 atan(p/4)
     = 2π − 1.6e-154 here) nor a warning."""
     module = get_module("wiener_milenkovic", module_dir)

@@ -1,6 +1,6 @@
 """Output files survive a full disk, signals and links; bad options end before any work (issue 55).
 
-Every output is written atomically (:mod:`symrot.atomic`); an emit of several backends replaces
+Every output is written atomically (:mod:`symrot.core.atomic`); an emit of several backends replaces
 all of its files or none; SIGINT (130) and SIGTERM (143) leave no temporary file or scratch
 directory; SIGKILL leaves the previous files whole and temporary files that the next run removes.
 A time limit here only catches a hang.
@@ -21,10 +21,10 @@ from typing import Any
 import pytest
 
 import symrot.cli.derive as derive_command
-from symrot import atomic
 from symrot.cli import MAX_TIMEOUT, main
 from symrot.cli.output import write_file, write_files
-from symrot.errors import SymrotError
+from symrot.core import atomic
+from symrot.core.errors import SymrotError
 
 FAST = "cayley_gibbs_rodrigues"
 """A parameterization whose plan takes about a second."""

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 import sympy as sp
 
-from symrot.errors import ParseError
-from symrot.functions import RealCbrt
-from symrot.parsing import PHI, parse_expression
+from symrot.core.errors import ParseError
+from symrot.core.functions import RealCbrt
+from symrot.core.parsing import PHI, parse_expression
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
 
@@ -151,7 +151,7 @@ def test_cbrt_is_the_real_odd_cube_root() -> None:
 def test_real_cube_root_in_mpmath_evaluation() -> None:
     import mpmath
 
-    from symrot.functions import mpmath_namespace
+    from symrot.core.functions import mpmath_namespace
 
     f = sp.lambdify(PHI, RealCbrt(PHI), modules=[mpmath_namespace(), "mpmath"])
     assert f(mpmath.mpf(-8)) == -2
@@ -163,7 +163,7 @@ def test_functions_nested_beyond_the_cap_are_refused_at_once() -> None:
     parser refuses it in one line, while the deepest accepted nesting still parses."""
     import time
 
-    from symrot.parsing import MAX_FUNCTION_NESTING
+    from symrot.core.parsing import MAX_FUNCTION_NESTING
 
     deepest = "tan(" * MAX_FUNCTION_NESTING + "phi" + ")" * MAX_FUNCTION_NESTING
     assert parse_expression(deepest).has(PHI)

@@ -7,20 +7,13 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symrot.algebraic import S
 from symrot.api import derive
-from symrot.parsing import PHI
-from symrot.plan import (
-    CHEAP_TERMS,
-    Algebraic,
-    Branch,
-    ClosedAngle,
-    Constant,
-    NewtonAngle,
-    X,
-    evaluation_plan,
-    near_half_turn,
-)
+from symrot.core.parsing import PHI
+from symrot.plan.algebraic import S, X
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import near_half_turn
+from symrot.plan.ir import Algebraic, Branch, ClosedAngle, Constant, NewtonAngle
+from symrot.plan.targets import CHEAP_TERMS
 
 from .reference import GeneratingFunction, Reference
 
@@ -154,7 +147,7 @@ def test_across_axis_part_is_planned_where_c0_is_not_constant(det_h_one_plan) ->
     """T = c0 I + c1 (p x) + c2 (p x)^2 = t I + c1 (p x) + c2 p p^T with t = c0 - c2 |p|^2: t is
     derived (the planar part a - c of the u-basis) and planned as a coefficient of its own where c0
     varies (H = mu I + ... of det_h_one), while R and G (c0 = 1) compute t from c2."""
-    from symrot.validation import evaluate
+    from symrot.core.validation import evaluate
 
     derivation = derive("det_h_one").derivation
     for tensor in derivation.tensors.values():
@@ -174,9 +167,9 @@ def test_across_axis_part_is_planned_where_c0_is_not_constant(det_h_one_plan) ->
 def test_forms_in_s_and_x_are_found_inside_products_and_sums() -> None:
     """p = sinh(phi) cosh(phi): 1/p^2 appears as sinh^-2 cosh^-2 inside a larger product, which
     must still become 1/x (the form that does not amplify the angle's rounding)."""
-    from symrot.algebraic import S
-    from symrot.measurement import with_length
-    from symrot.parsing import PHI
+    from symrot.core.parsing import PHI
+    from symrot.plan.algebraic import S
+    from symrot.plan.measurement import with_length
 
     product = sp.sinh(PHI) * sp.cosh(PHI)
     assert with_length(2 * sp.sin(PHI / 4) ** 2 / product**2, product) == 2 * sp.sin(PHI / 4) ** 2 / X
@@ -220,8 +213,8 @@ def test_forms_in_s_and_x_are_found_inside_products_and_sums() -> None:
 ])
 def test_forms_in_s_and_x_are_found_when_a_factor_of_p_is_rescaled(argument: str, form: sp.Expr,
                                                                    expected: sp.Expr) -> None:
-    from symrot.measurement import with_length
-    from symrot.parsing import parse_expression
+    from symrot.core.parsing import parse_expression
+    from symrot.plan.measurement import with_length
 
     p = parse_expression(argument)
     written = with_length(form, p)
@@ -236,8 +229,8 @@ def test_the_half_angle_form_through_x_is_a_candidate_when_p_is_a_sum_of_cosines
     inside p, so p is no longer recognized in it; written through x first, (1 - cos(phi/2))/x
     cancels at small phi. The planned form recomputed p from the rounded angle (9 ulp of G in
     float32 at 6.18); 2 sin^2(phi/4)/x must be measured."""
-    from symrot.parsing import parse_expression
-    from symrot.plan import candidate_forms
+    from symrot.core.parsing import parse_expression
+    from symrot.plan.branches import candidate_forms
 
     p = parse_expression("3*phi*cos(phi/3)/5 + 2*sqrt(2*phi**2 + 1)*sinh(phi)/5")
     closed = 25 * (1 - sp.cos(PHI / 2)) / (3 * PHI * sp.cos(PHI / 3)
@@ -250,8 +243,10 @@ def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
     """G_2 of sinh(phi) cosh(phi) next to 2 pi is ~ 2/x, far below G_2(0) = 1/8: measured relative
     to 1/8 its form in phi (sinh amplifies the float32 angle's rounding 4 times, 6 ulp of G_2 x)
     would tie with 2 sin^2(phi/4)/x; measured relative to |G| / |p|^2 it must lose."""
-    from symrot.plan import MAX_TERMS, closed_inverse, plan_branch, tensor_part
-    from symrot.singularities import validity
+    from symrot.core.singularities import validity
+    from symrot.plan.branches import plan_branch, tensor_part
+    from symrot.plan.forms import closed_inverse
+    from symrot.plan.targets import MAX_TERMS
 
     derivation = derive("sinh(phi)*cosh(phi)").derivation
     phi_max = float(validity(derivation).phi_max_float)
@@ -276,11 +271,11 @@ def test_tensor_coefficients_are_measured_as_they_enter_the_tensor() -> None:
 
 
 def test_the_reduction_to_x_is_sized_by_the_largest_multiple_angle() -> None:
-    """symrot.algebraic.REDUCTION_MULTIPLE: for tan(φ/20) the coefficient 4 sin²(φ/2)/(…) expands
+    """symrot.plan.algebraic.REDUCTION_MULTIPLE: for tan(φ/20) the coefficient 4 sin²(φ/2)/(…) expands
     sin(20η) (η = atan(s)/2) and simplified in 34 s, past its nominal bound; it is not attempted.
     The tangent family up to m = 6 (sin φ = sin(12η) for 6 tan(φ/6)) still is."""
-    from symrot.algebraic import REDUCTION_MULTIPLE, expanded_in_s
-    from symrot.parsing import PHI
+    from symrot.core.parsing import PHI
+    from symrot.plan.algebraic import REDUCTION_MULTIPLE, expanded_in_s
 
     assert REDUCTION_MULTIPLE >= 12
     tangent = sp.tan(PHI / 20)
@@ -296,7 +291,7 @@ def test_an_inverse_of_a_radical_is_not_reduced_to_x() -> None:
     simplify ran into its 6 s bound on each coefficient expanded through it, and ``--emit`` ran out
     of its 60 s budget during planning. No reduction is attempted (the coefficients get branches);
     one whose inverse is an atan of s/k still is."""
-    from symrot.algebraic import S, expanded_in_s
+    from symrot.plan.algebraic import S, expanded_in_s
 
     p = sp.tan(PHI) ** 3 / 3 + sp.tan(PHI)
     root = (-81 * S / 2 + sp.sqrt(6561 * S**2 + 2916) / 2) ** sp.Rational(1, 3)
@@ -310,7 +305,7 @@ def test_whole_multiples_of_the_base_angle_reduce_without_half_angle_radicals() 
     """sin φ/(5 tan(φ/5)) of 5 tan(φ/5) has only whole multiples of θ = atan(s/5): expanded in θ it
     is algebraic in x. Through the half angle η = θ/2 (radicals √((1 ± cos θ)/2)) SymPy's simplify
     found nothing, in 1–2 s; the R₁ of 3 tan(φ/3) was a branch with sin φ/s for the same reason."""
-    from symrot.algebraic import S, algebraic_in_x, reduce_to_x
+    from symrot.plan.algebraic import S, algebraic_in_x, reduce_to_x
 
     closed = sp.sin(PHI) / (5 * sp.tan(PHI / 5))
     reduced = reduce_to_x(closed, 5 * sp.atan(S / 5))
@@ -325,8 +320,10 @@ def test_whole_multiples_of_the_base_angle_reduce_without_half_angle_radicals() 
 def test_hyperbolic_inverses_are_inverse_hyperbolic_functions(text: str, expected: str) -> None:
     """sp.solve writes φ(s) for sinh φ = s as log(s + √(s² + 1)), which loses every digit for small s:
     the plan took the Newton angle, and cosh(φ) = √(1 + x) was never found for H₀ = 1/p′."""
-    from symrot.parsing import PHI
-    from symrot.plan import ANGLE_TOLERANCE_ULP, S, closed_angle_error, closed_inverse
+    from symrot.core.parsing import PHI
+    from symrot.plan.algebraic import S
+    from symrot.plan.forms import closed_angle_error, closed_inverse
+    from symrot.plan.targets import ANGLE_TOLERANCE_ULP
 
     p = sp.sympify(text, locals={"phi": PHI})
     inverse = closed_inverse(p, sp.Integer(1))
@@ -356,9 +353,10 @@ def test_one_plus_cosine_is_written_through_the_half_angle_next_to_a_half_turn()
 def test_every_branch_measures_candidate_forms_computed_before_the_precisions(monkeypatch) -> None:
     """The candidate forms of every branch in x are computed once, half in a forked child, before
     the precisions part (plan._prepare_shared_work), and equal those computed in place."""
-    import symrot.plan as plan
-    from symrot.core import derive_expression
-    from symrot.parsing import parse_expression
+    import symrot.plan.branches as branches
+    import symrot.plan.builder as plan
+    from symrot.core.derivation import derive_expression
+    from symrot.core.parsing import parse_expression
 
     original_forms, original_precision = plan._candidate_forms, plan._precision_plan
     late: list[sp.Expr] = []
@@ -378,6 +376,7 @@ def test_every_branch_measures_candidate_forms_computed_before_the_precisions(mo
             in_precision = False
 
     monkeypatch.setattr(plan, "_candidate_forms", forms)
+    monkeypatch.setattr(branches, "_candidate_forms", forms)
     monkeypatch.setattr(plan, "_precision_plan", precision)
     derivation = derive_expression(parse_expression("2*asinh(phi/2)"))  # a p no other test plans
     result = plan.evaluation_plan(derivation, "two_asinh_half")
@@ -392,8 +391,8 @@ def test_hyperbolic_complement_is_the_same_function_without_cancellation() -> No
     """k − k tanh²(u) in a sum becomes k/cosh²(u) (the forms through φ = 4 tanh(s/4) of 4 atanh(φ/4));
     other sums are left alone; the value is unchanged (40 digits at a large u, where the old form
     has lost every digit in float64)."""
-    from symrot.measurement import S
-    from symrot.plan import hyperbolic_complement
+    from symrot.plan.forms import hyperbolic_complement
+    from symrot.plan.measurement import S
 
     form = 16 - 16 * sp.tanh(S / 4) ** 2 + PHI
     rewritten = hyperbolic_complement(form)

@@ -26,9 +26,9 @@ from symrot.api import derive
 from symrot.backends.numpy_backend import module_source
 from symrot.cli import plan_cache
 from symrot.entry import SEED
-from symrot.plan import evaluation_plan
-from symrot.plan_ir import EvaluationPlan, NewtonAngle
-from symrot.plan_json import PlanFormatError, decode_plan, encode_plan
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.ir import EvaluationPlan, NewtonAngle
+from symrot.plan.serialized import PlanFormatError, decode_plan, encode_plan
 from tests.helpers import files
 from tests.helpers import run_symrot as run_cli
 

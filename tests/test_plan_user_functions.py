@@ -9,8 +9,11 @@ import pytest
 import sympy as sp
 
 from symrot.api import derive
-from symrot.parsing import PHI, parse_expression
-from symrot.plan import ClosedAngle, S, closed_angle_error, closed_inverse, evaluation_plan, half_angle_sums
+from symrot.core.parsing import PHI, parse_expression
+from symrot.plan.algebraic import S
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import closed_angle_error, closed_inverse, half_angle_sums
+from symrot.plan.ir import ClosedAngle
 
 
 def test_a_solver_that_raises_means_no_closed_inverse() -> None:
@@ -76,7 +79,7 @@ def test_p_cubic_in_its_one_function_is_not_solved() -> None:
     """asinh³φ + asinh φ = s: sp.solve wrote sinh of Cardano's root and spent its whole bound on it,
     and ``--emit`` ran out of its 60 s budget (61.8 s). A cubic or higher in the one call is not
     handed to the solver (the Newton angle serves it); a quadratic or linear one still is."""
-    from symrot.plan import _solvable_shape
+    from symrot.plan.forms import _solvable_shape
 
     assert not _solvable_shape(sp.asinh(PHI) ** 3 + sp.asinh(PHI))
     assert not _solvable_shape(sp.tan(PHI) ** 3 / 3 + sp.tan(PHI))
@@ -85,7 +88,7 @@ def test_p_cubic_in_its_one_function_is_not_solved() -> None:
 
 
 def test_a_triple_pole_keeps_its_domain_up_to_where_det_h_underflows() -> None:
-    """tan φ + tan³φ/3 = N/(D cos³φ): cos φ through s as ∛(N/(D·s)) (symrot.pole), and in float32,
+    """tan φ + tan³φ/3 = N/(D cos³φ): cos φ through s as ∛(N/(D·s)) (symrot.plan.pole), and in float32,
     where det H ~ 1/x² underflows next to the pole, forms are compared only where the value is a
     normal number. Without both, every form kept cos φ from the rounded angle and the domain ended
     at |p|² = 2³² in both precisions (NaN from φ = 1.56 of π/2)."""
@@ -101,7 +104,7 @@ def test_a_p_too_small_for_a_format_is_refused_before_any_planning() -> None:
 
     import pytest
 
-    from symrot.errors import SymrotError
+    from symrot.core.errors import SymrotError
 
     derivation = derive("1e-20*phi").derivation
     started = time.process_time()
@@ -196,8 +199,8 @@ def test_newton_next_to_a_pole_steps_on_the_reciprocal_below_the_pole() -> None:
     import textwrap
 
     from symrot.backends.numpy_backend import _angle_lines, _branch_lines
-    from symrot.plan import _bracket_top, _newton_angle
-    from symrot.singularities import validity
+    from symrot.core.singularities import validity
+    from symrot.plan.angles import _bracket_top, _newton_angle
 
     expression = "3*tan(2*phi/3)/(2*(3*phi**2/4 + 1))"
     derivation = derive(expression).derivation
@@ -231,7 +234,8 @@ def test_an_arcsine_of_tanh_inverse_is_offered_as_the_arctangent_of_sinh(dtype: 
     asin(tanh s), which loses the digits of π/2 − φ where tanh s rounds next to 1; the Newton angle
     that replaced it converged below |p| = 5.02 only, and the range ended there (φ = 1.5576 of π/2).
     atan(sinh s), the same function, is offered next and measures within the tolerance."""
-    from symrot.plan import ANGLE_TOLERANCE_ULP, angle_forms
+    from symrot.plan.forms import angle_forms
+    from symrot.plan.targets import ANGLE_TOLERANCE_ULP
 
     p = sp.atanh(sp.sin(PHI))
     inverse = closed_inverse(p, sp.Integer(1))
@@ -248,7 +252,7 @@ def test_the_quaternion_scale_of_atanh_sin_is_measured_as_asinh_tan(dtype: type)
     """σ = p(φ)/sin(φ/2) of p = atanh(sin φ): 1 − sin φ from the rounded φ keeps none of its digits
     next to π/2, and from_quaternion was 1.4·10¹⁰ (float64) and 3.4·10⁶ (float32) ulp off at
     π/2 − 10⁻⁶; asinh(tan φ), the same function there, is a candidate and the plan takes it."""
-    from symrot.plan import _quaternion_scale
+    from symrot.plan.angles import _quaternion_scale
 
     scale = _quaternion_scale(sp.atanh(sp.sin(PHI)), float(np.pi) / 2, dtype)
     assert scale.algebraic is None and scale.branch is not None
@@ -260,7 +264,8 @@ def test_a_closed_inverse_that_cancels_is_rejected_not_crashed() -> None:
     cancel for small s. They were judged against their own value at 40 digits, which is 0 (or a
     division by zero, and the emit ended in an internal error) at s = 10⁻³⁰⁰; the reference is now
     the angle refined by Newton on p itself, and both forms are rejected (float64 gives 0 there)."""
-    from symrot.plan import ANGLE_TOLERANCE_ULP, angle_forms
+    from symrot.plan.forms import angle_forms
+    from symrot.plan.targets import ANGLE_TOLERANCE_ULP
 
     p = PHI * sp.sqrt(1 + PHI**2)
     inverse = closed_inverse(p, sp.Integer(1))
@@ -287,8 +292,8 @@ def test_a_definition_form_that_runs_out_of_time_stops_the_plan_instead_of_being
         monkeypatch: pytest.MonkeyPatch) -> None:
     """definition_forms leaves out forms whose computation fails, but not on an expired time bound:
     whether that happens depends on the machine, and so would the plan (docs/architecture.md)."""
-    import symrot.plan as plan_module
-    from symrot.errors import SymrotTimeout
+    import symrot.plan.builder as plan_module
+    from symrot.core.errors import SymrotTimeout
 
     def expired(*_: object) -> None:
         raise SymrotTimeout("bound expired")
@@ -309,8 +314,8 @@ def test_nested_roots_are_not_rationalized_so_tan_2phi_over_2_can_be_emitted() -
     4/((4x + 1)^(1/4) (2 (4x + 1)^(1/4) + √2 √(√(4x + 1) + 1)) (√(4x + 1) + 1)), and ``radsimp`` of
     that ran past its 120 s safety bound: ``--emit`` failed after two minutes. Nested roots now skip
     the rationalized alternatives (the reduced form itself is still measured)."""
-    from symrot.algebraic import algebraic_in_x, has_nested_radical, reduce_to_x
-    from symrot.timeouts import time_limit
+    from symrot.core.timeouts import time_limit
+    from symrot.plan.algebraic import algebraic_in_x, has_nested_radical, reduce_to_x
 
     p = sp.tan(2 * PHI) / 2
     inverse = closed_inverse(p, sp.Integer(1))
@@ -385,7 +390,7 @@ def test_solutions_are_checked_numerically_not_by_sympy(monkeypatch: pytest.Monk
     """solve(…, check=False) returns the roots that squaring adds (−√(√(4s² + 1)/2 − 1/2) for
     φ√(1 + φ²)); the numeric checks keep the one that starts as s/κ and solves p(φ) = s. SymPy's
     own symbolic check was 1.5 of the 2 s that log((1 + φ/2)/(1 − φ/2)) spent solving."""
-    from symrot import plan
+    from symrot.plan import builder as plan
 
     s = sp.Symbol("s", nonnegative=True)
     checked: list[object] = []
@@ -410,7 +415,7 @@ def test_parts_with_log_or_inverse_calls_are_not_trigsimped(monkeypatch: pytest.
     leaves the call itself: trigsimp does not rewrite it (log((1 + tanh(s/2))/(1 − tanh(s/2))) stays
     as it is), and each such part cost 0.2–0.3 s, 3 s of the 12 s emit of
     log((1 + φ/2)/(1 − φ/2)). Its algebraic siblings are still written through φ(s)."""
-    from symrot import algebraic
+    from symrot.plan import algebraic
 
     algebraic.with_inverse.cache_clear()
     algebraic._part_with_inverse.cache_clear()
@@ -485,7 +490,8 @@ def test_a_polynomial_is_measured_below_its_switch_not_only_estimated() -> None:
     after its first term (every later term zero): the estimate then says 1 is exact everywhere,
     and only the measurement against the reference moves the switch down to where 1 is within
     POLYNOMIAL_TOLERANCE_ULP of sin φ/p = 1 − x³/5040 + …"""
-    from symrot.plan import POLYNOMIAL_TOLERANCE_ULP, plan_branch
+    from symrot.plan.branches import plan_branch
+    from symrot.plan.targets import POLYNOMIAL_TOLERANCE_ULP
 
     p = PHI - PHI**3 / 6 + PHI**5 / 120
     wrong_series = [sp.Integer(1)] + [sp.Integer(0)] * 10

@@ -1,4 +1,4 @@
-"""symrot.pole: the vanishing factor of a pole edge written through s = |p| (issue 16).
+"""symrot.plan.pole: the vanishing factor of a pole edge written through s = |p| (issue 16).
 
 Next to a pole of p, forms evaluated from the rounded angle φ̂ lose digits in every factor that
 vanishes there; the rewrite must (1) keep the value exactly, (2) be accurate in floating point where
@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symrot.algebraic import D, S, X
-from symrot.evaluation import model_function
-from symrot.functions import mpmath_namespace
-from symrot.parsing import PHI
-from symrot.pole import pole_factor, with_pole_factor
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
+from symrot.plan.algebraic import D, S, X
+from symrot.plan.evaluation import model_function
+from symrot.plan.pole import pole_factor, with_pole_factor
 
 POLES = {  # p: φ_max (the pole)
     "phi/(1 - phi**2/10)": "sqrt(10)",

@@ -3,7 +3,7 @@
 Nothing whose result depends on the CPU may feed ``generated/``: NumPy dispatches ``sin``,
 ``power``, ``geomspace``, … to SIMD kernels chosen at run time (their last bits differ between
 AVX-512, AVX2 and baseline x86-64), and OpenBLAS picks its kernels by CPU (``OPENBLAS_CORETYPE``).
-The plan layer therefore measures with :mod:`symrot.evaluation` (an mpmath-backed ideal libm) and
+The plan layer therefore measures with :mod:`symrot.plan.evaluation` (an mpmath-backed ideal libm) and
 fits with exact Chebyshev interpolation. These tests regenerate the files whose plans use every
 such measurement (a Newton start and its fit: eq 35; closed forms with switches: the rotation
 vector; the sine-family fold: euler_rodrigues) in fresh interpreters made to behave like other
@@ -22,9 +22,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symrot.evaluation import log_grid, model_function
-from symrot.newton_start import chebyshev_interpolant, clenshaw
-from symrot.parsing import PHI
+from symrot.core.parsing import PHI
+from symrot.plan.evaluation import log_grid, model_function
+from symrot.plan.newton_start import chebyshev_interpolant, clenshaw
 
 from .blas_core import openblas_core
 
@@ -35,7 +35,7 @@ import sys
 from tests.blas_core import openblas_core
 from symrot.api import derive
 from symrot.backends.numpy_backend import module_source
-from symrot.plan import evaluation_plan
+from symrot.plan.builder import evaluation_plan
 import mpmath.libmp
 import sympy.external.gmpy
 sys.stdout.write(str(openblas_core()) + "\\0")
@@ -102,7 +102,7 @@ def test_a_remembered_model_call_is_the_call_and_its_result_belongs_to_the_calle
     the same call dozens of times): a repeated call returns the same values in the same dtype, a
     caller that writes into a result changes no later one, and arguments that differ in one lane,
     in dtype or in shape are other calls."""
-    from symrot import evaluation
+    from symrot.plan import evaluation
 
     evaluation._ARRAYS.clear()
     sine = model_function(sp.sin(PHI / 2), [PHI])
@@ -126,7 +126,7 @@ def test_a_remembered_model_call_is_the_call_and_its_result_belongs_to_the_calle
 def test_a_model_source_is_printed_once_per_form_and_can_come_from_another_process() -> None:
     """Model sources are remembered per (form, variables): the plan prints the candidate forms'
     models where it computes the forms (half in a forked child) and takes the child's sources."""
-    from symrot import evaluation
+    from symrot.plan import evaluation
 
     form = sp.cos(PHI / 3) / (1 + PHI**2)
     key = evaluation.model_key(form, [PHI])
@@ -172,7 +172,7 @@ def test_chebyshev_interpolant_reproduces_a_polynomial_exactly() -> None:
 
 def test_symrot_fixes_the_dummy_base_when_imported() -> None:
     """SymPy draws the base of its Dummy numbering at random per process (symrot.entry)."""
-    from symrot.parsing import DUMMY_BASE
+    from symrot.core.parsing import DUMMY_BASE
 
     assert sp.Dummy._base_dummy_index == DUMMY_BASE
 
@@ -206,7 +206,7 @@ def test_symrot_keeps_sympys_assumption_facts_in_their_listed_order() -> None:
     """SymPy shuffles the facts its assumptions system tries with a generator seeded from the OS,
     and the order decides whether a sign query answers: ``derive 'sinh(phi)' --emit numpy`` wrote
     one of two modules (the base-angle reduction of K₂ returned either sign arrangement), so the
-    next test failed in one run of three (symrot.parsing turns the shuffle off)."""
+    next test failed in one run of three (symrot.core.parsing turns the shuffle off)."""
     import importlib
 
     facts = list(range(32))

@@ -8,9 +8,9 @@ import sympy as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from symrot.errors import NonAnalyticError
-from symrot.parsing import PHI, parse_expression
-from symrot.series import coefficient_list, compose_even_in_x, revert, taylor_series
+from symrot.core.errors import NonAnalyticError
+from symrot.core.parsing import PHI, parse_expression
+from symrot.core.series import coefficient_list, compose_even_in_x, revert, taylor_series
 
 SIMPLE = [
     "sin(phi)/phi", "tan(phi/4)", "(1 - cos(phi))/phi**2", "exp(phi)*cos(phi)",
@@ -123,7 +123,7 @@ def test_exact_rational_coefficients_survive_the_symbolic_domain() -> None:
     """pi/2 − acos(φ) has its series in the EX domain (pi in the constant term); its φ^27
     coefficient 1300075/226492416 once went through nsimplify, which returned an irrational number
     equal to 15 digits only, so the series was wrong and reverting it ran for minutes."""
-    from symrot.series_engine import exact_number
+    from symrot.core.series_engine import exact_number
 
     rational = sp.Rational(1300075, 226492416)
     assert exact_number(rational) == rational

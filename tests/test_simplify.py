@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 import sympy as sp
 
-from symrot.parsing import PHI
-from symrot.simplify import complexity, simplest
+from symrot.core.parsing import PHI
+from symrot.core.simplify import complexity, simplest
 
 
 def test_numbers_beyond_the_str_digit_limit_are_ranked_and_simplified() -> None:
@@ -16,9 +16,9 @@ def test_numbers_beyond_the_str_digit_limit_are_ranked_and_simplified() -> None:
 
 
 def test_the_remainder_modulo_the_circle_is_sympys() -> None:
-    """The ring-arithmetic remainder (symrot.simplify._reduced_modulo) is sp.reduced's, also with
+    """The ring-arithmetic remainder (symrot.core.simplify._reduced_modulo) is sp.reduced's, also with
     coefficients outside QQ (√3), which take sp.reduced itself."""
-    from symrot.simplify import _reduced_modulo
+    from symrot.core.simplify import _reduced_modulo
 
     s, c, o = sp.symbols("s c o")
     relation = s**2 + c**2 - 1
@@ -32,7 +32,7 @@ def test_tangents_of_two_frequencies_reduce_or_stop_at_the_size_cap() -> None:
     """Coefficients of tan(φ/3) + 8 tan(3φ/4)/9 (base angle φ/12, multiples up to 9): the
     reduction expanded its Expr tree for 4.5 s and `derive` stopped at the 5 s safety bound. A small
     one reduces and keeps its value; the largest is beyond REDUCTION_DEGREE and is not factored."""
-    from symrot.simplify import base_angle_reduction
+    from symrot.core.simplify import base_angle_reduction
 
     t = sp.tan(PHI / 3) + 8 * sp.tan(3 * PHI / 4) / 9
     slope = sp.tan(PHI / 3) ** 2 / 3 + 2 * sp.tan(3 * PHI / 4) ** 2 / 3 + 1
@@ -49,7 +49,7 @@ def test_a_large_reduction_is_refused_by_size_not_time() -> None:
     """tan(2φ)cosh(φ/3)/4 + 3 sin(2φ/3)/(4(φ² + 1)) (hypothesis row 4): the reduction of its
     coefficient 4 sin²(φ/2)/(p² p′) ran past the 5 s safety bound (polynomials of up to 490 terms
     in sin, cos, φ and cosh(φ/3)); it is now refused by the term and degree caps."""
-    from symrot.simplify import base_angle_reduction
+    from symrot.core.simplify import base_angle_reduction
 
     p = sp.tan(2 * PHI) * sp.cosh(PHI / 3) / 4 + 3 * sp.sin(2 * PHI / 3) / (4 * (PHI**2 + 1))
     assert base_angle_reduction(4 * sp.sin(PHI / 2) ** 2 / (p**2 * sp.diff(p, PHI))) is None
@@ -60,7 +60,7 @@ def test_trigsimp_sees_hyperbolic_functions_as_symbols(monkeypatch: pytest.Monke
     trigsimp rewrote the hyperbolic functions through imaginary arguments (3.7 s under load, the
     safety bound met in CI); it now gets them as opaque symbols and returns the same contraction,
     tan² + 1 = 1/cos², with the hyperbolic functions restored."""
-    from symrot import simplify
+    from symrot.core import simplify
 
     factor = (6 * (sp.tan(2 * PHI) ** 2 + 1) * sp.cosh(PHI / 3) + sp.tan(2 * PHI) * sp.sinh(PHI / 3)
               + 6 * sp.cos(2 * PHI / 3) / (PHI**2 + 1))
@@ -82,8 +82,8 @@ def test_trigsimp_sees_hyperbolic_functions_as_symbols(monkeypatch: pytest.Monke
 
 _ROW_1_REDUCTION = """
 import sympy as sp
-from symrot.parsing import PHI
-from symrot.simplify import base_angle_reduction
+from symrot.core.parsing import PHI
+from symrot.core.simplify import base_angle_reduction
 p = (PHI**3 * sp.sqrt(PHI**2 / 2 + 1) / 4 + 2 * sp.sqrt(PHI**2 + 1) * sp.asinh(PHI / 4)
      + 2 * sp.tan(PHI / 4) * sp.cosh(3 * PHI / 4))
 print(sp.srepr(base_angle_reduction((1 - sp.cos(PHI)) / p**2)))
@@ -112,7 +112,7 @@ def test_the_reduction_is_the_same_under_every_string_hash_seed() -> None:
 def test_factoring_skips_factors_that_are_plainly_irreducible(monkeypatch: pytest.MonkeyPatch) -> None:
     """A square-free factor of degree one in some symbol with coprime coefficients there is not
     handed to ``sp.factor`` (Wang's algorithm); the others are, and the product is unchanged."""
-    from symrot import simplify
+    from symrot.core import simplify
 
     a, b, c = sp.symbols("a b c")
     linear = a * b + c**3 + 2  # degree one in a, coefficients b and c^3 + 2 coprime

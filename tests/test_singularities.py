@@ -7,10 +7,10 @@ import time
 import pytest
 import sympy as sp
 
-from symrot.core import derive_expression
-from symrot.parsing import parse_expression
-from symrot.registry import PAPER_TABLE_1_VALIDITY, family_member, lookup
-from symrot.singularities import _validity_of, validity
+from symrot.core.derivation import derive_expression
+from symrot.core.parsing import parse_expression
+from symrot.core.registry import PAPER_TABLE_1_VALIDITY, family_member, lookup
+from symrot.core.singularities import _validity_of, validity
 
 pi = sp.pi
 EXPECTED = {
@@ -78,7 +78,7 @@ def test_analysis_is_fast() -> None:
 
 
 def test_symbolic_candidates_find_poles_inside_tan_and_zeros_of_p_prime() -> None:
-    from symrot.singularities import _symbolic_candidates
+    from symrot.core.singularities import _symbolic_candidates
 
     p = 2 * sp.tan(parse_expression("phi") / 2)
     poles, confirmed = _symbolic_candidates(p, sp.diff(p, parse_expression("phi")))
@@ -113,9 +113,9 @@ def test_the_edge_of_the_real_domain_is_a_singularity(text: str, edge: sp.Expr, 
 
 
 def test_solveset_is_tried_on_one_frequency_or_on_sines_and_cosines_only() -> None:
-    """A shape decides (symrot.singularities._one_frequency_or_polynomial): solveset took 7–400 s
+    """A shape decides (symrot.core.singularities._one_frequency_or_polynomial): solveset took 7–400 s
     on p′ of sums of tangents of several frequencies; their edges are then located numerically."""
-    from symrot.singularities import _one_frequency_or_polynomial
+    from symrot.core.singularities import _one_frequency_or_polynomial
 
     shapes = {"tan(phi/4)**2 + 1": True, "sin(phi) + sin(2*phi)/4": True, "cos(phi/3) + cos(phi/2)": True,
               "tan(phi/2)**2/2 + cos(phi)/2 + 1/2": False, "tan(phi/3)**2 + tan(3*phi/4)**2": False}
@@ -146,7 +146,7 @@ def test_infinitely_many_zeros_are_polished_only_near_the_smallest_angles() -> N
     """p′ = cos(sinh φ) cosh φ of sin(sinh φ) vanishes wherever sinh φ = π/2 + kπ: ~10⁵ zeros in
     (0, 4π]. At most MAX_CANDIDATES brackets per quantity are polished (smallest angles first); the
     edge is the first fold, asinh(π/2)."""
-    from symrot.singularities import MAX_CANDIDATES, QUANTITIES
+    from symrot.core.singularities import MAX_CANDIDATES, QUANTITIES
 
     result = validity(derive_expression(parse_expression("sin(sinh(phi))")))
     assert abs(result.phi_max_float - float(sp.asinh(sp.pi / 2))) < 1e-12
@@ -154,7 +154,7 @@ def test_infinitely_many_zeros_are_polished_only_near_the_smallest_angles() -> N
 
 
 def test_the_scale_of_a_base_angle_is_read_without_simplify() -> None:
-    from symrot.algebraic import S, linear_scale
+    from symrot.plan.algebraic import S, linear_scale
 
     assert linear_scale(S / 4) == 4 and linear_scale(3 * S / 2) == sp.Rational(2, 3)
     assert linear_scale(sp.sinh(S)) is None and linear_scale(-S) is None
@@ -178,7 +178,7 @@ def test_a_jump_of_p_prime_across_zero_ends_the_range() -> None:
 def test_every_cause_has_its_latex_meaning() -> None:
     """A cause without a meaning made ``symrot sheet`` fail on the functions that have it."""
     from symrot.backends.latex import CAUSE_MEANINGS
-    from symrot.singularities import CAUSES
+    from symrot.core.singularities import CAUSES
 
     assert set(CAUSES) == set(CAUSE_MEANINGS)
 
@@ -187,8 +187,8 @@ def test_a_cubic_in_the_cosine_is_left_to_the_numeric_scan() -> None:
     """p′ = 1 + 3 sin²φ cos φ of φ + sin³φ is a cubic in cos φ: solveset ran past its 15 s safety
     bound on it and ``derive`` exited 2. It is not attempted (shape, not time); the scan finds the
     zero of p′ at 1.97679 (3c³ − 3c − 1 = 0 in c = cos φ)."""
-    from symrot.parsing import PHI
-    from symrot.singularities import _low_degree_in_calls
+    from symrot.core.parsing import PHI
+    from symrot.core.singularities import _low_degree_in_calls
 
     assert not _low_degree_in_calls(1 + 3 * sp.sin(PHI) ** 2 * sp.cos(PHI))
     assert _low_degree_in_calls(sp.cos(PHI / 4)) and _low_degree_in_calls(1 / sp.cos(PHI) ** 2)

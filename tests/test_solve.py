@@ -10,11 +10,11 @@ import pytest
 import sympy as sp
 
 from symrot.cli import main
-from symrot.errors import SymrotError
-from symrot.functions import RealCbrt
-from symrot.parsing import PHI
-from symrot.registry import NAMED, family_member, lookup
-from symrot.solve import solve_property
+from symrot.core.errors import SymrotError
+from symrot.core.functions import RealCbrt
+from symrot.core.parsing import PHI
+from symrot.core.registry import NAMED, family_member, lookup
+from symrot.core.solve import solve_property
 
 PAPER = {
     "nu**2 = c*eps": (sp.sin(PHI), 1),  # eq 31, c = 1

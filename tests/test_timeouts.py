@@ -7,8 +7,8 @@ import time
 
 import pytest
 
-from symrot.errors import SymrotTimeout
-from symrot.timeouts import bounded, time_fallbacks, time_limit
+from symrot.core.errors import SymrotTimeout
+from symrot.core.timeouts import bounded, time_fallbacks, time_limit
 
 SPIN = 30.0
 """Seconds the interrupted work would run on its own: a limit of 0.05–0.1 s that works ends it long
@@ -51,7 +51,7 @@ def test_deterministic_mode_is_the_default_and_turns_a_time_fallback_into_an_err
     """By default a bounded step never silently falls back because the machine was slow (its
     result feeds derived forms and generated code): it gets SAFETY_FACTOR more time, and an expiry
     is an error. Only time_fallbacks() returns the fallback at the nominal bound."""
-    from symrot.timeouts import SAFETY_FACTOR, deterministic, is_deterministic
+    from symrot.core.timeouts import SAFETY_FACTOR, deterministic, is_deterministic
 
     assert is_deterministic()
     assert bounded(0.02, "fallback", spin, 0.05) == "finished"  # within 0.02 * SAFETY_FACTOR
@@ -138,8 +138,8 @@ def test_a_slow_machine_gets_the_same_simplified_form(monkeypatch: pytest.Monkey
     ulp). A machine on which every trigsimp takes 0.6 s longer must get the same form."""
     import sympy as sp
 
-    from symrot.parsing import PHI
-    from symrot.simplify import _trigsimp, simplest
+    from symrot.core.parsing import PHI
+    from symrot.core.simplify import _trigsimp, simplest
 
     expr = (PHI * (2 * sp.cos(PHI / 2) ** 2 - 1) - sp.sin(PHI)) / PHI**3
     fast = simplest.__wrapped__(expr)
@@ -190,8 +190,8 @@ def test_a_bounded_step_starts_from_the_same_sympy_random_state() -> None:
     import sympy as sp
     from sympy.core import random as sympy_random
 
-    from symrot.parsing import PHI
-    from symrot.simplify import base_angle_reduction
+    from symrot.core.parsing import PHI
+    from symrot.core.simplify import base_angle_reduction
 
     p = PHI**3 / 4 + sp.sin(2 * PHI) * sp.cos(PHI / 4) / 2
     det_h = 4 * sp.sin(PHI / 2) ** 2 / (p**2 * sp.diff(p, PHI))

@@ -1,4 +1,4 @@
-"""symrot.two_processes: work split between the process and a forked child gives what the process
+"""symrot.core.two_processes: work split between the process and a forked child gives what the process
 alone gives."""
 
 from __future__ import annotations
@@ -7,9 +7,9 @@ import os
 
 import sympy as sp
 
-from symrot.core import TENSOR_NAMES, derive_expression
-from symrot.parsing import PHI, parse_expression
-from symrot.two_processes import computed_in_two_processes, simplify_tensors
+from symrot.core.derivation import TENSOR_NAMES, derive_expression
+from symrot.core.parsing import PHI, parse_expression
+from symrot.core.two_processes import computed_in_two_processes, simplify_tensors
 
 
 def test_every_job_is_computed_once_and_half_of_them_in_the_child() -> None:

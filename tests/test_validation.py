@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 import sympy as sp
 
-from symrot.errors import InvalidGeneratingFunction
-from symrot.parsing import parse_expression
-from symrot.validation import validate
+from symrot.core.errors import InvalidGeneratingFunction
+from symrot.core.parsing import parse_expression
+from symrot.core.validation import validate
 
 
 @pytest.mark.parametrize(
@@ -63,8 +63,8 @@ def test_oddness_beyond_the_series_order_is_caught_numerically() -> None:
 
 def test_a_timeout_in_the_numeric_check_is_not_reported_as_a_bad_function(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    from symrot import validation
-    from symrot.errors import SymrotTimeout
+    from symrot.core import validation
+    from symrot.core.errors import SymrotTimeout
 
     def slow(*args: object, **kwargs: object) -> None:
         raise SymrotTimeout("derivation took longer than 60 s")

@@ -285,7 +285,7 @@ def emitted(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], Emitted
     from symrot.api import derive
     from symrot.backends.c_backend import header_source
     from symrot.backends.numpy_backend import module_source
-    from symrot.plan import evaluation_plan
+    from symrot.plan.builder import evaluation_plan
 
     built: dict[str, Emitted] = {}
 

@@ -164,7 +164,7 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
@@ -301,7 +301,7 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *p, double *H)
 {
@@ -445,7 +445,7 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
@@ -597,7 +597,7 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const double *p, double *G)
 {
@@ -742,7 +742,7 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const double *p, double *K)
 {
@@ -1762,7 +1762,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
@@ -1898,7 +1898,7 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float *p, float *H)
 {
@@ -2042,7 +2042,7 @@ static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], fl
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
@@ -2194,7 +2194,7 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
@@ -2338,7 +2338,7 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const float *p, float *K)
 {

@@ -161,7 +161,7 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
@@ -298,7 +298,7 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, double *H)
 {
@@ -458,7 +458,7 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
@@ -640,7 +640,7 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, double *G)
 {
@@ -784,7 +784,7 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, double *K)
 {
@@ -1868,7 +1868,7 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
@@ -2004,7 +2004,7 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
@@ -2161,7 +2161,7 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
@@ -2333,7 +2333,7 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
@@ -2477,7 +2477,7 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = 1/sqrt(sqrt(25 - x) + 5), u1 = sqrt(25 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p, float *K)
 {

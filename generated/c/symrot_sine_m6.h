@@ -279,7 +279,7 @@ static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = 1/sqrt(36 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, double *H)
 {
@@ -541,7 +541,7 @@ static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, double *G)
 {
@@ -676,7 +676,7 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, double *K)
 {
@@ -1792,7 +1792,7 @@ static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = 1/sqrt(36 - x).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, float *H)
 {
@@ -2053,7 +2053,7 @@ static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
@@ -2187,7 +2187,7 @@ static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p, float *K)
 {

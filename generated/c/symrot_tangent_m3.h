@@ -165,7 +165,7 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 9)**(-3/2).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
@@ -303,7 +303,7 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 9)**(-3/2), u1 = sqrt(x + 9).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, double *H)
 {
@@ -598,7 +598,7 @@ static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p, double *G)
 {
@@ -753,7 +753,7 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *p, double *K)
 {
@@ -1791,7 +1791,7 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 9)**(-3/2).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
@@ -1929,7 +1929,7 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 9)**(-3/2), u1 = sqrt(x + 9).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
@@ -2224,7 +2224,7 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
@@ -2379,7 +2379,7 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: s, phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float *p, float *K)
 {

@@ -161,7 +161,7 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
@@ -292,7 +292,7 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, double *H)
 {
@@ -539,7 +539,7 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 36)**(-3/2).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p, double *G)
 {
@@ -675,7 +675,7 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 36)**(-3/2), u1 = sqrt(x + 36).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 1.647e+06), Taylor degree 17/16 on |r| <= pi/4 (truncation < 2.9e-18), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *p, double *K)
 {
@@ -1665,7 +1665,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
@@ -1797,7 +1797,7 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi.
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, float *H)
 {
@@ -2045,7 +2045,7 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 36)**(-3/2).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
@@ -2181,7 +2181,7 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
  * vectors, library calls in a scalar pass, the coefficients in a branch-free pass
  * (sin/cos by the polynomial kernel), then the entries.
  * Scalar pass: phi, u0 = (x + 36)**(-3/2), u1 = sqrt(x + 36).
- * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.
+ * sin/cos: a - q pi/2 in three parts (exact for |a| < 400.6), Taylor degree 9/10 on |r| <= pi/4 (truncation < 2.5e-09), quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.
  */
 static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float *p, float *K)
 {

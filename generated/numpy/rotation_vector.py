@@ -1357,7 +1357,7 @@ def _skew(v):
 
 
 def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
-    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.derivatives)."""
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
     pa = _cross(p, a)
     ppa = _cross(p, pa)
     u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
@@ -1369,7 +1369,7 @@ def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
 
 
 def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
-    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.derivatives)."""
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
     pa = _cross(p, a)
     ppa = _cross(p, pa)
     pta = numpy.einsum('...i,...i->...', p, a)

@@ -5,6 +5,6 @@ symbolically under a time limit or at 50 digits on random points and trajectorie
 :func:`run_all` runs them and :mod:`symrot.audit.report` renders the table and ``docs/errata.md``.
 """
 
-from .checks import Check, Outcome, Result, all_checks, run_all
+from symrot.audit.checks import Check, Outcome, Result, all_checks, run_all
 
 __all__ = ["Check", "Outcome", "Result", "all_checks", "run_all"]

@@ -13,8 +13,8 @@ from typing import Any
 import mpmath
 import sympy as sp
 
-from .claims import dual_outcome
-from .numeric import (
+from symrot.audit.claims import dual_outcome
+from symrot.audit.numeric import (
     TOLERANCE,
     Vector,
     fmt,
@@ -24,7 +24,7 @@ from .numeric import (
     rotation,
     vector,
 )
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
 
 E = sp.symbols("e0:4")
 F = sp.symbols("f0:4")

@@ -13,11 +13,9 @@ from collections.abc import Callable
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from ..validation import validate
-from .appendix_a import SAMPLES, F, Q, compose, conjugate, exact_identity, m_right
-from .claims import Claim, settle
-from .numeric import (
+from symrot.audit.appendix_a import SAMPLES, F, Q, compose, conjugate, exact_identity, m_right
+from symrot.audit.claims import Claim, settle
+from symrot.audit.numeric import (
     TOLERANCE,
     Trajectory,
     cross,
@@ -27,8 +25,10 @@ from .numeric import (
     relative,
     vector,
 )
-from .proof import EPS, MU, NU, U_VECTOR, P
-from .records import HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.proof import EPS, MU, NU, U_VECTOR, P
+from symrot.audit.records import HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.core.parsing import PHI
+from symrot.core.validation import validate
 
 
 def _quaternion_path(label: str) -> tuple[Trajectory, Callable[[mpmath.mpf], mpmath.matrix]]:

@@ -12,14 +12,14 @@ from typing import Any
 import mpmath
 import sympy as sp
 
-from ..core import root_tangent
-from ..parsing import PHI
-from .claims import Claim, evidence, settle, settle_dual
-from .kinematics import describe, tensor_at, trajectory_sweep
-from .numeric import TOLERANCE, Trajectory, derivative, fmt, precision, relative, skew
-from .proof import EPS, EYE, GENERIC_P, MU, NU, U_CROSS, P, core_tensor, generic
-from .records import HOLDS, AuditInconsistency, Check, Outcome, definition
-from .subjects import scope, subject
+from symrot.audit.claims import Claim, evidence, settle, settle_dual
+from symrot.audit.kinematics import describe, tensor_at, trajectory_sweep
+from symrot.audit.numeric import TOLERANCE, Trajectory, derivative, fmt, precision, relative, skew
+from symrot.audit.proof import EPS, EYE, GENERIC_P, MU, NU, U_CROSS, P, core_tensor, generic
+from symrot.audit.records import HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.subjects import scope, subject
+from symrot.core.derivation import root_tangent
+from symrot.core.parsing import PHI
 
 ORDERS = range(1, 7)
 PX = P * U_CROSS
@@ -124,7 +124,7 @@ CHECKS = [
         "definition",
         lambda: definition(
             "defines the m-th root (the rotation by phi/m about u, eq 1); used by (77)-(85), "
-            "(102) and the core (symrot.core.root_tensor)"
+            "(102) and the core (symrot.core.derivation.root_tensor)"
         ),
     ),
     Check("77", r"\mathbf{R} = \mathbf{G}_{(m)}{}^{m}", "symbolic + numeric", _eq77),
@@ -148,7 +148,8 @@ CHECKS = [
         "80",
         r"\boldsymbol{\gamma}_{(m)} = \mathbf{K}_{(m)} \dot{\mathbf{p}}",
         "definition",
-        lambda: definition("defines K_(m); the core derives it from (79) (symrot.core.root_tangent)"),
+        lambda: definition("defines K_(m); the core derives it from (79) "
+                           "(symrot.core.derivation.root_tangent)"),
     ),
     Check(
         "text after (80): H = K_(1)",

@@ -3,7 +3,7 @@
 Power series of (φ×) are compared in the axial-tensor algebra: (φ×)^k = φ^k U^k with
 U^(2j+1) = (−1)^j U and U^(2j) = (−1)^(j−1) U² (j ≥ 1), so a series in (φ×) is a triple of power
 series in φ on I, U, U², compared exactly (rational coefficients) with the exact Taylor series of
-the core's tensors for p = φ (:mod:`symrot.series`), and summed numerically at 60 digits.
+the core's tensors for p = φ (:mod:`symrot.core.series`), and summed numerically at 60 digits.
 """
 
 from __future__ import annotations
@@ -14,13 +14,23 @@ from typing import Any
 import mpmath
 import sympy as sp
 
-from ..core import root_tangent, root_tensor
-from ..parsing import PHI
-from ..series import coefficient_list, taylor_series
-from .claims import Claim, dual_outcome, settle
-from .numeric import TOLERANCE, fmt, precision, random_angle, random_axis, relative, rng, rotation, skew
-from .proof import NU, U_VECTOR, P
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.claims import Claim, dual_outcome, settle
+from symrot.audit.numeric import (
+    TOLERANCE,
+    fmt,
+    precision,
+    random_angle,
+    random_axis,
+    relative,
+    rng,
+    rotation,
+    skew,
+)
+from symrot.audit.proof import NU, U_VECTOR, P
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.core.derivation import root_tangent, root_tensor
+from symrot.core.parsing import PHI
+from symrot.core.series import coefficient_list, taylor_series
 
 ORDER = 24
 """Exact series comparisons through φ^(ORDER − 1)."""

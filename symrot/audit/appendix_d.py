@@ -11,12 +11,9 @@ from typing import Any
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from ..registry import family_member
-from ..validation import validate
-from .claims import Claim, dual_outcome, evidence, settle, settle_dual, sweep_function
-from .kinematics import describe, tensor_at, trajectory_sweep
-from .numeric import (
+from symrot.audit.claims import Claim, dual_outcome, evidence, settle, settle_dual, sweep_function
+from symrot.audit.kinematics import describe, tensor_at, trajectory_sweep
+from symrot.audit.numeric import (
     TOLERANCE,
     Vector,
     cross,
@@ -30,9 +27,12 @@ from .numeric import (
     rotation,
     skew,
 )
-from .proof import EPS, EYE, MU, NU, U_CROSS, P, at_e1, core_tensor, identity
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
-from .subjects import Subject, scope, subject, subjects
+from symrot.audit.proof import EPS, EYE, MU, NU, U_CROSS, P, at_e1, core_tensor, identity
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.subjects import Subject, scope, subject, subjects
+from symrot.core.parsing import PHI
+from symrot.core.registry import family_member
+from symrot.core.validation import validate
 
 ORDERS = range(1, 7)
 ZETA = sp.tan(PHI / 2)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import time
 
-from .records import (
+from symrot.audit.records import (
     DEFINITION,
     ERRATUM,
     HOLDS,
@@ -21,7 +21,7 @@ from .records import (
 
 
 def _registry() -> list[Check]:
-    from . import (
+    from symrot.audit import (
         appendix_a,
         appendix_a_rates,
         appendix_b,

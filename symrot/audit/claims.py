@@ -18,8 +18,7 @@ from typing import Any
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from .numeric import (
+from symrot.audit.numeric import (
     REFUTED,
     TOLERANCE,
     Vector,
@@ -31,9 +30,10 @@ from .numeric import (
     relative,
     rng,
 )
-from .proof import DP, U1, U2, U3, P, Verdict, at_e1, identity
-from .records import ERRATUM, HOLDS, AuditInconsistency, Outcome
-from .subjects import Subject, subject, subjects
+from symrot.audit.proof import DP, U1, U2, U3, P, Verdict, at_e1, identity
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Outcome
+from symrot.audit.subjects import Subject, subject, subjects
+from symrot.core.parsing import PHI
 
 ARGUMENTS = (PHI, P, DP, U1, U2, U3)
 POINTS = 3

@@ -13,9 +13,9 @@ from collections.abc import Callable, Sequence
 import mpmath
 import sympy as sp
 
-from .claims import Sweep, compile_numeric
-from .numeric import Trajectory, Vector, derivative, fmt, fmt_vector, precision, relative
-from .subjects import Subject, subjects
+from symrot.audit.claims import Sweep, compile_numeric
+from symrot.audit.numeric import Trajectory, Vector, derivative, fmt, fmt_vector, precision, relative
+from symrot.audit.subjects import Subject, subjects
 
 TRAJECTORIES = 2
 """Random trajectories per generating function."""

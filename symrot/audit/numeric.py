@@ -15,8 +15,8 @@ from typing import Any, TypeAlias
 import mpmath
 import sympy as sp
 
-from ..functions import mpmath_namespace
-from ..parsing import PHI
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
 
 DIGITS = 60
 TOLERANCE = mpmath.mpf(10) ** -45

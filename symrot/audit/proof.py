@@ -2,7 +2,7 @@
 
 *Generic generating function.* Identities claimed "for any p" are proved once for all p: p and
 p′ become free symbols ``p``, ``dp`` (ν = 2 sin(φ/2)/p (15), ε = 2 tan(φ/2)/p (16), μ = 1/p′
-(21)), and the truth is the symbolic core (:func:`symrot.core.tensor_definitions` applied to an
+(21)), and the truth is the symbolic core (:func:`symrot.core.derivation.tensor_definitions` applied to an
 undefined function p(φ)).
 
 *One axis suffices.* Every tensor built from I and (u×) by sums, products, inverses and
@@ -22,10 +22,10 @@ from functools import cache
 
 import sympy as sp
 
-from ..core import tensor_definitions
-from ..parsing import PHI
-from ..simplify import base_angle_reduction
-from ..timeouts import bounded
+from symrot.core.derivation import tensor_definitions
+from symrot.core.parsing import PHI
+from symrot.core.simplify import base_angle_reduction
+from symrot.core.timeouts import bounded
 
 P, DP = sp.symbols("p dp")
 """Generic p(φ) and p′(φ) as free symbols."""

@@ -9,8 +9,8 @@ from __future__ import annotations
 from collections import Counter
 from typing import Any
 
-from .records import ERRATUM, NOT_RUN, Result
-from .subjects import names
+from symrot.audit.records import ERRATUM, NOT_RUN, Result
+from symrot.audit.subjects import names
 
 REGENERATE = "make audit"
 """The command that rewrites docs/errata.md (``symrot audit --write docs/errata.md``)."""

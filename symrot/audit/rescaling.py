@@ -14,9 +14,8 @@ from collections.abc import Callable
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from .claims import Claim, settle, sweep_function
-from .numeric import (
+from symrot.audit.claims import Claim, settle, sweep_function
+from symrot.audit.numeric import (
     REFUTED,
     TOLERANCE,
     Vector,
@@ -32,9 +31,10 @@ from .numeric import (
     rotation,
     unit,
 )
-from .proof import NU, P, is_zero
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
-from .subjects import Subject, scope, subjects
+from symrot.audit.proof import NU, P, is_zero
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
+from symrot.audit.subjects import Subject, scope, subjects
+from symrot.core.parsing import PHI
 
 WM = 4 * sp.tan(PHI / 4)
 SINE4 = 4 * sp.sin(PHI / 4)

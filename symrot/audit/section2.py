@@ -10,9 +10,8 @@ from __future__ import annotations
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from .claims import Claim, settle
-from .numeric import (
+from symrot.audit.claims import Claim, settle
+from symrot.audit.numeric import (
     REFUTED,
     TOLERANCE,
     Trajectory,
@@ -29,8 +28,9 @@ from .numeric import (
     rotation,
     skew,
 )
-from .proof import EYE, U_CROSS, U_VECTOR, at_e1, is_zero, matrix_is_zero
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
+from symrot.audit.proof import EYE, U_CROSS, U_VECTOR, at_e1, is_zero, matrix_is_zero
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
+from symrot.core.parsing import PHI
 
 R_EQ1 = EYE + sp.sin(PHI) * U_CROSS + (1 - sp.cos(PHI)) * U_CROSS**2
 """Eq (1) as printed: R = I + sin φ (u×) + (1 − cos φ)(u×)²."""

@@ -12,12 +12,9 @@ from __future__ import annotations
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from ..series import coefficient_list, taylor_series
-from ..validation import validate
-from .claims import Claim, Sweep, conclude, evidence, settle, sweep_function
-from .kinematics import tensor_at
-from .numeric import (
+from symrot.audit.claims import Claim, Sweep, conclude, evidence, settle, sweep_function
+from symrot.audit.kinematics import tensor_at
+from symrot.audit.numeric import (
     Vector,
     cross,
     dot,
@@ -28,9 +25,12 @@ from .numeric import (
     skew,
     unit,
 )
-from .proof import DP, EPS, EYE, NU, U_CROSS, P, Verdict, at_e1, core_tensor, identity
-from .records import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
-from .subjects import Subject, scope, subjects
+from symrot.audit.proof import DP, EPS, EYE, NU, U_CROSS, P, Verdict, at_e1, core_tensor, identity
+from symrot.audit.records import DEFINITION, ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.subjects import Subject, scope, subjects
+from symrot.core.parsing import PHI
+from symrot.core.series import coefficient_list, taylor_series
+from symrot.core.validation import validate
 
 PX = P * U_CROSS
 """(p×) = p (u×) (eq 11)."""
@@ -167,7 +167,7 @@ def series_limits(label: str, expressions: dict[str, tuple[sp.Expr, int]]) -> Ou
             if value != expected:
                 raise AuditInconsistency(f"{label}: lim {name} = {value} for {fn.name}")
     limits = ", ".join(f"lim {name} = {expected}" for name, (_, expected) in expressions.items())
-    return Outcome(HOLDS, f"exact series (symrot.series): {limits} at phi -> 0 [{scope()}]")
+    return Outcome(HOLDS, f"exact series (symrot.core.series): {limits} at phi -> 0 [{scope()}]")
 
 
 def _kappa_one() -> Outcome:
@@ -213,7 +213,7 @@ CHECKS = [
         r"\lim_{\varphi \to 0} \frac{p(\varphi)}{\varphi} = \kappa",
         "definition",
         lambda: definition(
-            "defines kappa; symrot.validation computes it from the exact Taylor "
+            "defines kappa; symrot.core.validation computes it from the exact Taylor "
             "series (used by (13), the kappa statements after (32), (33), (75), (98), "
             "(101))"
         ),

@@ -13,10 +13,9 @@ from collections.abc import Callable
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from .claims import Claim, conclude, evidence, sweep_function
-from .kinematics import describe, tensor_at, trajectory_sweep
-from .numeric import (
+from symrot.audit.claims import Claim, conclude, evidence, sweep_function
+from symrot.audit.kinematics import describe, tensor_at, trajectory_sweep
+from symrot.audit.numeric import (
     TOLERANCE,
     Trajectory,
     Vector,
@@ -26,10 +25,11 @@ from .numeric import (
     relative,
     skew,
 )
-from .proof import DP, EPS, EYE, MU, NU, P, Verdict, at_e1, core_tensor, identity
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
-from .section31 import PX, canonical_matrix, canonical_outcome, series_limits
-from .subjects import Subject, scope, subjects
+from symrot.audit.proof import DP, EPS, EYE, MU, NU, P, Verdict, at_e1, core_tensor, identity
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.section31 import PX, canonical_matrix, canonical_outcome, series_limits
+from symrot.audit.subjects import Subject, scope, subjects
+from symrot.core.parsing import PHI
 
 H22 = MU * EYE + NU**2 / 2 * PX + (MU - NU**2 / EPS) / P**2 * PX**2
 H_INVERSE26 = EYE / MU - PX / 2 - (1 / EPS - 1 / MU) / P**2 * PX**2

@@ -10,14 +10,14 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..core import root_tangent, root_tensor
-from ..functions import RealCbrt
-from ..parsing import PHI
-from ..registry import family_member, lookup
-from ..validation import validate
-from .claims import Claim, settle
-from .proof import DP, EPS, MU, NU, P, is_zero
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.audit.claims import Claim, settle
+from symrot.audit.proof import DP, EPS, MU, NU, P, is_zero
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome, definition
+from symrot.core.derivation import root_tangent, root_tensor
+from symrot.core.functions import RealCbrt
+from symrot.core.parsing import PHI
+from symrot.core.registry import family_member, lookup
+from symrot.core.validation import validate
 
 C = sp.Symbol("c", positive=True)
 P0 = sp.cos(PHI / 4)

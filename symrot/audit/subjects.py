@@ -14,9 +14,9 @@ from functools import lru_cache
 import mpmath
 import sympy as sp
 
-from ..parsing import PHI
-from ..registry import TABLE_1, family_member, lookup
-from .numeric import Scalar, mp_function, precision
+from symrot.audit.numeric import Scalar, mp_function, precision
+from symrot.core.parsing import PHI
+from symrot.core.registry import TABLE_1, family_member, lookup
 
 FAMILY_ORDERS = range(1, 7)
 SCAN_POINTS = 400

@@ -2,7 +2,7 @@
 
 Columns as printed: name, p(φ), p′, ν, ε, validity range. The p cell is checked against the
 numbered equation of the named parameterization; p′, ν, ε against the core's scalar functions
-(symbolic and numeric); the validity range against :func:`symrot.singularities.validity` (the
+(symbolic and numeric); the validity range against :func:`symrot.core.singularities.validity` (the
 first singular angle), with an independent exact counterexample where the table is wrong.
 """
 
@@ -14,13 +14,13 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..core import derive_expression, scalar_definitions
-from ..parsing import PHI
-from ..registry import lookup
-from ..singularities import validity
-from .claims import Claim, evidence
-from .records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
-from .section2 import R_EQ1
+from symrot.audit.claims import Claim, evidence
+from symrot.audit.records import ERRATUM, HOLDS, AuditInconsistency, Check, Outcome
+from symrot.audit.section2 import R_EQ1
+from symrot.core.derivation import derive_expression, scalar_definitions
+from symrot.core.parsing import PHI
+from symrot.core.registry import lookup
+from symrot.core.singularities import validity
 
 HALF, QUARTER = PHI / 2, PHI / 4
 
@@ -168,12 +168,12 @@ def _validity_cell(row: Row) -> Callable[[], Outcome]:
         causes = "; ".join(sorted({s.cause for s in first}))
         found = f"first singular angle phi = {result.phi_max} ({causes})"
         if sp.simplify(result.phi_max - row.validity[1]) == 0:
-            return Outcome(HOLDS, f"symrot.singularities: {found}")
+            return Outcome(HOLDS, f"symrot.core.singularities: {found}")
         if row.key != "linear":
             raise AuditInconsistency(f"{row.key}: validity {row.validity[1]} vs {found}")
         return Outcome(
             ERRATUM,
-            f"symrot.singularities: {found}. {_linear_counterexample()}",
+            f"symrot.core.singularities: {found}. {_linear_counterexample()}",
             rf"<\pm {sp.latex(result.phi_max)} \text{{ (mu = 1/cos(phi) is infinite and p = "
             r"sin(phi) stops being monotonic at |phi| = pi/2)}",
         )

@@ -12,7 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..errors import SymrotError
+from symrot.core.errors import SymrotError
 
 Emitter = Callable[[Any, str, Path], list[Path]]
 EMITTERS: dict[str, str] = {"numpy": "symrot.backends.numpy_backend:emit",

@@ -1,6 +1,6 @@
 """Array-framework backends (JAX, PyTorch): print an ``EvaluationPlan`` as a branch-free module.
 
-One printer and one template (``symrot/templates/array_module.py.j2``) serve both frameworks; the
+One printer and one template (``symrot/backends/templates/array_module.py.j2``) serve both frameworks; the
 thin adapters :mod:`symrot.backends.jax_backend` and :mod:`symrot.backends.torch_backend` only
 choose the framework's prelude.  Unlike the NumPy module, which evaluates each branch on its own
 lanes, every ``Branch`` here is evaluated on all lanes and selected with ``where``, each side on
@@ -28,23 +28,7 @@ from typing import Any
 import mpmath
 import sympy as sp
 
-from ..algebraic import D, X
-from ..atomic import write_atomic
-from ..newton_start import FarStart
-from ..parsing import PHI
-from ..plan import (
-    Algebraic,
-    Branch,
-    ClosedAngle,
-    Constant,
-    EvaluationPlan,
-    NewtonAngle,
-    S,
-    evaluation_plan,
-    half_angle,
-)
-from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
-from .numpy_backend import (
+from symrot.backends.numpy_backend import (
     SUFFIX,
     angle_low_helpers,
     complement_low,
@@ -54,8 +38,16 @@ from .numpy_backend import (
     print_expression,
     uses_phi,
 )
-from .subexpressions import common_subexpressions
-from .templating import render
+from symrot.backends.subexpressions import common_subexpressions
+from symrot.backends.templating import render
+from symrot.core.atomic import write_atomic
+from symrot.core.parsing import PHI
+from symrot.plan.algebraic import D, S, X
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import half_angle
+from symrot.plan.ir import Algebraic, Branch, ClosedAngle, Constant, EvaluationPlan, NewtonAngle
+from symrot.plan.newton_start import FarStart
+from symrot.plan.quaternion import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 
 FRAMEWORKS = ("jax", "torch")
 
@@ -212,7 +204,7 @@ def _coefficient_lines(coefficient: Any, suffix: str, complement: sp.Rational | 
 
 
 def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
-    """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.quaternion_plan)."""
+    """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.plan.quaternion)."""
     if scale.algebraic is not None:
         expression = scale.algebraic.subs(E0, sp.Symbol("e0"))
         lines = ["e0 = _wide(e0)"] if suffix == "32" else []

@@ -1,6 +1,6 @@
 """Header-only C99 backend: ``symrot derive EXPR --name NAME --emit c`` → ``symrot_NAME.h``.
 
-Prints the evaluation plan of :mod:`symrot.plan` (one per precision) through
+Prints the evaluation plan of :mod:`symrot.plan.builder` (one per precision) through
 ``templates/c/header.h.j2``; it builds no plan of its own. For each function of
 :data:`~symrot.backends.c_functions.FUNCTIONS` the header has a double version and a float version
 (suffix ``_f``, float math functions, the float32 plan), and matrix functions also a ``_batch``
@@ -19,23 +19,23 @@ from typing import Any
 
 import sympy as sp
 
-from ..atomic import write_atomic
-from ..core import Derivation, derive_expression
-from ..derivatives import rate_vector, tensor_derivative
-from ..errors import SymrotError
-from ..forked import first_here_others_in_children
-from ..plan import evaluation_plan
-from ..plan_ir import ClosedAngle, EvaluationPlan
-from ..registry import NAMED, find_by_expression, lookup
-from .c_aliasing import stored_last
-from .c_batch import DEFAULT_BLOCK, BatchWriter
-from .c_derivatives import DerivativeWriter
-from .c_functions import FUNCTIONS, CFunction
-from .c_operations import OperationWriter
-from .c_printer import PRECISIONS, Precision
-from .c_sincos import NEAREST
-from .c_writer import FunctionWriter
-from .templating import render
+from symrot.backends.c_aliasing import stored_last
+from symrot.backends.c_batch import DEFAULT_BLOCK, BatchWriter
+from symrot.backends.c_derivatives import DerivativeWriter
+from symrot.backends.c_functions import FUNCTIONS, CFunction
+from symrot.backends.c_operations import OperationWriter
+from symrot.backends.c_printer import PRECISIONS, Precision
+from symrot.backends.c_sincos import NEAREST
+from symrot.backends.c_writer import FunctionWriter
+from symrot.backends.templating import render
+from symrot.core.atomic import write_atomic
+from symrot.core.derivation import Derivation, derive_expression
+from symrot.core.derivatives import rate_vector, tensor_derivative
+from symrot.core.errors import SymrotError
+from symrot.core.forked import first_here_others_in_children
+from symrot.core.registry import NAMED, find_by_expression, lookup
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.ir import ClosedAngle, EvaluationPlan
 
 HEADER_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -46,8 +46,8 @@ class InvalidHeaderName(SymrotError):
 
 def header_source(plan: EvaluationPlan, name: str, expression: str | None = None) -> str:
     """The text of ``symrot_NAME.h`` for ``plan``: the float functions are printed in a forked
-    child while this process prints the double ones (:mod:`symrot.forked`), after the derivative
-    algebra both read (:func:`symrot.derivatives.tensor_derivative`, :func:`rate_vector`)."""
+    child while this process prints the double ones (:mod:`symrot.core.forked`), after the derivative
+    algebra both read (:func:`symrot.core.derivatives.tensor_derivative`, :func:`rate_vector`)."""
     if not HEADER_NAME.fullmatch(name):
         raise InvalidHeaderName(f"--name {name[:40]!r} is not a C identifier")
     tensor_derivative()

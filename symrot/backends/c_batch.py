@@ -40,11 +40,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..algebraic import D, S, X
-from ..functions import BoundedPower
-from ..parsing import PHI
-from ..plan_ir import Algebraic, Branch, Coefficient, Constant
-from .c_functions import (
+from symrot.backends.c_functions import (
     OUTPUT_NAMES,
     TENSOR_OF,
     CFunction,
@@ -53,10 +49,14 @@ from .c_functions import (
     tensor_coefficients,
     tensor_entries,
 )
-from .c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
-from .c_sincos import TRIG, SinCosWriter
-from .c_writer import HALF_LOW, PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
-from .subexpressions import common_subexpressions
+from symrot.backends.c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
+from symrot.backends.c_sincos import TRIG, SinCosWriter
+from symrot.backends.c_writer import HALF_LOW, PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
+from symrot.backends.subexpressions import common_subexpressions
+from symrot.core.functions import BoundedPower
+from symrot.core.parsing import PHI
+from symrot.plan.algebraic import D, S, X
+from symrot.plan.ir import Algebraic, Branch, Coefficient, Constant
 
 BLOCK = "SYMROT_BATCH_BLOCK"
 DEFAULT_BLOCK = 32

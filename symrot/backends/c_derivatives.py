@@ -5,11 +5,11 @@ Single calls in double and, suffixed ``_f``, float; no allocation; matrices row-
 
 * ``rotation_derivative(p, a, D)``, ``rotation_transpose_derivative``, ``tangent_derivative``,
   ``tangent_transpose_derivative``, ``tangent_inverse_derivative``: ∂(T a)/∂p printed entry by entry
-  from the form the core derives (:func:`symrot.derivatives.tensor_derivative`), with the planned
+  from the form the core derives (:func:`symrot.core.derivatives.tensor_derivative`), with the planned
   coefficients c_k and slopes c_k′ = dc_k/dx (Tᵀ: c1, c1′ negated); NaN outside the range, as
   every function of the header;
 * ``angular_acceleration(p, pdot, pddot, alpha)``: α = H p̈ + Ḣ ṗ with Ḣ ṗ from
-  :func:`symrot.derivatives.rate_value`;
+  :func:`symrot.core.derivatives.rate_value`;
 * ``compose_jacobians(p1, p2, J1, J2)``: ∂p₃/∂p₁ = H(p₃)⁻¹ R(p₂) H(p₁), ∂p₃/∂p₂ = H(p₃)⁻¹ H(p₂) for
   p₃ = compose(p₁, p₂); ``rescale_jacobian(p, J)``: H(p_r)⁻¹ H(p) when p is rescaled to p_r, I when
   it is kept. Both return the status of compose/rescale (0, or 1 with NaN outputs).
@@ -23,12 +23,12 @@ from typing import Any
 
 import sympy as sp
 
-from ..derivatives import SLOPES, VALUES, rate_value, rate_vector, slope_name, tensor_derivative
-from ..plan_ir import EvaluationPlan
-from .c_functions import P, vector_entries
-from .c_printer import Precision
-from .c_writer import FunctionWriter, Statement, ops_of
-from .subexpressions import common_subexpressions
+from symrot.backends.c_functions import P, vector_entries
+from symrot.backends.c_printer import Precision
+from symrot.backends.c_writer import FunctionWriter, Statement, ops_of
+from symrot.backends.subexpressions import common_subexpressions
+from symrot.core.derivatives import SLOPES, VALUES, rate_value, rate_vector, slope_name, tensor_derivative
+from symrot.plan.ir import EvaluationPlan
 
 DERIVATIVES = {"rotation_derivative": ("R", 1, "d(R a)/dp"),
                "rotation_transpose_derivative": ("R", -1, "d(R^T a)/dp"),

@@ -56,7 +56,7 @@ FUNCTIONS: tuple[CFunction, ...] = (
 # -- outputs from coefficients ---------------------------------------------------------------------
 def tensor_coefficients(tensor: str, across: Collection[str]) -> list[str]:
     """The coefficients a tensor's outputs read: its across-axis part t = c₀ − c₂|p|² where the plan
-    has it (``T_across``, :meth:`~symrot.plan_ir.EvaluationPlan.across_tensors`), else c₀; c₁; c₂."""
+    has it (``T_across``, :meth:`~symrot.plan.ir.EvaluationPlan.across_tensors`), else c₀; c₁; c₂."""
     first = f"{tensor}_across" if tensor in across else f"{tensor}_0"
     return [first, f"{tensor}_1", f"{tensor}_2"]
 

@@ -1,7 +1,7 @@
 """C functions for rotations of any size (issue 6): quaternion conversion, composition, rescaling.
 
-Printed from the same evaluation plan as the rest of the header (:mod:`symrot.plan`, with the
-quaternion entries of :mod:`symrot.quaternion_plan`); quaternions are scalar first, matrices
+Printed from the same evaluation plan as the rest of the header (:mod:`symrot.plan.builder`, with the
+quaternion entries of :mod:`symrot.plan.quaternion`); quaternions are scalar first, matrices
 row-major. Every function that can fail returns an ``int`` status: 0 on success, 1 when an input
 is outside the validity range or not finite, or when the resulting rotation cannot be represented
 by this parameterization (|φ| ≥ φ_max with φ_max ≤ π), or when the computed **p** fails the validity
@@ -16,7 +16,7 @@ A status 0 therefore promises that every function of the header accepts the resu
 * ``from_rotation_matrix``: Shepperd's largest pivot (eqs 61–65); the selected row is 4 e_k e, so
   no square root is needed before the normalization of ``from_quaternion``. Eqs 61–65 hold for
   rotations only, so R is first checked: max |RᵀR − I| ≤ 2⁻²⁶ (2⁻¹¹ in float) and det R > 0
-  (:data:`~symrot.quaternion_plan.ROTATION_TOLERANCE_POWER`), otherwise status 1;
+  (:data:`~symrot.plan.quaternion.ROTATION_TOLERANCE_POWER`), otherwise status 1;
 * ``compose`` (eqs 18–19, 67): p₃ with R(p₃) = R(p₂) R(p₁), p₁ applied first: e₃ = e₂ ∘ e₁;
 * ``rescale``: **p** itself when e₀ ≥ 0, otherwise ``from_quaternion`` of −e.
 """
@@ -27,10 +27,18 @@ from typing import Any
 
 import sympy as sp
 
-from ..parsing import PHI
-from ..plan_ir import Branch
-from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER
-from .c_writer import LARGEST, PHI_SYMBOL, PLAN_LABEL, T_SYMBOL, FunctionWriter, Statement, ops_of
+from symrot.backends.c_writer import (
+    LARGEST,
+    PHI_SYMBOL,
+    PLAN_LABEL,
+    T_SYMBOL,
+    FunctionWriter,
+    Statement,
+    ops_of,
+)
+from symrot.core.parsing import PHI
+from symrot.plan.ir import Branch
+from symrot.plan.quaternion import E0, ROTATION_TOLERANCE_POWER
 
 E_SYMBOL = sp.Symbol("c0", real=True)
 
@@ -196,7 +204,7 @@ class OperationWriter(FunctionWriter):
 
     def rotation_check(self) -> list[Statement]:
         """Status 1 and NaN unless max |RᵀR − I| ≤ 2^power and det R > 0
-        (:data:`~symrot.quaternion_plan.ROTATION_TOLERANCE_POWER`); NaN fails every comparison, so
+        (:data:`~symrot.plan.quaternion.ROTATION_TOLERANCE_POWER`); NaN fails every comparison, so
         non-finite R and R whose products overflow are refused too."""
         t = self.ctype
         f = "" if t == "double" else "f"

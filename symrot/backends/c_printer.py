@@ -5,7 +5,7 @@ from what the C backend needs:
 
 * **precision**: the float variant uses SymPy's own ``type_aliases`` machinery (``sinf``, ``sqrtf``,
   ``1.0F`` literals); nothing else is hand-written for it;
-* :class:`~symrot.functions.RealCbrt` prints as ``cbrt``/``cbrtf`` (the real cube root, which is
+* :class:`~symrot.core.functions.RealCbrt` prints as ``cbrt``/``cbrtf`` (the real cube root, which is
   what C's ``cbrt`` computes);
 * small integer powers of a symbol print as parenthesized products (``(x*x*x)``, ``1.0/(x*x)``),
   not ``pow``;
@@ -15,8 +15,8 @@ from what the C backend needs:
   rounded value (SymPy's default prints 17 or 9 decimal digits, which rounds twice);
 * no ``M_PI``-style macros: they are POSIX, not C99, and ``-std=c99 -Wpedantic`` rejects them;
 * **every literal finite**: a number that rounds to ±inf or NaN in the type (e.g. a Horner
-  coefficient 1e39 in float) raises :class:`~symrot.errors.NonFiniteLiteral` (a one-line
-  :class:`~symrot.errors.SymrotError`) instead of printing ``inf.0F``, which no compiler accepts.
+  coefficient 1e39 in float) raises :class:`~symrot.core.errors.NonFiniteLiteral` (a one-line
+  :class:`~symrot.core.errors.SymrotError`) instead of printing ``inf.0F``, which no compiler accepts.
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ import sympy as sp
 from sympy.codegen.ast import float32, float64, real
 from sympy.printing.c import C99CodePrinter
 
-from ..errors import NonFiniteLiteral
-from ..plan_ir import nearest_binary
+from symrot.core.errors import NonFiniteLiteral
+from symrot.plan.ir import nearest_binary
 
 Precision = Literal["double", "float"]
 PRECISIONS: tuple[Precision, ...] = ("double", "float")
@@ -134,7 +134,7 @@ class SymrotCPrinter(C99CodePrinter):
         return str(super()._print_Pow(expr))
 
     def _print_BoundedPower(self, expr: sp.Expr) -> str:
-        """(b)**n of :class:`symrot.functions.BoundedPower`: the base once, or a product of its
+        """(b)**n of :class:`symrot.core.functions.BoundedPower`: the base once, or a product of its
         copies (which the compiler computes once) up to :data:`MAX_EXPANDED_POWER`."""
         base, exponent = expr.args
         text = f"({self._print(base)})"

@@ -1,4 +1,4 @@
-"""sin and cos of bounded arguments in generated C: the kernel of :mod:`symrot.sincos_kernel`.
+"""sin and cos of bounded arguments in generated C: the kernel of :mod:`symrot.plan.sincos_kernel`.
 
 The closed forms of a plan call sin, cos and tan of arguments c·φ, and φ never leaves
 [0, φ_max]. Where |c|·φ_max is far inside the kernel's exact range, the C backend prints the
@@ -19,8 +19,8 @@ from typing import Any
 
 import sympy as sp
 
-from ..sincos_kernel import SinCosKernel, sincos_kernel
-from .c_printer import MANTISSA_BITS, Precision, SymrotCPrinter, horner
+from symrot.backends.c_printer import MANTISSA_BITS, Precision, SymrotCPrinter, horner
+from symrot.plan.sincos_kernel import SinCosKernel, sincos_kernel
 
 TRIG = (sp.sin, sp.cos, sp.tan)
 NEAREST: dict[Precision, str] = {"double": "SYMROT_NEAREST", "float": "SYMROT_NEARESTF"}
@@ -28,7 +28,7 @@ NEAREST: dict[Precision, str] = {"double": "SYMROT_NEAREST", "float": "SYMROT_NE
 (1.5·2^23 in float), which rounds |y| < 2^51 (2^22) to the nearest integer, ties to even, exactly as
 rint does in the default rounding mode, and vectorizes with SSE2 alone: at baseline x86-64 gcc
 writes rint as a compare-and-branch sequence (no SSE4.1 ``roundsd``) and the loop holding it was not
-vectorized. The kernel's |q| stays below 2^20 (:data:`symrot.sincos_kernel.QUADRANT_BITS`)."""
+vectorized. The kernel's |q| stays below 2^20 (:data:`symrot.plan.sincos_kernel.QUADRANT_BITS`)."""
 
 
 class SinCosWriter:
@@ -121,7 +121,7 @@ class SinCosWriter:
         degrees = (2 * len(kernel.sin_coefficients) + 1, 2 * len(kernel.cos_coefficients))
         return (f"sin/cos: a - q pi/2 in three parts (exact for |a| < {kernel.max_argument:.4g}), Taylor "
                 f"degree {degrees[0]}/{degrees[1]} on |r| <= pi/4 (truncation < {kernel.truncation:.1e}), "
-                "quadrant by exact products (symrot.sincos_kernel); assumes round-to-nearest.")
+                "quadrant by exact products (symrot.plan.sincos_kernel); assumes round-to-nearest.")
 
 
 __all__ = ["NEAREST", "TRIG", "SinCosWriter"]

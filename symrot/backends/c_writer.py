@@ -1,6 +1,6 @@
 """The statements of the C functions of one plan in one precision: the layer under the C backend.
 
-:class:`FunctionWriter` turns the evaluation plan of :mod:`symrot.plan` into statements (dicts that
+:class:`FunctionWriter` turns the evaluation plan of :mod:`symrot.plan.builder` into statements (dicts that
 ``templates/c/header.h.j2`` prints) with :class:`~symrot.backends.c_printer.SymrotCPrinter`; the
 header (:mod:`symrot.backends.c_backend`), the ``_batch`` kernels (:mod:`symrot.backends.c_batch`)
 and the operations (:mod:`symrot.backends.c_operations`) build on it. How a plan becomes C:
@@ -9,9 +9,9 @@ and the operations (:mod:`symrot.backends.c_operations`) build on it. How a plan
   x_limit, at most 2^600, 2^100 in float) when p is unbounded, which also catches inf and NaN)
   every output is NaN; for the sine family also d = p_max² − x with fma-exact products and TwoSum
   (``__complement``), which the plan's expressions use instead of k² − x;
-* coefficients: a :class:`~symrot.plan.Constant` is folded into the output expressions, an
-  :class:`~symrot.plan.Algebraic` one is a single expression in x (no branch, no trig); the
-  :class:`~symrot.plan.Branch` ones of a function share one ``if (x < smallest threshold)``:
+* coefficients: a :class:`~symrot.plan.ir.Constant` is folded into the output expressions, an
+  :class:`~symrot.plan.ir.Algebraic` one is a single expression in x (no branch, no trig); the
+  :class:`~symrot.plan.ir.Branch` ones of a function share one ``if (x < smallest threshold)``:
   below it every coefficient is its Horner polynomial, above it φ is computed once, the closed
   forms share common subexpressions (``sympy.cse``, inside that branch only, where x > 0) and a
   coefficient whose own threshold is larger still takes its polynomial (sin and cos are libm's
@@ -37,23 +37,7 @@ from typing import Any
 
 import sympy as sp
 
-from ..algebraic import S, X
-from ..errors import NonFiniteLiteral
-from ..newton_start import CHANGE, EDGE_STEP, FarStart, edge_floor, edge_step
-from ..parsing import PHI
-from ..plan import half_angle
-from ..plan_ir import (
-    ANGLE_CORRECTION_GROWTH,
-    ANGLE_CORRECTION_LIMIT,
-    Algebraic,
-    Branch,
-    ClosedAngle,
-    Constant,
-    EvaluationPlan,
-    NewtonAngle,
-    PrecisionPlan,
-)
-from .c_functions import (
+from symrot.backends.c_functions import (
     OUTPUT_NAMES,
     TENSOR_OF,
     VECTOR_NAMES,
@@ -64,8 +48,24 @@ from .c_functions import (
     tensor_coefficients,
     tensor_entries,
 )
-from .c_printer import MANTISSA_BITS, Precision, SymrotCPrinter, horner
-from .subexpressions import common_subexpressions
+from symrot.backends.c_printer import MANTISSA_BITS, Precision, SymrotCPrinter, horner
+from symrot.backends.subexpressions import common_subexpressions
+from symrot.core.errors import NonFiniteLiteral
+from symrot.core.parsing import PHI
+from symrot.plan.algebraic import S, X
+from symrot.plan.forms import half_angle
+from symrot.plan.ir import (
+    ANGLE_CORRECTION_GROWTH,
+    ANGLE_CORRECTION_LIMIT,
+    Algebraic,
+    Branch,
+    ClosedAngle,
+    Constant,
+    EvaluationPlan,
+    NewtonAngle,
+    PrecisionPlan,
+)
+from symrot.plan.newton_start import CHANGE, EDGE_STEP, FarStart, edge_floor, edge_step
 
 # -- statements ------------------------------------------------------------------------------------
 Statement = dict[str, Any]
@@ -309,7 +309,7 @@ class FunctionWriter:
     def residual(self, angle: NewtonAngle, declared: bool) -> list[Statement]:
         """tail = φ·(g − g(0)), the residual (φ·g(0) − s) + tail where the tail's polynomial applies
         (the difference first, exact once φ is within a factor 2 of s) and φ·(g(0) + ratio) − s =
-        φ·g − s above, and value = p(φ) for the reciprocal step (:class:`symrot.plan_ir.NewtonAngle`)."""
+        φ·g − s above, and value = p(φ) for the reciprocal step (:class:`symrot.plan.ir.NewtonAngle`)."""
         head = "phi" if angle.leading == 1 else f"phi*{self.c(angle.leading)}"
         whole = "1" if angle.leading == 1 else self.c(angle.leading)
         switch = self.printer.literal(angle.split_below)
@@ -324,7 +324,7 @@ class FunctionWriter:
     def newton_step(self, angle: NewtonAngle) -> list[Statement]:
         """The step of the safeguarded iteration and its acceptance: Newton in φ (on 1/p if
         reciprocal) or, with an edge exponent k, in w = (φ_max − φ)^k
-        (:attr:`symrot.plan_ir.NewtonAngle.edge`); a rejected step bisects the bracket."""
+        (:attr:`symrot.plan.ir.NewtonAngle.edge`); a rejected step bisects the bracket."""
         bisect = {"kind": "if", "condition": "", "then": [self.set("phi", "step")],
                   "otherwise": [self.set("phi", (sp.Symbol("low") + sp.Symbol("high")) / 2)]}
         if angle.edge is None:
@@ -365,7 +365,7 @@ class FunctionWriter:
     def half_angle_corrected(self, expr: sp.Expr) -> sp.Expr:
         """``expr`` with sin(φ/2) → sin(φ/2) + (λ/2) cos(φ/2) and cos(φ/2) → cos(φ/2) − (λ/2) sin(φ/2)
         where the angle is a Newton iteration (see ``EvaluationPlan.angle_correction``), sin φ and
-        cos φ written through them first (:func:`symrot.plan.half_angle`)."""
+        cos φ written through them first (:func:`symrot.plan.forms.half_angle`)."""
         if not self.corrects_angle:
             return expr
         sine, cosine = sp.sin(PHI_SYMBOL / 2), sp.cos(PHI_SYMBOL / 2)
@@ -436,7 +436,7 @@ class FunctionWriter:
         return functions
 
     def far_variable(self, far: FarStart) -> str:
-        """v(s) of the far-field Newton start (symrot.newton_start), as C."""
+        """v(s) of the far-field Newton start (symrot.plan.newton_start), as C."""
         f = "" if self.precision == "double" else "f"
         ratio = f"s / {self.printer.literal(far.scale)}"
         if far.kind == "fold":

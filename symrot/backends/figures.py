@@ -28,11 +28,11 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from ..core import Derivation, derive_expression
-from ..functions import mpmath_namespace
-from ..parsing import PHI
-from ..registry import family_member, lookup
-from .latex import QUANTITY_SYMBOLS, latex
+from symrot.backends.latex import QUANTITY_SYMBOLS, latex
+from symrot.core.derivation import Derivation, derive_expression
+from symrot.core.functions import mpmath_namespace
+from symrot.core.parsing import PHI
+from symrot.core.registry import family_member, lookup
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -126,7 +126,7 @@ def evaluate(derivation: Derivation, quantity: str, phi: np.ndarray) -> np.ndarr
 def _singularities(derivation: Derivation, quantity: str) -> tuple[float | None,
                                                                     tuple[float, ...]]:
     """(validity bound if in range, poles of ``quantity`` in range) from Section 3.4's analysis."""
-    from ..singularities import validity
+    from symrot.core.singularities import validity
 
     result = validity(derivation)
     in_range = [s for s in result.singularities if s.phi_float <= ANGLE_RANGE[1] + 1e-9]

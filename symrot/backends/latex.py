@@ -20,8 +20,9 @@ from typing import Any, Protocol
 import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
-from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES, Derivation
-from ..derivatives import (
+from symrot.backends.templating import render
+from symrot.core.derivation import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES, Derivation
+from symrot.core.derivatives import (
     DIFFERENTIATED,
     ROOT_DIFFERENTIATED,
     SLOPES,
@@ -30,10 +31,9 @@ from ..derivatives import (
     slope_name,
     tensor_derivative,
 )
-from ..functions import RealCbrt
-from ..parsing import PHI
-from ..registry import NamedParameterization
-from .templating import render
+from symrot.core.functions import RealCbrt
+from symrot.core.parsing import PHI
+from symrot.core.registry import NamedParameterization
 
 
 class NamedDerivation(Protocol):
@@ -139,7 +139,7 @@ def latex(expr: sp.Expr | int) -> str:
 
 QUANTITY_SYMBOLS = {"p": "p", "p_prime": "p'", "nu": r"\nu", "epsilon": r"\varepsilon",
                     "mu": r"\mu", "det_H": r"\det\mathbf{H}"}
-"""The paper's symbol of each scalar function (keys as in :data:`symrot.core.SCALAR_NAMES`)."""
+"""The paper's symbol of each scalar function (keys as in :data:`symrot.core.derivation.SCALAR_NAMES`)."""
 TENSOR_SYMBOLS = {"R": r"\mathbf{R}", "H": r"\mathbf{H}", "H_inverse": r"\mathbf{H}^{-1}",
                   "G": r"\mathbf{G}", "K": r"\mathbf{K}"}
 CANONICAL_EQUATIONS = {"R": "17", "H": "23", "H_inverse": "27", "G": "81", "K": "83"}
@@ -161,7 +161,7 @@ CAUSE_MEANINGS = {
                               r" determines $\varphi$",
     ("p", "jump"): r"$p$ jumps (is discontinuous), so $\|\mathbf{p}\|$ no longer determines $\varphi$",
 }
-"""What each kind of singularity of :data:`symrot.singularities.CAUSES` means, as LaTeX."""
+"""What each kind of singularity of :data:`symrot.core.singularities.CAUSES` means, as LaTeX."""
 SERIES = (("nu", r"\nu"), ("mu", r"\mu"), ("det_H", r"\det\mathbf{H}"),
           ("R_1", r"c_1^{\mathbf{R}}"), ("R_2", r"c_2^{\mathbf{R}}"),
           ("H_2", r"c_2^{\mathbf{H}}"), ("H_inverse_2", r"c_2^{\mathbf{H}^{-1}}"))
@@ -204,7 +204,7 @@ class CauseText:
 
 @dataclass(frozen=True)
 class ValidityText:
-    """Validity range and singularities as LaTeX, from :mod:`symrot.singularities`."""
+    """Validity range and singularities as LaTeX, from :mod:`symrot.core.singularities`."""
 
     phi_max: sp.Expr
     range: str
@@ -215,7 +215,7 @@ class ValidityText:
 
 
 def validity_text(derivation: Derivation) -> ValidityText:
-    from ..singularities import validity
+    from symrot.core.singularities import validity
 
     result = validity(derivation)
     p_max = r"\infty" if result.p_max_float == float("inf") else f"{result.p_max_float:.6g}"
@@ -398,7 +398,7 @@ def _combination(terms: dict[sp.Symbol, dict[str, sp.Rational]], symbols: dict[s
 
 
 def derivative_latex() -> tuple[str, str]:
-    """∂(T a)/∂p as derived by :func:`symrot.derivatives.tensor_derivative` (c_k′ = dc_k/dx): the
+    """∂(T a)/∂p as derived by :func:`symrot.core.derivatives.tensor_derivative` (c_k′ = dc_k/dx): the
     rank-one terms, then the others."""
     symbols = {**{v: f"c_{k}" for k, v in enumerate(VALUES)}, **{s: f"c_{k}'" for k, s in enumerate(SLOPES)}}
     terms = tensor_derivative().terms
@@ -407,7 +407,7 @@ def derivative_latex() -> tuple[str, str]:
 
 
 def rate_latex() -> tuple[str, str]:
-    """Ḣ ṗ as derived by :func:`symrot.derivatives.rate_vector` (coefficients of H), in two lines."""
+    """Ḣ ṗ as derived by :func:`symrot.core.derivatives.rate_vector` (coefficients of H), in two lines."""
     symbols = {**{v: rf"c_{k}^{{\mathbf{{H}}}}" for k, v in enumerate(VALUES)},
                **{s: rf"c_{k}^{{\mathbf{{H}}\prime}}" for k, s in enumerate(SLOPES)}}
     return _combination(rate_vector(), symbols, 2)

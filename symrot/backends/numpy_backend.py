@@ -1,4 +1,4 @@
-"""NumPy backend: prints an ``EvaluationPlan`` (``symrot.plan``) as a self-contained module.
+"""NumPy backend: prints an ``EvaluationPlan`` (``symrot.plan.builder``) as a self-contained module.
 
 The module (NumPy only) exposes, for p of shape (..., 3): ``angle`` (φ), ``rotation_matrix`` (R,
 eq 16), ``tangent`` (H, ω = H ṗ, eq 20), ``tangent_inverse`` (H⁻¹, eq 26), ``tangent_det`` (det H,
@@ -28,26 +28,26 @@ import numpy as np
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
-from ..algebraic import D, X
-from ..atomic import write_atomic
-from ..newton_start import FarStart, edge_floor, edge_step
-from ..parsing import PHI
-from ..plan import (
+from symrot.backends.numpy_derivatives import derivative_lines, rate_lines
+from symrot.backends.subexpressions import common_subexpressions
+from symrot.backends.templating import render
+from symrot.core.atomic import write_atomic
+from symrot.core.parsing import PHI
+from symrot.plan.algebraic import D, S, X
+from symrot.plan.builder import evaluation_plan
+from symrot.plan.forms import half_angle
+from symrot.plan.ir import (
+    ANGLE_CORRECTION_GROWTH,
     Algebraic,
     Branch,
     ClosedAngle,
     Constant,
     EvaluationPlan,
     NewtonAngle,
-    S,
-    evaluation_plan,
-    half_angle,
+    uses_angle,
 )
-from ..plan_ir import ANGLE_CORRECTION_GROWTH, uses_angle
-from ..quaternion_plan import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
-from .numpy_derivatives import derivative_lines, rate_lines
-from .subexpressions import common_subexpressions
-from .templating import render
+from symrot.plan.newton_start import FarStart, edge_floor, edge_step
+from symrot.plan.quaternion import E0, ROTATION_TOLERANCE_POWER, QuaternionScale
 
 TENSORS = ("R", "H", "H_inverse", "G", "K")
 SUFFIX = {"float64": "64", "float32": "32"}
@@ -66,7 +66,7 @@ class SymrotNumPyPrinter(NumPyPrinter):
         return "0.5"
 
     def _print_BoundedPower(self, expr: Any) -> str:
-        """(b)**n of :class:`symrot.functions.BoundedPower`, never bⁿ's expansion."""
+        """(b)**n of :class:`symrot.core.functions.BoundedPower`, never bⁿ's expansion."""
         base, exponent = expr.args
         text = f"({self._print(base)})"
         return text if exponent == 1 else f"{text}**{self._print(exponent)}"
@@ -114,7 +114,7 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
     block whose lanes are all inside the range (None otherwise, see the template's _span) lets a
     block on one side of the switch take its branch on all lanes, without masks or indexing.
     ``corrected``: the angle's half-angle sine and cosine carry λ (``EvaluationPlan.angle_correction``),
-    and sin φ, cos φ are printed through them (:func:`symrot.plan.half_angle`)."""
+    and sin φ, cos φ are printed through them (:func:`symrot.plan.forms.half_angle`)."""
     threshold, horner = branch.smallest_switch
     closed = half_angle(branch.closed) if corrected else branch.closed
     if half_angles:  # sin(φ/2), cos(φ/2) come precomputed, shared by the coefficients of a tensor
@@ -205,7 +205,7 @@ def newton_residual_lines(angle: NewtonAngle, ratio_call: str, literal: Callable
                           where: str = "numpy.where") -> list[str]:
     """``tail`` = φ·(g − g(0)) and the residual of the Newton angle: (φ·g(0) − s) + tail where the
     tail's polynomial applies (the difference first: exact once φ is within a factor 2 of s), and
-    φ·(g(0) + tail's ratio) − s = φ·g − s above (:class:`symrot.plan_ir.NewtonAngle`); ``value`` =
+    φ·(g(0) + tail's ratio) − s = φ·g − s above (:class:`symrot.plan.ir.NewtonAngle`); ``value`` =
     p(φ) where the reciprocal step needs it. ``ratio_call`` prints g − g(0)."""
     head = "phi" if angle.leading == 1 else f"phi * {literal(angle.leading)}"
     whole = "1.0" if angle.leading == 1 else literal(angle.leading)
@@ -229,7 +229,7 @@ def newton_low_lines(angle: NewtonAngle, where: str) -> list[str]:
 def newton_step_lines(angle: NewtonAngle, where: str = "numpy.where", module: str = "numpy",
                       printer: Callable[[sp.Expr], str] | None = None) -> list[str]:
     """``step`` and ``inside`` of the safeguarded iteration: Newton in φ (on 1/p if reciprocal) or,
-    with an edge exponent k, in w = (φ_max − φ)^k (:func:`symrot.newton_start.edge_step`); every
+    with an edge exponent k, in w = (φ_max − φ)^k (:func:`symrot.plan.newton_start.edge_step`); every
     operand is safe on every lane (the array backends pass their own ``where``, ``module`` and
     printer)."""
     finite = f"    safe = safe & {module}.isfinite(slope)"  # p′ = ∞: a zero step would stay
@@ -262,7 +262,7 @@ def _angle_low_lines(angle: NewtonAngle) -> list[str]:
 
 
 def _far_variable(far: FarStart) -> str:
-    """v(s) of the far-field Newton start (symrot.newton_start)."""
+    """v(s) of the far-field Newton start (symrot.plan.newton_start)."""
     if far.kind == "fold":
         power = f"numpy.power({{}}, {1 / far.order!r})"
         root = {2: "numpy.sqrt({})", 3: "numpy.cbrt({})"}.get(far.order, power)
@@ -358,7 +358,7 @@ def module_context_functions(precision: Any, suffix: str,
 
 
 def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
-    """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.quaternion_plan)."""
+    """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.plan.quaternion)."""
     if scale.algebraic is not None:
         expression = scale.algebraic.subs(E0, sp.Symbol("e0"))
         return ["e0 = e0.astype(numpy.float64)",

@@ -1,4 +1,4 @@
-"""The derivatives of :mod:`symrot.derivatives` as NumPy statements (issue 19).
+"""The derivatives of :mod:`symrot.core.derivatives` as NumPy statements (issue 19).
 
 The core derives ∂(T a)/∂p as rational combinations of the scalars c_k, c_k′ on tensors built from
 p and a, and Ṫ ṗ on vectors; this module prints those combinations term by term (nothing is
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..derivatives import SLOPES, VALUES, rate_vector, tensor_derivative
+from symrot.core.derivatives import SLOPES, VALUES, rate_vector, tensor_derivative
 
 _SCALARS = {**{s: f"c{k}" for k, s in enumerate(VALUES)}, **{s: f"d{k}" for k, s in enumerate(SLOPES)}}
 

@@ -3,7 +3,7 @@
 Strict (``StrictUndefined``: a missing variable is an error, never an empty string), no
 auto-escaping (we emit code and LaTeX, not HTML), trailing newlines kept, and nothing
 time-dependent is ever passed in, so output is byte-identical across runs. Templates live in the
-``symrot/templates/`` directory (the ``symrot.templates`` package, shipped in the wheel).
+``symrot/backends/templates/`` directory (the ``symrot.backends.templates`` package, shipped in the wheel).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import jinja2
 
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
-    root = files("symrot.templates")
+    root = files("symrot.backends.templates")
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(root)),
         undefined=jinja2.StrictUndefined,

@@ -9,9 +9,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..plan import EvaluationPlan
-from .array_backend import emit_framework
-from .array_backend import module_source as array_module_source
+from symrot.backends.array_backend import emit_framework
+from symrot.backends.array_backend import module_source as array_module_source
+from symrot.plan.ir import EvaluationPlan
 
 
 def module_source(plan: EvaluationPlan) -> str:

@@ -16,7 +16,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import SymrotError
+from symrot.core.errors import SymrotError
 
 TOOLS = ("pdflatex", "pdftoppm")
 TIMEOUT = 120

@@ -1,13 +1,13 @@
 """The ``symrot`` command line. Each subcommand is a small module with ``register(subparsers)``.
 
-Any :class:`~symrot.errors.SymrotError` becomes one line on stderr and exit status 2; nothing
+Any :class:`~symrot.core.errors.SymrotError` becomes one line on stderr and exit status 2; nothing
 the user types produces a traceback. Every command runs under one time budget (``--timeout``,
 default :data:`DEFAULT_TIMEOUT` s, at most :data:`MAX_TIMEOUT` s) that covers everything from
 parsing to writing files; from
 the real command line (``main()`` without arguments) it runs in a worker process that also has
 an address-space limit (:mod:`symrot.cli.worker`). Exit status 70 is kept for genuine bugs;
 SIGINT ends a command with 130 and SIGTERM with 143, in both cases after the temporary files are
-removed and with every output file whole (:mod:`symrot.atomic`).
+removed and with every output file whole (:mod:`symrot.core.atomic`).
 Conventions: ``symrot`` alone prints the help (exit 0, as ``--help``); misuse is exit 2;
 ``--version``; ``--quiet`` silences the progress that long steps draw on stderr (drawn only when
 stderr is a terminal).
@@ -22,9 +22,9 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-from .. import budget
-from ..errors import SymrotError
-from . import audit, derive, latex_commands, plot, progress, solve, worker
+from symrot.cli import audit, derive, latex_commands, plot, progress, solve, worker
+from symrot.core import budget
+from symrot.core.errors import SymrotError
 
 COMMANDS = [derive, solve, latex_commands, plot, audit]
 """Subcommand modules, in the order ``symrot --help`` lists them."""
@@ -97,7 +97,7 @@ def version() -> str:
     try:
         return distribution_version("symrot")
     except PackageNotFoundError:
-        from .. import __version__
+        from symrot import __version__
 
         return __version__
 

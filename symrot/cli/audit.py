@@ -8,9 +8,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .. import strict_json
-from ..budget import stage
-from .output import write_file
+from symrot.cli import strict_json
+from symrot.cli.output import write_file
+from symrot.core.budget import stage
 
 EXIT_CHECK_FAILED = 1
 DEFAULT_ERRATA = "docs/errata.md"
@@ -43,10 +43,10 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..audit import all_checks, run_all
-    from ..audit.report import REGENERATE, as_json, errata_markdown, table
-    from ..errors import SymrotError
-    from .progress import each
+    from symrot.audit import all_checks, run_all
+    from symrot.audit.report import REGENERATE, as_json, errata_markdown, table
+    from symrot.cli.progress import each
+    from symrot.core.errors import SymrotError
 
     only = {key.strip() for key in args.only.split(",")} if args.only else None
     selected = [c for c in all_checks() if only is None or c.equation in only]
@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _read(path: Path) -> str:
     """The text of ``path`` ('' when it does not exist); exit 2 with one line when unreadable."""
-    from ..errors import SymrotError
+    from symrot.core.errors import SymrotError
 
     try:
         return path.read_text(encoding="utf-8") if path.exists() else ""

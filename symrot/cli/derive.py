@@ -10,12 +10,12 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .. import strict_json
-from ..api import DEFAULT_SERIES_TERMS, DerivationResult, derive
-from ..budget import stage
-from ..core import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
-from ..errors import SymrotError
-from .output import check_writable, write_files
+from symrot.api import DEFAULT_SERIES_TERMS, DerivationResult, derive
+from symrot.cli import strict_json
+from symrot.cli.output import check_writable, write_files
+from symrot.core.budget import stage
+from symrot.core.derivation import SCALAR_EQUATIONS, TENSOR_EQUATIONS, TENSOR_NAMES
+from symrot.core.errors import SymrotError
 
 SCALAR_LABELS = {
     "p_prime": "p'",
@@ -70,7 +70,7 @@ def register(subparsers: Any) -> None:
 def backend_names(text: str) -> list[str]:
     """The backends of ``--emit`` (comma-separated, each once, in the order given; ``all``: every
     registered backend)."""
-    from ..backends import EMITTERS, emitter
+    from symrot.backends import EMITTERS, emitter
 
     names = list(EMITTERS) if text.strip() == "all" else [part.strip() for part in text.split(",")]
     if not all(names):
@@ -113,7 +113,7 @@ def remove_stale_scratch() -> None:
     import shutil
     import tempfile
 
-    from ..atomic import process_running
+    from symrot.core.atomic import process_running
 
     try:
         entries = list(Path(tempfile.gettempdir()).glob(f"{SCRATCH_PREFIX}*-*"))
@@ -134,11 +134,11 @@ def emit_code(result: DerivationResult, args: argparse.Namespace) -> int:
     the files in ``--out`` all or none (nothing is written when a backend fails)."""
     import tempfile
 
-    from ..backends import emitter
-    from ..plan import evaluation_plan
-    from ..singularities import validity
-    from .plan_cache import cached_plan
-    from .progress import stages
+    from symrot.backends import emitter
+    from symrot.cli.plan_cache import cached_plan
+    from symrot.cli.progress import stages
+    from symrot.core.singularities import validity
+    from symrot.plan.builder import evaluation_plan
 
     name = args.name or (result.entry.identifier if result.entry else "rotation")
     backends = backend_names(args.emit)
@@ -172,8 +172,8 @@ def run(args: argparse.Namespace) -> int:
     result = derive(args.expression, normalize=args.normalize)
     if getattr(args, "emit", None):
         return emit_code(result, args)
-    from ..singularities import validity
-    from ..two_processes import simplify_tensors
+    from symrot.core.singularities import validity
+    from symrot.core.two_processes import simplify_tensors
 
     derivation = result.derivation
     simplify_tensors(derivation, beside=lambda: validity(derivation))
@@ -196,7 +196,7 @@ def _series_text(coefficients: list[Any]) -> str:
 
 
 def validity_lines(derivation: Any) -> list[str]:
-    from ..singularities import validity
+    from symrot.core.singularities import validity
 
     result = validity(derivation)
     if not result.singularities:

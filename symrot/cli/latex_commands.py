@@ -6,12 +6,12 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from ..api import derive
-from ..backends.latex import FITS, sheet, standalone, table
-from ..budget import stage
-from ..errors import SymrotError
-from ..registry import PAPER_TABLE_1_VALIDITY, TABLE_1
-from .output import write_file
+from symrot.api import derive
+from symrot.backends.latex import FITS, sheet, standalone, table
+from symrot.cli.output import write_file
+from symrot.core.budget import stage
+from symrot.core.errors import SymrotError
+from symrot.core.registry import PAPER_TABLE_1_VALIDITY, TABLE_1
 
 EXTRA_COLUMNS = ("mu", "det_H", "causes")
 

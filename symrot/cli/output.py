@@ -1,8 +1,8 @@
 """Writing output files for every command: one place for the checks and the one-line errors.
 
 Any ``OSError`` (a missing or read-only directory, ``/proc``, ``/dev/null/x``, a full disk)
-becomes a :class:`~symrot.errors.SymrotError`. Every file is written atomically
-(:mod:`symrot.atomic`): after a failure, ``SIGINT`` or ``SIGTERM`` the previous file is whole and
+becomes a :class:`~symrot.core.errors.SymrotError`. Every file is written atomically
+(:mod:`symrot.core.atomic`): after a failure, ``SIGINT`` or ``SIGTERM`` the previous file is whole and
 no temporary file is left; :func:`write_files` replaces several files all or none.
 
 Inside the output directory (``--out``, which may itself be a link the user chose) no symbolic
@@ -18,9 +18,9 @@ import stat
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..atomic import replace_all, stage_file
-from ..budget import stage
-from ..errors import SymrotError
+from symrot.core.atomic import replace_all, stage_file
+from symrot.core.budget import stage
+from symrot.core.errors import SymrotError
 
 
 def check_writable(directory: Path) -> None:

@@ -1,6 +1,6 @@
 """The evaluation plans of ``symrot derive --emit``, kept on disk between runs.
 
-A plan (:func:`symrot.plan.evaluation_plan`) takes seconds to minutes and is a function of p(φ), the
+A plan (:func:`symrot.plan.builder.evaluation_plan`) takes seconds to minutes and is a function of p(φ), the
 module name and the code that computes it, nothing else: it is the same on every machine and under
 any load. So it is stored under a key made of exactly those: p's ``srepr``, the name, the bytes of
 every file of the installed symrot package, and the versions of Python, SymPy, NumPy and mpmath.
@@ -17,7 +17,7 @@ file of another name, nothing outside that directory.
 
 An entry is two lines of JSON (:func:`entry_bytes`): a header with the entry format, its version,
 the key and the SHA-256 of the payload, then the payload, the plan in the format of
-:mod:`symrot.plan_json`, which never runs code when read. Every check (the header, the checksum,
+:mod:`symrot.plan.serialized`, which never runs code when read. Every check (the header, the checksum,
 the decoding, p and the name) is made before a plan is used, and any failure is a miss: the plan
 is computed again and the entry rewritten. The cache is an optimisation, so every failure (an
 unreadable, corrupt, truncated or foreign file; a read-only or full disk) is silent. A file is
@@ -44,10 +44,10 @@ import mpmath
 import numpy
 import sympy as sp
 
-from ..core import Derivation
-from ..plan import evaluation_plan, remember_plan
-from ..plan_ir import EvaluationPlan
-from ..plan_json import canonical_json, decode_plan, encode_plan
+from symrot.core.derivation import Derivation
+from symrot.plan.builder import evaluation_plan, remember_plan
+from symrot.plan.ir import EvaluationPlan
+from symrot.plan.serialized import canonical_json, decode_plan, encode_plan
 
 COMMANDS_HASH_SEED = "0"
 """``symrot.entry.SEED``, the hash seed every command runs with (not imported: ``symrot.entry`` imports
@@ -210,7 +210,7 @@ def store(plan: EvaluationPlan) -> None:
 def cached_plan(derivation: Derivation, name: str) -> tuple[EvaluationPlan, bool]:
     """(the plan of ``derivation`` named ``name``, whether it came from the disk). Either way the
     backends printing it in this process get it without computing it again (a plan read back is
-    handed to :func:`symrot.plan.remember_plan`; a computed one is remembered by the plan layer)."""
+    handed to :func:`symrot.plan.builder.remember_plan`; a computed one is remembered by the plan layer)."""
     plan = load(derivation.p, name)
     if plan is not None:
         remember_plan(plan)

@@ -6,13 +6,13 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from ..api import resolve
-from ..backends.figures import DEFAULT_STYLE, FIGURES, STYLES, render
-from ..budget import stage
-from ..errors import SymrotError
-from ..validation import validate
-from .output import output_directory, write_file
-from .progress import each
+from symrot.api import resolve
+from symrot.backends.figures import DEFAULT_STYLE, FIGURES, STYLES, render
+from symrot.cli.output import output_directory, write_file
+from symrot.cli.progress import each
+from symrot.core.budget import stage
+from symrot.core.errors import SymrotError
+from symrot.core.validation import validate
 
 
 def register(subparsers: Any) -> None:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from .. import strict_json
-from ..budget import stage
-from ..registry import find_by_expression
-from ..solve import solve_property
+from symrot.cli import strict_json
+from symrot.core.budget import stage
+from symrot.core.registry import find_by_expression
+from symrot.core.solve import solve_property
 
 
 def register(subparsers: Any) -> None:

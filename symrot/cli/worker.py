@@ -2,7 +2,7 @@
 
 SymPy can loop in C-level big-integer arithmetic that no signal interrupts, or grow to gigabytes
 within seconds. The parent therefore never does the work itself: it forks, the worker sets
-``RLIMIT_AS`` and runs the command under :func:`symrot.budget.enforce` (a clean, in-process
+``RLIMIT_AS`` and runs the command under :func:`symrot.core.budget.enforce` (a clean, in-process
 expiry with the stage named), and the parent waits until the budget plus a short grace period
 has passed, then kills the worker and names the stage the worker last published in shared
 memory. The worker inherits stdout and stderr, so its output passes through unchanged; argument
@@ -25,8 +25,8 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 
-from .. import budget
-from ..forked import die_with_parent
+from symrot.core import budget
+from symrot.core.forked import die_with_parent
 
 GRACE_SECONDS = 1.5
 """How long the parent waits after the budget for the worker to report its own expiry."""

@@ -1,1 +1,0 @@
-"""Jinja2 templates of the symrot backends (shipped inside the wheel as symrot.templates)."""
