@@ -6,7 +6,7 @@ TEST_JOBS ?= auto
 SYMFORCE_VENV ?= /tmp/symforce_venv
 
 .DEFAULT_GOAL := help
-.PHONY: audit help setup setup-bench setup-system setup-python test lint typecheck pytest generate check-generated mutations bench clean
+.PHONY: audit help check-versions setup setup-bench setup-system setup-python test lint typecheck pytest generate check-generated mutations bench clean
 
 help: ## List the targets with what they do
 	@grep -E '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-16s %s\n", $$1, $$2}'
@@ -35,9 +35,9 @@ setup-bench: ## Install the benchmark peer SymForce in a venv (SYMFORCE_VENV, de
 	$(SYMFORCE_VENV)/bin/pip install -q symforce
 
 setup-python: ## pip install symrot in editable mode with its dev extras, CPU PyTorch and JAX
-	$(PIP) install -q -e '.[dev]'
-	$(PIP) install -q torch==2.13.0
-	$(PIP) install -q -e '.[dev,jax,torch]'
+	$(PIP) install -q -c constraints.txt -e '.[dev]'
+	$(PIP) install -q -c constraints.txt torch==2.13.0
+	$(PIP) install -q -c constraints.txt -e '.[dev,jax,torch]'
 
 test: lint typecheck pytest ## ruff, mypy and the test suite (tests/test_generated.py checks generated/ as check-generated does)
 
@@ -50,10 +50,13 @@ typecheck: ## mypy over the package
 pytest: ## The test suite only, on TEST_JOBS processes (pytest-xdist; default: one per CPU), with the 25 slowest tests listed
 	$(PYTHON) -m pytest -n $(TEST_JOBS) --dist worksteal --durations=25 $(PYTEST_ARGS)
 
-generate: ## Rewrite generated/ for the named parameterizations (deterministic)
+check-versions: ## Fail unless the installed SymPy, matplotlib and mpmath are those of constraints.txt
+	@$(PYTHON) -c 'import sys, importlib.metadata as m; pins = [l.split("==") for l in open("constraints.txt") if "==" in l and not l.startswith("#")]; bad = [f"{n} {m.version(n)} (constraints.txt: {v.strip()})" for n, v in pins if m.version(n) != v.strip()]; sys.exit("generated/ needs other versions: " + ", ".join(bad) if bad else 0)'
+
+generate: check-versions ## Rewrite generated/ for the named parameterizations (deterministic)
 	$(PYTHON) -m symrot.generate generated
 
-check-generated: ## Fail with a diff when generated/ is stale
+check-generated: check-versions ## Fail with a diff when generated/ is stale
 	$(PYTHON) -m symrot.generate --check generated
 
 mutations: ## Mutation check: every fault of bench/mutation_list.py must fail a test of make test; writes docs/mutations.md

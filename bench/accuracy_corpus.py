@@ -39,7 +39,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
-from accuracy import DTYPES, load_module, sweep  # noqa: E402
+from accuracy_common import DTYPES, load_module, sweep  # noqa: E402
 
 from tests.corpus import CORPUS  # noqa: E402
 from tests.measure import TARGET_ULP, Worst, condition  # noqa: E402

@@ -55,8 +55,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
-from accuracy import load_module as emitted_module  # noqa: E402
-from accuracy import sweep  # noqa: E402
+from accuracy_common import load_module as emitted_module  # noqa: E402
+from accuracy_common import sweep  # noqa: E402
 from accuracy_corpus import c_library, emit, one_line, run_worker  # noqa: E402
 
 from tests.c_harness import build_config  # noqa: E402

@@ -29,7 +29,7 @@ from typing import Any
 
 import mpmath
 import numpy as np
-from accuracy import DIGITS, DTYPES, Reference, Worst, condition, load_module, subject, sweep
+from accuracy_common import DIGITS, DTYPES, Reference, Worst, condition, load_module, subject, sweep
 
 OPERATIONS = ("to_quaternion", "from_quaternion", "from_rotation_matrix", "compose", "rescale")
 

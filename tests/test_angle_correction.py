@@ -165,7 +165,7 @@ def test_a_closed_angle_growing_slower_than_four_phi_corrects_float32_too() -> N
     from .reference import GeneratingFunction, Reference
 
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
-    from accuracy import condition
+    from accuracy_common import condition
 
     expression = "3*sinh(phi/3)"
     assert plan_of(expression).angle_correction() == {"float32": "float64"}

@@ -35,7 +35,7 @@ from .strategies import MIN_PHI_MAX, sampled_expression
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
-from accuracy import load_module  # noqa: E402
+from accuracy_common import load_module  # noqa: E402
 from accuracy_corpus import Measurement, emit, verdict  # noqa: E402
 
 CATEGORIES = {"polynomial", "rational", "hyperbolic", "inverse hyperbolic", "inverse trigonometric",
@@ -342,7 +342,7 @@ def test_a_miss_is_reported_where_its_error_exceeds_the_condition() -> None:
     """The worst ulp and the worst ulp/κ may be at different angles: corpus entry 5 (φ − φ³/6 + φ⁵/120)
     had 1.15·10¹² ulp at its fold, within κ there, and was reported at the fold while it missed by
     9·10⁵ κ at φ = 0.1. A tally keeps both, and the report names the second."""
-    from accuracy import Worst
+    from accuracy_common import Worst
     from accuracy_corpus import miss_text
 
     worst = Worst()

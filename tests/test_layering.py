@@ -149,3 +149,32 @@ def test_no_import_cycle() -> None:
     """Stricter than the rule between layers: modules of one layer do not import each other in a
     circle either (shared code goes into a module below both, as c_writer, plan_ir, audit.records)."""
     assert not CYCLES, f"import cycles: {[sorted(cycle) for cycle in CYCLES]}"
+
+
+def test_bench_has_no_import_cycle() -> None:
+    """Issue 56: the drivers of bench/ import shared code below them, never each other in a circle."""
+    bench = PACKAGE.parent / "bench"
+    local = {path.stem: path for path in bench.glob("*.py")}
+    graph: dict[str, set[str]] = {}
+    for name, path in local.items():
+        found: set[str] = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module and not node.level:
+                found.add(node.module.split(".")[0])
+            elif isinstance(node, ast.Import):
+                found.update(alias.name.split(".")[0] for alias in node.names)
+        graph[name] = {target for target in found if target in local and target != name}
+
+    def reaches(start: str, goal: str) -> bool:
+        seen, todo = set(), [start]
+        while todo:
+            node = todo.pop()
+            if node == goal:
+                return True
+            if node not in seen:
+                seen.add(node)
+                todo.extend(graph[node])
+        return False
+
+    circles = sorted(name for name in graph if any(reaches(target, name) for target in graph[name]))
+    assert not circles, f"bench/ modules in an import cycle: {circles}"

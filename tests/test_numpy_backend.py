@@ -129,7 +129,7 @@ def _independent_sweep(name: str, points: int) -> dict[tuple[str, str], Any]:
     1e-8, 1e-3, 0.1 and 1, random axes; φ_max and p_max from the reference."""
     from types import SimpleNamespace
 
-    from accuracy import load_module
+    from accuracy_common import load_module
     from accuracy_corpus import Measurement
 
     from symrot.api import derive

@@ -390,7 +390,7 @@ def test_solutions_are_checked_numerically_not_by_sympy(monkeypatch: pytest.Monk
     """solve(…, check=False) returns the roots that squaring adds (−√(√(4s² + 1)/2 − 1/2) for
     φ√(1 + φ²)); the numeric checks keep the one that starts as s/κ and solves p(φ) = s. SymPy's
     own symbolic check was 1.5 of the 2 s that log((1 + φ/2)/(1 − φ/2)) spent solving."""
-    from symrot.plan import builder as plan
+    from symrot.plan import forms as plan
 
     s = sp.Symbol("s", nonnegative=True)
     checked: list[object] = []
