@@ -24,8 +24,8 @@ if TYPE_CHECKING:
 __all__ = ["PHI", "DerivationResult", "SymrotError", "derive", "lookup", "parse_expression"]
 __version__ = "0.1.0"
 
-_HOME = {"DerivationResult": "api", "derive": "api", "SymrotError": "errors", "PHI": "parsing",
-         "parse_expression": "parsing", "lookup": "registry"}
+_HOME = {"DerivationResult": "api", "derive": "api", "SymrotError": "core.errors", "PHI": "core.parsing",
+         "parse_expression": "core.parsing", "lookup": "core.registry"}
 
 
 def __getattr__(name: str) -> Any:

@@ -47,7 +47,7 @@ def test_wheel_ships_every_package_and_the_templates(wheel: Path) -> None:
     names = set(zipfile.ZipFile(wheel).namelist())
     sources = {str(p.relative_to(ROOT)) for p in (ROOT / "symrot").rglob("*.py")}
     assert sources <= names, f"missing from the wheel: {sorted(sources - names)}"
-    templates = {str(p.relative_to(ROOT)) for p in (ROOT / "symrot" / "templates").rglob("*.j2")}
+    templates = {str(p.relative_to(ROOT)) for p in (ROOT / "symrot" / "backends" / "templates").rglob("*.j2")}
     assert templates and templates <= names
     assert any(n.endswith(".dist-info/licenses/LICENSE") or n.endswith(".dist-info/LICENSE") for n in names)
 

@@ -178,3 +178,8 @@ def test_bench_has_no_import_cycle() -> None:
 
     circles = sorted(name for name in graph if any(reaches(target, name) for target in graph[name]))
     assert not circles, f"bench/ modules in an import cycle: {circles}"
+
+
+def test_every_public_name_resolves() -> None:
+    """The public face (issue 56: unchanged by the move): every name of ``symrot.__all__`` imports."""
+    assert all(getattr(symrot, name) is not None for name in symrot.__all__)
