@@ -9,6 +9,7 @@ Run: ``python bench/angle_steps.py generated/numpy/det_h_one.py [OTHER.py ...]``
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import sys
 from pathlib import Path
@@ -54,4 +55,6 @@ def main(paths: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("modules", nargs="+", help="generated NumPy modules of eq 35 (det_h_one)")
+    main(parser.parse_args().modules)

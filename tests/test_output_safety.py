@@ -33,6 +33,17 @@ HANG = 240.0
 OLD = "old = 'whole'\n" * 1000
 
 
+@pytest.fixture(autouse=True)
+def shell_sigint() -> Any:
+    """Each test starts with SIGINT as a shell gives it: Python's default handler, not blocked (another
+    test in the same pytest-xdist worker may leave it otherwise; the children inherit both)."""
+    handler = signal.signal(signal.SIGINT, signal.default_int_handler)
+    mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, [signal.SIGINT])
+    yield
+    signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+    signal.signal(signal.SIGINT, handler)
+
+
 def leftovers(directory: Path) -> list[str]:
     """Temporary files of symrot in ``directory`` (recursively)."""
     return sorted(str(p) for p in directory.rglob("*") if p.name.endswith((atomic.PARTIAL, atomic.BACKUP)))
