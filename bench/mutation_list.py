@@ -49,6 +49,7 @@ NUMPY = "generated/numpy/*.py"
 ARRAYS = "generated/[jt]*/*.py"
 VALUES = "tests/test_independent_values.py"
 EDGES = "tests/test_validity_edges.py"
+FEW_ROWS_ENTRY = "                    q02 - b1, q12 + b0, a_k + c_k * s2)"
 
 MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
@@ -92,11 +93,12 @@ MUTATIONS: tuple[Mutation, ...] = (
         (("numpy", "rotation_vector"),)),
     Mutation(
         "numpy-compose-swapped", "runtime",
-        "NumPy compose computes R(p1) R(p2) instead of R(p2) R(p1) (cross product order)",
-        (Edit("symrot/backends/templates/numpy_module.py.j2", "b0[..., None] * a + _cross(b, a)",
+        "NumPy compose computes R(p1) R(p2) instead of R(p2) R(p1) (cross product order; runtime "
+        "and generated/numpy)",
+        (Edit("symrot/backends/runtime/numpy_runtime.py", "b0[..., None] * a + _cross(b, a)",
               "b0[..., None] * a + _cross(a, b)"),
          Edit(NUMPY, "b0[..., None] * a + _cross(b, a)", "b0[..., None] * a + _cross(a, b)")),
-        ("tests/test_operations_numpy.py", VALUES)),
+        ("tests/test_operations_numpy.py", VALUES, "tests/test_runtime.py")),
     Mutation(
         "c-quaternion-product-sign", "backend",
         "a sign of the quaternion product of C compose flipped (rotation_vector regenerated)",
@@ -169,11 +171,18 @@ MUTATIONS: tuple[Mutation, ...] = (
         ("tests/test_c_aliasing.py",), (("c", "rotation_vector"),)),
     Mutation(
         "numpy-apply-transposed", "runtime",
-        "NumPy omega/pdot apply the transpose: (v×p) for (p×v) (template and generated/numpy)",
-        (Edit("symrot/backends/templates/numpy_module.py.j2", "    p_cross_v = _cross(p, v)\n",
+        "NumPy omega/pdot apply the transpose: (v×p) for (p×v) (runtime and generated/numpy)",
+        (Edit("symrot/backends/runtime/numpy_runtime.py", "    p_cross_v = _cross(p, v)\n",
               "    p_cross_v = _cross(v, p)\n"),
          Edit(NUMPY, "    p_cross_v = _cross(p, v)\n", "    p_cross_v = _cross(v, p)\n")),
         (VALUES, "tests/test_numpy_backend.py")),
+    Mutation(
+        "numpy-few-rows-entry-sign", "runtime",
+        "NumPy tensors of a few rows (the scalar path): entry (2, 0) as q02 + b1 for q02 - b1 "
+        "(runtime and generated/numpy)",
+        (Edit("symrot/backends/runtime/numpy_runtime.py", FEW_ROWS_ENTRY, FEW_ROWS_ENTRY.replace("-", "+")),
+         Edit(NUMPY, FEW_ROWS_ENTRY, FEW_ROWS_ENTRY.replace("-", "+"))),
+        ("tests/test_runtime.py", VALUES)),
     Mutation(
         "numpy-printer-constants-8-digits", "backend",
         "NumPy printer rounds rational constants to 8 digits (det_h_one regenerated)",
@@ -183,16 +192,16 @@ MUTATIONS: tuple[Mutation, ...] = (
         (("numpy", "det_h_one"),)),
     Mutation(
         "array-compose-swapped", "runtime",
-        "JAX/PyTorch compose computes R(p1) R(p2) (template and generated/jax, generated/torch)",
-        (Edit("symrot/backends/templates/array_module.py.j2", "b0[..., None] * a + _cross(b, a)",
+        "JAX/PyTorch compose computes R(p1) R(p2) (array runtime and generated/jax, generated/torch)",
+        (Edit("symrot/backends/runtime/array_runtime.py", "b0[..., None] * a + _cross(b, a)",
               "b0[..., None] * a + _cross(a, b)"),
          Edit(ARRAYS, "b0[..., None] * a + _cross(b, a)", "b0[..., None] * a + _cross(a, b)")),
-        ("tests/test_array_backends.py", VALUES)),
+        ("tests/test_array_backends.py", VALUES, "tests/test_runtime.py")),
     Mutation(
         "latex-minus-dropped", "backend",
         "LaTeX: the minus sign of a slashed inner fraction dropped (tables and sheets regenerated)",
         (Edit("symrot/backends/latex.py", '            sign = "- "\n', '            sign = ""\n'),),
-        ("tests/test_latex.py",),
+        ("tests/test_latex.py", "tests/test_latex_values.py"),
         (("latex", ""),)),
     Mutation(
         "cli-bad-input-exit-1", "cli",

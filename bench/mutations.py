@@ -138,8 +138,17 @@ def pytest_command(mutation: Mutation, jobs: int) -> list[str]:
 
 
 def failed_tests(output: str) -> list[str]:
-    """The node ids pytest reported as failed (``-rf``)."""
-    return sorted(set(re.findall(r"^FAILED (\S+)", output, flags=re.MULTILINE)))
+    """The node ids pytest reported as failed (``-rf``: ``FAILED <node id> - <message>``). A node
+    id's parameters may hold spaces and " - " (``[phi - sin(phi)]``): it ends at the first "]"
+    followed by the message or the end of the line."""
+    found = set()
+    for line in re.findall(r"^FAILED (.+)$", output, flags=re.MULTILINE):
+        head = line.split(" ", 1)[0]
+        if "[" in head:
+            ends = [m.end() for m in re.finditer(r"\](?= - |$)", line)]
+            head = line[:ends[0]] if ends else head
+        found.add(head)
+    return sorted(found)
 
 
 def run(mutation: Mutation, jobs: int, with_tests: bool = True) -> Outcome:
@@ -237,8 +246,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.baseline:
         tests = tuple(dict.fromkeys(t for m in chosen for t in m.tests))
         clean = run(Mutation("baseline", "-", "none", (), tests), args.jobs, not args.no_tests)
-        print(f"baseline {clean.seconds:6.0f} s  {clean.status} {clean.detail} {' '.join(clean.killers)}",
-              flush=True)
+        verdict = "passed" if clean.status == "survived" else f"{clean.status} {clean.detail}"
+        print(f"baseline {clean.seconds:6.0f} s  {verdict} {' '.join(clean.killers)}", flush=True)
         if clean.status not in ("survived", "applies"):
             print("error: the unmutated copy does not pass the tests of the list", file=sys.stderr)
             return 2

@@ -118,29 +118,35 @@ def _jvp(function, primals, tangents):
 
 
 @jax.custom_jvp
-def _angle_newton_64(s):
-    return _newton_64(s)
+def _norm(v):
+    """|v| over the last axis without underflow or overflow, for finite v; derivative n = v/|v|
+    (0 at v = 0: the safe side of a double where), second derivative (I - n n^T)/|v|."""
+    return _norm_value(v)
 
 
-@_angle_newton_64.defjvp
-def _angle_newton_64_jvp(primals, tangents):
-    """Implicit function theorem: p(phi) = s, so dphi = ds / p'(phi)."""
-    (s,), (ds,) = primals, tangents
-    phi = _angle_newton_64(s)
-    return phi, ds / _slope_64(phi * phi, phi)
+@_norm.defjvp
+def _norm_jvp(primals, tangents):
+    (v,), (dv,) = primals, tangents
+    return _norm(v), _dot(_direction(v), dv)
 
 
-@jax.custom_jvp
-def _angle_newton_32(s):
-    return _newton_32(s)
+def _implicit_angle(newton, slope):
+    """The angle phi(s, d) = newton(s) of a plan without a closed inverse, its derivative by the
+    implicit function theorem: p(phi) = s, so dphi = ds / p'(phi) = ds / slope(phi^2, phi), not
+    the derivative of the fixed-count iteration."""
+    @jax.custom_jvp
+    def angle(s):
+        return newton(s)
 
+    @angle.defjvp
+    def angle_jvp(primals, tangents):
+        (s,), (ds,) = primals, tangents
+        phi = angle(s)
+        return phi, ds / slope(phi * phi, phi)
 
-@_angle_newton_32.defjvp
-def _angle_newton_32_jvp(primals, tangents):
-    """Implicit function theorem: p(phi) = s, so dphi = ds / p'(phi)."""
-    (s,), (ds,) = primals, tangents
-    phi = _angle_newton_32(s)
-    return phi, ds / _slope_32(phi * phi, phi)
+    def angle_of(s, d):
+        return angle(s)
+    return angle_of
 
 
 P_MAX = 3.3530783864394875
@@ -219,8 +225,7 @@ def _det_H_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 1.0)
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_R_0_64 = _det_H_64  # the same code
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
@@ -258,38 +263,10 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.1103124080629894
-    t = _where(small, x, 0.0)
-    series = 1.3075291305333323e-08 + 0.0 * x
-    series = 1.548516833380779e-07 + t * series
-    series = 1.8513431013431014e-06 + t * series
-    series = 2.2437384044526902e-05 + t * series
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
-    x = _where(small, 0.1103124080629894, x)
-    sin_half = _where(small, 0.1656068549609148, sin_half)
-    closed = (0.25)*x/sin_half**2
-    return _where(small, series, closed)
+_H_0_64 = _mu_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.1103124080629894
-    t = _where(small, x, 0.0)
-    series = -3.236771326819846e-10 + 0.0 * x
-    series = -4.75496882809808e-09 + t * series
-    series = -7.343103325246183e-08 + t * series
-    series = -1.2201092558235415e-06 + t * series
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
-    x = _where(small, 0.1103124080629894, x)
-    sin_half = _where(small, 0.1656068549609148, sin_half)
-    closed = 2*sin_half**2/x
-    return _where(small, series, closed)
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
@@ -321,21 +298,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.1103124080629894
-    t = _where(small, x, 0.0)
-    series = -6.473542653639692e-10 + 0.0 * x
-    series = -9.50993765619616e-09 + t * series
-    series = -1.4686206650492366e-07 + t * series
-    series = -2.440218511647083e-06 + t * series
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
-    x = _where(small, 0.1103124080629894, x)
-    sin_half = _where(small, 0.1656068549609148, sin_half)
-    closed = 4*sin_half**2/x
-    return _where(small, series, closed)
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
@@ -377,8 +340,7 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_64 = _det_H_64  # the same code
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
@@ -432,21 +394,7 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.1103124080629894
-    t = _where(small, x, 0.0)
-    series = 5.844969408074523e-11 + 0.0 * x
-    series = 8.286380574805527e-10 + t * series
-    series = 1.2203463534465907e-08 + t * series
-    series = 1.8955121406990826e-07 + t * series
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
-    phi = _where(small, 0.33274666277661247, phi)
-    x = _where(small, 0.1103124080629894, x)
-    closed = 2*_xp.sin((0.25)*phi)**2/x
-    return _where(small, series, closed)
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
@@ -477,22 +425,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_across_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.1103124080629894
-    t = _where(small, x, 0.0)
-    series = 8.716860870222215e-10 + 0.0 * x
-    series = 1.1911667949082915e-08 + t * series
-    series = 1.683039183039183e-07 + t * series
-    series = 2.4930426716141e-06 + t * series
-    series = 3.968253968253968e-05 + t * series
-    series = 0.0007142857142857143 + t * series
-    series = -0.15 + t * series
-    series = 1.0 + t * series
-    s = _where(small, 0.33213311798583023, s)
-    sin_half = _where(small, 0.1656068549609148, sin_half)
-    cos_half = _where(small, 0.9861918523238541, cos_half)
-    closed = 2*cos_half*sin_half/s
-    return _where(small, series, closed)
+_H_across_64 = _R_1_64  # the same code
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
@@ -515,21 +448,7 @@ def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _K_across_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.1103124080629894
-    t = _where(small, x, 0.0)
-    series = -4.517630699305304e-10 + 0.0 * x
-    series = -6.22104590536751e-09 + t * series
-    series = -8.889107582955239e-08 + t * series
-    series = -1.340206714788188e-06 + t * series
-    series = -2.201140873015873e-05 + t * series
-    series = -0.00042410714285714285 + t * series
-    series = -0.0125 + t * series
-    series = 0.5 + t * series
-    s = _where(small, 0.33213311798583023, s)
-    sin_half = _where(small, 0.1656068549609148, sin_half)
-    closed = sin_half/s
-    return _where(small, series, closed)
+_K_across_64 = _G_1_64  # the same code
 
 
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
@@ -629,38 +548,7 @@ def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.6302227241416043
-    t = _where(small, x, 0.0)
-    series = -1.713507963984835e-25 + 0.0 * x
-    series = -1.9911676878064524e-24 + t * series
-    series = -2.3176419769991988e-23 + t * series
-    series = -2.70256607423881e-22 + t * series
-    series = -3.1578003265100976e-21 + t * series
-    series = -3.6980551434799796e-20 + t * series
-    series = -4.341734551994152e-19 + t * series
-    series = -5.112093930302394e-18 + t * series
-    series = -6.03885929516599e-17 + t * series
-    series = -7.160541684001784e-16 + t * series
-    series = -8.527828450903873e-15 + t * series
-    series = -1.0208698466596667e-13 + t * series
-    series = -1.2296404066927483e-12 + t * series
-    series = -1.4922439654526148e-11 + t * series
-    series = -1.82786662181949e-10 + t * series
-    series = -2.2657399287738925e-09 + t * series
-    series = -2.852981296858848e-08 + t * series
-    series = -3.671551662623091e-07 + t * series
-    series = -4.880437023294166e-06 + t * series
-    series = -6.845238095238096e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.025 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    sin_half = _where(small, 0.7520427801883164, sin_half)
-    cos_half = _where(small, 0.6591142971948246, cos_half)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    closed = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
-    return _where(small, series, closed)
+_H_1_x_64 = _R_2_x_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -732,8 +620,7 @@ def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_64 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -979,12 +866,10 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _det_H_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_det_H_32 = _det_H_64  # the same code
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_R_0_32 = _det_H_64  # the same code
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
@@ -1020,21 +905,7 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
-    t = _where(small, x, 0.0)
-    series = 1.3075291305333323e-08 + 0.0 * x
-    series = 1.548516833380779e-07 + t * series
-    series = 1.8513431013431014e-06 + t * series
-    series = 2.2437384044526902e-05 + t * series
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
-    x = _where(small, 1.4342812011199078, x)
-    sin_half = _where(small, 0.5762057860563947, sin_half)
-    closed = (0.25)*x/sin_half**2
-    return _where(small, series, closed)
+_H_0_32 = _mu_32  # the same code
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
@@ -1098,8 +969,7 @@ def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
@@ -1132,8 +1002,7 @@ def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_32 = _det_H_64  # the same code
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
@@ -1185,20 +1054,7 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
-    t = _where(small, x, 0.0)
-    series = 8.286380574805527e-10 + 0.0 * x
-    series = 1.2203463534465907e-08 + t * series
-    series = 1.8955121406990826e-07 + t * series
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
-    phi = _where(small, 1.2281574046507382, phi)
-    x = _where(small, 1.4342812011199078, x)
-    closed = 2*_xp.sin((0.25)*phi)**2/x
-    return _where(small, series, closed)
+_K_1_32 = _G_2_32  # the same code
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
@@ -1232,21 +1088,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_across_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
-    t = _where(small, x, 0.0)
-    series = 1.1911667949082915e-08 + 0.0 * x
-    series = 1.683039183039183e-07 + t * series
-    series = 2.4930426716141e-06 + t * series
-    series = 3.968253968253968e-05 + t * series
-    series = 0.0007142857142857143 + t * series
-    series = -0.15 + t * series
-    series = 1.0 + t * series
-    s = _where(small, 1.1976147966353403, s)
-    sin_half = _where(small, 0.5762057860563947, sin_half)
-    cos_half = _where(small, 0.8173046507362676, cos_half)
-    closed = 2*cos_half*sin_half/s
-    return _where(small, series, closed)
+_H_across_32 = _R_1_32  # the same code
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
@@ -1267,24 +1109,10 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _K_across_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 1.4342812011199078
-    t = _where(small, x, 0.0)
-    series = -6.22104590536751e-09 + 0.0 * x
-    series = -8.889107582955239e-08 + t * series
-    series = -1.340206714788188e-06 + t * series
-    series = -2.201140873015873e-05 + t * series
-    series = -0.00042410714285714285 + t * series
-    series = -0.0125 + t * series
-    series = 0.5 + t * series
-    s = _where(small, 1.1976147966353403, s)
-    sin_half = _where(small, 0.5762057860563947, sin_half)
-    closed = sin_half/s
-    return _where(small, series, closed)
+_K_across_32 = _G_1_32  # the same code
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_0_x_32 = _R_0_x_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
@@ -1372,34 +1200,7 @@ def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 4.619481091176478
-    t = _where(small, x, 0.0)
-    series = -3.1578003265100976e-21 + 0.0 * x
-    series = -3.6980551434799796e-20 + t * series
-    series = -4.341734551994152e-19 + t * series
-    series = -5.112093930302394e-18 + t * series
-    series = -6.03885929516599e-17 + t * series
-    series = -7.160541684001784e-16 + t * series
-    series = -8.527828450903873e-15 + t * series
-    series = -1.0208698466596667e-13 + t * series
-    series = -1.2296404066927483e-12 + t * series
-    series = -1.4922439654526148e-11 + t * series
-    series = -1.82786662181949e-10 + t * series
-    series = -2.2657399287738925e-09 + t * series
-    series = -2.852981296858848e-08 + t * series
-    series = -3.671551662623091e-07 + t * series
-    series = -4.880437023294166e-06 + t * series
-    series = -6.845238095238096e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.025 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    closed = (0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*_cbrt(6*phi - 12*w0))
-    return _where(small, series, closed)
+_H_1_x_32 = _R_2_x_32  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -1471,8 +1272,7 @@ def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_32 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -1634,12 +1434,10 @@ def _scale_32(e0, e_norm):
     return _narrow(_where(small, series, closed), e0)
 
 
-def _angle_64(s, d):
-    return _angle_newton_64(s)
+_angle_64 = _implicit_angle(_newton_64, _slope_64)
 
 
-def _angle_32(s, d):
-    return _angle_newton_32(s)
+_angle_32 = _implicit_angle(_newton_32, _slope_32)
 
 
 _COEFFICIENTS = {
@@ -1716,16 +1514,27 @@ _COEFFICIENTS = {
 }
 _ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
     "32": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
-_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
-_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": 1.2676506002282294e+30}
 E0_MIN = -math.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": 2.0 ** -11}
+_COMPLEMENT = None  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x <= P_MAX_SQUARED
+
+
+_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
+_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 
 
 def _dot(a, b):
@@ -1764,17 +1573,31 @@ def _direction(v):
     return _where(nonzero[..., None], unit / length[..., None], 0.0)
 
 
-@jax.custom_jvp
-def _norm(v):
-    """|v| over the last axis without underflow or overflow, for finite v; derivative n = v/|v|
-    (0 at v = 0: the safe side of a double where), second derivative (I - n n^T)/|v|."""
-    return _norm_value(v)
+def _two_square(a):
+    """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
+    c = 134217729.0 * a
+    high = c - (c - a)
+    low = a - high
+    square = a * a
+    return square, ((high * high - square) + 2.0 * high * low) + low * low
 
 
-@_norm.defjvp
-def _norm_jvp(primals, tangents):
-    (v,), (dv,) = primals, tangents
-    return _norm(v), _dot(_direction(v), dv)
+def _complement(p, x):
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form) accurate to a
+    few ulp of d (compensated products and sums, float64); its derivative is that of _COMPLEMENT - x."""
+    if _suffix(p) == "32":
+        q = _wide(p)
+        value = _narrow(_COMPLEMENT - _dot(q, q), p)
+    else:
+        high = _COMPLEMENT + 0.0 * x
+        low = _COMPLEMENT_LOW + 0.0 * x  # p_max^2 - float(p_max^2)
+        for i in range(3):
+            square, error = _two_square(p[..., i])
+            total = high - square
+            low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
+            high = total
+        value = high + low
+    return _stop(value) + (_stop(x) - x)
 
 
 def _length(p, x, suffix):
@@ -1782,11 +1605,6 @@ def _length(p, x, suffix):
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
     root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
-
-
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
-    return x <= P_MAX_SQUARED
 
 
 def _prepare(p, names):
@@ -1797,11 +1615,17 @@ def _prepare(p, names):
     p = _where(valid[..., None], p, 0.0)
     x = _squared_norm(p)
     s = _length(p, x, suffix)
-    d = None
+    d = None if _COMPLEMENT is None else _complement(p, x)
     if any(_USES_PHI[suffix][name] for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, _xp.sin(half), _xp.cos(half)), valid, suffix
+        sin_half, cos_half = _xp.sin(half), _xp.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            wide = _wide(_stop(phi))
+            low = _stop(_ANGLE_LOW[suffix](_wide(_stop(s)), wide))
+            low = _narrow(_where(_xp.abs(low) <= _ANGLE_LOW_BOUND[suffix] * wide, 0.5 * low, 0.0), s)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half), valid, suffix
     return p, (x, None, s, d, None, None), valid, suffix
 
 

@@ -115,6 +115,38 @@ def _jvp(function, primals, tangents):
     return jax.jvp(function, primals, tangents)
 
 
+@jax.custom_jvp
+def _norm(v):
+    """|v| over the last axis without underflow or overflow, for finite v; derivative n = v/|v|
+    (0 at v = 0: the safe side of a double where), second derivative (I - n n^T)/|v|."""
+    return _norm_value(v)
+
+
+@_norm.defjvp
+def _norm_jvp(primals, tangents):
+    (v,), (dv,) = primals, tangents
+    return _norm(v), _dot(_direction(v), dv)
+
+
+def _implicit_angle(newton, slope):
+    """The angle phi(s, d) = newton(s) of a plan without a closed inverse, its derivative by the
+    implicit function theorem: p(phi) = s, so dphi = ds / p'(phi) = ds / slope(phi^2, phi), not
+    the derivative of the fixed-count iteration."""
+    @jax.custom_jvp
+    def angle(s):
+        return newton(s)
+
+    @angle.defjvp
+    def angle_jvp(primals, tangents):
+        (s,), (ds,) = primals, tangents
+        phi = angle(s)
+        return phi, ds / slope(phi * phi, phi)
+
+    def angle_of(s, d):
+        return angle(s)
+    return angle_of
+
+
 P_MAX = 2.0
 P_MAX_SQUARED = 4.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
 
@@ -131,40 +163,33 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
     return (2/_sqrt(d)) + 0.0 * x
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_sqrt(d)) + 0.0 * x
+_mu_64 = _epsilon_64  # the same code
 
 
-def _det_H_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_sqrt(d)) + 0.0 * x
+_det_H_64 = _epsilon_64  # the same code
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_R_0_64 = _nu_64  # the same code
 
 
-def _R_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_sqrt(d)) + 0.0 * x
+_R_1_64 = _p_prime_64  # the same code
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.5)
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    return (2/_sqrt(d)) + 0.0 * x
+_H_0_64 = _epsilon_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
     return ((0.5)/_sqrt(d)) + 0.0 * x
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_sqrt(d)) + 0.0 * x
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
@@ -175,12 +200,10 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.0)
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_64 = _nu_64  # the same code
 
 
-def _G_1_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_G_1_64 = _R_2_64  # the same code
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
@@ -191,8 +214,7 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
     return (1/_sqrt(d)) + 0.0 * x
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)/(_sqrt(d) + 2)) + 0.0 * x
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
@@ -212,56 +234,46 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_across_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_sqrt(d)) + 0.0 * x
+_H_across_64 = _p_prime_64  # the same code
 
 
-def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_sqrt(d)) + 0.0 * x
+_H_inverse_across_64 = _p_prime_64  # the same code
 
 
-def _K_across_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_K_across_64 = _R_2_64  # the same code
 
 
-def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_0_x_64 = _H_inverse_2_64  # the same code
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
     return (-(0.25)/_sqrt(d)) + 0.0 * x
 
 
-def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_2_x_64 = _H_inverse_2_64  # the same code
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
     return (d**(-1.5)) + 0.0 * x
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_1_x_64 = _H_inverse_2_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     return ((0.25)/d**(1.5)) + 0.0 * x
 
 
-def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-(0.25)/_sqrt(d)) + 0.0 * x
+_H_inverse_0_x_64 = _R_1_x_64  # the same code
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_64 = _H_inverse_2_64  # the same code
 
 
-def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_2_x_64 = _H_inverse_2_64  # the same code
 
 
-def _e_0_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*_sqrt(d)) + 0.0 * x
+_e_0_64 = _p_prime_64  # the same code
 
 
 def _scale_64(e0, e_norm):
@@ -274,8 +286,7 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
 
 
-def _nu_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_nu_32 = _nu_64  # the same code
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
@@ -284,40 +295,25 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((2/_sqrt(d)) + 0.0 * x, s)
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
+_mu_32 = _epsilon_32  # the same code
 
 
-def _det_H_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
+_det_H_32 = _epsilon_32  # the same code
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_R_0_32 = _nu_64  # the same code
 
 
-def _R_1_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
+_R_1_32 = _p_prime_32  # the same code
 
 
-def _R_2_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_R_2_32 = _R_2_64  # the same code
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow((2/_sqrt(d)) + 0.0 * x, s)
+_H_0_32 = _epsilon_32  # the same code
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_H_1_32 = _R_2_64  # the same code
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
@@ -326,26 +322,19 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     return _narrow(((0.5)/_sqrt(d)) + 0.0 * x, s)
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
+_H_inverse_0_32 = _p_prime_32  # the same code
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
-def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_2_32 = _H_inverse_2_64  # the same code
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_32 = _nu_64  # the same code
 
 
-def _G_1_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_G_1_32 = _R_2_64  # the same code
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
@@ -360,10 +349,7 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((1/_sqrt(d)) + 0.0 * x, s)
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow(((0.5)/(_sqrt(d) + 2)) + 0.0 * x, s)
+_K_1_32 = _G_2_32  # the same code
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
@@ -383,24 +369,16 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_across_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
+_H_across_32 = _p_prime_32  # the same code
 
 
-def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
+_H_inverse_across_32 = _p_prime_32  # the same code
 
 
-def _K_across_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_K_across_32 = _R_2_64  # the same code
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_0_x_32 = _H_inverse_2_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
@@ -409,8 +387,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((-(0.25)/_sqrt(d)) + 0.0 * x, s)
 
 
-def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_2_x_32 = _H_inverse_2_64  # the same code
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
@@ -419,8 +396,7 @@ def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((d**(-1.5)) + 0.0 * x, s)
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_1_x_32 = _H_inverse_2_64  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -429,24 +405,16 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     return _narrow(((0.25)/d**(1.5)) + 0.0 * x, s)
 
 
-def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow((-(0.25)/_sqrt(d)) + 0.0 * x, s)
+_H_inverse_0_x_32 = _R_1_x_32  # the same code
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_32 = _H_inverse_2_64  # the same code
 
 
-def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_2_x_32 = _H_inverse_2_64  # the same code
 
 
-def _e_0_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    d = _wide(d)
-    return _narrow(((0.5)*_sqrt(d)) + 0.0 * x, s)
+_e_0_32 = _p_prime_32  # the same code
 
 
 def _scale_32(e0, e_norm):
@@ -536,16 +504,27 @@ _COEFFICIENTS = {
 }
 _ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
     "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
 }
-_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
-_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": 1.2676506002282294e+30}
 E0_MIN = 0.0
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": 2.0 ** -11}
+_COMPLEMENT = 4.0  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x < P_MAX_SQUARED
+
+
+_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
+_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 
 
 def _dot(a, b):
@@ -584,19 +563,6 @@ def _direction(v):
     return _where(nonzero[..., None], unit / length[..., None], 0.0)
 
 
-@jax.custom_jvp
-def _norm(v):
-    """|v| over the last axis without underflow or overflow, for finite v; derivative n = v/|v|
-    (0 at v = 0: the safe side of a double where), second derivative (I - n n^T)/|v|."""
-    return _norm_value(v)
-
-
-@_norm.defjvp
-def _norm_jvp(primals, tangents):
-    (v,), (dv,) = primals, tangents
-    return _norm(v), _dot(_direction(v), dv)
-
-
 def _two_square(a):
     """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
     c = 134217729.0 * a
@@ -607,14 +573,14 @@ def _two_square(a):
 
 
 def _complement(p, x):
-    """d = 4 - |p|^2 accurate to a few ulp of d (compensated products and sums,
-    float64); its derivative is that of 4 - x."""
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form) accurate to a
+    few ulp of d (compensated products and sums, float64); its derivative is that of _COMPLEMENT - x."""
     if _suffix(p) == "32":
         q = _wide(p)
-        value = _narrow(4.0 - _dot(q, q), p)
+        value = _narrow(_COMPLEMENT - _dot(q, q), p)
     else:
-        high = 4.0 + 0.0 * x
-        low = 0.0 * x
+        high = _COMPLEMENT + 0.0 * x
+        low = _COMPLEMENT_LOW + 0.0 * x  # p_max^2 - float(p_max^2)
         for i in range(3):
             square, error = _two_square(p[..., i])
             total = high - square
@@ -631,11 +597,6 @@ def _length(p, x, suffix):
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
 
 
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
-    return x < P_MAX_SQUARED
-
-
 def _prepare(p, names):
     """p, (x, phi, s, d, sin(phi/2), cos(phi/2)), valid, suffix for the coefficient functions
     ``names``; p is replaced by 0 outside the validity range (safe for every derivative)."""
@@ -644,11 +605,17 @@ def _prepare(p, names):
     p = _where(valid[..., None], p, 0.0)
     x = _squared_norm(p)
     s = _length(p, x, suffix)
-    d = _complement(p, x)
+    d = None if _COMPLEMENT is None else _complement(p, x)
     if any(_USES_PHI[suffix][name] for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, _xp.sin(half), _xp.cos(half)), valid, suffix
+        sin_half, cos_half = _xp.sin(half), _xp.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            wide = _wide(_stop(phi))
+            low = _stop(_ANGLE_LOW[suffix](_wide(_stop(s)), wide))
+            low = _narrow(_where(_xp.abs(low) <= _ANGLE_LOW_BOUND[suffix] * wide, 0.5 * low, 0.0), s)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half), valid, suffix
     return p, (x, None, s, d, None, None), valid, suffix
 
 

@@ -115,6 +115,38 @@ def _jvp(function, primals, tangents):
     return jax.jvp(function, primals, tangents)
 
 
+@jax.custom_jvp
+def _norm(v):
+    """|v| over the last axis without underflow or overflow, for finite v; derivative n = v/|v|
+    (0 at v = 0: the safe side of a double where), second derivative (I - n n^T)/|v|."""
+    return _norm_value(v)
+
+
+@_norm.defjvp
+def _norm_jvp(primals, tangents):
+    (v,), (dv,) = primals, tangents
+    return _norm(v), _dot(_direction(v), dv)
+
+
+def _implicit_angle(newton, slope):
+    """The angle phi(s, d) = newton(s) of a plan without a closed inverse, its derivative by the
+    implicit function theorem: p(phi) = s, so dphi = ds / p'(phi) = ds / slope(phi^2, phi), not
+    the derivative of the fixed-count iteration."""
+    @jax.custom_jvp
+    def angle(s):
+        return newton(s)
+
+    @angle.defjvp
+    def angle_jvp(primals, tangents):
+        (s,), (ds,) = primals, tangents
+        phi = angle(s)
+        return phi, ds / slope(phi * phi, phi)
+
+    def angle_of(s, d):
+        return angle(s)
+    return angle_of
+
+
 P_MAX = 6.283185307179586
 P_MAX_SQUARED = 39.47841760435743  # fl(p_max^2); inside the range: x = |p|^2 <= P_MAX_SQUARED
 
@@ -156,8 +188,7 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_mu_64 = _p_prime_64  # the same code
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
@@ -177,8 +208,7 @@ def _det_H_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_R_0_64 = _p_prime_64  # the same code
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
@@ -216,25 +246,10 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_H_0_64 = _p_prime_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 0.7851233626304374
-    t = _where(small, x, 0.0)
-    series = -4.779477332387385e-14 + 0.0 * x
-    series = 1.1470745597729725e-11 + t * series
-    series = -2.08767569878681e-09 + t * series
-    series = 2.755731922398589e-07 + t * series
-    series = -2.48015873015873e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = -0.041666666666666664 + t * series
-    series = 0.5 + t * series
-    phi = _where(small, 0.886071872158482, phi)
-    sin_half = _where(small, 0.42868426614277505, sin_half)
-    closed = 2*sin_half**2/phi**2
-    return _where(small, series, closed)
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
@@ -253,8 +268,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
@@ -290,8 +304,7 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_64 = _p_prime_64  # the same code
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
@@ -331,20 +344,7 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.5)
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 2.897865491219683
-    t = _where(small, x, 0.0)
-    series = -7.292903644389931e-19 + 0.0 * x
-    series = 7.001187498614334e-16 + t * series
-    series = -5.096864498991235e-13 + t * series
-    series = 2.691144455467372e-10 + t * series
-    series = -9.68812003968254e-08 + t * series
-    series = 2.170138888888889e-05 + t * series
-    series = -0.0026041666666666665 + t * series
-    series = 0.125 + t * series
-    phi = _where(small, 1.7023118078717785, phi)
-    closed = 2*_xp.sin((0.25)*phi)**2/phi**2
-    return _where(small, series, closed)
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
@@ -408,30 +408,10 @@ def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_0_x_64 = _R_0_x_64  # the same code
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.5673482008975155
-    t = _where(small, x, 0.0)
-    series = 2.975515515869757e-26 + 0.0 * x
-    series = -1.77291132820573e-23 + t * series
-    series = 8.896791392450573e-21 + t * series
-    series = -3.6992858609809485e-18 + t * series
-    series = 1.249536557486898e-15 + t * series
-    series = -3.3456341326711696e-13 + t * series
-    series = 6.882447358637835e-11 + t * series
-    series = -1.043837849393405e-08 + t * series
-    series = 1.1022927689594355e-06 + t * series
-    series = -7.440476190476191e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.041666666666666664 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = (0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3
-    return _where(small, series, closed)
+_H_1_x_64 = _R_2_x_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -453,12 +433,10 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_0_x_64 = _R_0_x_64  # the same code
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_64 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -527,8 +505,7 @@ def _scale_64(e0, e_norm):
     return _where(small, series, closed)
 
 
-def _p_prime_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_p_prime_32 = _p_prime_64  # the same code
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half):
@@ -561,8 +538,7 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_mu_32 = _p_prime_64  # the same code
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
@@ -581,8 +557,7 @@ def _det_H_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_R_0_32 = _p_prime_64  # the same code
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
@@ -619,24 +594,10 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_H_0_32 = _p_prime_64  # the same code
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
-    t = _where(small, x, 0.0)
-    series = 1.1470745597729725e-11 + 0.0 * x
-    series = -2.08767569878681e-09 + t * series
-    series = 2.755731922398589e-07 + t * series
-    series = -2.48015873015873e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = -0.041666666666666664 + t * series
-    series = 0.5 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    closed = 2*sin_half**2/phi**2
-    return _where(small, series, closed)
+_H_1_32 = _R_2_32  # the same code
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
@@ -654,12 +615,10 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_H_inverse_0_32 = _p_prime_64  # the same code
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
@@ -681,8 +640,7 @@ def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_32 = _p_prime_64  # the same code
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
@@ -713,21 +671,10 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _K_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.5)
+_K_0_32 = _K_0_64  # the same code
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
-    t = _where(small, x, 0.0)
-    series = 2.691144455467372e-10 + 0.0 * x
-    series = -9.68812003968254e-08 + t * series
-    series = 2.170138888888889e-05 + t * series
-    series = -0.0026041666666666665 + t * series
-    series = 0.125 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    closed = 2*_xp.sin((0.25)*phi)**2/phi**2
-    return _where(small, series, closed)
+_K_1_32 = _G_2_32  # the same code
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
@@ -744,8 +691,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_0_x_32 = _R_0_x_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
@@ -782,25 +728,10 @@ def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_0_x_32 = _R_0_x_64  # the same code
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
-    small = x < 5.567347935831094
-    t = _where(small, x, 0.0)
-    series = -3.3456341326711696e-13 + 0.0 * x
-    series = 6.882447358637835e-11 + t * series
-    series = -1.043837849393405e-08 + t * series
-    series = 1.1022927689594355e-06 + t * series
-    series = -7.440476190476191e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.041666666666666664 + t * series
-    phi = _where(small, 2.3595228756885396, phi)
-    sin_half = _where(small, 0.9245151118510668, sin_half)
-    cos_half = _where(small, 0.3811453895287326, cos_half)
-    closed = (0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3
-    return _where(small, series, closed)
+_H_1_x_32 = _R_2_x_32  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -820,12 +751,10 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     return _where(small, series, closed)
 
 
-def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_0_x_32 = _R_0_x_64  # the same code
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_32 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -956,16 +885,27 @@ _COEFFICIENTS = {
 }
 _ACROSS = ()  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': False, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
     "32": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': False, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
 }
-_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
-_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 _X_LIMIT = {"64": 4.149515568880993e+180, "32": 1.2676506002282294e+30}
 E0_MIN = -math.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": 2.0 ** -11}
+_COMPLEMENT = None  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x <= P_MAX_SQUARED
+
+
+_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
+_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 
 
 def _dot(a, b):
@@ -1004,17 +944,31 @@ def _direction(v):
     return _where(nonzero[..., None], unit / length[..., None], 0.0)
 
 
-@jax.custom_jvp
-def _norm(v):
-    """|v| over the last axis without underflow or overflow, for finite v; derivative n = v/|v|
-    (0 at v = 0: the safe side of a double where), second derivative (I - n n^T)/|v|."""
-    return _norm_value(v)
+def _two_square(a):
+    """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
+    c = 134217729.0 * a
+    high = c - (c - a)
+    low = a - high
+    square = a * a
+    return square, ((high * high - square) + 2.0 * high * low) + low * low
 
 
-@_norm.defjvp
-def _norm_jvp(primals, tangents):
-    (v,), (dv,) = primals, tangents
-    return _norm(v), _dot(_direction(v), dv)
+def _complement(p, x):
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form) accurate to a
+    few ulp of d (compensated products and sums, float64); its derivative is that of _COMPLEMENT - x."""
+    if _suffix(p) == "32":
+        q = _wide(p)
+        value = _narrow(_COMPLEMENT - _dot(q, q), p)
+    else:
+        high = _COMPLEMENT + 0.0 * x
+        low = _COMPLEMENT_LOW + 0.0 * x  # p_max^2 - float(p_max^2)
+        for i in range(3):
+            square, error = _two_square(p[..., i])
+            total = high - square
+            low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
+            high = total
+        value = high + low
+    return _stop(value) + (_stop(x) - x)
 
 
 def _length(p, x, suffix):
@@ -1022,11 +976,6 @@ def _length(p, x, suffix):
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
     root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
-
-
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
-    return x <= P_MAX_SQUARED
 
 
 def _prepare(p, names):
@@ -1037,11 +986,17 @@ def _prepare(p, names):
     p = _where(valid[..., None], p, 0.0)
     x = _squared_norm(p)
     s = _length(p, x, suffix)
-    d = None
+    d = None if _COMPLEMENT is None else _complement(p, x)
     if any(_USES_PHI[suffix][name] for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, _xp.sin(half), _xp.cos(half)), valid, suffix
+        sin_half, cos_half = _xp.sin(half), _xp.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            wide = _wide(_stop(phi))
+            low = _stop(_ANGLE_LOW[suffix](_wide(_stop(s)), wide))
+            low = _narrow(_where(_xp.abs(low) <= _ANGLE_LOW_BOUND[suffix] * wide, 0.5 * low, 0.0), s)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half), valid, suffix
     return p, (x, None, s, d, None, None), valid, suffix
 
 

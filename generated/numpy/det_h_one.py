@@ -37,122 +37,106 @@ P_MAX_SQUARED = 11.243134665607636  # fl(p_max^2); inside the range: x = |p|^2 <
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = -6.473542653639692e-10
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = -6.473542653639692e-10
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -6.473542653639692e-10
+    series = -9.50993765619616e-09 + t * series
+    series = -1.4686206650492366e-07 + t * series
+    series = -2.440218511647083e-06 + t * series
+    series = -4.563492063492064e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.05 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = -9.035261398610608e-10
-        series = -1.244209181073502e-08 + t * series
-        series = -1.7778215165910478e-07 + t * series
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = -9.035261398610608e-10
-        series = -1.244209181073502e-08 + t * series
-        series = -1.7778215165910478e-07 + t * series
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -9.035261398610608e-10
+    series = -1.244209181073502e-08 + t * series
+    series = -1.7778215165910478e-07 + t * series
+    series = -2.680413429576376e-06 + t * series
+    series = -4.402281746031746e-05 + t * series
+    series = -0.0008482142857142857 + t * series
+    series = -0.025 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.05752053308030299:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.05752053308030299  # every lane on it
+    if polynomial:
         t = x
-        series = 7.141710355470859e-07
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 0.05752053308030299:  # every lane on the closed form
-        return out
-    small = x < 0.05752053308030299
-    if small.any():
+    else:
+        out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
+        if span is not None and span[0] >= 0.05752053308030299:  # every lane on the closed form
+            return out
+        small = x < 0.05752053308030299
+        if not small.any():
+            return out
         t = x[small]
-        series = 7.141710355470859e-07
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = 7.141710355470859e-07
+    series = 5.063042332919034e-06 + t * series
+    series = 3.592768342768343e-05 + t * series
+    series = 0.0002554692331478046 + t * series
+    series = 0.0018253968253968255 + t * series
+    series = 0.013214285714285715 + t * series
+    series = 0.1 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = 1.3075291305333323e-08
+    series = 1.548516833380779e-07 + t * series
+    series = 1.8513431013431014e-06 + t * series
+    series = 2.2437384044526902e-05 + t * series
+    series = 0.0002777777777777778 + t * series
+    series = 0.0035714285714285713 + t * series
+    series = 0.05 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
@@ -160,208 +144,104 @@ def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 1.0)
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_R_0_64 = _det_H_64  # the same code
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = 8.716860870222215e-10
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = 8.716860870222215e-10
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = 8.716860870222215e-10
+    series = 1.1911667949082915e-08 + t * series
+    series = 1.683039183039183e-07 + t * series
+    series = 2.4930426716141e-06 + t * series
+    series = 3.968253968253968e-05 + t * series
+    series = 0.0007142857142857143 + t * series
+    series = -0.15 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = -3.236771326819846e-10
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = -3.236771326819846e-10
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        out[small] = series
+    series = -3.236771326819846e-10
+    series = -4.75496882809808e-09 + t * series
+    series = -7.343103325246183e-08 + t * series
+    series = -1.2201092558235415e-06 + t * series
+    series = -2.281746031746032e-05 + t * series
+    series = -0.0005357142857142857 + t * series
+    series = -0.025 + t * series
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
-        t = x
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
-        t = x[small]
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
-    return out
+_H_0_64 = _mu_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
-        t = x
-        series = -3.236771326819846e-10
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
-        t = x[small]
-        series = -3.236771326819846e-10
-        series = -4.75496882809808e-09 + t * series
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        out[small] = series
-    return out
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812090283275  # every lane on it
+    if polynomial:
         t = x
-        series = 2.5501224371929e-20
-        series = 2.918170543767923e-19 + t * series
-        series = 3.3425985887827363e-18 + t * series
-        series = 3.8329294257465515e-17 + t * series
-        series = 4.4005658265072545e-16 + t * series
-        series = 5.0592551808267075e-15 + t * series
-        series = 5.825704915999495e-14 + t * series
-        series = 6.720412596247862e-13 + t * series
-        series = 7.768808765054745e-12 + t * series
-        series = 9.002866267756873e-11 + t * series
-        series = 1.046342173054307e-09 + t * series
-        series = 1.22036052183111e-08 + t * series
-        series = 1.42940015388995e-07 + t * series
-        series = 1.683039183039183e-06 + t * series
-        series = 1.99443413729128e-05 + t * series
-        series = 0.0002380952380952381 + t * series
-        series = 0.002857142857142857 + t * series
-        series = 0.2 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
-        return out
-    small = x < 1.4342812090283275
-    if small.any():
+    else:
+        out = numpy.asarray((-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+            return out
+        small = x < 1.4342812090283275
+        if not small.any():
+            return out
         t = x[small]
-        series = 2.5501224371929e-20
-        series = 2.918170543767923e-19 + t * series
-        series = 3.3425985887827363e-18 + t * series
-        series = 3.8329294257465515e-17 + t * series
-        series = 4.4005658265072545e-16 + t * series
-        series = 5.0592551808267075e-15 + t * series
-        series = 5.825704915999495e-14 + t * series
-        series = 6.720412596247862e-13 + t * series
-        series = 7.768808765054745e-12 + t * series
-        series = 9.002866267756873e-11 + t * series
-        series = 1.046342173054307e-09 + t * series
-        series = 1.22036052183111e-08 + t * series
-        series = 1.42940015388995e-07 + t * series
-        series = 1.683039183039183e-06 + t * series
-        series = 1.99443413729128e-05 + t * series
-        series = 0.0002380952380952381 + t * series
-        series = 0.002857142857142857 + t * series
-        series = 0.2 + t * series
-        out[small] = series
+    series = 2.5501224371929e-20
+    series = 2.918170543767923e-19 + t * series
+    series = 3.3425985887827363e-18 + t * series
+    series = 3.8329294257465515e-17 + t * series
+    series = 4.4005658265072545e-16 + t * series
+    series = 5.0592551808267075e-15 + t * series
+    series = 5.825704915999495e-14 + t * series
+    series = 6.720412596247862e-13 + t * series
+    series = 7.768808765054745e-12 + t * series
+    series = 9.002866267756873e-11 + t * series
+    series = 1.046342173054307e-09 + t * series
+    series = 1.22036052183111e-08 + t * series
+    series = 1.42940015388995e-07 + t * series
+    series = 1.683039183039183e-06 + t * series
+    series = 1.99443413729128e-05 + t * series
+    series = 0.0002380952380952381 + t * series
+    series = 0.002857142857142857 + t * series
+    series = 0.2 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
-        t = x
-        series = -6.473542653639692e-10
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
-        t = x[small]
-        series = -6.473542653639692e-10
-        series = -9.50993765619616e-09 + t * series
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
-    return out
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -369,329 +249,199 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 2.6302227241416043  # every lane on it
+    if polynomial:
         t = x
-        series = 3.42701592796967e-25
-        series = 3.982335375612905e-24 + t * series
-        series = 4.6352839539983977e-23 + t * series
-        series = 5.40513214847762e-22 + t * series
-        series = 6.315600653020195e-21 + t * series
-        series = 7.396110286959959e-20 + t * series
-        series = 8.683469103988305e-19 + t * series
-        series = 1.0224187860604788e-17 + t * series
-        series = 1.207771859033198e-16 + t * series
-        series = 1.4321083368003567e-15 + t * series
-        series = 1.7055656901807745e-14 + t * series
-        series = 2.0417396933193335e-13 + t * series
-        series = 2.4592808133854965e-12 + t * series
-        series = 2.9844879309052296e-11 + t * series
-        series = 3.65573324363898e-10 + t * series
-        series = 4.531479857547785e-09 + t * series
-        series = 5.705962593717696e-08 + t * series
-        series = 7.343103325246182e-07 + t * series
-        series = 9.760874046588332e-06 + t * series
-        series = 0.0001369047619047619 + t * series
-        series = 0.002142857142857143 + t * series
-        series = 0.05 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = x**(-1.0)
-    w1 = numpy.cos(phi)
-    w2 = numpy.sin(phi)
-    out = numpy.asarray(w0*((0.3333333333333333)*w0*(6 - 6*w1) - w2/(s*(w0*w2**2 + w0*(1 - w1)**2))), dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
-        return out
-    small = x < 2.6302227241416043
-    if small.any():
+    else:
+        w0 = x**(-1.0)
+        w1 = numpy.cos(phi)
+        w2 = numpy.sin(phi)
+        out = numpy.asarray(w0*((0.3333333333333333)*w0*(6 - 6*w1) - w2/(s*(w0*w2**2 + w0*(1 - w1)**2))), dtype=x.dtype)
+        if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+            return out
+        small = x < 2.6302227241416043
+        if not small.any():
+            return out
         t = x[small]
-        series = 3.42701592796967e-25
-        series = 3.982335375612905e-24 + t * series
-        series = 4.6352839539983977e-23 + t * series
-        series = 5.40513214847762e-22 + t * series
-        series = 6.315600653020195e-21 + t * series
-        series = 7.396110286959959e-20 + t * series
-        series = 8.683469103988305e-19 + t * series
-        series = 1.0224187860604788e-17 + t * series
-        series = 1.207771859033198e-16 + t * series
-        series = 1.4321083368003567e-15 + t * series
-        series = 1.7055656901807745e-14 + t * series
-        series = 2.0417396933193335e-13 + t * series
-        series = 2.4592808133854965e-12 + t * series
-        series = 2.9844879309052296e-11 + t * series
-        series = 3.65573324363898e-10 + t * series
-        series = 4.531479857547785e-09 + t * series
-        series = 5.705962593717696e-08 + t * series
-        series = 7.343103325246182e-07 + t * series
-        series = 9.760874046588332e-06 + t * series
-        series = 0.0001369047619047619 + t * series
-        series = 0.002142857142857143 + t * series
-        series = 0.05 + t * series
-        out[small] = series
+    series = 3.42701592796967e-25
+    series = 3.982335375612905e-24 + t * series
+    series = 4.6352839539983977e-23 + t * series
+    series = 5.40513214847762e-22 + t * series
+    series = 6.315600653020195e-21 + t * series
+    series = 7.396110286959959e-20 + t * series
+    series = 8.683469103988305e-19 + t * series
+    series = 1.0224187860604788e-17 + t * series
+    series = 1.207771859033198e-16 + t * series
+    series = 1.4321083368003567e-15 + t * series
+    series = 1.7055656901807745e-14 + t * series
+    series = 2.0417396933193335e-13 + t * series
+    series = 2.4592808133854965e-12 + t * series
+    series = 2.9844879309052296e-11 + t * series
+    series = 3.65573324363898e-10 + t * series
+    series = 4.531479857547785e-09 + t * series
+    series = 5.705962593717696e-08 + t * series
+    series = 7.343103325246182e-07 + t * series
+    series = 9.760874046588332e-06 + t * series
+    series = 0.0001369047619047619 + t * series
+    series = 0.002142857142857143 + t * series
+    series = 0.05 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_64 = _det_H_64  # the same code
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = -4.517630699305304e-10
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray(sin_half/s, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = -4.517630699305304e-10
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        out[small] = series
+    series = -4.517630699305304e-10
+    series = -6.22104590536751e-09 + t * series
+    series = -8.889107582955239e-08 + t * series
+    series = -1.340206714788188e-06 + t * series
+    series = -2.201140873015873e-05 + t * series
+    series = -0.00042410714285714285 + t * series
+    series = -0.0125 + t * series
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = 5.844969408074523e-11
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = 5.844969408074523e-11
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        out[small] = series
+    series = 5.844969408074523e-11
+    series = 8.286380574805527e-10 + t * series
+    series = 1.2203463534465907e-08 + t * series
+    series = 1.8955121406990826e-07 + t * series
+    series = 3.189329117063492e-06 + t * series
+    series = 6.138392857142858e-05 + t * series
+    series = 0.0015625 + t * series
+    series = 0.125 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = 6.5376456526666615e-09
-        series = 7.742584166903895e-08 + t * series
-        series = 9.256715506715507e-07 + t * series
-        series = 1.1218692022263451e-05 + t * series
-        series = 0.0001388888888888889 + t * series
-        series = 0.0017857142857142857 + t * series
-        series = 0.025 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = 6.5376456526666615e-09
-        series = 7.742584166903895e-08 + t * series
-        series = 9.256715506715507e-07 + t * series
-        series = 1.1218692022263451e-05 + t * series
-        series = 0.0001388888888888889 + t * series
-        series = 0.0017857142857142857 + t * series
-        series = 0.025 + t * series
-        series = 0.5 + t * series
-        out[small] = series
+    series = 6.5376456526666615e-09
+    series = 7.742584166903895e-08 + t * series
+    series = 9.256715506715507e-07 + t * series
+    series = 1.1218692022263451e-05 + t * series
+    series = 0.0001388888888888889 + t * series
+    series = 0.0017857142857142857 + t * series
+    series = 0.025 + t * series
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
-        t = x
-        series = 5.844969408074523e-11
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
-        t = x[small]
-        series = 5.844969408074523e-11
-        series = 8.286380574805527e-10 + t * series
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        out[small] = series
-    return out
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812090283275  # every lane on it
+    if polynomial:
         t = x
-        series = 1.3462827495637501e-20
-        series = 1.5454156215361094e-19 + t * series
-        series = 1.7764157194142527e-18 + t * series
-        series = 2.0451064003372294e-17 + t * series
-        series = 2.3586252560910385e-16 + t * series
-        series = 2.725820183855303e-15 + t * series
-        series = 3.157810155130715e-14 + t * series
-        series = 3.6688033619582197e-13 + t * series
-        series = 4.277333653830018e-12 + t * series
-        series = 5.008208696060211e-11 + t * series
-        series = 5.895736922222117e-10 + t * series
-        series = 6.9894087225971915e-09 + t * series
-        series = 8.364688757440645e-08 + t * series
-        series = 1.0145626265011032e-06 + t * series
-        series = 1.2558898737051639e-05 + t * series
-        series = 0.0001609002976190476 + t * series
-        series = 0.0022098214285714286 + t * series
-        series = 0.0375 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(((0.125)*x/sin_half**2 - sin_half/s)/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
-        return out
-    small = x < 1.4342812090283275
-    if small.any():
+    else:
+        out = numpy.asarray(((0.125)*x/sin_half**2 - sin_half/s)/x, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+            return out
+        small = x < 1.4342812090283275
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.3462827495637501e-20
-        series = 1.5454156215361094e-19 + t * series
-        series = 1.7764157194142527e-18 + t * series
-        series = 2.0451064003372294e-17 + t * series
-        series = 2.3586252560910385e-16 + t * series
-        series = 2.725820183855303e-15 + t * series
-        series = 3.157810155130715e-14 + t * series
-        series = 3.6688033619582197e-13 + t * series
-        series = 4.277333653830018e-12 + t * series
-        series = 5.008208696060211e-11 + t * series
-        series = 5.895736922222117e-10 + t * series
-        series = 6.9894087225971915e-09 + t * series
-        series = 8.364688757440645e-08 + t * series
-        series = 1.0145626265011032e-06 + t * series
-        series = 1.2558898737051639e-05 + t * series
-        series = 0.0001609002976190476 + t * series
-        series = 0.0022098214285714286 + t * series
-        series = 0.0375 + t * series
-        out[small] = series
+    series = 1.3462827495637501e-20
+    series = 1.5454156215361094e-19 + t * series
+    series = 1.7764157194142527e-18 + t * series
+    series = 2.0451064003372294e-17 + t * series
+    series = 2.3586252560910385e-16 + t * series
+    series = 2.725820183855303e-15 + t * series
+    series = 3.157810155130715e-14 + t * series
+    series = 3.6688033619582197e-13 + t * series
+    series = 4.277333653830018e-12 + t * series
+    series = 5.008208696060211e-11 + t * series
+    series = 5.895736922222117e-10 + t * series
+    series = 6.9894087225971915e-09 + t * series
+    series = 8.364688757440645e-08 + t * series
+    series = 1.0145626265011032e-06 + t * series
+    series = 1.2558898737051639e-05 + t * series
+    series = 0.0001609002976190476 + t * series
+    series = 0.0022098214285714286 + t * series
+    series = 0.0375 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
-        t = x
-        series = 8.716860870222215e-10
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
-        t = x[small]
-        series = 8.716860870222215e-10
-        series = 1.1911667949082915e-08 + t * series
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        out[small] = series
-    return out
+_H_across_64 = _R_1_64  # the same code
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = -5.178834122911754e-09
-        series = -6.656956359337311e-08 + t * series
-        series = -8.811723990295419e-07 + t * series
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = 4/x
-    out = numpy.asarray(2*cos_half*sin_half/(s*(cos_half**2*sin_half**2*w0 + sin_half**4*w0)), dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        w0 = 4/x
+        out = numpy.asarray(2*cos_half*sin_half/(s*(cos_half**2*sin_half**2*w0 + sin_half**4*w0)), dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = -5.178834122911754e-09
-        series = -6.656956359337311e-08 + t * series
-        series = -8.811723990295419e-07 + t * series
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -5.178834122911754e-09
+    series = -6.656956359337311e-08 + t * series
+    series = -8.811723990295419e-07 + t * series
+    series = -1.2201092558235416e-05 + t * series
+    series = -0.00018253968253968255 + t * series
+    series = -0.0032142857142857142 + t * series
+    series = -0.1 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _K_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
-        t = x
-        series = -4.517630699305304e-10
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
-        t = x[small]
-        series = -4.517630699305304e-10
-        series = -6.22104590536751e-09 + t * series
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        out[small] = series
-    return out
+_K_across_64 = _G_1_64  # the same code
 
 
 def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -699,445 +449,284 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812090283275  # every lane on it
+    if polynomial:
         t = x
-        series = 1.4590852718839616e-19
-        series = 1.6712992943913682e-18 + t * series
-        series = 1.9164647128732757e-17 + t * series
-        series = 2.2002829132536273e-16 + t * series
-        series = 2.5296275904133537e-15 + t * series
-        series = 2.912852457999748e-14 + t * series
-        series = 3.360206298123931e-13 + t * series
-        series = 3.884404382527373e-12 + t * series
-        series = 4.5014331338784364e-11 + t * series
-        series = 5.231710865271535e-10 + t * series
-        series = 6.10180260915555e-09 + t * series
-        series = 7.14700076944975e-08 + t * series
-        series = 8.415195915195915e-07 + t * series
-        series = 9.9721706864564e-06 + t * series
-        series = 0.00011904761904761905 + t * series
-        series = 0.0014285714285714286 + t * series
-        series = -0.15 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    w1 = numpy.sin(phi)
-    out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + numpy.cos(phi))/w0, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
-        return out
-    small = x < 1.4342812090283275
-    if small.any():
+    else:
+        w0 = sin_half**2
+        w1 = numpy.sin(phi)
+        out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + numpy.cos(phi))/w0, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+            return out
+        small = x < 1.4342812090283275
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.4590852718839616e-19
-        series = 1.6712992943913682e-18 + t * series
-        series = 1.9164647128732757e-17 + t * series
-        series = 2.2002829132536273e-16 + t * series
-        series = 2.5296275904133537e-15 + t * series
-        series = 2.912852457999748e-14 + t * series
-        series = 3.360206298123931e-13 + t * series
-        series = 3.884404382527373e-12 + t * series
-        series = 4.5014331338784364e-11 + t * series
-        series = 5.231710865271535e-10 + t * series
-        series = 6.10180260915555e-09 + t * series
-        series = 7.14700076944975e-08 + t * series
-        series = 8.415195915195915e-07 + t * series
-        series = 9.9721706864564e-06 + t * series
-        series = 0.00011904761904761905 + t * series
-        series = 0.0014285714285714286 + t * series
-        series = -0.15 + t * series
-        out[small] = series
+    series = 1.4590852718839616e-19
+    series = 1.6712992943913682e-18 + t * series
+    series = 1.9164647128732757e-17 + t * series
+    series = 2.2002829132536273e-16 + t * series
+    series = 2.5296275904133537e-15 + t * series
+    series = 2.912852457999748e-14 + t * series
+    series = 3.360206298123931e-13 + t * series
+    series = 3.884404382527373e-12 + t * series
+    series = 4.5014331338784364e-11 + t * series
+    series = 5.231710865271535e-10 + t * series
+    series = 6.10180260915555e-09 + t * series
+    series = 7.14700076944975e-08 + t * series
+    series = 8.415195915195915e-07 + t * series
+    series = 9.9721706864564e-06 + t * series
+    series = 0.00011904761904761905 + t * series
+    series = 0.0014285714285714286 + t * series
+    series = -0.15 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 2.6302227241416043  # every lane on it
+    if polynomial:
         t = x
-        series = -1.713507963984835e-25
-        series = -1.9911676878064524e-24 + t * series
-        series = -2.3176419769991988e-23 + t * series
-        series = -2.70256607423881e-22 + t * series
-        series = -3.1578003265100976e-21 + t * series
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
-        return out
-    small = x < 2.6302227241416043
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+        if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+            return out
+        small = x < 2.6302227241416043
+        if not small.any():
+            return out
         t = x[small]
-        series = -1.713507963984835e-25
-        series = -1.9911676878064524e-24 + t * series
-        series = -2.3176419769991988e-23 + t * series
-        series = -2.70256607423881e-22 + t * series
-        series = -3.1578003265100976e-21 + t * series
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        out[small] = series
+    series = -1.713507963984835e-25
+    series = -1.9911676878064524e-24 + t * series
+    series = -2.3176419769991988e-23 + t * series
+    series = -2.70256607423881e-22 + t * series
+    series = -3.1578003265100976e-21 + t * series
+    series = -3.6980551434799796e-20 + t * series
+    series = -4.341734551994152e-19 + t * series
+    series = -5.112093930302394e-18 + t * series
+    series = -6.03885929516599e-17 + t * series
+    series = -7.160541684001784e-16 + t * series
+    series = -8.527828450903873e-15 + t * series
+    series = -1.0208698466596667e-13 + t * series
+    series = -1.2296404066927483e-12 + t * series
+    series = -1.4922439654526148e-11 + t * series
+    series = -1.82786662181949e-10 + t * series
+    series = -2.2657399287738925e-09 + t * series
+    series = -2.852981296858848e-08 + t * series
+    series = -3.671551662623091e-07 + t * series
+    series = -4.880437023294166e-06 + t * series
+    series = -6.845238095238096e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.025 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812090283275  # every lane on it
+    if polynomial:
         t = x
-        series = 4.002447216098616e-21
-        series = 4.349386634459199e-20 + t * series
-        series = 4.717726508806865e-19 + t * series
-        series = 5.106798451593866e-18 + t * series
-        series = 5.515287671491515e-17 + t * series
-        series = 5.941040609907155e-16 + t * series
-        series = 6.3808204484355186e-15 + t * series
-        series = 6.829994494116056e-14 + t * series
-        series = 7.28213114499937e-13 + t * series
-        series = 7.72847448568504e-12 + t * series
-        series = 8.157249203307483e-11 + t * series
-        series = 8.552722954369029e-10 + t * series
-        series = 8.893908470961609e-09 + t * series
-        series = 9.152703913733326e-08 + t * series
-        series = 9.291101000284673e-07 + t * series
-        series = 9.256715506715507e-06 + t * series
-        series = 8.974953617810761e-05 + t * series
-        series = 0.0008333333333333334 + t * series
-        series = 0.007142857142857143 + t * series
-        series = 0.05 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    out = numpy.asarray((0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
-        return out
-    small = x < 1.4342812090283275
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        out = numpy.asarray((0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+            return out
+        small = x < 1.4342812090283275
+        if not small.any():
+            return out
         t = x[small]
-        series = 4.002447216098616e-21
-        series = 4.349386634459199e-20 + t * series
-        series = 4.717726508806865e-19 + t * series
-        series = 5.106798451593866e-18 + t * series
-        series = 5.515287671491515e-17 + t * series
-        series = 5.941040609907155e-16 + t * series
-        series = 6.3808204484355186e-15 + t * series
-        series = 6.829994494116056e-14 + t * series
-        series = 7.28213114499937e-13 + t * series
-        series = 7.72847448568504e-12 + t * series
-        series = 8.157249203307483e-11 + t * series
-        series = 8.552722954369029e-10 + t * series
-        series = 8.893908470961609e-09 + t * series
-        series = 9.152703913733326e-08 + t * series
-        series = 9.291101000284673e-07 + t * series
-        series = 9.256715506715507e-06 + t * series
-        series = 8.974953617810761e-05 + t * series
-        series = 0.0008333333333333334 + t * series
-        series = 0.007142857142857143 + t * series
-        series = 0.05 + t * series
-        out[small] = series
+    series = 4.002447216098616e-21
+    series = 4.349386634459199e-20 + t * series
+    series = 4.717726508806865e-19 + t * series
+    series = 5.106798451593866e-18 + t * series
+    series = 5.515287671491515e-17 + t * series
+    series = 5.941040609907155e-16 + t * series
+    series = 6.3808204484355186e-15 + t * series
+    series = 6.829994494116056e-14 + t * series
+    series = 7.28213114499937e-13 + t * series
+    series = 7.72847448568504e-12 + t * series
+    series = 8.157249203307483e-11 + t * series
+    series = 8.552722954369029e-10 + t * series
+    series = 8.893908470961609e-09 + t * series
+    series = 9.152703913733326e-08 + t * series
+    series = 9.291101000284673e-07 + t * series
+    series = 9.256715506715507e-06 + t * series
+    series = 8.974953617810761e-05 + t * series
+    series = 0.0008333333333333334 + t * series
+    series = 0.007142857142857143 + t * series
+    series = 0.05 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
-        t = x
-        series = -1.713507963984835e-25
-        series = -1.9911676878064524e-24 + t * series
-        series = -2.3176419769991988e-23 + t * series
-        series = -2.70256607423881e-22 + t * series
-        series = -3.1578003265100976e-21 + t * series
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
-        return out
-    small = x < 2.6302227241416043
-    if small.any():
-        t = x[small]
-        series = -1.713507963984835e-25
-        series = -1.9911676878064524e-24 + t * series
-        series = -2.3176419769991988e-23 + t * series
-        series = -2.70256607423881e-22 + t * series
-        series = -3.1578003265100976e-21 + t * series
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        out[small] = series
-    return out
+_H_1_x_64 = _R_2_x_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812090283275:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812090283275  # every lane on it
+    if polynomial:
         t = x
-        series = 3.420541589612275e-22
-        series = 3.7095852246767656e-21 + t * series
-        series = 4.0148184318084914e-20 + t * series
-        series = 4.33520814322793e-19 + t * series
-        series = 4.669072870028677e-18 + t * series
-        series = 5.0138978831741045e-17 + t * series
-        series = 5.366101196045172e-16 + t * series
-        series = 5.720735574459431e-15 + t * series
-        series = 6.07110621699205e-14 + t * series
-        series = 6.408275407599445e-13 + t * series
-        series = 6.7204125962478614e-12 + t * series
-        series = 6.991927888549271e-11 + t * series
-        series = 7.202293014205498e-10 + t * series
-        series = 7.324395211380149e-09 + t * series
-        series = 7.32216313098666e-08 + t * series
-        series = 7.147000769449749e-07 + t * series
-        series = 6.732156732156732e-06 + t * series
-        series = 5.983302411873841e-05 + t * series
-        series = 0.0004761904761904762 + t * series
-        series = 0.002857142857142857 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**(-2.0)
-    w1 = numpy.sin(phi)
-    w2 = (phi - w1)**(-1.0)
-    w3 = 6*phi
-    w4 = 2*phi
-    w5 = 8*w1 - w3 - numpy.sin(w4)
-    out = numpy.asarray(-0.020833333333333332*w0*w2*(-0.5*w0*(4*numpy.cos(phi) - numpy.cos(w4) - 3) + (0.5)*w2*w5 + (0.125)*w1*w5/sin_half**4)*numpy.cbrt(6*w1 - w3), dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
-        return out
-    small = x < 1.4342812090283275
-    if small.any():
+    else:
+        w0 = sin_half**(-2.0)
+        w1 = numpy.sin(phi)
+        w2 = (phi - w1)**(-1.0)
+        w3 = 6*phi
+        w4 = 2*phi
+        w5 = 8*w1 - w3 - numpy.sin(w4)
+        out = numpy.asarray(-0.020833333333333332*w0*w2*(-0.5*w0*(4*numpy.cos(phi) - numpy.cos(w4) - 3) + (0.5)*w2*w5 + (0.125)*w1*w5/sin_half**4)*numpy.cbrt(6*w1 - w3), dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812090283275:  # every lane on the closed form
+            return out
+        small = x < 1.4342812090283275
+        if not small.any():
+            return out
         t = x[small]
-        series = 3.420541589612275e-22
-        series = 3.7095852246767656e-21 + t * series
-        series = 4.0148184318084914e-20 + t * series
-        series = 4.33520814322793e-19 + t * series
-        series = 4.669072870028677e-18 + t * series
-        series = 5.0138978831741045e-17 + t * series
-        series = 5.366101196045172e-16 + t * series
-        series = 5.720735574459431e-15 + t * series
-        series = 6.07110621699205e-14 + t * series
-        series = 6.408275407599445e-13 + t * series
-        series = 6.7204125962478614e-12 + t * series
-        series = 6.991927888549271e-11 + t * series
-        series = 7.202293014205498e-10 + t * series
-        series = 7.324395211380149e-09 + t * series
-        series = 7.32216313098666e-08 + t * series
-        series = 7.147000769449749e-07 + t * series
-        series = 6.732156732156732e-06 + t * series
-        series = 5.983302411873841e-05 + t * series
-        series = 0.0004761904761904762 + t * series
-        series = 0.002857142857142857 + t * series
-        out[small] = series
+    series = 3.420541589612275e-22
+    series = 3.7095852246767656e-21 + t * series
+    series = 4.0148184318084914e-20 + t * series
+    series = 4.33520814322793e-19 + t * series
+    series = 4.669072870028677e-18 + t * series
+    series = 5.0138978831741045e-17 + t * series
+    series = 5.366101196045172e-16 + t * series
+    series = 5.720735574459431e-15 + t * series
+    series = 6.07110621699205e-14 + t * series
+    series = 6.408275407599445e-13 + t * series
+    series = 6.7204125962478614e-12 + t * series
+    series = 6.991927888549271e-11 + t * series
+    series = 7.202293014205498e-10 + t * series
+    series = 7.324395211380149e-09 + t * series
+    series = 7.32216313098666e-08 + t * series
+    series = 7.147000769449749e-07 + t * series
+    series = 6.732156732156732e-06 + t * series
+    series = 5.983302411873841e-05 + t * series
+    series = 0.0004761904761904762 + t * series
+    series = 0.002857142857142857 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 2.6302227241416043  # every lane on it
+    if polynomial:
         t = x
-        series = -3.42701592796967e-25
-        series = -3.982335375612905e-24 + t * series
-        series = -4.6352839539983977e-23 + t * series
-        series = -5.40513214847762e-22 + t * series
-        series = -6.315600653020195e-21 + t * series
-        series = -7.396110286959959e-20 + t * series
-        series = -8.683469103988305e-19 + t * series
-        series = -1.0224187860604788e-17 + t * series
-        series = -1.207771859033198e-16 + t * series
-        series = -1.4321083368003567e-15 + t * series
-        series = -1.7055656901807745e-14 + t * series
-        series = -2.0417396933193335e-13 + t * series
-        series = -2.4592808133854965e-12 + t * series
-        series = -2.9844879309052296e-11 + t * series
-        series = -3.65573324363898e-10 + t * series
-        series = -4.531479857547785e-09 + t * series
-        series = -5.705962593717696e-08 + t * series
-        series = -7.343103325246182e-07 + t * series
-        series = -9.760874046588332e-06 + t * series
-        series = -0.0001369047619047619 + t * series
-        series = -0.002142857142857143 + t * series
-        series = -0.05 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    out = numpy.asarray((0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
-        return out
-    small = x < 2.6302227241416043
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out = numpy.asarray((0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+        if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+            return out
+        small = x < 2.6302227241416043
+        if not small.any():
+            return out
         t = x[small]
-        series = -3.42701592796967e-25
-        series = -3.982335375612905e-24 + t * series
-        series = -4.6352839539983977e-23 + t * series
-        series = -5.40513214847762e-22 + t * series
-        series = -6.315600653020195e-21 + t * series
-        series = -7.396110286959959e-20 + t * series
-        series = -8.683469103988305e-19 + t * series
-        series = -1.0224187860604788e-17 + t * series
-        series = -1.207771859033198e-16 + t * series
-        series = -1.4321083368003567e-15 + t * series
-        series = -1.7055656901807745e-14 + t * series
-        series = -2.0417396933193335e-13 + t * series
-        series = -2.4592808133854965e-12 + t * series
-        series = -2.9844879309052296e-11 + t * series
-        series = -3.65573324363898e-10 + t * series
-        series = -4.531479857547785e-09 + t * series
-        series = -5.705962593717696e-08 + t * series
-        series = -7.343103325246182e-07 + t * series
-        series = -9.760874046588332e-06 + t * series
-        series = -0.0001369047619047619 + t * series
-        series = -0.002142857142857143 + t * series
-        series = -0.05 + t * series
-        out[small] = series
+    series = -3.42701592796967e-25
+    series = -3.982335375612905e-24 + t * series
+    series = -4.6352839539983977e-23 + t * series
+    series = -5.40513214847762e-22 + t * series
+    series = -6.315600653020195e-21 + t * series
+    series = -7.396110286959959e-20 + t * series
+    series = -8.683469103988305e-19 + t * series
+    series = -1.0224187860604788e-17 + t * series
+    series = -1.207771859033198e-16 + t * series
+    series = -1.4321083368003567e-15 + t * series
+    series = -1.7055656901807745e-14 + t * series
+    series = -2.0417396933193335e-13 + t * series
+    series = -2.4592808133854965e-12 + t * series
+    series = -2.9844879309052296e-11 + t * series
+    series = -3.65573324363898e-10 + t * series
+    series = -4.531479857547785e-09 + t * series
+    series = -5.705962593717696e-08 + t * series
+    series = -7.343103325246182e-07 + t * series
+    series = -9.760874046588332e-06 + t * series
+    series = -0.0001369047619047619 + t * series
+    series = -0.002142857142857143 + t * series
+    series = -0.05 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_64 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.6302227241416043:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 2.6302227241416043  # every lane on it
+    if polynomial:
         t = x
-        series = 6.497844255354877e-25
-        series = 7.196733448736306e-24 + t * series
-        series = 7.96467075122581e-23 + t * series
-        series = 8.807039512596957e-22 + t * series
-        series = 9.729237867259716e-21 + t * series
-        series = 1.0736521110134332e-19 + t * series
-        series = 1.1833776459135935e-18 + t * series
-        series = 1.3025203655982459e-17 + t * series
-        series = 1.4313863004846702e-16 + t * series
-        series = 1.5701034167431574e-15 + t * series
-        series = 1.718530004160428e-14 + t * series
-        series = 1.8761222591988522e-13 + t * series
-        series = 2.0417396933193335e-12 + t * series
-        series = 2.213352732046947e-11 + t * series
-        series = 2.3875903447241837e-10 + t * series
-        series = 2.559013270547286e-09 + t * series
-        series = 2.7188879145286708e-08 + t * series
-        series = 2.852981296858848e-07 + t * series
-        series = 2.937241330098473e-06 + t * series
-        series = 2.9282622139764997e-05 + t * series
-        series = 0.0002738095238095238 + t * series
-        series = 0.002142857142857143 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    w2 = (phi - w1)**(-1.0)
-    w3 = sin_half**2
-    w4 = 1 - 2*w3
-    w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
-    out = numpy.asarray(-0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4, dtype=x.dtype)
-    if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
-        return out
-    small = x < 2.6302227241416043
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        w2 = (phi - w1)**(-1.0)
+        w3 = sin_half**2
+        w4 = 1 - 2*w3
+        w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+        out = numpy.asarray(-0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4, dtype=x.dtype)
+        if span is not None and span[0] >= 2.6302227241416043:  # every lane on the closed form
+            return out
+        small = x < 2.6302227241416043
+        if not small.any():
+            return out
         t = x[small]
-        series = 6.497844255354877e-25
-        series = 7.196733448736306e-24 + t * series
-        series = 7.96467075122581e-23 + t * series
-        series = 8.807039512596957e-22 + t * series
-        series = 9.729237867259716e-21 + t * series
-        series = 1.0736521110134332e-19 + t * series
-        series = 1.1833776459135935e-18 + t * series
-        series = 1.3025203655982459e-17 + t * series
-        series = 1.4313863004846702e-16 + t * series
-        series = 1.5701034167431574e-15 + t * series
-        series = 1.718530004160428e-14 + t * series
-        series = 1.8761222591988522e-13 + t * series
-        series = 2.0417396933193335e-12 + t * series
-        series = 2.213352732046947e-11 + t * series
-        series = 2.3875903447241837e-10 + t * series
-        series = 2.559013270547286e-09 + t * series
-        series = 2.7188879145286708e-08 + t * series
-        series = 2.852981296858848e-07 + t * series
-        series = 2.937241330098473e-06 + t * series
-        series = 2.9282622139764997e-05 + t * series
-        series = 0.0002738095238095238 + t * series
-        series = 0.002142857142857143 + t * series
-        out[small] = series
+    series = 6.497844255354877e-25
+    series = 7.196733448736306e-24 + t * series
+    series = 7.96467075122581e-23 + t * series
+    series = 8.807039512596957e-22 + t * series
+    series = 9.729237867259716e-21 + t * series
+    series = 1.0736521110134332e-19 + t * series
+    series = 1.1833776459135935e-18 + t * series
+    series = 1.3025203655982459e-17 + t * series
+    series = 1.4313863004846702e-16 + t * series
+    series = 1.5701034167431574e-15 + t * series
+    series = 1.718530004160428e-14 + t * series
+    series = 1.8761222591988522e-13 + t * series
+    series = 2.0417396933193335e-12 + t * series
+    series = 2.213352732046947e-11 + t * series
+    series = 2.3875903447241837e-10 + t * series
+    series = 2.559013270547286e-09 + t * series
+    series = 2.7188879145286708e-08 + t * series
+    series = 2.852981296858848e-07 + t * series
+    series = 2.937241330098473e-06 + t * series
+    series = 2.9282622139764997e-05 + t * series
+    series = 0.0002738095238095238 + t * series
+    series = 0.002142857142857143 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.1103124080629894:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.1103124080629894  # every lane on it
+    if polynomial:
         t = x
-        series = -8.286380574805527e-10
-        series = -1.2203463534465907e-08 + t * series
-        series = -1.8955121406990826e-07 + t * series
-        series = -3.189329117063492e-06 + t * series
-        series = -6.138392857142858e-05 + t * series
-        series = -0.0015625 + t * series
-        series = -0.125 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.array(cos_half, dtype=x.dtype)
-    if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
-        return out
-    small = x < 0.1103124080629894
-    if small.any():
+    else:
+        out = numpy.array(cos_half, dtype=x.dtype)
+        if span is not None and span[0] >= 0.1103124080629894:  # every lane on the closed form
+            return out
+        small = x < 0.1103124080629894
+        if not small.any():
+            return out
         t = x[small]
-        series = -8.286380574805527e-10
-        series = -1.2203463534465907e-08 + t * series
-        series = -1.8955121406990826e-07 + t * series
-        series = -3.189329117063492e-06 + t * series
-        series = -6.138392857142858e-05 + t * series
-        series = -0.0015625 + t * series
-        series = -0.125 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -8.286380574805527e-10
+    series = -1.2203463534465907e-08 + t * series
+    series = -1.8955121406990826e-07 + t * series
+    series = -3.189329117063492e-06 + t * series
+    series = -6.138392857142858e-05 + t * series
+    series = -0.0015625 + t * series
+    series = -0.125 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
@@ -1280,1049 +869,717 @@ def _scale_64(e0, e_norm):
 
 
 def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -9.50993765619616e-09
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray(4*sin_half**2/x, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -9.50993765619616e-09
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -9.50993765619616e-09
+    series = -1.4686206650492366e-07 + t * series
+    series = -2.440218511647083e-06 + t * series
+    series = -4.563492063492064e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.05 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -1.244209181073502e-08
-        series = -1.7778215165910478e-07 + t * series
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray(2*sin_half/s, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -1.244209181073502e-08
-        series = -1.7778215165910478e-07 + t * series
-        series = -2.680413429576376e-06 + t * series
-        series = -4.402281746031746e-05 + t * series
-        series = -0.0008482142857142857 + t * series
-        series = -0.025 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -1.244209181073502e-08
+    series = -1.7778215165910478e-07 + t * series
+    series = -2.680413429576376e-06 + t * series
+    series = -4.402281746031746e-05 + t * series
+    series = -0.0008482142857142857 + t * series
+    series = -0.025 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7648242161335777:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.7648242161335777  # every lane on it
+    if polynomial:
         t = x
-        series = 7.141710355470859e-07
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
-        return out
-    small = x < 0.7648242161335777
-    if small.any():
+    else:
+        out = numpy.asarray(2*numpy.tan((0.5)*phi)/s, dtype=x.dtype)
+        if span is not None and span[0] >= 0.7648242161335777:  # every lane on the closed form
+            return out
+        small = x < 0.7648242161335777
+        if not small.any():
+            return out
         t = x[small]
-        series = 7.141710355470859e-07
-        series = 5.063042332919034e-06 + t * series
-        series = 3.592768342768343e-05 + t * series
-        series = 0.0002554692331478046 + t * series
-        series = 0.0018253968253968255 + t * series
-        series = 0.013214285714285715 + t * series
-        series = 0.1 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = 7.141710355470859e-07
+    series = 5.063042332919034e-06 + t * series
+    series = 3.592768342768343e-05 + t * series
+    series = 0.0002554692331478046 + t * series
+    series = 0.0018253968253968255 + t * series
+    series = 0.013214285714285715 + t * series
+    series = 0.1 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = 1.3075291305333323e-08
+    series = 1.548516833380779e-07 + t * series
+    series = 1.8513431013431014e-06 + t * series
+    series = 2.2437384044526902e-05 + t * series
+    series = 0.0002777777777777778 + t * series
+    series = 0.0035714285714285713 + t * series
+    series = 0.05 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_det_H_32 = _det_H_64  # the same code
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_R_0_32 = _det_H_64  # the same code
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = 1.1911667949082915e-08
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.1911667949082915e-08
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = 1.1911667949082915e-08
+    series = 1.683039183039183e-07 + t * series
+    series = 2.4930426716141e-06 + t * series
+    series = 3.968253968253968e-05 + t * series
+    series = 0.0007142857142857143 + t * series
+    series = -0.15 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -4.75496882809808e-09
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((1 - numpy.cos(phi))/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray((1 - numpy.cos(phi))/x, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -4.75496882809808e-09
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        out[small] = series
+    series = -4.75496882809808e-09
+    series = -7.343103325246183e-08 + t * series
+    series = -1.2201092558235415e-06 + t * series
+    series = -2.281746031746032e-05 + t * series
+    series = -0.0005357142857142857 + t * series
+    series = -0.025 + t * series
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
-        t = x
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.25)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
-        t = x[small]
-        series = 1.3075291305333323e-08
-        series = 1.548516833380779e-07 + t * series
-        series = 1.8513431013431014e-06 + t * series
-        series = 2.2437384044526902e-05 + t * series
-        series = 0.0002777777777777778 + t * series
-        series = 0.0035714285714285713 + t * series
-        series = 0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
-    return out
+_H_0_32 = _mu_32  # the same code
 
 
 def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -4.75496882809808e-09
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray(2*sin_half**2/x, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -4.75496882809808e-09
-        series = -7.343103325246183e-08 + t * series
-        series = -1.2201092558235415e-06 + t * series
-        series = -2.281746031746032e-05 + t * series
-        series = -0.0005357142857142857 + t * series
-        series = -0.025 + t * series
-        series = 0.5 + t * series
-        out[small] = series
+    series = -4.75496882809808e-09
+    series = -7.343103325246183e-08 + t * series
+    series = -1.2201092558235415e-06 + t * series
+    series = -2.281746031746032e-05 + t * series
+    series = -0.0005357142857142857 + t * series
+    series = -0.025 + t * series
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = 2.5501224371929e-20
-        series = 2.918170543767923e-19 + t * series
-        series = 3.3425985887827363e-18 + t * series
-        series = 3.8329294257465515e-17 + t * series
-        series = 4.4005658265072545e-16 + t * series
-        series = 5.0592551808267075e-15 + t * series
-        series = 5.825704915999495e-14 + t * series
-        series = 6.720412596247862e-13 + t * series
-        series = 7.768808765054745e-12 + t * series
-        series = 9.002866267756873e-11 + t * series
-        series = 1.046342173054307e-09 + t * series
-        series = 1.22036052183111e-08 + t * series
-        series = 1.42940015388995e-07 + t * series
-        series = 1.683039183039183e-06 + t * series
-        series = 1.99443413729128e-05 + t * series
-        series = 0.0002380952380952381 + t * series
-        series = 0.002857142857142857 + t * series
-        series = 0.2 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        out = numpy.asarray((-2*cos_half*sin_half/s + (0.25)*x/sin_half**2)/x, dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = 2.5501224371929e-20
-        series = 2.918170543767923e-19 + t * series
-        series = 3.3425985887827363e-18 + t * series
-        series = 3.8329294257465515e-17 + t * series
-        series = 4.4005658265072545e-16 + t * series
-        series = 5.0592551808267075e-15 + t * series
-        series = 5.825704915999495e-14 + t * series
-        series = 6.720412596247862e-13 + t * series
-        series = 7.768808765054745e-12 + t * series
-        series = 9.002866267756873e-11 + t * series
-        series = 1.046342173054307e-09 + t * series
-        series = 1.22036052183111e-08 + t * series
-        series = 1.42940015388995e-07 + t * series
-        series = 1.683039183039183e-06 + t * series
-        series = 1.99443413729128e-05 + t * series
-        series = 0.0002380952380952381 + t * series
-        series = 0.002857142857142857 + t * series
-        series = 0.2 + t * series
-        out[small] = series
+    series = 2.5501224371929e-20
+    series = 2.918170543767923e-19 + t * series
+    series = 3.3425985887827363e-18 + t * series
+    series = 3.8329294257465515e-17 + t * series
+    series = 4.4005658265072545e-16 + t * series
+    series = 5.0592551808267075e-15 + t * series
+    series = 5.825704915999495e-14 + t * series
+    series = 6.720412596247862e-13 + t * series
+    series = 7.768808765054745e-12 + t * series
+    series = 9.002866267756873e-11 + t * series
+    series = 1.046342173054307e-09 + t * series
+    series = 1.22036052183111e-08 + t * series
+    series = 1.42940015388995e-07 + t * series
+    series = 1.683039183039183e-06 + t * series
+    series = 1.99443413729128e-05 + t * series
+    series = 0.0002380952380952381 + t * series
+    series = 0.002857142857142857 + t * series
+    series = 0.2 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -9.50993765619616e-09
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*(1 - numpy.cos(phi))/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray(2*(1 - numpy.cos(phi))/x, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -9.50993765619616e-09
-        series = -1.4686206650492366e-07 + t * series
-        series = -2.440218511647083e-06 + t * series
-        series = -4.563492063492064e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.05 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -9.50993765619616e-09
+    series = -1.4686206650492366e-07 + t * series
+    series = -2.440218511647083e-06 + t * series
+    series = -4.563492063492064e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.05 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = 6.315600653020195e-21
-        series = 7.396110286959959e-20 + t * series
-        series = 8.683469103988305e-19 + t * series
-        series = 1.0224187860604788e-17 + t * series
-        series = 1.207771859033198e-16 + t * series
-        series = 1.4321083368003567e-15 + t * series
-        series = 1.7055656901807745e-14 + t * series
-        series = 2.0417396933193335e-13 + t * series
-        series = 2.4592808133854965e-12 + t * series
-        series = 2.9844879309052296e-11 + t * series
-        series = 3.65573324363898e-10 + t * series
-        series = 4.531479857547785e-09 + t * series
-        series = 5.705962593717696e-08 + t * series
-        series = 7.343103325246182e-07 + t * series
-        series = 9.760874046588332e-06 + t * series
-        series = 0.0001369047619047619 + t * series
-        series = 0.002142857142857143 + t * series
-        series = 0.05 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    out = numpy.asarray(-0.5*(6*cos_half*phi*sin_half - 8*w0 + (1 - 2*w0)**2 - 1)/(s**4*w0), dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        w0 = sin_half**2
+        out = numpy.asarray(-0.5*(6*cos_half*phi*sin_half - 8*w0 + (1 - 2*w0)**2 - 1)/(s**4*w0), dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = 6.315600653020195e-21
-        series = 7.396110286959959e-20 + t * series
-        series = 8.683469103988305e-19 + t * series
-        series = 1.0224187860604788e-17 + t * series
-        series = 1.207771859033198e-16 + t * series
-        series = 1.4321083368003567e-15 + t * series
-        series = 1.7055656901807745e-14 + t * series
-        series = 2.0417396933193335e-13 + t * series
-        series = 2.4592808133854965e-12 + t * series
-        series = 2.9844879309052296e-11 + t * series
-        series = 3.65573324363898e-10 + t * series
-        series = 4.531479857547785e-09 + t * series
-        series = 5.705962593717696e-08 + t * series
-        series = 7.343103325246182e-07 + t * series
-        series = 9.760874046588332e-06 + t * series
-        series = 0.0001369047619047619 + t * series
-        series = 0.002142857142857143 + t * series
-        series = 0.05 + t * series
-        out[small] = series
+    series = 6.315600653020195e-21
+    series = 7.396110286959959e-20 + t * series
+    series = 8.683469103988305e-19 + t * series
+    series = 1.0224187860604788e-17 + t * series
+    series = 1.207771859033198e-16 + t * series
+    series = 1.4321083368003567e-15 + t * series
+    series = 1.7055656901807745e-14 + t * series
+    series = 2.0417396933193335e-13 + t * series
+    series = 2.4592808133854965e-12 + t * series
+    series = 2.9844879309052296e-11 + t * series
+    series = 3.65573324363898e-10 + t * series
+    series = 4.531479857547785e-09 + t * series
+    series = 5.705962593717696e-08 + t * series
+    series = 7.343103325246182e-07 + t * series
+    series = 9.760874046588332e-06 + t * series
+    series = 0.0001369047619047619 + t * series
+    series = 0.002142857142857143 + t * series
+    series = 0.05 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_32 = _det_H_64  # the same code
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -6.22104590536751e-09
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray(sin_half/s, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -6.22104590536751e-09
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        out[small] = series
+    series = -6.22104590536751e-09
+    series = -8.889107582955239e-08 + t * series
+    series = -1.340206714788188e-06 + t * series
+    series = -2.201140873015873e-05 + t * series
+    series = -0.00042410714285714285 + t * series
+    series = -0.0125 + t * series
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = 8.286380574805527e-10
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = 8.286380574805527e-10
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        out[small] = series
+    series = 8.286380574805527e-10
+    series = 1.2203463534465907e-08 + t * series
+    series = 1.8955121406990826e-07 + t * series
+    series = 3.189329117063492e-06 + t * series
+    series = 6.138392857142858e-05 + t * series
+    series = 0.0015625 + t * series
+    series = 0.125 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = 6.5376456526666615e-09
-        series = 7.742584166903895e-08 + t * series
-        series = 9.256715506715507e-07 + t * series
-        series = 1.1218692022263451e-05 + t * series
-        series = 0.0001388888888888889 + t * series
-        series = 0.0017857142857142857 + t * series
-        series = 0.025 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray((0.125)*x/sin_half**2, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = 6.5376456526666615e-09
-        series = 7.742584166903895e-08 + t * series
-        series = 9.256715506715507e-07 + t * series
-        series = 1.1218692022263451e-05 + t * series
-        series = 0.0001388888888888889 + t * series
-        series = 0.0017857142857142857 + t * series
-        series = 0.025 + t * series
-        series = 0.5 + t * series
-        out[small] = series
+    series = 6.5376456526666615e-09
+    series = 7.742584166903895e-08 + t * series
+    series = 9.256715506715507e-07 + t * series
+    series = 1.1218692022263451e-05 + t * series
+    series = 0.0001388888888888889 + t * series
+    series = 0.0017857142857142857 + t * series
+    series = 0.025 + t * series
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
-        t = x
-        series = 8.286380574805527e-10
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/x, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
-        t = x[small]
-        series = 8.286380574805527e-10
-        series = 1.2203463534465907e-08 + t * series
-        series = 1.8955121406990826e-07 + t * series
-        series = 3.189329117063492e-06 + t * series
-        series = 6.138392857142858e-05 + t * series
-        series = 0.0015625 + t * series
-        series = 0.125 + t * series
-        out[small] = series
-    return out
+_K_1_32 = _G_2_32  # the same code
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = 1.1742209353136828e-21
-        series = 1.3462827495637501e-20 + t * series
-        series = 1.5454156215361094e-19 + t * series
-        series = 1.7764157194142527e-18 + t * series
-        series = 2.0451064003372294e-17 + t * series
-        series = 2.3586252560910385e-16 + t * series
-        series = 2.725820183855303e-15 + t * series
-        series = 3.157810155130715e-14 + t * series
-        series = 3.6688033619582197e-13 + t * series
-        series = 4.277333653830018e-12 + t * series
-        series = 5.008208696060211e-11 + t * series
-        series = 5.895736922222117e-10 + t * series
-        series = 6.9894087225971915e-09 + t * series
-        series = 8.364688757440645e-08 + t * series
-        series = 1.0145626265011032e-06 + t * series
-        series = 1.2558898737051639e-05 + t * series
-        series = 0.0001609002976190476 + t * series
-        series = 0.0022098214285714286 + t * series
-        series = 0.0375 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
-    w1 = w0**2
-    out = numpy.asarray((sin_half/w0 + (0.125)*w1/sin_half**2)/w1, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        w0 = numpy.cbrt(12*cos_half*sin_half - 6*phi)
+        w1 = w0**2
+        out = numpy.asarray((sin_half/w0 + (0.125)*w1/sin_half**2)/w1, dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.1742209353136828e-21
-        series = 1.3462827495637501e-20 + t * series
-        series = 1.5454156215361094e-19 + t * series
-        series = 1.7764157194142527e-18 + t * series
-        series = 2.0451064003372294e-17 + t * series
-        series = 2.3586252560910385e-16 + t * series
-        series = 2.725820183855303e-15 + t * series
-        series = 3.157810155130715e-14 + t * series
-        series = 3.6688033619582197e-13 + t * series
-        series = 4.277333653830018e-12 + t * series
-        series = 5.008208696060211e-11 + t * series
-        series = 5.895736922222117e-10 + t * series
-        series = 6.9894087225971915e-09 + t * series
-        series = 8.364688757440645e-08 + t * series
-        series = 1.0145626265011032e-06 + t * series
-        series = 1.2558898737051639e-05 + t * series
-        series = 0.0001609002976190476 + t * series
-        series = 0.0022098214285714286 + t * series
-        series = 0.0375 + t * series
-        out[small] = series
+    series = 1.1742209353136828e-21
+    series = 1.3462827495637501e-20 + t * series
+    series = 1.5454156215361094e-19 + t * series
+    series = 1.7764157194142527e-18 + t * series
+    series = 2.0451064003372294e-17 + t * series
+    series = 2.3586252560910385e-16 + t * series
+    series = 2.725820183855303e-15 + t * series
+    series = 3.157810155130715e-14 + t * series
+    series = 3.6688033619582197e-13 + t * series
+    series = 4.277333653830018e-12 + t * series
+    series = 5.008208696060211e-11 + t * series
+    series = 5.895736922222117e-10 + t * series
+    series = 6.9894087225971915e-09 + t * series
+    series = 8.364688757440645e-08 + t * series
+    series = 1.0145626265011032e-06 + t * series
+    series = 1.2558898737051639e-05 + t * series
+    series = 0.0001609002976190476 + t * series
+    series = 0.0022098214285714286 + t * series
+    series = 0.0375 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
-        t = x
-        series = 1.1911667949082915e-08
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*cos_half*sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
-        t = x[small]
-        series = 1.1911667949082915e-08
-        series = 1.683039183039183e-07 + t * series
-        series = 2.4930426716141e-06 + t * series
-        series = 3.968253968253968e-05 + t * series
-        series = 0.0007142857142857143 + t * series
-        series = -0.15 + t * series
-        series = 1.0 + t * series
-        out[small] = series
-    return out
+_H_across_32 = _R_1_32  # the same code
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -5.178834122911754e-09
-        series = -6.656956359337311e-08 + t * series
-        series = -8.811723990295419e-07 + t * series
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*cos_half*s/sin_half, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*cos_half*s/sin_half, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -5.178834122911754e-09
-        series = -6.656956359337311e-08 + t * series
-        series = -8.811723990295419e-07 + t * series
-        series = -1.2201092558235416e-05 + t * series
-        series = -0.00018253968253968255 + t * series
-        series = -0.0032142857142857142 + t * series
-        series = -0.1 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -5.178834122911754e-09
+    series = -6.656956359337311e-08 + t * series
+    series = -8.811723990295419e-07 + t * series
+    series = -1.2201092558235416e-05 + t * series
+    series = -0.00018253968253968255 + t * series
+    series = -0.0032142857142857142 + t * series
+    series = -0.1 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _K_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
-        t = x
-        series = -6.22104590536751e-09
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/s, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
-        t = x[small]
-        series = -6.22104590536751e-09
-        series = -8.889107582955239e-08 + t * series
-        series = -1.340206714788188e-06 + t * series
-        series = -2.201140873015873e-05 + t * series
-        series = -0.00042410714285714285 + t * series
-        series = -0.0125 + t * series
-        series = 0.5 + t * series
-        out[small] = series
-    return out
+_K_across_32 = _G_1_32  # the same code
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_0_x_32 = _R_0_x_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 2.630222574480542:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 2.630222574480542  # every lane on it
+    if polynomial:
         t = x
-        series = 3.360206298123931e-13
-        series = 3.884404382527373e-12 + t * series
-        series = 4.5014331338784364e-11 + t * series
-        series = 5.231710865271535e-10 + t * series
-        series = 6.10180260915555e-09 + t * series
-        series = 7.14700076944975e-08 + t * series
-        series = 8.415195915195915e-07 + t * series
-        series = 9.9721706864564e-06 + t * series
-        series = 0.00011904761904761905 + t * series
-        series = 0.0014285714285714286 + t * series
-        series = -0.15 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    w1 = numpy.sin(phi)
-    out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + numpy.cos(phi))/w0, dtype=x.dtype)
-    if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
-        return out
-    small = x < 2.630222574480542
-    if small.any():
+    else:
+        w0 = sin_half**2
+        w1 = numpy.sin(phi)
+        out = numpy.asarray((0.125)*(-0.6666666666666666*w0*w1/(phi - w1) + numpy.cos(phi))/w0, dtype=x.dtype)
+        if span is not None and span[0] >= 2.630222574480542:  # every lane on the closed form
+            return out
+        small = x < 2.630222574480542
+        if not small.any():
+            return out
         t = x[small]
-        series = 3.360206298123931e-13
-        series = 3.884404382527373e-12 + t * series
-        series = 4.5014331338784364e-11 + t * series
-        series = 5.231710865271535e-10 + t * series
-        series = 6.10180260915555e-09 + t * series
-        series = 7.14700076944975e-08 + t * series
-        series = 8.415195915195915e-07 + t * series
-        series = 9.9721706864564e-06 + t * series
-        series = 0.00011904761904761905 + t * series
-        series = 0.0014285714285714286 + t * series
-        series = -0.15 + t * series
-        out[small] = series
+    series = 3.360206298123931e-13
+    series = 3.884404382527373e-12 + t * series
+    series = 4.5014331338784364e-11 + t * series
+    series = 5.231710865271535e-10 + t * series
+    series = 6.10180260915555e-09 + t * series
+    series = 7.14700076944975e-08 + t * series
+    series = 8.415195915195915e-07 + t * series
+    series = 9.9721706864564e-06 + t * series
+    series = 0.00011904761904761905 + t * series
+    series = 0.0014285714285714286 + t * series
+    series = -0.15 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = -3.1578003265100976e-21
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = -3.1578003265100976e-21
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        out[small] = series
+    series = -3.1578003265100976e-21
+    series = -3.6980551434799796e-20 + t * series
+    series = -4.341734551994152e-19 + t * series
+    series = -5.112093930302394e-18 + t * series
+    series = -6.03885929516599e-17 + t * series
+    series = -7.160541684001784e-16 + t * series
+    series = -8.527828450903873e-15 + t * series
+    series = -1.0208698466596667e-13 + t * series
+    series = -1.2296404066927483e-12 + t * series
+    series = -1.4922439654526148e-11 + t * series
+    series = -1.82786662181949e-10 + t * series
+    series = -2.2657399287738925e-09 + t * series
+    series = -2.852981296858848e-08 + t * series
+    series = -3.671551662623091e-07 + t * series
+    series = -4.880437023294166e-06 + t * series
+    series = -6.845238095238096e-05 + t * series
+    series = -0.0010714285714285715 + t * series
+    series = -0.025 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = 3.373091494469352e-23
-        series = 3.6770822088331955e-22 + t * series
-        series = 4.002447216098616e-21 + t * series
-        series = 4.349386634459199e-20 + t * series
-        series = 4.717726508806865e-19 + t * series
-        series = 5.106798451593866e-18 + t * series
-        series = 5.515287671491515e-17 + t * series
-        series = 5.941040609907155e-16 + t * series
-        series = 6.3808204484355186e-15 + t * series
-        series = 6.829994494116056e-14 + t * series
-        series = 7.28213114499937e-13 + t * series
-        series = 7.72847448568504e-12 + t * series
-        series = 8.157249203307483e-11 + t * series
-        series = 8.552722954369029e-10 + t * series
-        series = 8.893908470961609e-09 + t * series
-        series = 9.152703913733326e-08 + t * series
-        series = 9.291101000284673e-07 + t * series
-        series = 9.256715506715507e-06 + t * series
-        series = 8.974953617810761e-05 + t * series
-        series = 0.0008333333333333334 + t * series
-        series = 0.007142857142857143 + t * series
-        series = 0.05 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    out = numpy.asarray((0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        out = numpy.asarray((0.020833333333333332)*(6*phi - 12*w0)*(-1.5*cos_half/sin_half**3 + 2/(phi - 2*w0))/sin_half**2, dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = 3.373091494469352e-23
-        series = 3.6770822088331955e-22 + t * series
-        series = 4.002447216098616e-21 + t * series
-        series = 4.349386634459199e-20 + t * series
-        series = 4.717726508806865e-19 + t * series
-        series = 5.106798451593866e-18 + t * series
-        series = 5.515287671491515e-17 + t * series
-        series = 5.941040609907155e-16 + t * series
-        series = 6.3808204484355186e-15 + t * series
-        series = 6.829994494116056e-14 + t * series
-        series = 7.28213114499937e-13 + t * series
-        series = 7.72847448568504e-12 + t * series
-        series = 8.157249203307483e-11 + t * series
-        series = 8.552722954369029e-10 + t * series
-        series = 8.893908470961609e-09 + t * series
-        series = 9.152703913733326e-08 + t * series
-        series = 9.291101000284673e-07 + t * series
-        series = 9.256715506715507e-06 + t * series
-        series = 8.974953617810761e-05 + t * series
-        series = 0.0008333333333333334 + t * series
-        series = 0.007142857142857143 + t * series
-        series = 0.05 + t * series
-        out[small] = series
+    series = 3.373091494469352e-23
+    series = 3.6770822088331955e-22 + t * series
+    series = 4.002447216098616e-21 + t * series
+    series = 4.349386634459199e-20 + t * series
+    series = 4.717726508806865e-19 + t * series
+    series = 5.106798451593866e-18 + t * series
+    series = 5.515287671491515e-17 + t * series
+    series = 5.941040609907155e-16 + t * series
+    series = 6.3808204484355186e-15 + t * series
+    series = 6.829994494116056e-14 + t * series
+    series = 7.28213114499937e-13 + t * series
+    series = 7.72847448568504e-12 + t * series
+    series = 8.157249203307483e-11 + t * series
+    series = 8.552722954369029e-10 + t * series
+    series = 8.893908470961609e-09 + t * series
+    series = 9.152703913733326e-08 + t * series
+    series = 9.291101000284673e-07 + t * series
+    series = 9.256715506715507e-06 + t * series
+    series = 8.974953617810761e-05 + t * series
+    series = 0.0008333333333333334 + t * series
+    series = 0.007142857142857143 + t * series
+    series = 0.05 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
-        t = x
-        series = -3.1578003265100976e-21
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    out = numpy.asarray((0.125)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
-        t = x[small]
-        series = -3.1578003265100976e-21
-        series = -3.6980551434799796e-20 + t * series
-        series = -4.341734551994152e-19 + t * series
-        series = -5.112093930302394e-18 + t * series
-        series = -6.03885929516599e-17 + t * series
-        series = -7.160541684001784e-16 + t * series
-        series = -8.527828450903873e-15 + t * series
-        series = -1.0208698466596667e-13 + t * series
-        series = -1.2296404066927483e-12 + t * series
-        series = -1.4922439654526148e-11 + t * series
-        series = -1.82786662181949e-10 + t * series
-        series = -2.2657399287738925e-09 + t * series
-        series = -2.852981296858848e-08 + t * series
-        series = -3.671551662623091e-07 + t * series
-        series = -4.880437023294166e-06 + t * series
-        series = -6.845238095238096e-05 + t * series
-        series = -0.0010714285714285715 + t * series
-        series = -0.025 + t * series
-        out[small] = series
-    return out
+_H_1_x_32 = _R_2_x_32  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = 2.892762495883202e-24
-        series = 3.1482187281713954e-23 + t * series
-        series = 3.420541589612275e-22 + t * series
-        series = 3.7095852246767656e-21 + t * series
-        series = 4.0148184318084914e-20 + t * series
-        series = 4.33520814322793e-19 + t * series
-        series = 4.669072870028677e-18 + t * series
-        series = 5.0138978831741045e-17 + t * series
-        series = 5.366101196045172e-16 + t * series
-        series = 5.720735574459431e-15 + t * series
-        series = 6.07110621699205e-14 + t * series
-        series = 6.408275407599445e-13 + t * series
-        series = 6.7204125962478614e-12 + t * series
-        series = 6.991927888549271e-11 + t * series
-        series = 7.202293014205498e-10 + t * series
-        series = 7.324395211380149e-09 + t * series
-        series = 7.32216313098666e-08 + t * series
-        series = 7.147000769449749e-07 + t * series
-        series = 6.732156732156732e-06 + t * series
-        series = 5.983302411873841e-05 + t * series
-        series = 0.0004761904761904762 + t * series
-        series = 0.002857142857142857 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    w1 = w0**(-1.0)
-    w2 = cos_half*sin_half
-    w3 = (phi - 2*w2)**(-1.0)
-    w4 = 6*phi
-    w5 = 2*phi
-    w6 = 16*cos_half*sin_half - w4 - numpy.sin(w5)
-    out = numpy.asarray(-0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - numpy.cos(w5) + 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        w0 = sin_half**2
+        w1 = w0**(-1.0)
+        w2 = cos_half*sin_half
+        w3 = (phi - 2*w2)**(-1.0)
+        w4 = 6*phi
+        w5 = 2*phi
+        w6 = 16*cos_half*sin_half - w4 - numpy.sin(w5)
+        out = numpy.asarray(-0.020833333333333332*w1*w3*((0.25)*cos_half*w6/sin_half**3 - 0.5*w1*(-8*w0 - numpy.cos(w5) + 1) + (0.5)*w3*w6)*numpy.cbrt(12*w2 - w4), dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = 2.892762495883202e-24
-        series = 3.1482187281713954e-23 + t * series
-        series = 3.420541589612275e-22 + t * series
-        series = 3.7095852246767656e-21 + t * series
-        series = 4.0148184318084914e-20 + t * series
-        series = 4.33520814322793e-19 + t * series
-        series = 4.669072870028677e-18 + t * series
-        series = 5.0138978831741045e-17 + t * series
-        series = 5.366101196045172e-16 + t * series
-        series = 5.720735574459431e-15 + t * series
-        series = 6.07110621699205e-14 + t * series
-        series = 6.408275407599445e-13 + t * series
-        series = 6.7204125962478614e-12 + t * series
-        series = 6.991927888549271e-11 + t * series
-        series = 7.202293014205498e-10 + t * series
-        series = 7.324395211380149e-09 + t * series
-        series = 7.32216313098666e-08 + t * series
-        series = 7.147000769449749e-07 + t * series
-        series = 6.732156732156732e-06 + t * series
-        series = 5.983302411873841e-05 + t * series
-        series = 0.0004761904761904762 + t * series
-        series = 0.002857142857142857 + t * series
-        out[small] = series
+    series = 2.892762495883202e-24
+    series = 3.1482187281713954e-23 + t * series
+    series = 3.420541589612275e-22 + t * series
+    series = 3.7095852246767656e-21 + t * series
+    series = 4.0148184318084914e-20 + t * series
+    series = 4.33520814322793e-19 + t * series
+    series = 4.669072870028677e-18 + t * series
+    series = 5.0138978831741045e-17 + t * series
+    series = 5.366101196045172e-16 + t * series
+    series = 5.720735574459431e-15 + t * series
+    series = 6.07110621699205e-14 + t * series
+    series = 6.408275407599445e-13 + t * series
+    series = 6.7204125962478614e-12 + t * series
+    series = 6.991927888549271e-11 + t * series
+    series = 7.202293014205498e-10 + t * series
+    series = 7.324395211380149e-09 + t * series
+    series = 7.32216313098666e-08 + t * series
+    series = 7.147000769449749e-07 + t * series
+    series = 6.732156732156732e-06 + t * series
+    series = 5.983302411873841e-05 + t * series
+    series = 0.0004761904761904762 + t * series
+    series = 0.002857142857142857 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = -6.315600653020195e-21
-        series = -7.396110286959959e-20 + t * series
-        series = -8.683469103988305e-19 + t * series
-        series = -1.0224187860604788e-17 + t * series
-        series = -1.207771859033198e-16 + t * series
-        series = -1.4321083368003567e-15 + t * series
-        series = -1.7055656901807745e-14 + t * series
-        series = -2.0417396933193335e-13 + t * series
-        series = -2.4592808133854965e-12 + t * series
-        series = -2.9844879309052296e-11 + t * series
-        series = -3.65573324363898e-10 + t * series
-        series = -4.531479857547785e-09 + t * series
-        series = -5.705962593717696e-08 + t * series
-        series = -7.343103325246182e-07 + t * series
-        series = -9.760874046588332e-06 + t * series
-        series = -0.0001369047619047619 + t * series
-        series = -0.002142857142857143 + t * series
-        series = -0.05 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    out = numpy.asarray((0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        out = numpy.asarray((0.25)*(-2.6666666666666665*sin_half**4/(phi - w1) + w1)/(sin_half**2*numpy.cbrt(6*phi - 12*w0)), dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = -6.315600653020195e-21
-        series = -7.396110286959959e-20 + t * series
-        series = -8.683469103988305e-19 + t * series
-        series = -1.0224187860604788e-17 + t * series
-        series = -1.207771859033198e-16 + t * series
-        series = -1.4321083368003567e-15 + t * series
-        series = -1.7055656901807745e-14 + t * series
-        series = -2.0417396933193335e-13 + t * series
-        series = -2.4592808133854965e-12 + t * series
-        series = -2.9844879309052296e-11 + t * series
-        series = -3.65573324363898e-10 + t * series
-        series = -4.531479857547785e-09 + t * series
-        series = -5.705962593717696e-08 + t * series
-        series = -7.343103325246182e-07 + t * series
-        series = -9.760874046588332e-06 + t * series
-        series = -0.0001369047619047619 + t * series
-        series = -0.002142857142857143 + t * series
-        series = -0.05 + t * series
-        out[small] = series
+    series = -6.315600653020195e-21
+    series = -7.396110286959959e-20 + t * series
+    series = -8.683469103988305e-19 + t * series
+    series = -1.0224187860604788e-17 + t * series
+    series = -1.207771859033198e-16 + t * series
+    series = -1.4321083368003567e-15 + t * series
+    series = -1.7055656901807745e-14 + t * series
+    series = -2.0417396933193335e-13 + t * series
+    series = -2.4592808133854965e-12 + t * series
+    series = -2.9844879309052296e-11 + t * series
+    series = -3.65573324363898e-10 + t * series
+    series = -4.531479857547785e-09 + t * series
+    series = -5.705962593717696e-08 + t * series
+    series = -7.343103325246182e-07 + t * series
+    series = -9.760874046588332e-06 + t * series
+    series = -0.0001369047619047619 + t * series
+    series = -0.002142857142857143 + t * series
+    series = -0.05 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_32 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 4.619481091176478:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 4.619481091176478  # every lane on it
+    if polynomial:
         t = x
-        series = 6.497844255354877e-25
-        series = 7.196733448736306e-24 + t * series
-        series = 7.96467075122581e-23 + t * series
-        series = 8.807039512596957e-22 + t * series
-        series = 9.729237867259716e-21 + t * series
-        series = 1.0736521110134332e-19 + t * series
-        series = 1.1833776459135935e-18 + t * series
-        series = 1.3025203655982459e-17 + t * series
-        series = 1.4313863004846702e-16 + t * series
-        series = 1.5701034167431574e-15 + t * series
-        series = 1.718530004160428e-14 + t * series
-        series = 1.8761222591988522e-13 + t * series
-        series = 2.0417396933193335e-12 + t * series
-        series = 2.213352732046947e-11 + t * series
-        series = 2.3875903447241837e-10 + t * series
-        series = 2.559013270547286e-09 + t * series
-        series = 2.7188879145286708e-08 + t * series
-        series = 2.852981296858848e-07 + t * series
-        series = 2.937241330098473e-06 + t * series
-        series = 2.9282622139764997e-05 + t * series
-        series = 0.0002738095238095238 + t * series
-        series = 0.002142857142857143 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = cos_half*sin_half
-    w1 = 2*w0
-    w2 = (phi - w1)**(-1.0)
-    w3 = sin_half**2
-    w4 = 1 - 2*w3
-    w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
-    out = numpy.asarray(-0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4, dtype=x.dtype)
-    if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
-        return out
-    small = x < 4.619481091176478
-    if small.any():
+    else:
+        w0 = cos_half*sin_half
+        w1 = 2*w0
+        w2 = (phi - w1)**(-1.0)
+        w3 = sin_half**2
+        w4 = 1 - 2*w3
+        w5 = 6*phi*w0 - 8*w3 + w4**2 - 1
+        out = numpy.asarray(-0.010416666666666666*w2*(-cos_half*w5/sin_half + 3*phi*w4 - 4*w0*w4 - w1 - 2.6666666666666665*w2*w3*w5)/sin_half**4, dtype=x.dtype)
+        if span is not None and span[0] >= 4.619481091176478:  # every lane on the closed form
+            return out
+        small = x < 4.619481091176478
+        if not small.any():
+            return out
         t = x[small]
-        series = 6.497844255354877e-25
-        series = 7.196733448736306e-24 + t * series
-        series = 7.96467075122581e-23 + t * series
-        series = 8.807039512596957e-22 + t * series
-        series = 9.729237867259716e-21 + t * series
-        series = 1.0736521110134332e-19 + t * series
-        series = 1.1833776459135935e-18 + t * series
-        series = 1.3025203655982459e-17 + t * series
-        series = 1.4313863004846702e-16 + t * series
-        series = 1.5701034167431574e-15 + t * series
-        series = 1.718530004160428e-14 + t * series
-        series = 1.8761222591988522e-13 + t * series
-        series = 2.0417396933193335e-12 + t * series
-        series = 2.213352732046947e-11 + t * series
-        series = 2.3875903447241837e-10 + t * series
-        series = 2.559013270547286e-09 + t * series
-        series = 2.7188879145286708e-08 + t * series
-        series = 2.852981296858848e-07 + t * series
-        series = 2.937241330098473e-06 + t * series
-        series = 2.9282622139764997e-05 + t * series
-        series = 0.0002738095238095238 + t * series
-        series = 0.002142857142857143 + t * series
-        out[small] = series
+    series = 6.497844255354877e-25
+    series = 7.196733448736306e-24 + t * series
+    series = 7.96467075122581e-23 + t * series
+    series = 8.807039512596957e-22 + t * series
+    series = 9.729237867259716e-21 + t * series
+    series = 1.0736521110134332e-19 + t * series
+    series = 1.1833776459135935e-18 + t * series
+    series = 1.3025203655982459e-17 + t * series
+    series = 1.4313863004846702e-16 + t * series
+    series = 1.5701034167431574e-15 + t * series
+    series = 1.718530004160428e-14 + t * series
+    series = 1.8761222591988522e-13 + t * series
+    series = 2.0417396933193335e-12 + t * series
+    series = 2.213352732046947e-11 + t * series
+    series = 2.3875903447241837e-10 + t * series
+    series = 2.559013270547286e-09 + t * series
+    series = 2.7188879145286708e-08 + t * series
+    series = 2.852981296858848e-07 + t * series
+    series = 2.937241330098473e-06 + t * series
+    series = 2.9282622139764997e-05 + t * series
+    series = 0.0002738095238095238 + t * series
+    series = 0.002142857142857143 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.4342812011199078:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.4342812011199078  # every lane on it
+    if polynomial:
         t = x
-        series = -1.2203463534465907e-08
-        series = -1.8955121406990826e-07 + t * series
-        series = -3.189329117063492e-06 + t * series
-        series = -6.138392857142858e-05 + t * series
-        series = -0.0015625 + t * series
-        series = -0.125 + t * series
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.array(cos_half, dtype=x.dtype)
-    if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
-        return out
-    small = x < 1.4342812011199078
-    if small.any():
+    else:
+        out = numpy.array(cos_half, dtype=x.dtype)
+        if span is not None and span[0] >= 1.4342812011199078:  # every lane on the closed form
+            return out
+        small = x < 1.4342812011199078
+        if not small.any():
+            return out
         t = x[small]
-        series = -1.2203463534465907e-08
-        series = -1.8955121406990826e-07 + t * series
-        series = -3.189329117063492e-06 + t * series
-        series = -6.138392857142858e-05 + t * series
-        series = -0.0015625 + t * series
-        series = -0.125 + t * series
-        series = 1.0 + t * series
-        out[small] = series
+    series = -1.2203463534465907e-08
+    series = -1.8955121406990826e-07 + t * series
+    series = -3.189329117063492e-06 + t * series
+    series = -6.138392857142858e-05 + t * series
+    series = -0.0015625 + t * series
+    series = -0.125 + t * series
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
@@ -2519,6 +1776,8 @@ _COEFFICIENTS = {
 }
 _ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': True, 'nu': True, 'epsilon': True, 'mu': True, 'det_H': False, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': True, 'H_1': True, 'H_2': True, 'H_inverse_0': True, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': True, 'K_1': True, 'K_2': True, 'H_across': True, 'H_inverse_across': True, 'K_across': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': True, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': True, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
@@ -2528,16 +1787,45 @@ _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the
     "64": {'p_prime': 0.1103124080629894, 'nu': 0.1103124080629894, 'epsilon': 0.05752053308030299, 'mu': 0.1103124080629894, 'R_1': 0.1103124080629894, 'R_2': 0.1103124080629894, 'H_0': 0.1103124080629894, 'H_1': 0.1103124080629894, 'H_2': 1.4342812090283275, 'H_inverse_0': 0.1103124080629894, 'H_inverse_2': 2.6302227241416043, 'G_1': 0.1103124080629894, 'G_2': 0.1103124080629894, 'K_0': 0.1103124080629894, 'K_1': 0.1103124080629894, 'K_2': 1.4342812090283275, 'H_across': 0.1103124080629894, 'H_inverse_across': 0.1103124080629894, 'K_across': 0.1103124080629894, 'R_1_x': 1.4342812090283275, 'R_2_x': 2.6302227241416043, 'H_0_x': 1.4342812090283275, 'H_1_x': 2.6302227241416043, 'H_2_x': 1.4342812090283275, 'H_inverse_0_x': 2.6302227241416043, 'H_inverse_2_x': 2.6302227241416043, 'e_0': 0.1103124080629894},
     "32": {'p_prime': 1.4342812011199078, 'nu': 1.4342812011199078, 'epsilon': 0.7648242161335777, 'mu': 1.4342812011199078, 'R_1': 1.4342812011199078, 'R_2': 1.4342812011199078, 'H_0': 1.4342812011199078, 'H_1': 1.4342812011199078, 'H_2': 4.619481091176478, 'H_inverse_0': 1.4342812011199078, 'H_inverse_2': 4.619481091176478, 'G_1': 1.4342812011199078, 'G_2': 1.4342812011199078, 'K_0': 1.4342812011199078, 'K_1': 1.4342812011199078, 'K_2': 4.619481091176478, 'H_across': 1.4342812011199078, 'H_inverse_across': 1.4342812011199078, 'K_across': 1.4342812011199078, 'R_1_x': 2.630222574480542, 'R_2_x': 4.619481091176478, 'H_0_x': 4.619481091176478, 'H_1_x': 4.619481091176478, 'H_2_x': 4.619481091176478, 'H_inverse_0_x': 4.619481091176478, 'H_inverse_2_x': 4.619481091176478, 'e_0': 1.4342812011199078},
 }
-_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
+_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+E0_MIN = -numpy.inf
+_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
+_COMPLEMENT = None  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x <= P_MAX_SQUARED
+
+
+def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
+    out = u[..., :, None] * p[..., None, :]
+    out = out + (-c1)[..., None, None] * (_skew(a))
+    out = out + (-c2)[..., None, None] * (_skew(pa))
+    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
+    return out
+
+
+def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    pta = numpy.einsum('...i,...i->...', p, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
+
+
+_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache, under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
 _FEW = {"d": 16, "f": 6}  # up to this many vectors (by dtype character): entries as scalar arithmetic
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
-_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 _FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
-_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
-E0_MIN = -numpy.inf
-_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 
 
 def _quiet(function):
@@ -2579,6 +1867,31 @@ def _norm(v):
     return scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))
 
 
+def _two_square(a):
+    """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
+    c = 134217729.0 * a
+    high = c - (c - a)
+    low = a - high
+    square = a * a
+    return square, ((high * high - square) + 2.0 * high * low) + low * low
+
+
+def _complement(p):
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form, eq 35 and
+    §3.4) accurate to a few ulp of d: compensated products and sums in float64."""
+    if p.dtype == numpy.float32:
+        q = p.astype(numpy.float64)
+        return _COMPLEMENT - numpy.einsum("...i,...i->...", q, q)
+    high = numpy.full(p.shape[:-1], _COMPLEMENT)
+    low = numpy.full(p.shape[:-1], _COMPLEMENT_LOW)  # p_max^2 - float(p_max^2)
+    for i in range(3):
+        square, error = _two_square(p[..., i])
+        total = high - square
+        low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
+        high = total
+    return high + low
+
+
 def _squared_norm(p):
     """x = |p|^2 = (p0^2 + p2^2) + p1^2: the one definition of x used by every validity test (the
     summation order of NumPy's einsum on x86-64, used before; written out, it is 3 to 4 times
@@ -2595,11 +1908,6 @@ def _length(p, suffix):
     if extreme.any():  # |p| without underflow or overflow
         s[extreme] = _norm(p[extreme])
     return x, s
-
-
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
-    return x <= P_MAX_SQUARED
 
 
 def _span(x, suffix):
@@ -2641,13 +1949,29 @@ def _prepare(p, names):
             p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
             s = numpy.where(valid, s, 0.0).astype(p.dtype)
             x = numpy.where(valid, x, 0.0).astype(p.dtype)  # a lane's x never depends on the others
-    d = None
+    # lanes with x <= k^2/4 (x <= d/3: the rounding error of x, under 2.5 ulp of x, stays below
+    # one ulp of d) take d = k^2 - x, the others the compensated complement: lane by lane, so a
+    # lane's d never depends on the other lanes of its block
+    if _COMPLEMENT is None:
+        d = None
+    elif span is not None and suffix == "64" and span[1] <= _COMPLEMENT / 4:
+        d = _COMPLEMENT - x
+    else:
+        d = numpy.where(valid, _complement(p), 1.0).astype(p.dtype)
+        if suffix == "64":
+            d = numpy.where(valid & (x <= _COMPLEMENT / 4), _COMPLEMENT - x, d)
     table = _USES_PHI[suffix]
     switch = _SWITCH[suffix]
     if any(table[name] and (span is None or span[1] >= switch[name]) for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half), span), valid, suffix
+        sin_half, cos_half = numpy.sin(half), numpy.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            low = _ANGLE_LOW[suffix](numpy.asarray(s, numpy.float64), numpy.asarray(phi, numpy.float64))
+            low = numpy.where(numpy.abs(low) <= _ANGLE_LOW_BOUND[suffix] * phi, 0.5 * low, 0.0)
+            low = low.astype(p.dtype)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half, span), valid, suffix
     return p, (x, None, s, d, None, None, span), valid, suffix
 
 
@@ -2704,7 +2028,7 @@ def _tensor_few(p, name, out):
     float32 rows as numpy.float32 scalars) than as NumPy calls on tiny arrays."""
     p, a, b, c, valid, suffix = _coefficients(p, name)
     columns = (p, a, b, c) if suffix == "32" else (p.tolist(), a.tolist(), b.tolist(), c.tolist())
-    entries = []
+    entries: list = []
     for (p0, p1, p2), a_k, b_k, c_k in zip(*columns, strict=True):
         c0, c1 = c_k * p0, c_k * p1
         b0, b1, b2 = b_k * p0, b_k * p1, b_k * p2
@@ -2781,26 +2105,6 @@ def _skew(v):
     out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
     out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
     return out
-
-
-def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
-    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
-    out = u[..., :, None] * p[..., None, :]
-    out = out + (-c1)[..., None, None] * (_skew(a))
-    out = out + (-c2)[..., None, None] * (_skew(pa))
-    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
-    return out
-
-
-def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
-    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    pta = numpy.einsum('...i,...i->...', p, a)
-    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
 
 
 def _with_slopes(p, a, name, sign):
@@ -2979,7 +2283,7 @@ def from_rotation_matrix(R):
     """p from a rotation matrix (..., 3, 3): Shepperd's largest pivot (eqs 61-65), then from_quaternion.
 
     R must be a rotation within the documented tolerance: max |R^T R - I| <= _ROTATION_TOLERANCE
-    (2^-26, 2^-11 in float32) and det R > 0; anything else (non-finite, singular,
+    (see the module's docstring) and det R > 0; anything else (non-finite, singular,
     scaled, a reflection) gives NaN.  No orthogonalization: for R = Q + D with Q a rotation the
     result differs from Q's parameter vector by O(|D|).
     """

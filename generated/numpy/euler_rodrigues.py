@@ -48,40 +48,33 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_mu_64 = _epsilon_64  # the same code
 
 
-def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_det_H_64 = _epsilon_64  # the same code
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_R_0_64 = _nu_64  # the same code
 
 
-def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_R_1_64 = _p_prime_64  # the same code
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.5)
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_H_0_64 = _epsilon_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(((0.5)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -92,12 +85,10 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_64 = _nu_64  # the same code
 
 
-def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_G_1_64 = _R_2_64  # the same code
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -108,79 +99,70 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((1/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(((0.5)/(numpy.sqrt(d) + 2)) + 0.0 * x).astype(numpy.float64, copy=False)
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 9.99999999999999e-15:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 9.99999999999999e-15  # every lane on it
+    if polynomial:
         t = x
-        series = 0.01171875
-        series = 0.0625 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = numpy.sqrt(d)
-    out = numpy.asarray((0.25)/(w0*((0.5)*w0 + 1)), dtype=x.dtype)
-    if span is not None and span[0] >= 9.99999999999999e-15:  # every lane on the closed form
-        return out
-    small = x < 9.99999999999999e-15
-    if small.any():
+    else:
+        w0 = numpy.sqrt(d)
+        out = numpy.asarray((0.25)/(w0*((0.5)*w0 + 1)), dtype=x.dtype)
+        if span is not None and span[0] >= 9.99999999999999e-15:  # every lane on the closed form
+            return out
+        small = x < 9.99999999999999e-15
+        if not small.any():
+            return out
         t = x[small]
-        series = 0.01171875
-        series = 0.0625 + t * series
-        out[small] = series
+    series = 0.01171875
+    series = 0.0625 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_H_across_64 = _p_prime_64  # the same code
 
 
-def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_H_inverse_across_64 = _p_prime_64  # the same code
 
 
-def _K_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_K_across_64 = _R_2_64  # the same code
 
 
-def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_0_x_64 = _H_inverse_2_64  # the same code
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _R_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_2_x_64 = _H_inverse_2_64  # the same code
 
 
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((d**(-1.5)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_1_x_64 = _H_inverse_2_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(((0.25)/d**(1.5)) + 0.0 * x).astype(numpy.float64, copy=False)
 
 
-def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_H_inverse_0_x_64 = _R_1_x_64  # the same code
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_64 = _H_inverse_2_64  # the same code
 
 
-def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_2_x_64 = _H_inverse_2_64  # the same code
 
 
-def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float64, copy=False)
+_e_0_64 = _p_prime_64  # the same code
 
 
 def _angle_64(s, d):
@@ -198,8 +180,7 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_nu_32 = _nu_64  # the same code
 
 
 def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -208,40 +189,25 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_mu_32 = _epsilon_32  # the same code
 
 
-def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_det_H_32 = _epsilon_32  # the same code
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_R_0_32 = _nu_64  # the same code
 
 
-def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_R_1_32 = _p_prime_32  # the same code
 
 
-def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_R_2_32 = _R_2_64  # the same code
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray((2/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_H_0_32 = _epsilon_32  # the same code
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_H_1_32 = _R_2_64  # the same code
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -250,26 +216,19 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(((0.5)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_H_inverse_0_32 = _p_prime_32  # the same code
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
-def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_2_32 = _H_inverse_2_64  # the same code
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_32 = _nu_64  # the same code
 
 
-def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_G_1_32 = _R_2_64  # the same code
 
 
 def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -284,10 +243,7 @@ def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((1/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray(((0.5)/(numpy.sqrt(d) + 2)) + 0.0 * x).astype(numpy.float32, copy=False)
+_K_1_32 = _G_2_32  # the same code
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -304,24 +260,16 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
-def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_H_across_32 = _p_prime_32  # the same code
 
 
-def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_H_inverse_across_32 = _p_prime_32  # the same code
 
 
-def _K_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_K_across_32 = _R_2_64  # the same code
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_0_x_32 = _H_inverse_2_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -330,8 +278,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _R_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_2_x_32 = _H_inverse_2_64  # the same code
 
 
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -340,8 +287,7 @@ def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((d**(-1.5)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_1_x_32 = _H_inverse_2_64  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -350,28 +296,19 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(((0.25)/d**(1.5)) + 0.0 * x).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray((-(0.25)/numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_H_inverse_0_x_32 = _R_1_x_32  # the same code
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_32 = _H_inverse_2_64  # the same code
 
 
-def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_2_x_32 = _H_inverse_2_64  # the same code
 
 
-def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    d = d.astype(numpy.float64)
-    return numpy.asarray(((0.5)*numpy.sqrt(d)) + 0.0 * x).astype(numpy.float32, copy=False)
+_e_0_32 = _p_prime_32  # the same code
 
 
-def _angle_32(s, d):
-    return 2*numpy.arctan2(s, numpy.sqrt(d)) + 0.0 * s
+_angle_32 = _angle_64  # the same code
 
 
 def _scale_32(e0, e_norm):
@@ -453,6 +390,8 @@ _COEFFICIENTS = {
 }
 _ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
@@ -462,16 +401,45 @@ _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the
     "64": {},
     "32": {},
 }
-_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
+_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+E0_MIN = 0.0
+_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
+_COMPLEMENT = 4.0  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x < P_MAX_SQUARED
+
+
+def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
+    out = u[..., :, None] * p[..., None, :]
+    out = out + (-c1)[..., None, None] * (_skew(a))
+    out = out + (-c2)[..., None, None] * (_skew(pa))
+    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
+    return out
+
+
+def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    pta = numpy.einsum('...i,...i->...', p, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
+
+
+_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache, under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
 _FEW = {"d": 16, "f": 6}  # up to this many vectors (by dtype character): entries as scalar arithmetic
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
-_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 _FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
-_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
-E0_MIN = 0.0
-_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 
 
 def _quiet(function):
@@ -523,12 +491,13 @@ def _two_square(a):
 
 
 def _complement(p):
-    """d = 4 - |p|^2 accurate to a few ulp of d (compensated products and sums), float64."""
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form, eq 35 and
+    §3.4) accurate to a few ulp of d: compensated products and sums in float64."""
     if p.dtype == numpy.float32:
         q = p.astype(numpy.float64)
-        return 4.0 - numpy.einsum("...i,...i->...", q, q)
-    high = numpy.full(p.shape[:-1], 4.0)
-    low = numpy.zeros(p.shape[:-1])
+        return _COMPLEMENT - numpy.einsum("...i,...i->...", q, q)
+    high = numpy.full(p.shape[:-1], _COMPLEMENT)
+    low = numpy.full(p.shape[:-1], _COMPLEMENT_LOW)  # p_max^2 - float(p_max^2)
     for i in range(3):
         square, error = _two_square(p[..., i])
         total = high - square
@@ -553,11 +522,6 @@ def _length(p, suffix):
     if extreme.any():  # |p| without underflow or overflow
         s[extreme] = _norm(p[extreme])
     return x, s
-
-
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
-    return x < P_MAX_SQUARED
 
 
 def _span(x, suffix):
@@ -602,18 +566,26 @@ def _prepare(p, names):
     # lanes with x <= k^2/4 (x <= d/3: the rounding error of x, under 2.5 ulp of x, stays below
     # one ulp of d) take d = k^2 - x, the others the compensated complement: lane by lane, so a
     # lane's d never depends on the other lanes of its block
-    if span is not None and suffix == "64" and span[1] <= 4.0 / 4:
-        d = 4.0 - x
+    if _COMPLEMENT is None:
+        d = None
+    elif span is not None and suffix == "64" and span[1] <= _COMPLEMENT / 4:
+        d = _COMPLEMENT - x
     else:
         d = numpy.where(valid, _complement(p), 1.0).astype(p.dtype)
         if suffix == "64":
-            d = numpy.where(valid & (x <= 4.0 / 4), 4.0 - x, d)
+            d = numpy.where(valid & (x <= _COMPLEMENT / 4), _COMPLEMENT - x, d)
     table = _USES_PHI[suffix]
     switch = _SWITCH[suffix]
     if any(table[name] and (span is None or span[1] >= switch[name]) for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half), span), valid, suffix
+        sin_half, cos_half = numpy.sin(half), numpy.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            low = _ANGLE_LOW[suffix](numpy.asarray(s, numpy.float64), numpy.asarray(phi, numpy.float64))
+            low = numpy.where(numpy.abs(low) <= _ANGLE_LOW_BOUND[suffix] * phi, 0.5 * low, 0.0)
+            low = low.astype(p.dtype)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half, span), valid, suffix
     return p, (x, None, s, d, None, None, span), valid, suffix
 
 
@@ -670,7 +642,7 @@ def _tensor_few(p, name, out):
     float32 rows as numpy.float32 scalars) than as NumPy calls on tiny arrays."""
     p, a, b, c, valid, suffix = _coefficients(p, name)
     columns = (p, a, b, c) if suffix == "32" else (p.tolist(), a.tolist(), b.tolist(), c.tolist())
-    entries = []
+    entries: list = []
     for (p0, p1, p2), a_k, b_k, c_k in zip(*columns, strict=True):
         c0, c1 = c_k * p0, c_k * p1
         b0, b1, b2 = b_k * p0, b_k * p1, b_k * p2
@@ -747,26 +719,6 @@ def _skew(v):
     out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
     out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
     return out
-
-
-def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
-    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
-    out = u[..., :, None] * p[..., None, :]
-    out = out + (-c1)[..., None, None] * (_skew(a))
-    out = out + (-c2)[..., None, None] * (_skew(pa))
-    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
-    return out
-
-
-def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
-    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    pta = numpy.einsum('...i,...i->...', p, a)
-    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
 
 
 def _with_slopes(p, a, name, sign):
@@ -945,7 +897,7 @@ def from_rotation_matrix(R):
     """p from a rotation matrix (..., 3, 3): Shepperd's largest pivot (eqs 61-65), then from_quaternion.
 
     R must be a rotation within the documented tolerance: max |R^T R - I| <= _ROTATION_TOLERANCE
-    (2^-26, 2^-11 in float32) and det R > 0; anything else (non-finite, singular,
+    (see the module's docstring) and det R > 0; anything else (non-finite, singular,
     scaled, a reflection) gives NaN.  No orthogonalization: for R = Q + D with Q a rotation the
     result differs from Q's parameter vector by O(|D|).
     """

@@ -41,157 +41,144 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _nu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.8559287093218047e-12:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.8559287093218047e-12  # every lane on it
+    if polynomial:
         t = x
-        series = -0.041666666666666664
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half/phi, dtype=x.dtype)
-    if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
-        return out
-    small = x < 1.8559287093218047e-12
-    if small.any():
+    else:
+        out = numpy.asarray(2*sin_half/phi, dtype=x.dtype)
+        if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
+            return out
+        small = x < 1.8559287093218047e-12
+        if not small.any():
+            return out
         t = x[small]
-        series = -0.041666666666666664
-        series = 1.0 + t * series
-        out[small] = series
+    series = -0.041666666666666664
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.9211893090849678e-14:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.9211893090849678e-14  # every lane on it
+    if polynomial:
         t = x
-        series = 0.08333333333333333
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.tan((0.5)*phi)/phi, dtype=x.dtype)
-    if span is not None and span[0] >= 1.9211893090849678e-14:  # every lane on the closed form
-        return out
-    small = x < 1.9211893090849678e-14
-    if small.any():
+    else:
+        out = numpy.asarray(2*numpy.tan((0.5)*phi)/phi, dtype=x.dtype)
+        if span is not None and span[0] >= 1.9211893090849678e-14:  # every lane on the closed form
+            return out
+        small = x < 1.9211893090849678e-14
+        if not small.any():
+            return out
         t = x[small]
-        series = 0.08333333333333333
-        series = 1.0 + t * series
-        out[small] = series
+    series = 0.08333333333333333
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_mu_64 = _p_prime_64  # the same code
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.028297529613116e-13:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.028297529613116e-13  # every lane on it
+    if polynomial:
         t = x
-        series = -0.08333333333333333
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(4*sin_half**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 5.028297529613116e-13:  # every lane on the closed form
-        return out
-    small = x < 5.028297529613116e-13
-    if small.any():
+    else:
+        out = numpy.asarray(4*sin_half**2/phi**2, dtype=x.dtype)
+        if span is not None and span[0] >= 5.028297529613116e-13:  # every lane on the closed form
+            return out
+        small = x < 5.028297529613116e-13
+        if not small.any():
+            return out
         t = x[small]
-        series = -0.08333333333333333
-        series = 1.0 + t * series
-        out[small] = series
+    series = -0.08333333333333333
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _R_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_R_0_64 = _p_prime_64  # the same code
 
 
 def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.028297529613116e-13:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.028297529613116e-13  # every lane on it
+    if polynomial:
         t = x
-        series = -0.16666666666666666
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*cos_half*sin_half/phi, dtype=x.dtype)
-    if span is not None and span[0] >= 5.028297529613116e-13:  # every lane on the closed form
-        return out
-    small = x < 5.028297529613116e-13
-    if small.any():
+    else:
+        out = numpy.asarray(2*cos_half*sin_half/phi, dtype=x.dtype)
+        if span is not None and span[0] >= 5.028297529613116e-13:  # every lane on the closed form
+            return out
+        small = x < 5.028297529613116e-13
+        if not small.any():
+            return out
         t = x[small]
-        series = -0.16666666666666666
-        series = 1.0 + t * series
-        out[small] = series
+    series = -0.16666666666666666
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.028297529613116e-13:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.028297529613116e-13  # every lane on it
+    if polynomial:
         t = x
-        series = -0.041666666666666664
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 5.028297529613116e-13:  # every lane on the closed form
-        return out
-    small = x < 5.028297529613116e-13
-    if small.any():
+    else:
+        out = numpy.asarray(2*sin_half**2/phi**2, dtype=x.dtype)
+        if span is not None and span[0] >= 5.028297529613116e-13:  # every lane on the closed form
+            return out
+        small = x < 5.028297529613116e-13
+        if not small.any():
+            return out
         t = x[small]
-        series = -0.041666666666666664
-        series = 0.5 + t * series
-        out[small] = series
+    series = -0.041666666666666664
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_H_0_64 = _p_prime_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.028297529613116e-13:  # every lane on the polynomial
-        t = x
-        series = -0.041666666666666664
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*sin_half**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 5.028297529613116e-13:  # every lane on the closed form
-        return out
-    small = x < 5.028297529613116e-13
-    if small.any():
-        t = x[small]
-        series = -0.041666666666666664
-        series = 0.5 + t * series
-        out[small] = series
-    return out
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7851233626304374:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.7851233626304374  # every lane on it
+    if polynomial:
         t = x
-        series = -2.8114572543455206e-15
-        series = 7.647163731819816e-13 + t * series
-        series = -1.6059043836821613e-10 + t * series
-        series = 2.505210838544172e-08 + t * series
-        series = -2.7557319223985893e-06 + t * series
-        series = 0.0001984126984126984 + t * series
-        series = -0.008333333333333333 + t * series
-        series = 0.16666666666666666 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((phi - numpy.sin(phi))/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7851233626304374:  # every lane on the closed form
-        return out
-    small = x < 0.7851233626304374
-    if small.any():
+    else:
+        out = numpy.asarray((phi - numpy.sin(phi))/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 0.7851233626304374:  # every lane on the closed form
+            return out
+        small = x < 0.7851233626304374
+        if not small.any():
+            return out
         t = x[small]
-        series = -2.8114572543455206e-15
-        series = 7.647163731819816e-13 + t * series
-        series = -1.6059043836821613e-10 + t * series
-        series = 2.505210838544172e-08 + t * series
-        series = -2.7557319223985893e-06 + t * series
-        series = 0.0001984126984126984 + t * series
-        series = -0.008333333333333333 + t * series
-        series = 0.16666666666666666 + t * series
-        out[small] = series
+    series = -2.8114572543455206e-15
+    series = 7.647163731819816e-13 + t * series
+    series = -1.6059043836821613e-10 + t * series
+    series = 2.505210838544172e-08 + t * series
+    series = -2.7557319223985893e-06 + t * series
+    series = 0.0001984126984126984 + t * series
+    series = -0.008333333333333333 + t * series
+    series = 0.16666666666666666 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -199,94 +186,82 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.5673482008975155:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.5673482008975155  # every lane on it
+    if polynomial:
         t = x
-        series = 9.336734257095045e-31
-        series = 3.6859949406653103e-29 + t * series
-        series = 1.455172475614865e-27 + t * series
-        series = 5.744790668872202e-26 + t * series
-        series = 2.267952452337683e-24 + t * series
-        series = 8.953517427037546e-23 + t * series
-        series = 3.534707039629467e-21 + t * series
-        series = 1.3954464685812522e-19 + t * series
-        series = 5.5090028283602295e-18 + t * series
-        series = 2.174868698558062e-16 + t * series
-        series = 8.586062056277845e-15 + t * series
-        series = 3.3896802963225827e-13 + t * series
-        series = 1.3382536530684679e-11 + t * series
-        series = 5.284190138687493e-10 + t * series
-        series = 2.08767569878681e-08 + t * series
-        series = 8.267195767195768e-07 + t * series
-        series = 3.306878306878307e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = 0.08333333333333333 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((-0.5*cos_half*phi/sin_half + 1)/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
-        return out
-    small = x < 5.5673482008975155
-    if small.any():
+    else:
+        out = numpy.asarray((-0.5*cos_half*phi/sin_half + 1)/phi**2, dtype=x.dtype)
+        if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
+            return out
+        small = x < 5.5673482008975155
+        if not small.any():
+            return out
         t = x[small]
-        series = 9.336734257095045e-31
-        series = 3.6859949406653103e-29 + t * series
-        series = 1.455172475614865e-27 + t * series
-        series = 5.744790668872202e-26 + t * series
-        series = 2.267952452337683e-24 + t * series
-        series = 8.953517427037546e-23 + t * series
-        series = 3.534707039629467e-21 + t * series
-        series = 1.3954464685812522e-19 + t * series
-        series = 5.5090028283602295e-18 + t * series
-        series = 2.174868698558062e-16 + t * series
-        series = 8.586062056277845e-15 + t * series
-        series = 3.3896802963225827e-13 + t * series
-        series = 1.3382536530684679e-11 + t * series
-        series = 5.284190138687493e-10 + t * series
-        series = 2.08767569878681e-08 + t * series
-        series = 8.267195767195768e-07 + t * series
-        series = 3.306878306878307e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = 0.08333333333333333 + t * series
-        out[small] = series
+    series = 9.336734257095045e-31
+    series = 3.6859949406653103e-29 + t * series
+    series = 1.455172475614865e-27 + t * series
+    series = 5.744790668872202e-26 + t * series
+    series = 2.267952452337683e-24 + t * series
+    series = 8.953517427037546e-23 + t * series
+    series = 3.534707039629467e-21 + t * series
+    series = 1.3954464685812522e-19 + t * series
+    series = 5.5090028283602295e-18 + t * series
+    series = 2.174868698558062e-16 + t * series
+    series = 8.586062056277845e-15 + t * series
+    series = 3.3896802963225827e-13 + t * series
+    series = 1.3382536530684679e-11 + t * series
+    series = 5.284190138687493e-10 + t * series
+    series = 2.08767569878681e-08 + t * series
+    series = 8.267195767195768e-07 + t * series
+    series = 3.306878306878307e-05 + t * series
+    series = 0.001388888888888889 + t * series
+    series = 0.08333333333333333 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_64 = _p_prime_64  # the same code
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.8559287093218047e-12:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.8559287093218047e-12  # every lane on it
+    if polynomial:
         t = x
-        series = -0.020833333333333332
-        series = 0.5 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(sin_half/phi, dtype=x.dtype)
-    if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
-        return out
-    small = x < 1.8559287093218047e-12
-    if small.any():
+    else:
+        out = numpy.asarray(sin_half/phi, dtype=x.dtype)
+        if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
+            return out
+        small = x < 1.8559287093218047e-12
+        if not small.any():
+            return out
         t = x[small]
-        series = -0.020833333333333332
-        series = 0.5 + t * series
-        out[small] = series
+    series = -0.020833333333333332
+    series = 0.5 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.8559287093218047e-12:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.8559287093218047e-12  # every lane on it
+    if polynomial:
         t = x
-        series = -0.0026041666666666665
-        series = 0.125 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
-        return out
-    small = x < 1.8559287093218047e-12
-    if small.any():
+    else:
+        out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/phi**2, dtype=x.dtype)
+        if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
+            return out
+        small = x < 1.8559287093218047e-12
+        if not small.any():
+            return out
         t = x[small]
-        series = -0.0026041666666666665
-        series = 0.125 + t * series
-        out[small] = series
+    series = -0.0026041666666666665
+    series = 0.125 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
@@ -294,53 +269,33 @@ def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.5)
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.8559287093218047e-12:  # every lane on the polynomial
-        t = x
-        series = -0.0026041666666666665
-        series = 0.125 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
-        return out
-    small = x < 1.8559287093218047e-12
-    if small.any():
-        t = x[small]
-        series = -0.0026041666666666665
-        series = 0.125 + t * series
-        out[small] = series
-    return out
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.5673482008975155:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.5673482008975155  # every lane on it
+    if polynomial:
         t = x
-        series = 1.5679617398499164e-23
-        series = -2.1449716601146855e-20 + t * series
-        series = 2.333729166204778e-17 + t * series
-        series = -1.9603324996120133e-14 + t * series
-        series = 1.2232474797578965e-11 + t * series
-        series = -5.382288910934745e-09 + t * series
-        series = 1.5500992063492063e-06 + t * series
-        series = -0.00026041666666666666 + t * series
-        series = 0.020833333333333332 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(phi - 2*sin_half)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
-        return out
-    small = x < 5.5673482008975155
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(phi - 2*sin_half)/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
+            return out
+        small = x < 5.5673482008975155
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.5679617398499164e-23
-        series = -2.1449716601146855e-20 + t * series
-        series = 2.333729166204778e-17 + t * series
-        series = -1.9603324996120133e-14 + t * series
-        series = 1.2232474797578965e-11 + t * series
-        series = -5.382288910934745e-09 + t * series
-        series = 1.5500992063492063e-06 + t * series
-        series = -0.00026041666666666666 + t * series
-        series = 0.020833333333333332 + t * series
-        out[small] = series
+    series = 1.5679617398499164e-23
+    series = -2.1449716601146855e-20 + t * series
+    series = 2.333729166204778e-17 + t * series
+    series = -1.9603324996120133e-14 + t * series
+    series = 1.2232474797578965e-11 + t * series
+    series = -5.382288910934745e-09 + t * series
+    series = 1.5500992063492063e-06 + t * series
+    series = -0.00026041666666666666 + t * series
+    series = 0.020833333333333332 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
@@ -349,233 +304,160 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 0.7851233626304374:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 0.7851233626304374  # every lane on it
+    if polynomial:
         t = x
-        series = -7.398571721961897e-17
-        series = 2.2491658034764165e-14 + t * series
-        series = -5.353014612273871e-12 + t * series
-        series = 9.635426302092969e-10 + t * series
-        series = -1.252605419272086e-07 + t * series
-        series = 1.1022927689594357e-05 + t * series
-        series = -0.0005952380952380953 + t * series
-        series = 0.016666666666666666 + t * series
-        series = -0.16666666666666666 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(numpy.cos(phi) - numpy.sin(phi)/phi)/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 0.7851233626304374:  # every lane on the closed form
-        return out
-    small = x < 0.7851233626304374
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(numpy.cos(phi) - numpy.sin(phi)/phi)/phi**2, dtype=x.dtype)
+        if span is not None and span[0] >= 0.7851233626304374:  # every lane on the closed form
+            return out
+        small = x < 0.7851233626304374
+        if not small.any():
+            return out
         t = x[small]
-        series = -7.398571721961897e-17
-        series = 2.2491658034764165e-14 + t * series
-        series = -5.353014612273871e-12 + t * series
-        series = 9.635426302092969e-10 + t * series
-        series = -1.252605419272086e-07 + t * series
-        series = 1.1022927689594357e-05 + t * series
-        series = -0.0005952380952380953 + t * series
-        series = 0.016666666666666666 + t * series
-        series = -0.16666666666666666 + t * series
-        out[small] = series
+    series = -7.398571721961897e-17
+    series = 2.2491658034764165e-14 + t * series
+    series = -5.353014612273871e-12 + t * series
+    series = 9.635426302092969e-10 + t * series
+    series = -1.252605419272086e-07 + t * series
+    series = 1.1022927689594357e-05 + t * series
+    series = -0.0005952380952380953 + t * series
+    series = 0.016666666666666666 + t * series
+    series = -0.16666666666666666 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.5673482008975155:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.5673482008975155  # every lane on it
+    if polynomial:
         t = x
-        series = 2.975515515869757e-26
-        series = -1.77291132820573e-23 + t * series
-        series = 8.896791392450573e-21 + t * series
-        series = -3.6992858609809485e-18 + t * series
-        series = 1.249536557486898e-15 + t * series
-        series = -3.3456341326711696e-13 + t * series
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
-        return out
-    small = x < 5.5673482008975155
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
+            return out
+        small = x < 5.5673482008975155
+        if not small.any():
+            return out
         t = x[small]
-        series = 2.975515515869757e-26
-        series = -1.77291132820573e-23 + t * series
-        series = 8.896791392450573e-21 + t * series
-        series = -3.6992858609809485e-18 + t * series
-        series = 1.249536557486898e-15 + t * series
-        series = -3.3456341326711696e-13 + t * series
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        out[small] = series
+    series = 2.975515515869757e-26
+    series = -1.77291132820573e-23 + t * series
+    series = 8.896791392450573e-21 + t * series
+    series = -3.6992858609809485e-18 + t * series
+    series = 1.249536557486898e-15 + t * series
+    series = -3.3456341326711696e-13 + t * series
+    series = 6.882447358637835e-11 + t * series
+    series = -1.043837849393405e-08 + t * series
+    series = 1.1022927689594355e-06 + t * series
+    series = -7.440476190476191e-05 + t * series
+    series = 0.002777777777777778 + t * series
+    series = -0.041666666666666664 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_0_x_64 = _R_0_x_64  # the same code
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.5673482008975155:  # every lane on the polynomial
-        t = x
-        series = 2.975515515869757e-26
-        series = -1.77291132820573e-23 + t * series
-        series = 8.896791392450573e-21 + t * series
-        series = -3.6992858609809485e-18 + t * series
-        series = 1.249536557486898e-15 + t * series
-        series = -3.3456341326711696e-13 + t * series
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
-        return out
-    small = x < 5.5673482008975155
-    if small.any():
-        t = x[small]
-        series = 2.975515515869757e-26
-        series = -1.77291132820573e-23 + t * series
-        series = 8.896791392450573e-21 + t * series
-        series = -3.6992858609809485e-18 + t * series
-        series = 1.249536557486898e-15 + t * series
-        series = -3.3456341326711696e-13 + t * series
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        out[small] = series
-    return out
+_H_1_x_64 = _R_2_x_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.5673482008975155:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.5673482008975155  # every lane on it
+    if polynomial:
         t = x
-        series = -7.091645312822921e-25
-        series = 3.868170170630684e-22 + t * series
-        series = -1.7615646957052136e-19 + t * series
-        series = 6.576508197299464e-17 + t * series
-        series = -1.9680200780418645e-14 + t * series
-        series = 4.58829823909189e-12 + t * series
-        series = -8.029521918410807e-10 + t * series
-        series = 1.0020843354176688e-07 + t * series
-        series = -8.267195767195768e-06 + t * series
-        series = 0.0003968253968253968 + t * series
-        series = -0.008333333333333333 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(-numpy.cos(phi) + 1 - 3*(phi - numpy.sin(phi))/phi)/phi**4, dtype=x.dtype)
-    if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
-        return out
-    small = x < 5.5673482008975155
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(-numpy.cos(phi) + 1 - 3*(phi - numpy.sin(phi))/phi)/phi**4, dtype=x.dtype)
+        if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
+            return out
+        small = x < 5.5673482008975155
+        if not small.any():
+            return out
         t = x[small]
-        series = -7.091645312822921e-25
-        series = 3.868170170630684e-22 + t * series
-        series = -1.7615646957052136e-19 + t * series
-        series = 6.576508197299464e-17 + t * series
-        series = -1.9680200780418645e-14 + t * series
-        series = 4.58829823909189e-12 + t * series
-        series = -8.029521918410807e-10 + t * series
-        series = 1.0020843354176688e-07 + t * series
-        series = -8.267195767195768e-06 + t * series
-        series = 0.0003968253968253968 + t * series
-        series = -0.008333333333333333 + t * series
-        out[small] = series
+    series = -7.091645312822921e-25
+    series = 3.868170170630684e-22 + t * series
+    series = -1.7615646957052136e-19 + t * series
+    series = 6.576508197299464e-17 + t * series
+    series = -1.9680200780418645e-14 + t * series
+    series = 4.58829823909189e-12 + t * series
+    series = -8.029521918410807e-10 + t * series
+    series = 1.0020843354176688e-07 + t * series
+    series = -8.267195767195768e-06 + t * series
+    series = 0.0003968253968253968 + t * series
+    series = -0.008333333333333333 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_0_x_64 = _R_0_x_64  # the same code
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_64 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.5673482008975155:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.5673482008975155  # every lane on it
+    if polynomial:
         t = x
-        series = 3.1866552573834097e-34
-        series = 1.1981343524964268e-32 + t * series
-        series = 4.4935425898311966e-31 + t * series
-        series = 1.6806121662771081e-29 + t * series
-        series = 6.266191399131027e-28 + t * series
-        series = 2.328275960983784e-26 + t * series
-        series = 8.617186003308303e-25 + t * series
-        series = 3.1751334332727565e-23 + t * series
-        series = 1.163957265514881e-21 + t * series
-        series = 4.241648447555361e-20 + t * series
-        series = 1.5349911154393775e-18 + t * series
-        series = 5.5090028283602297e-17 + t * series
-        series = 1.9573818287022555e-15 + t * series
-        series = 6.868849645022276e-14 + t * series
-        series = 2.372776207425808e-12 + t * series
-        series = 8.029521918410807e-11 + t * series
-        series = 2.6420950693437467e-09 + t * series
-        series = 8.35070279514724e-08 + t * series
-        series = 2.48015873015873e-06 + t * series
-        series = 6.613756613756614e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    out = numpy.asarray((0.5)*((0.25)*(2*cos_half**2*phi - 2*cos_half*sin_half - phi*(1 - 2*w0))/w0 - (-cos_half*phi/sin_half + 2)/phi)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
-        return out
-    small = x < 5.5673482008975155
-    if small.any():
+    else:
+        w0 = sin_half**2
+        out = numpy.asarray((0.5)*((0.25)*(2*cos_half**2*phi - 2*cos_half*sin_half - phi*(1 - 2*w0))/w0 - (-cos_half*phi/sin_half + 2)/phi)/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 5.5673482008975155:  # every lane on the closed form
+            return out
+        small = x < 5.5673482008975155
+        if not small.any():
+            return out
         t = x[small]
-        series = 3.1866552573834097e-34
-        series = 1.1981343524964268e-32 + t * series
-        series = 4.4935425898311966e-31 + t * series
-        series = 1.6806121662771081e-29 + t * series
-        series = 6.266191399131027e-28 + t * series
-        series = 2.328275960983784e-26 + t * series
-        series = 8.617186003308303e-25 + t * series
-        series = 3.1751334332727565e-23 + t * series
-        series = 1.163957265514881e-21 + t * series
-        series = 4.241648447555361e-20 + t * series
-        series = 1.5349911154393775e-18 + t * series
-        series = 5.5090028283602297e-17 + t * series
-        series = 1.9573818287022555e-15 + t * series
-        series = 6.868849645022276e-14 + t * series
-        series = 2.372776207425808e-12 + t * series
-        series = 8.029521918410807e-11 + t * series
-        series = 2.6420950693437467e-09 + t * series
-        series = 8.35070279514724e-08 + t * series
-        series = 2.48015873015873e-06 + t * series
-        series = 6.613756613756614e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        out[small] = series
+    series = 3.1866552573834097e-34
+    series = 1.1981343524964268e-32 + t * series
+    series = 4.4935425898311966e-31 + t * series
+    series = 1.6806121662771081e-29 + t * series
+    series = 6.266191399131027e-28 + t * series
+    series = 2.328275960983784e-26 + t * series
+    series = 8.617186003308303e-25 + t * series
+    series = 3.1751334332727565e-23 + t * series
+    series = 1.163957265514881e-21 + t * series
+    series = 4.241648447555361e-20 + t * series
+    series = 1.5349911154393775e-18 + t * series
+    series = 5.5090028283602297e-17 + t * series
+    series = 1.9573818287022555e-15 + t * series
+    series = 6.868849645022276e-14 + t * series
+    series = 2.372776207425808e-12 + t * series
+    series = 8.029521918410807e-11 + t * series
+    series = 2.6420950693437467e-09 + t * series
+    series = 8.35070279514724e-08 + t * series
+    series = 2.48015873015873e-06 + t * series
+    series = 6.613756613756614e-05 + t * series
+    series = 0.001388888888888889 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.8559287093218047e-12:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.8559287093218047e-12  # every lane on it
+    if polynomial:
         t = x
-        series = -0.125
-        series = 1.0 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.array(cos_half, dtype=x.dtype)
-    if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
-        return out
-    small = x < 1.8559287093218047e-12
-    if small.any():
+    else:
+        out = numpy.array(cos_half, dtype=x.dtype)
+        if span is not None and span[0] >= 1.8559287093218047e-12:  # every lane on the closed form
+            return out
+        small = x < 1.8559287093218047e-12
+        if not small.any():
+            return out
         t = x[small]
-        series = -0.125
-        series = 1.0 + t * series
-        out[small] = series
+    series = -0.125
+    series = 1.0 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
@@ -600,8 +482,7 @@ def _scale_64(e0, e_norm):
     return out
 
 
-def _p_prime_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_p_prime_32 = _p_prime_64  # the same code
 
 
 def _nu_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -630,8 +511,7 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_mu_32 = _p_prime_64  # the same code
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -647,8 +527,7 @@ def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_R_0_32 = _p_prime_64  # the same code
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -677,89 +556,69 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_H_0_32 = _p_prime_64  # the same code
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.028297329387876e-13:  # every lane on the polynomial
-        return numpy.full_like(x, 0.5)
-    out = numpy.asarray(2*sin_half**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 5.028297329387876e-13:  # every lane on the closed form
-        return out
-    small = x < 5.028297329387876e-13
-    if small.any():
-        series = 0.5
-        out[small] = series
-    return out
+_H_1_32 = _R_2_32  # the same code
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.5083706018396157:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.5083706018396157  # every lane on it
+    if polynomial:
         t = x
-        series = 2.505210838544172e-08
-        series = -2.7557319223985893e-06 + t * series
-        series = 0.0001984126984126984 + t * series
-        series = -0.008333333333333333 + t * series
-        series = 0.16666666666666666 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((phi - numpy.sin(phi))/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 1.5083706018396157:  # every lane on the closed form
-        return out
-    small = x < 1.5083706018396157
-    if small.any():
+    else:
+        out = numpy.asarray((phi - numpy.sin(phi))/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 1.5083706018396157:  # every lane on the closed form
+            return out
+        small = x < 1.5083706018396157
+        if not small.any():
+            return out
         t = x[small]
-        series = 2.505210838544172e-08
-        series = -2.7557319223985893e-06 + t * series
-        series = 0.0001984126984126984 + t * series
-        series = -0.008333333333333333 + t * series
-        series = 0.16666666666666666 + t * series
-        out[small] = series
+    series = 2.505210838544172e-08
+    series = -2.7557319223985893e-06 + t * series
+    series = 0.0001984126984126984 + t * series
+    series = -0.008333333333333333 + t * series
+    series = 0.16666666666666666 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_H_inverse_0_32 = _p_prime_64  # the same code
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.567347935831094:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.567347935831094  # every lane on it
+    if polynomial:
         t = x
-        series = 8.586062056277845e-15
-        series = 3.3896802963225827e-13 + t * series
-        series = 1.3382536530684679e-11 + t * series
-        series = 5.284190138687493e-10 + t * series
-        series = 2.08767569878681e-08 + t * series
-        series = 8.267195767195768e-07 + t * series
-        series = 3.306878306878307e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = 0.08333333333333333 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((-0.5*cos_half*phi/sin_half + 1)/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
-        return out
-    small = x < 5.567347935831094
-    if small.any():
+    else:
+        out = numpy.asarray((-0.5*cos_half*phi/sin_half + 1)/phi**2, dtype=x.dtype)
+        if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
+            return out
+        small = x < 5.567347935831094
+        if not small.any():
+            return out
         t = x[small]
-        series = 8.586062056277845e-15
-        series = 3.3896802963225827e-13 + t * series
-        series = 1.3382536530684679e-11 + t * series
-        series = 5.284190138687493e-10 + t * series
-        series = 2.08767569878681e-08 + t * series
-        series = 8.267195767195768e-07 + t * series
-        series = 3.306878306878307e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        series = 0.08333333333333333 + t * series
-        out[small] = series
+    series = 8.586062056277845e-15
+    series = 3.3896802963225827e-13 + t * series
+    series = 1.3382536530684679e-11 + t * series
+    series = 5.284190138687493e-10 + t * series
+    series = 2.08767569878681e-08 + t * series
+    series = 8.267195767195768e-07 + t * series
+    series = 3.306878306878307e-05 + t * series
+    series = 0.001388888888888889 + t * series
+    series = 0.08333333333333333 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_32 = _p_prime_64  # the same code
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -788,207 +647,151 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
-def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.5)
+_K_0_32 = _K_0_64  # the same code
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.855928654006444e-12:  # every lane on the polynomial
-        return numpy.full_like(x, 0.125)
-    out = numpy.asarray(2*numpy.sin((0.25)*phi)**2/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.855928654006444e-12:  # every lane on the closed form
-        return out
-    small = x < 1.855928654006444e-12
-    if small.any():
-        series = 0.125
-        out[small] = series
-    return out
+_K_1_32 = _G_2_32  # the same code
 
 
 def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.567347935831094:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.567347935831094  # every lane on it
+    if polynomial:
         t = x
-        series = 1.2232474797578965e-11
-        series = -5.382288910934745e-09 + t * series
-        series = 1.5500992063492063e-06 + t * series
-        series = -0.00026041666666666666 + t * series
-        series = 0.020833333333333332 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(phi - 2*sin_half)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
-        return out
-    small = x < 5.567347935831094
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(phi - 2*sin_half)/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
+            return out
+        small = x < 5.567347935831094
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.2232474797578965e-11
-        series = -5.382288910934745e-09 + t * series
-        series = 1.5500992063492063e-06 + t * series
-        series = -0.00026041666666666666 + t * series
-        series = 0.020833333333333332 + t * series
-        out[small] = series
+    series = 1.2232474797578965e-11
+    series = -5.382288910934745e-09 + t * series
+    series = 1.5500992063492063e-06 + t * series
+    series = -0.00026041666666666666 + t * series
+    series = 0.020833333333333332 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_0_x_32 = _R_0_x_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 1.5083706018396157:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 1.5083706018396157  # every lane on it
+    if polynomial:
         t = x
-        series = 9.635426302092969e-10
-        series = -1.252605419272086e-07 + t * series
-        series = 1.1022927689594357e-05 + t * series
-        series = -0.0005952380952380953 + t * series
-        series = 0.016666666666666666 + t * series
-        series = -0.16666666666666666 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(-2*cos_half*sin_half/phi - 2*sin_half**2 + 1)/phi**2, dtype=x.dtype)
-    if span is not None and span[0] >= 1.5083706018396157:  # every lane on the closed form
-        return out
-    small = x < 1.5083706018396157
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(-2*cos_half*sin_half/phi - 2*sin_half**2 + 1)/phi**2, dtype=x.dtype)
+        if span is not None and span[0] >= 1.5083706018396157:  # every lane on the closed form
+            return out
+        small = x < 1.5083706018396157
+        if not small.any():
+            return out
         t = x[small]
-        series = 9.635426302092969e-10
-        series = -1.252605419272086e-07 + t * series
-        series = 1.1022927689594357e-05 + t * series
-        series = -0.0005952380952380953 + t * series
-        series = 0.016666666666666666 + t * series
-        series = -0.16666666666666666 + t * series
-        out[small] = series
+    series = 9.635426302092969e-10
+    series = -1.252605419272086e-07 + t * series
+    series = 1.1022927689594357e-05 + t * series
+    series = -0.0005952380952380953 + t * series
+    series = 0.016666666666666666 + t * series
+    series = -0.16666666666666666 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.567347935831094:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.567347935831094  # every lane on it
+    if polynomial:
         t = x
-        series = -3.3456341326711696e-13
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
-        return out
-    small = x < 5.567347935831094
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
+            return out
+        small = x < 5.567347935831094
+        if not small.any():
+            return out
         t = x[small]
-        series = -3.3456341326711696e-13
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        out[small] = series
+    series = -3.3456341326711696e-13
+    series = 6.882447358637835e-11 + t * series
+    series = -1.043837849393405e-08 + t * series
+    series = 1.1022927689594355e-06 + t * series
+    series = -7.440476190476191e-05 + t * series
+    series = 0.002777777777777778 + t * series
+    series = -0.041666666666666664 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_0_x_32 = _R_0_x_64  # the same code
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.567347935831094:  # every lane on the polynomial
-        t = x
-        series = -3.3456341326711696e-13
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(2*cos_half*sin_half - 4*sin_half**2/phi)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
-        return out
-    small = x < 5.567347935831094
-    if small.any():
-        t = x[small]
-        series = -3.3456341326711696e-13
-        series = 6.882447358637835e-11 + t * series
-        series = -1.043837849393405e-08 + t * series
-        series = 1.1022927689594355e-06 + t * series
-        series = -7.440476190476191e-05 + t * series
-        series = 0.002777777777777778 + t * series
-        series = -0.041666666666666664 + t * series
-        out[small] = series
-    return out
+_H_1_x_32 = _R_2_x_32  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.567347935831094:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.567347935831094  # every lane on it
+    if polynomial:
         t = x
-        series = -1.9680200780418645e-14
-        series = 4.58829823909189e-12 + t * series
-        series = -8.029521918410807e-10 + t * series
-        series = 1.0020843354176688e-07 + t * series
-        series = -8.267195767195768e-06 + t * series
-        series = 0.0003968253968253968 + t * series
-        series = -0.008333333333333333 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    out = numpy.asarray((0.5)*(2*sin_half**2 - 3*(-2*cos_half*sin_half + phi)/phi)/phi**4, dtype=x.dtype)
-    if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
-        return out
-    small = x < 5.567347935831094
-    if small.any():
+    else:
+        out = numpy.asarray((0.5)*(2*sin_half**2 - 3*(-2*cos_half*sin_half + phi)/phi)/phi**4, dtype=x.dtype)
+        if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
+            return out
+        small = x < 5.567347935831094
+        if not small.any():
+            return out
         t = x[small]
-        series = -1.9680200780418645e-14
-        series = 4.58829823909189e-12 + t * series
-        series = -8.029521918410807e-10 + t * series
-        series = 1.0020843354176688e-07 + t * series
-        series = -8.267195767195768e-06 + t * series
-        series = 0.0003968253968253968 + t * series
-        series = -0.008333333333333333 + t * series
-        out[small] = series
+    series = -1.9680200780418645e-14
+    series = 4.58829823909189e-12 + t * series
+    series = -8.029521918410807e-10 + t * series
+    series = 1.0020843354176688e-07 + t * series
+    series = -8.267195767195768e-06 + t * series
+    series = 0.0003968253968253968 + t * series
+    series = -0.008333333333333333 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
-def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_0_x_32 = _R_0_x_64  # the same code
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_32 = _R_0_x_64  # the same code
 
 
 def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    if span is not None and span[1] < 5.567347935831094:  # every lane on the polynomial
+    polynomial = span is not None and span[1] < 5.567347935831094  # every lane on it
+    if polynomial:
         t = x
-        series = 1.5349911154393775e-18
-        series = 5.5090028283602297e-17 + t * series
-        series = 1.9573818287022555e-15 + t * series
-        series = 6.868849645022276e-14 + t * series
-        series = 2.372776207425808e-12 + t * series
-        series = 8.029521918410807e-11 + t * series
-        series = 2.6420950693437467e-09 + t * series
-        series = 8.35070279514724e-08 + t * series
-        series = 2.48015873015873e-06 + t * series
-        series = 6.613756613756614e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        return numpy.asarray(series, dtype=x.dtype)
-    w0 = sin_half**2
-    out = numpy.asarray((0.5)*((0.25)*(2*cos_half**2*phi - 2*cos_half*sin_half - phi*(1 - 2*w0))/w0 - (-cos_half*phi/sin_half + 2)/phi)/phi**3, dtype=x.dtype)
-    if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
-        return out
-    small = x < 5.567347935831094
-    if small.any():
+    else:
+        w0 = sin_half**2
+        out = numpy.asarray((0.5)*((0.25)*(2*cos_half**2*phi - 2*cos_half*sin_half - phi*(1 - 2*w0))/w0 - (-cos_half*phi/sin_half + 2)/phi)/phi**3, dtype=x.dtype)
+        if span is not None and span[0] >= 5.567347935831094:  # every lane on the closed form
+            return out
+        small = x < 5.567347935831094
+        if not small.any():
+            return out
         t = x[small]
-        series = 1.5349911154393775e-18
-        series = 5.5090028283602297e-17 + t * series
-        series = 1.9573818287022555e-15 + t * series
-        series = 6.868849645022276e-14 + t * series
-        series = 2.372776207425808e-12 + t * series
-        series = 8.029521918410807e-11 + t * series
-        series = 2.6420950693437467e-09 + t * series
-        series = 8.35070279514724e-08 + t * series
-        series = 2.48015873015873e-06 + t * series
-        series = 6.613756613756614e-05 + t * series
-        series = 0.001388888888888889 + t * series
-        out[small] = series
+    series = 1.5349911154393775e-18
+    series = 5.5090028283602297e-17 + t * series
+    series = 1.9573818287022555e-15 + t * series
+    series = 6.868849645022276e-14 + t * series
+    series = 2.372776207425808e-12 + t * series
+    series = 8.029521918410807e-11 + t * series
+    series = 2.6420950693437467e-09 + t * series
+    series = 8.35070279514724e-08 + t * series
+    series = 2.48015873015873e-06 + t * series
+    series = 6.613756613756614e-05 + t * series
+    series = 0.001388888888888889 + t * series
+    if polynomial:
+        return numpy.asarray(series, dtype=x.dtype)
+    out[small] = series
     return out
 
 
@@ -1005,8 +808,7 @@ def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
     return out
 
 
-def _angle_32(s, d):
-    return s + 0.0 * s
+_angle_32 = _angle_64  # the same code
 
 
 def _scale_32(e0, e_norm):
@@ -1092,6 +894,8 @@ _COEFFICIENTS = {
 }
 _ACROSS = ()  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': False, 'nu': True, 'epsilon': True, 'mu': False, 'det_H': True, 'R_0': False, 'R_1': True, 'R_2': True, 'H_0': False, 'H_1': True, 'H_2': True, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': True, 'G_0': False, 'G_1': True, 'G_2': True, 'K_0': False, 'K_1': True, 'K_2': True, 'R_0_x': False, 'R_1_x': True, 'R_2_x': True, 'H_0_x': False, 'H_1_x': True, 'H_2_x': True, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': True, 'e_0': True},
@@ -1101,16 +905,45 @@ _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the
     "64": {'nu': 1.8559287093218047e-12, 'epsilon': 1.9211893090849678e-14, 'det_H': 5.028297529613116e-13, 'R_1': 5.028297529613116e-13, 'R_2': 5.028297529613116e-13, 'H_1': 5.028297529613116e-13, 'H_2': 0.7851233626304374, 'H_inverse_2': 5.5673482008975155, 'G_1': 1.8559287093218047e-12, 'G_2': 1.8559287093218047e-12, 'K_1': 1.8559287093218047e-12, 'K_2': 5.5673482008975155, 'R_1_x': 0.7851233626304374, 'R_2_x': 5.5673482008975155, 'H_1_x': 5.5673482008975155, 'H_2_x': 5.5673482008975155, 'H_inverse_2_x': 5.5673482008975155, 'e_0': 1.8559287093218047e-12},
     "32": {'nu': 1.855928654006444e-12, 'epsilon': 1.9211894444362143e-14, 'det_H': 5.028297329387876e-13, 'R_1': 5.028297329387876e-13, 'R_2': 5.028297329387876e-13, 'H_1': 5.028297329387876e-13, 'H_2': 1.5083706018396157, 'H_inverse_2': 5.567347935831094, 'G_1': 1.855928654006444e-12, 'G_2': 1.855928654006444e-12, 'K_1': 1.855928654006444e-12, 'K_2': 5.567347935831094, 'R_1_x': 1.5083706018396157, 'R_2_x': 5.567347935831094, 'H_1_x': 5.567347935831094, 'H_2_x': 5.567347935831094, 'H_inverse_2_x': 5.567347935831094, 'e_0': 1.855928654006444e-12},
 }
-_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
+_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
+E0_MIN = -numpy.inf
+_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
+_COMPLEMENT = None  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
+    return x <= P_MAX_SQUARED
+
+
+def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
+    out = u[..., :, None] * p[..., None, :]
+    out = out + (-c1)[..., None, None] * (_skew(a))
+    out = out + (-c2)[..., None, None] * (_skew(pa))
+    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
+    return out
+
+
+def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    pta = numpy.einsum('...i,...i->...', p, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
+
+
+_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache, under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
 _FEW = {"d": 16, "f": 6}  # up to this many vectors (by dtype character): entries as scalar arithmetic
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
-_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
 _FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
-_DERIVATIVE_X_LIMIT = {"64": 4.149515568880993e+180, "32": numpy.float32(1.2676506002282294e+30)}
-E0_MIN = -numpy.inf
-_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 
 
 def _quiet(function):
@@ -1152,6 +985,31 @@ def _norm(v):
     return scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))
 
 
+def _two_square(a):
+    """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
+    c = 134217729.0 * a
+    high = c - (c - a)
+    low = a - high
+    square = a * a
+    return square, ((high * high - square) + 2.0 * high * low) + low * low
+
+
+def _complement(p):
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form, eq 35 and
+    §3.4) accurate to a few ulp of d: compensated products and sums in float64."""
+    if p.dtype == numpy.float32:
+        q = p.astype(numpy.float64)
+        return _COMPLEMENT - numpy.einsum("...i,...i->...", q, q)
+    high = numpy.full(p.shape[:-1], _COMPLEMENT)
+    low = numpy.full(p.shape[:-1], _COMPLEMENT_LOW)  # p_max^2 - float(p_max^2)
+    for i in range(3):
+        square, error = _two_square(p[..., i])
+        total = high - square
+        low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
+        high = total
+    return high + low
+
+
 def _squared_norm(p):
     """x = |p|^2 = (p0^2 + p2^2) + p1^2: the one definition of x used by every validity test (the
     summation order of NumPy's einsum on x86-64, used before; written out, it is 3 to 4 times
@@ -1168,11 +1026,6 @@ def _length(p, suffix):
     if extreme.any():  # |p| without underflow or overflow
         s[extreme] = _norm(p[extreme])
     return x, s
-
-
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: x within p_max^2."""
-    return x <= P_MAX_SQUARED
 
 
 def _span(x, suffix):
@@ -1214,13 +1067,29 @@ def _prepare(p, names):
             p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
             s = numpy.where(valid, s, 0.0).astype(p.dtype)
             x = numpy.where(valid, x, 0.0).astype(p.dtype)  # a lane's x never depends on the others
-    d = None
+    # lanes with x <= k^2/4 (x <= d/3: the rounding error of x, under 2.5 ulp of x, stays below
+    # one ulp of d) take d = k^2 - x, the others the compensated complement: lane by lane, so a
+    # lane's d never depends on the other lanes of its block
+    if _COMPLEMENT is None:
+        d = None
+    elif span is not None and suffix == "64" and span[1] <= _COMPLEMENT / 4:
+        d = _COMPLEMENT - x
+    else:
+        d = numpy.where(valid, _complement(p), 1.0).astype(p.dtype)
+        if suffix == "64":
+            d = numpy.where(valid & (x <= _COMPLEMENT / 4), _COMPLEMENT - x, d)
     table = _USES_PHI[suffix]
     switch = _SWITCH[suffix]
     if any(table[name] and (span is None or span[1] >= switch[name]) for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half), span), valid, suffix
+        sin_half, cos_half = numpy.sin(half), numpy.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            low = _ANGLE_LOW[suffix](numpy.asarray(s, numpy.float64), numpy.asarray(phi, numpy.float64))
+            low = numpy.where(numpy.abs(low) <= _ANGLE_LOW_BOUND[suffix] * phi, 0.5 * low, 0.0)
+            low = low.astype(p.dtype)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half, span), valid, suffix
     return p, (x, None, s, d, None, None, span), valid, suffix
 
 
@@ -1277,7 +1146,7 @@ def _tensor_few(p, name, out):
     float32 rows as numpy.float32 scalars) than as NumPy calls on tiny arrays."""
     p, a, b, c, valid, suffix = _coefficients(p, name)
     columns = (p, a, b, c) if suffix == "32" else (p.tolist(), a.tolist(), b.tolist(), c.tolist())
-    entries = []
+    entries: list = []
     for (p0, p1, p2), a_k, b_k, c_k in zip(*columns, strict=True):
         c0, c1 = c_k * p0, c_k * p1
         b0, b1, b2 = b_k * p0, b_k * p1, b_k * p2
@@ -1354,26 +1223,6 @@ def _skew(v):
     out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
     out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
     return out
-
-
-def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
-    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
-    out = u[..., :, None] * p[..., None, :]
-    out = out + (-c1)[..., None, None] * (_skew(a))
-    out = out + (-c2)[..., None, None] * (_skew(pa))
-    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
-    return out
-
-
-def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
-    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    pta = numpy.einsum('...i,...i->...', p, a)
-    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
 
 
 def _with_slopes(p, a, name, sign):
@@ -1552,7 +1401,7 @@ def from_rotation_matrix(R):
     """p from a rotation matrix (..., 3, 3): Shepperd's largest pivot (eqs 61-65), then from_quaternion.
 
     R must be a rotation within the documented tolerance: max |R^T R - I| <= _ROTATION_TOLERANCE
-    (2^-26, 2^-11 in float32) and det R > 0; anything else (non-finite, singular,
+    (see the module's docstring) and det R > 0; anything else (non-finite, singular,
     scaled, a reflection) gives NaN.  No orthogonalization: for R = Q + D with Q a rotation the
     result differs from Q's parameter vector by O(|D|).
     """

@@ -48,8 +48,7 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(-16/(x - 16)).astype(numpy.float64, copy=False)
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(16/(x + 16)).astype(numpy.float64, copy=False)
+_mu_64 = _nu_64  # the same code
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -68,20 +67,17 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(16/(x + 16)).astype(numpy.float64, copy=False)
+_H_0_64 = _nu_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float64, copy=False)
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((0.125)*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray((0.0625)*x + 1).astype(numpy.float64, copy=False)
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -92,8 +88,7 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.125)
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_64 = _R_0_64  # the same code
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -104,32 +99,27 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(2/(x + 16)).astype(numpy.float64, copy=False)
 
 
-def _K_0_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(8/(x + 16)).astype(numpy.float64, copy=False)
+_K_0_64 = _G_1_64  # the same code
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(2/(x + 16)).astype(numpy.float64, copy=False)
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0)
 
 
-def _H_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-(x - 16)*(16/(x + 16))/(x + 16)).astype(numpy.float64, copy=False)
+_H_across_64 = _R_1_64  # the same code
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(1 - 0.0625*x).astype(numpy.float64, copy=False)
 
 
-def _K_across_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(8/(x + 16)).astype(numpy.float64, copy=False)
+_K_across_64 = _G_1_64  # the same code
 
 
-def _R_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_0_x_64 = _K_2_64  # the same code
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -144,8 +134,7 @@ def _H_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(-0.0625*(16/(x + 16))**2).astype(numpy.float64, copy=False)
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.asarray(-0.0625*(16/(x + 16))**3).astype(numpy.float64, copy=False)
+_H_1_x_64 = _R_2_x_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -156,12 +145,10 @@ def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.full_like(x, 0.0625)
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_64 = _K_2_64  # the same code
 
 
-def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_2_x_64 = _K_2_64  # the same code
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -192,9 +179,7 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(-16/(x - 16)).astype(numpy.float32, copy=False)
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray(16/(x + 16)).astype(numpy.float32, copy=False)
+_mu_32 = _nu_32  # the same code
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -202,8 +187,7 @@ def _det_H_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((16/(x + 16))**3).astype(numpy.float32, copy=False)
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_R_0_32 = _R_0_64  # the same code
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -216,14 +200,10 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray(16/(x + 16)).astype(numpy.float32, copy=False)
+_H_0_32 = _nu_32  # the same code
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray((0.5)*(16/(x + 16))**2).astype(numpy.float32, copy=False)
+_H_1_32 = _R_2_32  # the same code
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -231,21 +211,16 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray((0.125)*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray((0.0625)*x + 1).astype(numpy.float32, copy=False)
+_H_inverse_0_32 = _p_prime_32  # the same code
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
-def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.125)
+_H_inverse_2_32 = _H_inverse_2_64  # the same code
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 1.0)
+_G_0_32 = _R_0_64  # the same code
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -258,23 +233,16 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(2/(x + 16)).astype(numpy.float32, copy=False)
 
 
-def _K_0_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray(8/(x + 16)).astype(numpy.float32, copy=False)
+_K_0_32 = _G_1_32  # the same code
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray(2/(x + 16)).astype(numpy.float32, copy=False)
+_K_1_32 = _G_2_32  # the same code
 
 
-def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_K_2_32 = _K_2_64  # the same code
 
 
-def _H_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray(-(x - 16)*(16/(x + 16))/(x + 16)).astype(numpy.float32, copy=False)
+_H_across_32 = _R_1_32  # the same code
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -282,13 +250,10 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(1 - 0.0625*x).astype(numpy.float32, copy=False)
 
 
-def _K_across_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray(8/(x + 16)).astype(numpy.float32, copy=False)
+_K_across_32 = _G_1_32  # the same code
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_R_0_x_32 = _K_2_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -306,9 +271,7 @@ def _H_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(-0.0625*(16/(x + 16))**2).astype(numpy.float32, copy=False)
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    x = x.astype(numpy.float64)
-    return numpy.asarray(-0.0625*(16/(x + 16))**3).astype(numpy.float32, copy=False)
+_H_1_x_32 = _R_2_x_32  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -316,16 +279,13 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(-0.015625*(16/(x + 16))**3).astype(numpy.float32, copy=False)
 
 
-def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0625)
+_H_inverse_0_x_32 = _H_inverse_0_x_64  # the same code
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_1_x_32 = _K_2_64  # the same code
 
 
-def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
-    return numpy.full_like(x, 0.0)
+_H_inverse_2_x_32 = _K_2_64  # the same code
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
@@ -333,8 +293,7 @@ def _e_0_32(x, phi, s, d, sin_half, cos_half, span=None):
     return numpy.asarray(-(x - 16)/(x + 16)).astype(numpy.float32, copy=False)
 
 
-def _angle_32(s, d):
-    return 4*numpy.arctan((0.25)*s) + 0.0 * s
+_angle_32 = _angle_64  # the same code
 
 
 def _scale_32(e0, e_norm):
@@ -416,6 +375,8 @@ _COEFFICIENTS = {
 }
 _ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
@@ -425,16 +386,46 @@ _SWITCH = {  # x at which a coefficient that needs phi leaves its series for the
     "64": {},
     "32": {},
 }
-_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache and under glibc's mmap threshold
+_X_LIMIT = {"64": 8.580997075163262e+155, "32": numpy.float32(5.902958103587057e+20)}
+_DERIVATIVE_X_LIMIT = {"64": 8.580997075163262e+155, "32": numpy.float32(5.902958103587057e+20)}
+E0_MIN = -numpy.inf
+_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
+_COMPLEMENT = None  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: p is unbounded, and x >= _X_LIMIT (at
+    most 2^600, 2^100 in float32) is outside."""
+    return x < _X_LIMIT[suffix]
+
+
+def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
+    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
+    out = u[..., :, None] * p[..., None, :]
+    out = out + (-c1)[..., None, None] * (_skew(a))
+    out = out + (-c2)[..., None, None] * (_skew(pa))
+    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
+    return out
+
+
+def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
+    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
+    pa = _cross(p, a)
+    ppa = _cross(p, pa)
+    pta = numpy.einsum('...i,...i->...', p, a)
+    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
+
+
+_BLOCK = 4096  # vectors per block: float64 temporaries of 32 KiB stay in cache, under glibc's mmap threshold
 _SMALL = 64  # up to this many vectors: one pass, entries gathered by index (fewest NumPy calls)
 _FEW = {"d": 16, "f": 6}  # up to this many vectors (by dtype character): entries as scalar arithmetic
 _TINY = {"64": 2.0 ** -600, "32": numpy.float32(2.0 ** -100)}
 _HUGE = {"64": 2.0 ** 600, "32": numpy.float32(2.0 ** 100)}
-_X_LIMIT = {"64": 8.580997075163262e+155, "32": numpy.float32(5.902958103587057e+20)}
 _FAST_LIMIT = {suffix: 0.999 * min(P_MAX_SQUARED, float(limit)) for suffix, limit in _X_LIMIT.items()}
-_DERIVATIVE_X_LIMIT = {"64": 8.580997075163262e+155, "32": numpy.float32(5.902958103587057e+20)}
-E0_MIN = -numpy.inf
-_ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": numpy.float32(2.0 ** -11)}
 
 
 def _quiet(function):
@@ -476,6 +467,31 @@ def _norm(v):
     return scale * numpy.sqrt(numpy.einsum("...i,...i->...", unit, unit))
 
 
+def _two_square(a):
+    """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
+    c = 134217729.0 * a
+    high = c - (c - a)
+    low = a - high
+    square = a * a
+    return square, ((high * high - square) + 2.0 * high * low) + low * low
+
+
+def _complement(p):
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form, eq 35 and
+    §3.4) accurate to a few ulp of d: compensated products and sums in float64."""
+    if p.dtype == numpy.float32:
+        q = p.astype(numpy.float64)
+        return _COMPLEMENT - numpy.einsum("...i,...i->...", q, q)
+    high = numpy.full(p.shape[:-1], _COMPLEMENT)
+    low = numpy.full(p.shape[:-1], _COMPLEMENT_LOW)  # p_max^2 - float(p_max^2)
+    for i in range(3):
+        square, error = _two_square(p[..., i])
+        total = high - square
+        low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
+        high = total
+    return high + low
+
+
 def _squared_norm(p):
     """x = |p|^2 = (p0^2 + p2^2) + p1^2: the one definition of x used by every validity test (the
     summation order of NumPy's einsum on x86-64, used before; written out, it is 3 to 4 times
@@ -492,12 +508,6 @@ def _length(p, suffix):
     if extreme.any():  # |p| without underflow or overflow
         s[extreme] = _norm(p[extreme])
     return x, s
-
-
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: p is unbounded, and x >= _X_LIMIT (at
-    most 2^600, 2^100 in float32) is outside."""
-    return x < _X_LIMIT[suffix]
 
 
 def _span(x, suffix):
@@ -539,13 +549,29 @@ def _prepare(p, names):
             p = numpy.where(valid[..., None], p, 0.0).astype(p.dtype)
             s = numpy.where(valid, s, 0.0).astype(p.dtype)
             x = numpy.where(valid, x, 0.0).astype(p.dtype)  # a lane's x never depends on the others
-    d = None
+    # lanes with x <= k^2/4 (x <= d/3: the rounding error of x, under 2.5 ulp of x, stays below
+    # one ulp of d) take d = k^2 - x, the others the compensated complement: lane by lane, so a
+    # lane's d never depends on the other lanes of its block
+    if _COMPLEMENT is None:
+        d = None
+    elif span is not None and suffix == "64" and span[1] <= _COMPLEMENT / 4:
+        d = _COMPLEMENT - x
+    else:
+        d = numpy.where(valid, _complement(p), 1.0).astype(p.dtype)
+        if suffix == "64":
+            d = numpy.where(valid & (x <= _COMPLEMENT / 4), _COMPLEMENT - x, d)
     table = _USES_PHI[suffix]
     switch = _SWITCH[suffix]
     if any(table[name] and (span is None or span[1] >= switch[name]) for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, numpy.sin(half), numpy.cos(half), span), valid, suffix
+        sin_half, cos_half = numpy.sin(half), numpy.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            low = _ANGLE_LOW[suffix](numpy.asarray(s, numpy.float64), numpy.asarray(phi, numpy.float64))
+            low = numpy.where(numpy.abs(low) <= _ANGLE_LOW_BOUND[suffix] * phi, 0.5 * low, 0.0)
+            low = low.astype(p.dtype)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half, span), valid, suffix
     return p, (x, None, s, d, None, None, span), valid, suffix
 
 
@@ -602,7 +628,7 @@ def _tensor_few(p, name, out):
     float32 rows as numpy.float32 scalars) than as NumPy calls on tiny arrays."""
     p, a, b, c, valid, suffix = _coefficients(p, name)
     columns = (p, a, b, c) if suffix == "32" else (p.tolist(), a.tolist(), b.tolist(), c.tolist())
-    entries = []
+    entries: list = []
     for (p0, p1, p2), a_k, b_k, c_k in zip(*columns, strict=True):
         c0, c1 = c_k * p0, c_k * p1
         b0, b1, b2 = b_k * p0, b_k * p1, b_k * p2
@@ -679,26 +705,6 @@ def _skew(v):
     out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
     out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
     return out
-
-
-def _derivative_matrix(c0, c1, c2, d0, d1, d2, p, a):
-    """d(T a)/dp for T = c0 I + c1 (p x) + c2 (p x)^2, d_k = dc_k/dx (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    u = (2.0 * d0)[..., None] * a + (2.0 * d1)[..., None] * pa + (2.0 * d2)[..., None] * ppa
-    out = u[..., :, None] * p[..., None, :]
-    out = out + (-c1)[..., None, None] * (_skew(a))
-    out = out + (-c2)[..., None, None] * (_skew(pa))
-    out = out + (-c2)[..., None, None] * (_skew(p) @ _skew(a))
-    return out
-
-
-def _rate_vector(c0, c1, c2, d0, d1, d2, p, a):
-    """Tdot pdot = [d(T a)/dp]_(a = pdot) pdot for a = pdot (derived by symrot.core.derivatives)."""
-    pa = _cross(p, a)
-    ppa = _cross(p, pa)
-    pta = numpy.einsum('...i,...i->...', p, a)
-    return (2.0 * d0)[..., None] * a * pta[..., None] + (2.0 * d1)[..., None] * pa * pta[..., None] + (2.0 * d2)[..., None] * ppa * pta[..., None] + (-c2)[..., None] * _cross(pa, a)
 
 
 def _with_slopes(p, a, name, sign):
@@ -877,7 +883,7 @@ def from_rotation_matrix(R):
     """p from a rotation matrix (..., 3, 3): Shepperd's largest pivot (eqs 61-65), then from_quaternion.
 
     R must be a rotation within the documented tolerance: max |R^T R - I| <= _ROTATION_TOLERANCE
-    (2^-26, 2^-11 in float32) and det R > 0; anything else (non-finite, singular,
+    (see the module's docstring) and det R > 0; anything else (non-finite, singular,
     scaled, a reflection) gives NaN.  No orthogonalization: for R = Q + D with Q a rotation the
     result differs from Q's parameter vector by O(|D|).
     """

@@ -101,7 +101,8 @@ def _as_float(value, name, shape):
     if value.dtype != _xp.float32:
         value = value.to(_xp.float64)
     if value.ndim < len(shape) or tuple(value.shape[value.ndim - len(shape):]) != shape:
-        raise ValueError(f"{name} must have shape (..., {', '.join(map(str, shape))}), got {tuple(value.shape)}")
+        raise ValueError(f"{name} must have shape (..., {', '.join(map(str, shape))}), "
+                         f"got {tuple(value.shape)}")
     return value
 
 
@@ -134,6 +135,68 @@ def _jvp(function, primals, tangents):
     return _xp.func.jvp(function, primals, tangents)
 
 
+class _Norm(_xp.autograd.Function):
+    """|v| over the last axis; derivative n = v/|v| (0 at v = 0), second (I - n n^T)/|v|."""
+
+    generate_vmap_rule = True
+
+    @staticmethod
+    def forward(v):
+        return _norm_value(v)
+
+    @staticmethod
+    def setup_context(ctx, inputs, output):
+        ctx.save_for_backward(inputs[0])
+        ctx.save_for_forward(inputs[0])
+
+    @staticmethod
+    def backward(ctx, grad):
+        (v,) = ctx.saved_tensors
+        return grad[..., None] * _direction(v)
+
+    @staticmethod
+    def jvp(ctx, dv):
+        (v,) = ctx.saved_tensors
+        return _dot(_direction(v), dv)
+
+
+def _norm(v):
+    """|v| over the last axis without underflow or overflow, for finite v."""
+    return _Norm.apply(v)
+
+
+def _implicit_angle(newton, slope):
+    """The angle phi(s, d) = newton(s) of a plan without a closed inverse, its derivative by the
+    implicit function theorem: p(phi) = s, so dphi = ds / p'(phi) = ds / slope(phi^2, phi), not
+    the derivative of the fixed-count iteration."""
+    class AngleNewton(_xp.autograd.Function):
+        generate_vmap_rule = True
+
+        @staticmethod
+        def forward(s):
+            with _xp.no_grad():
+                return newton(s)
+
+        @staticmethod
+        def setup_context(ctx, inputs, output):
+            ctx.save_for_backward(output)
+            ctx.save_for_forward(output)
+
+        @staticmethod
+        def backward(ctx, grad):
+            (phi,) = ctx.saved_tensors
+            return grad / slope(phi * phi, phi)
+
+        @staticmethod
+        def jvp(ctx, ds):
+            (phi,) = ctx.saved_tensors
+            return ds / slope(phi * phi, phi)
+
+    def angle_of(s, d):
+        return AngleNewton.apply(s)
+    return angle_of
+
+
 P_MAX = math.inf
 P_MAX_SQUARED = math.inf  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
 
@@ -150,8 +213,7 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
     return (-16/(x - 16)) + 0.0 * x
 
 
-def _mu_64(x, phi, s, d, sin_half, cos_half):
-    return (16/(x + 16)) + 0.0 * x
+_mu_64 = _nu_64  # the same code
 
 
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
@@ -170,20 +232,17 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half):
     return ((0.5)*(16/(x + 16))**2) + 0.0 * x
 
 
-def _H_0_64(x, phi, s, d, sin_half, cos_half):
-    return (16/(x + 16)) + 0.0 * x
+_H_0_64 = _nu_64  # the same code
 
 
-def _H_1_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.5)*(16/(x + 16))**2) + 0.0 * x
+_H_1_64 = _R_2_64  # the same code
 
 
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
     return ((0.125)*(16/(x + 16))**2) + 0.0 * x
 
 
-def _H_inverse_0_64(x, phi, s, d, sin_half, cos_half):
-    return ((0.0625)*x + 1) + 0.0 * x
+_H_inverse_0_64 = _p_prime_64  # the same code
 
 
 def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
@@ -194,8 +253,7 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.125)
 
 
-def _G_0_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_64 = _R_0_64  # the same code
 
 
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
@@ -206,32 +264,27 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
     return (2/(x + 16)) + 0.0 * x
 
 
-def _K_0_64(x, phi, s, d, sin_half, cos_half):
-    return (8/(x + 16)) + 0.0 * x
+_K_0_64 = _G_1_64  # the same code
 
 
-def _K_1_64(x, phi, s, d, sin_half, cos_half):
-    return (2/(x + 16)) + 0.0 * x
+_K_1_64 = _G_2_64  # the same code
 
 
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.0)
 
 
-def _H_across_64(x, phi, s, d, sin_half, cos_half):
-    return (-(x - 16)*(16/(x + 16))/(x + 16)) + 0.0 * x
+_H_across_64 = _R_1_64  # the same code
 
 
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
     return (1 - 0.0625*x) + 0.0 * x
 
 
-def _K_across_64(x, phi, s, d, sin_half, cos_half):
-    return (8/(x + 16)) + 0.0 * x
+_K_across_64 = _G_1_64  # the same code
 
 
-def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_0_x_64 = _K_2_64  # the same code
 
 
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
@@ -246,8 +299,7 @@ def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
     return (-0.0625*(16/(x + 16))**2) + 0.0 * x
 
 
-def _H_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return (-0.0625*(16/(x + 16))**3) + 0.0 * x
+_H_1_x_64 = _R_2_x_64  # the same code
 
 
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
@@ -258,12 +310,10 @@ def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
     return _xp.full_like(x, 0.0625)
 
 
-def _H_inverse_1_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_64 = _K_2_64  # the same code
 
 
-def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_2_x_64 = _K_2_64  # the same code
 
 
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
@@ -289,9 +339,7 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((-16/(x - 16)) + 0.0 * x, s)
 
 
-def _mu_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow((16/(x + 16)) + 0.0 * x, s)
+_mu_32 = _nu_32  # the same code
 
 
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
@@ -299,8 +347,7 @@ def _det_H_32(x, phi, s, d, sin_half, cos_half):
     return _narrow(((16/(x + 16))**3) + 0.0 * x, s)
 
 
-def _R_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_R_0_32 = _R_0_64  # the same code
 
 
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
@@ -313,14 +360,10 @@ def _R_2_32(x, phi, s, d, sin_half, cos_half):
     return _narrow(((0.5)*(16/(x + 16))**2) + 0.0 * x, s)
 
 
-def _H_0_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow((16/(x + 16)) + 0.0 * x, s)
+_H_0_32 = _nu_32  # the same code
 
 
-def _H_1_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow(((0.5)*(16/(x + 16))**2) + 0.0 * x, s)
+_H_1_32 = _R_2_32  # the same code
 
 
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
@@ -328,21 +371,16 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
     return _narrow(((0.125)*(16/(x + 16))**2) + 0.0 * x, s)
 
 
-def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow(((0.0625)*x + 1) + 0.0 * x, s)
+_H_inverse_0_32 = _p_prime_32  # the same code
 
 
-def _H_inverse_1_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, -0.5)
+_H_inverse_1_32 = _H_inverse_1_64  # the same code
 
 
-def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.125)
+_H_inverse_2_32 = _H_inverse_2_64  # the same code
 
 
-def _G_0_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 1.0)
+_G_0_32 = _R_0_64  # the same code
 
 
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
@@ -355,23 +393,16 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((2/(x + 16)) + 0.0 * x, s)
 
 
-def _K_0_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow((8/(x + 16)) + 0.0 * x, s)
+_K_0_32 = _G_1_32  # the same code
 
 
-def _K_1_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow((2/(x + 16)) + 0.0 * x, s)
+_K_1_32 = _G_2_32  # the same code
 
 
-def _K_2_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_K_2_32 = _K_2_64  # the same code
 
 
-def _H_across_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow((-(x - 16)*(16/(x + 16))/(x + 16)) + 0.0 * x, s)
+_H_across_32 = _R_1_32  # the same code
 
 
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
@@ -379,13 +410,10 @@ def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((1 - 0.0625*x) + 0.0 * x, s)
 
 
-def _K_across_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow((8/(x + 16)) + 0.0 * x, s)
+_K_across_32 = _G_1_32  # the same code
 
 
-def _R_0_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_R_0_x_32 = _K_2_64  # the same code
 
 
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
@@ -403,9 +431,7 @@ def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((-0.0625*(16/(x + 16))**2) + 0.0 * x, s)
 
 
-def _H_1_x_32(x, phi, s, d, sin_half, cos_half):
-    x = _wide(x)
-    return _narrow((-0.0625*(16/(x + 16))**3) + 0.0 * x, s)
+_H_1_x_32 = _R_2_x_32  # the same code
 
 
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
@@ -413,16 +439,13 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     return _narrow((-0.015625*(16/(x + 16))**3) + 0.0 * x, s)
 
 
-def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0625)
+_H_inverse_0_x_32 = _H_inverse_0_x_64  # the same code
 
 
-def _H_inverse_1_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_1_x_32 = _K_2_64  # the same code
 
 
-def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
-    return _xp.full_like(x, 0.0)
+_H_inverse_2_x_32 = _K_2_64  # the same code
 
 
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
@@ -517,16 +540,28 @@ _COEFFICIENTS = {
 }
 _ACROSS = ('H', 'H_inverse', 'K')  # tensors whose c0 - c2 |p|^2 is planned (the others have a constant c0)
 _ANGLE = {"64": _angle_64, "32": _angle_32}
+_ANGLE_LOW = {}  # phi's correction
+_ANGLE_LOW_BOUND = {}
 _SCALE = {"64": _scale_64, "32": _scale_32}
 _USES_PHI = {
     "64": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
     "32": {'p_prime': False, 'nu': False, 'epsilon': False, 'mu': False, 'det_H': False, 'R_0': False, 'R_1': False, 'R_2': False, 'H_0': False, 'H_1': False, 'H_2': False, 'H_inverse_0': False, 'H_inverse_1': False, 'H_inverse_2': False, 'G_0': False, 'G_1': False, 'G_2': False, 'K_0': False, 'K_1': False, 'K_2': False, 'H_across': False, 'H_inverse_across': False, 'K_across': False, 'R_0_x': False, 'R_1_x': False, 'R_2_x': False, 'H_0_x': False, 'H_1_x': False, 'H_2_x': False, 'H_inverse_0_x': False, 'H_inverse_1_x': False, 'H_inverse_2_x': False, 'e_0': False},
 }
-_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
-_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 _X_LIMIT = {"64": 8.580997075163262e+155, "32": 5.902958103587057e+20}
 E0_MIN = -math.inf
 _ROTATION_TOLERANCE = {"64": 2.0 ** -26, "32": 2.0 ** -11}
+_COMPLEMENT = None  # k^2 of the distance d = k^2 - |p|^2 (None: no d)
+_COMPLEMENT_LOW = 0.0  # p_max^2 - float(p_max^2)
+
+
+def _inside(x, suffix):
+    """The validity test on x = |p|^2, as in the C header: p is unbounded, and x >= _X_LIMIT is
+    outside."""
+    return x < _X_LIMIT[suffix]
+
+
+_TINY = {"64": 2.0 ** -600, "32": 2.0 ** -100}
+_HUGE = {"64": 2.0 ** 600, "32": 2.0 ** 100}
 
 
 def _dot(a, b):
@@ -565,34 +600,31 @@ def _direction(v):
     return _where(nonzero[..., None], unit / length[..., None], 0.0)
 
 
-class _Norm(_xp.autograd.Function):
-    """|v| over the last axis; derivative n = v/|v| (0 at v = 0), second (I - n n^T)/|v|."""
-
-    generate_vmap_rule = True
-
-    @staticmethod
-    def forward(v):
-        return _norm_value(v)
-
-    @staticmethod
-    def setup_context(ctx, inputs, output):
-        ctx.save_for_backward(inputs[0])
-        ctx.save_for_forward(inputs[0])
-
-    @staticmethod
-    def backward(ctx, grad):
-        (v,) = ctx.saved_tensors
-        return grad[..., None] * _direction(v)
-
-    @staticmethod
-    def jvp(ctx, dv):
-        (v,) = ctx.saved_tensors
-        return _dot(_direction(v), dv)
+def _two_square(a):
+    """(a*a, error) with a*a + error = a^2 exactly (Veltkamp split, no FMA needed)."""
+    c = 134217729.0 * a
+    high = c - (c - a)
+    low = a - high
+    square = a * a
+    return square, ((high * high - square) + 2.0 * high * low) + low * low
 
 
-def _norm(v):
-    """|v| over the last axis without underflow or overflow, for finite v."""
-    return _Norm.apply(v)
+def _complement(p, x):
+    """d = _COMPLEMENT - |p|^2 (the distance to the pole of the plan's distance form) accurate to a
+    few ulp of d (compensated products and sums, float64); its derivative is that of _COMPLEMENT - x."""
+    if _suffix(p) == "32":
+        q = _wide(p)
+        value = _narrow(_COMPLEMENT - _dot(q, q), p)
+    else:
+        high = _COMPLEMENT + 0.0 * x
+        low = _COMPLEMENT_LOW + 0.0 * x  # p_max^2 - float(p_max^2)
+        for i in range(3):
+            square, error = _two_square(p[..., i])
+            total = high - square
+            low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
+            high = total
+        value = high + low
+    return _stop(value) + (_stop(x) - x)
 
 
 def _length(p, x, suffix):
@@ -600,12 +632,6 @@ def _length(p, x, suffix):
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])
     root = _sqrt(_where(normal, x, 1.0))
     return _where(normal, root, _norm(_where(normal[..., None], 1.0, p)))
-
-
-def _inside(x, suffix):
-    """The validity test on x = |p|^2, as in the C header: p is unbounded, and x >= _X_LIMIT is
-    outside."""
-    return x < _X_LIMIT[suffix]
 
 
 def _prepare(p, names):
@@ -616,11 +642,17 @@ def _prepare(p, names):
     p = _where(valid[..., None], p, 0.0)
     x = _squared_norm(p)
     s = _length(p, x, suffix)
-    d = None
+    d = None if _COMPLEMENT is None else _complement(p, x)
     if any(_USES_PHI[suffix][name] for name in names):
         phi = _ANGLE[suffix](s, d)
         half = 0.5 * phi
-        return p, (x, phi, s, d, _xp.sin(half), _xp.cos(half)), valid, suffix
+        sin_half, cos_half = _xp.sin(half), _xp.cos(half)
+        if suffix in _ANGLE_LOW:  # phi + low: the Newton angle beyond phi's last bit
+            wide = _wide(_stop(phi))
+            low = _stop(_ANGLE_LOW[suffix](_wide(_stop(s)), wide))
+            low = _narrow(_where(_xp.abs(low) <= _ANGLE_LOW_BOUND[suffix] * wide, 0.5 * low, 0.0), s)
+            sin_half, cos_half = sin_half + cos_half * low, cos_half - sin_half * low
+        return p, (x, phi, s, d, sin_half, cos_half), valid, suffix
     return p, (x, None, s, d, None, None), valid, suffix
 
 

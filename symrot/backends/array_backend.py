@@ -38,7 +38,8 @@ from symrot.backends.numpy_backend import (
     print_expression,
     uses_phi,
 )
-from symrot.backends.subexpressions import common_subexpressions
+from symrot.backends.runtime import runtime_text
+from symrot.backends.subexpressions import alias_repeated, common_subexpressions
 from symrot.backends.templating import render
 from symrot.core.atomic import write_atomic
 from symrot.core.parsing import PHI
@@ -254,7 +255,9 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
                           "body": _scale_lines(precision.quaternion_scale, suffix)})
     squared, inclusive = plan.boundary(53)
     finite_p_max = math.isfinite(plan.p_max)
-    return {"framework": framework, "name": plan.name, "p_text": str(plan.p), "functions": functions,
+    return {"framework": framework, "runtime": runtime_text("array_runtime"),
+            "framework_runtime": runtime_text(f"{framework}_runtime"), "name": plan.name,
+            "p_text": str(plan.p), "functions": alias_repeated(functions),
             "newton": newton, "closed_angles": closed_angles,
             "angle_low": angle_low_helpers(plan),
             "names": list(plan.precisions["float64"].coefficients),

@@ -29,7 +29,8 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from symrot.backends.numpy_derivatives import derivative_lines, rate_lines
-from symrot.backends.subexpressions import common_subexpressions
+from symrot.backends.runtime import runtime_text
+from symrot.backends.subexpressions import alias_repeated, common_subexpressions
 from symrot.backends.templating import render
 from symrot.core.atomic import write_atomic
 from symrot.core.parsing import PHI
@@ -128,28 +129,33 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
         series_lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
     lines: list[str] = []
     if half_angles:
-        lines += [f"if span is not None and span[1] < {threshold!r}:  # every lane on the polynomial"]
+        # one Horner polynomial for both paths: on every lane (the block is below the switch) or on
+        # the lanes below it, after the closed form on every lane (phi, sin and cos are there for
+        # the whole block), where the closed form may be 0/0
         if len(horner) > 1:
-            lines += [f"    t = {variable}", *("    " + line for line in series_lines),
-                      f"    return numpy.asarray(series, dtype={variable}.dtype)"]
+            lines += [f"polynomial = span is not None and span[1] < {threshold!r}  # every lane on it",
+                      "if polynomial:", f"    t = {variable}", "else:"]
         else:
-            lines.append(f"    return numpy.full_like({variable}, {_literal(horner[0])})")
-        # the closed form on every lane (phi, sin and cos are there for the whole block), then the
-        # polynomial on the lanes below the switch, where the closed form may be 0/0
-        lines += closed_lines
+            lines += [f"if span is not None and span[1] < {threshold!r}:  # every lane on the polynomial",
+                      f"    return numpy.full_like({variable}, {_literal(horner[0])})"]
+        body = list(closed_lines)
         if not reduced.free_symbols:
-            lines.append(f"out = numpy.full_like({variable}, {print_expression(reduced)})")
+            body.append(f"out = numpy.full_like({variable}, {print_expression(reduced)})")
         else:
             copy = "array" if reduced.is_Symbol else "asarray"  # never write into an argument
-            lines.append(f"out = numpy.{copy}({print_expression(reduced)}, dtype={variable}.dtype)")
-        lines.append(f"if span is not None and span[0] >= {threshold!r}:  # every lane on the closed form")
-        lines.append("    return out")
-        lines.append(f"small = {variable} < {threshold!r}")
-        lines.append("if small.any():")
+            body.append(f"out = numpy.{copy}({print_expression(reduced)}, dtype={variable}.dtype)")
+        body += [f"if span is not None and span[0] >= {threshold!r}:  # every lane on the closed form",
+                 "    return out", f"small = {variable} < {threshold!r}"]
         if len(horner) > 1:
-            lines.append(f"    t = {variable}[small]")
-        lines += ["    " + line for line in series_lines]
-        lines += ["    out[small] = series", "return out"]
+            body += ["if not small.any():", "    return out", f"t = {variable}[small]"]
+            lines += ["    " + line for line in body]
+            lines += series_lines
+            lines += ["if polynomial:", f"    return numpy.asarray(series, dtype={variable}.dtype)",
+                      "out[small] = series", "return out"]
+        else:
+            lines += body
+            lines += ["if small.any():", *("    " + line for line in series_lines),
+                      "    out[small] = series", "return out"]
         return lines
     lines += [f"small = {variable} < {threshold!r}", f"out = numpy.empty_like({variable})",
               "if small.any():"]
@@ -279,7 +285,8 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
     p_max = plan.p_max
     e0_min = repr(plan.e0_min) if plan.e0_min is not None else None
     squared, inclusive = plan.boundary(53)  # float32 x compares exactly against the double bound
-    return {"name": plan.name, "p_text": str(plan.p), "functions": functions, "e0_min": e0_min,
+    return {"name": plan.name, "p_text": str(plan.p), "functions": alias_repeated(functions),
+            "e0_min": e0_min,
             "names": list(plan.precisions["float64"].coefficients),
             "across": repr(tuple(sorted(plan.across_tensors()))),
             "p_max": repr(p_max) if np.isfinite(p_max) else None, "phi_max": repr(plan.phi_max),
@@ -297,6 +304,7 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
                                          for label in plan.precisions},
             "derivative_lines": derivative_lines(), "rate_lines": rate_lines(),
+            "runtime": runtime_text("numpy_runtime"),
             "angle_low": angle_low_helpers(plan),
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()},
