@@ -6,7 +6,7 @@ TEST_JOBS ?= auto
 SYMFORCE_VENV ?= /tmp/symforce_venv
 
 .DEFAULT_GOAL := help
-.PHONY: audit help check-versions setup setup-bench setup-system setup-python test lint typecheck pytest generate check-generated mutations bench clean
+.PHONY: audit docs help check-versions setup setup-bench setup-system setup-python test lint typecheck pytest generate check-generated mutations bench clean
 
 help: ## List the targets with what they do
 	@grep -E '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-16s %s\n", $$1, $$2}'
@@ -34,10 +34,10 @@ setup-bench: ## Install the benchmark peer SymForce in a venv (SYMFORCE_VENV, de
 	test -x $(SYMFORCE_VENV)/bin/python || $(PYTHON) -m venv $(SYMFORCE_VENV)
 	$(SYMFORCE_VENV)/bin/pip install -q symforce
 
-setup-python: ## pip install symrot in editable mode with its dev extras, CPU PyTorch and JAX
+setup-python: ## pip install symrot in editable mode with its dev and docs extras, CPU PyTorch and JAX
 	$(PIP) install -q -c constraints.txt -e '.[dev]'
 	$(PIP) install -q -c constraints.txt torch==2.13.0
-	$(PIP) install -q -c constraints.txt -e '.[dev,jax,torch]'
+	$(PIP) install -q -c constraints.txt -e '.[dev,docs,jax,torch]'
 
 test: lint typecheck pytest ## ruff, mypy and the test suite (tests/test_generated.py checks generated/ as check-generated does)
 
@@ -49,6 +49,10 @@ typecheck: ## mypy over the package
 
 pytest: ## The test suite only, on TEST_JOBS processes (pytest-xdist; default: one per CPU), with the 25 slowest tests listed
 	$(PYTHON) -m pytest -n $(TEST_JOBS) --dist worksteal --durations=25 $(PYTEST_ARGS)
+
+docs: ## The documentation site into docs/_build/html (warnings are errors), then the doctests of its examples
+	$(PYTHON) -m sphinx -W --keep-going -b html docs docs/_build/html
+	$(PYTHON) -m sphinx -W -b doctest docs docs/_build/doctest
 
 check-versions: ## Fail unless the installed SymPy, matplotlib and mpmath are those of constraints.txt
 	@$(PYTHON) -c 'import sys, importlib.metadata as m; pins = [l.split("==") for l in open("constraints.txt") if "==" in l and not l.startswith("#")]; bad = [f"{n} {m.version(n)} (constraints.txt: {v.strip()})" for n, v in pins if m.version(n) != v.strip()]; sys.exit("generated/ needs other versions: " + ", ".join(bad) if bad else 0)'

@@ -85,7 +85,7 @@ class DerivationResult:
         raise AttributeError(name)
 
     def series(self, name: str, n_terms: int = DEFAULT_SERIES_TERMS) -> list[sp.Expr]:
-        """Exact Taylor coefficients of coefficient ``name`` (e.g. 'H_2', 'nu') in x = |p|²."""
+        """Exact Taylor coefficients of coefficient ``name`` (e.g. 'H_2', 'nu') in ``x = |p|²``."""
         return self.derivation.series_in_x(name, n_terms)
 
     # -- serialization ----------------------------------------------------------------------

@@ -3,7 +3,7 @@
 A generated module's functions map (..., 3) to (..., 3, 3), (..., 3) or (...) block by block with no
 state across lanes, so ``dask.array.map_blocks`` runs them on arrays larger than memory or on a
 cluster; here on a small chunked array with the local synchronous scheduler, compared bit for bit
-with the same function on the whole NumPy array (the recipe of README.md, "Large data: Dask").
+with the same function on the whole NumPy array (the recipe of docs/guide/numpy.md, "Large data: Dask").
 """
 
 from __future__ import annotations

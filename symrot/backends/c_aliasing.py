@@ -10,7 +10,7 @@ Early NaN returns write only after every read. The ``_batch`` kernels
 (:mod:`symrot.backends.c_batch`) run their blocks and vectors backward, so that with the output
 and p at the same base pointer (output stride 9 ≥ 3) no vector's entries overwrite a p not yet
 read. Partial overlaps other than identical base pointers are not supported (the header's
-comment block and README.md say so).
+comment block and docs/guide/c.md say so).
 """
 
 from __future__ import annotations
