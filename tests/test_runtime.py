@@ -20,6 +20,7 @@ import pytest
 from symrot.backends.runtime import MARKER, runtime_text
 
 P_MAX_SQUARED = 1.0e6
+NUMPY_RUNTIME = ("numpy_runtime", "numpy_operations")
 NUMPY_PLAN = '''
 import functools
 
@@ -81,7 +82,7 @@ def _module(source: str, name: str) -> types.ModuleType:
 @pytest.fixture(scope="module")
 def gibbs() -> types.ModuleType:
     """The NumPy runtime on the Gibbs plan."""
-    return _module(NUMPY_PLAN + "\n\n" + runtime_text("numpy_runtime"), "runtime_gibbs")
+    return _module("\n\n".join([NUMPY_PLAN, *map(runtime_text, NUMPY_RUNTIME)]), "runtime_gibbs")
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -104,7 +105,7 @@ def _vectors(n: int, dtype: type, seed: int = 3) -> np.ndarray:
 
 
 def test_every_runtime_has_one_marker() -> None:
-    for name in ("numpy_runtime", "array_runtime", "jax_runtime", "torch_runtime"):
+    for name in (*NUMPY_RUNTIME, "array_runtime", "jax_runtime", "torch_runtime"):
         text = runtime_text(name)
         assert text and MARKER not in text
         assert "{{" not in text and "{%" not in text, f"{name}: template syntax in a runtime"
@@ -203,7 +204,7 @@ def test_two_square_is_exact(gibbs: types.ModuleType) -> None:
 def test_complement_to_a_few_ulp() -> None:
     """d = k² − |p|² next to the pole, against exact rationals (float64: ≤ 2 ulp of d)."""
     source = NUMPY_PLAN.replace("_COMPLEMENT = None", "_COMPLEMENT = 4.0")
-    module = _module(source + "\n\n" + runtime_text("numpy_runtime"), "runtime_complement")
+    module = _module("\n\n".join([source, *map(runtime_text, NUMPY_RUNTIME)]), "runtime_complement")
     rng = np.random.default_rng(11)
     u = rng.normal(size=(400, 3))
     u /= np.linalg.norm(u, axis=1)[:, None]
@@ -313,5 +314,31 @@ def test_array_runtime_derivative_by_forward_mode(array_gibbs: types.ModuleType)
     for k in range(3):
         e = np.zeros(3)
         e[k] = step
-        column = (np.einsum("...ij,...j->...i", _gibbs_rotation(g + e) - _gibbs_rotation(g - e), a)) / (2 * step)
+        difference = _gibbs_rotation(g + e) - _gibbs_rotation(g - e)
+        column = np.einsum("...ij,...j->...i", difference, a) / (2 * step)
         assert np.allclose(jac[..., k], column, atol=2e-4), k
+
+
+def test_horner_and_clenshaw_against_their_sums(gibbs: types.ModuleType) -> None:
+    """The runtime's polynomial helpers against the sums they stand for (zero terms included)."""
+    coefficients = (1.0, 0.0, -0.25, 0.0, 0.125, 3.0)
+    t = np.linspace(-1.0, 1.0, 41)
+    for terms in range(1, len(coefficients) + 1):
+        expected = sum(c * t ** k for k, c in enumerate(coefficients[:terms]))
+        assert np.allclose(gibbs._horner(coefficients, terms, t), expected, rtol=0, atol=1e-15)
+    chebyshev = (0.5, -1.0, 0.25, 0.0, 2.0)
+    assert np.allclose(gibbs._clenshaw(chebyshev, t), np.polynomial.chebyshev.chebval(t, chebyshev),
+                       rtol=0, atol=1e-14)
+
+
+def test_series_tables_share_only_common_starts() -> None:
+    from symrot.backends.series_tables import SeriesTables
+
+    tables = SeriesTables()
+    first = tables.reference("R_2", ["1.0", "0.5"])
+    assert tables.reference("R_2", ["1.0", "0.5", "0.25"]) == first  # lengthened
+    assert tables.reference("H_0", ["1.0"]) == first  # a start of it
+    other = tables.reference("R_2", ["1.0", "0.4"])
+    assert other != first
+    rows = {table["name"]: table["rows"] for table in tables.context()}
+    assert rows[first] == ["1.0, 0.5, 0.25,"] and rows[other] == ["1.0, 0.4,"]

@@ -151,19 +151,187 @@ def _implicit_angle(newton, slope):
 
 P_MAX = 3.3530783864394875
 P_MAX_SQUARED = 11.243134665607636  # fl(p_max^2); inside the range: x = |p|^2 <= P_MAX_SQUARED
+_SERIES_p_prime = (  # Taylor coefficients, constant term first
+    1.0, -0.05, -0.0010714285714285715,
+    -4.563492063492064e-05, -2.440218511647083e-06, -1.4686206650492366e-07,
+    -9.50993765619616e-09, -6.473542653639692e-10,
+)
+_SERIES_nu = (  # Taylor coefficients, constant term first
+    1.0, -0.025, -0.0008482142857142857,
+    -4.402281746031746e-05, -2.680413429576376e-06, -1.7778215165910478e-07,
+    -1.244209181073502e-08, -9.035261398610608e-10,
+)
+_SERIES_epsilon = (  # Taylor coefficients, constant term first
+    1.0, 0.1, 0.013214285714285715,
+    0.0018253968253968255, 0.0002554692331478046, 3.592768342768343e-05,
+    5.063042332919034e-06, 7.141710355470859e-07,
+)
+_SERIES_mu = (  # Taylor coefficients, constant term first
+    1.0, 0.05, 0.0035714285714285713,
+    0.0002777777777777778, 2.2437384044526902e-05, 1.8513431013431014e-06,
+    1.548516833380779e-07, 1.3075291305333323e-08,
+)
+_SERIES_R_1 = (  # Taylor coefficients, constant term first
+    1.0, -0.15, 0.0007142857142857143,
+    3.968253968253968e-05, 2.4930426716141e-06, 1.683039183039183e-07,
+    1.1911667949082915e-08, 8.716860870222215e-10,
+)
+_SERIES_R_2 = (  # Taylor coefficients, constant term first
+    0.5, -0.025, -0.0005357142857142857,
+    -2.281746031746032e-05, -1.2201092558235415e-06, -7.343103325246183e-08,
+    -4.75496882809808e-09, -3.236771326819846e-10,
+)
+_SERIES_H_2 = (  # Taylor coefficients, constant term first
+    0.2, 0.002857142857142857, 0.0002380952380952381,
+    1.99443413729128e-05, 1.683039183039183e-06, 1.42940015388995e-07,
+    1.22036052183111e-08, 1.046342173054307e-09, 9.002866267756873e-11,
+    7.768808765054745e-12, 6.720412596247862e-13, 5.825704915999495e-14,
+    5.0592551808267075e-15, 4.4005658265072545e-16, 3.8329294257465515e-17,
+    3.3425985887827363e-18, 2.918170543767923e-19, 2.5501224371929e-20,
+)
+_SERIES_H_inverse_2 = (  # Taylor coefficients, constant term first
+    0.05, 0.002142857142857143, 0.0001369047619047619,
+    9.760874046588332e-06, 7.343103325246182e-07, 5.705962593717696e-08,
+    4.531479857547785e-09, 3.65573324363898e-10, 2.9844879309052296e-11,
+    2.4592808133854965e-12, 2.0417396933193335e-13, 1.7055656901807745e-14,
+    1.4321083368003567e-15, 1.207771859033198e-16, 1.0224187860604788e-17,
+    8.683469103988305e-19, 7.396110286959959e-20, 6.315600653020195e-21,
+    5.40513214847762e-22, 4.6352839539983977e-23, 3.982335375612905e-24,
+    3.42701592796967e-25,
+)
+_SERIES_G_1 = (  # Taylor coefficients, constant term first
+    0.5, -0.0125, -0.00042410714285714285,
+    -2.201140873015873e-05, -1.340206714788188e-06, -8.889107582955239e-08,
+    -6.22104590536751e-09, -4.517630699305304e-10,
+)
+_SERIES_G_2 = (  # Taylor coefficients, constant term first
+    0.125, 0.0015625, 6.138392857142858e-05,
+    3.189329117063492e-06, 1.8955121406990826e-07, 1.2203463534465907e-08,
+    8.286380574805527e-10, 5.844969408074523e-11,
+)
+_SERIES_K_0 = (  # Taylor coefficients, constant term first
+    0.5, 0.025, 0.0017857142857142857,
+    0.0001388888888888889, 1.1218692022263451e-05, 9.256715506715507e-07,
+    7.742584166903895e-08, 6.5376456526666615e-09,
+)
+_SERIES_K_2 = (  # Taylor coefficients, constant term first
+    0.0375, 0.0022098214285714286, 0.0001609002976190476,
+    1.2558898737051639e-05, 1.0145626265011032e-06, 8.364688757440645e-08,
+    6.9894087225971915e-09, 5.895736922222117e-10, 5.008208696060211e-11,
+    4.277333653830018e-12, 3.6688033619582197e-13, 3.157810155130715e-14,
+    2.725820183855303e-15, 2.3586252560910385e-16, 2.0451064003372294e-17,
+    1.7764157194142527e-18, 1.5454156215361094e-19, 1.3462827495637501e-20,
+    1.1742209353136828e-21,
+)
+_SERIES_H_inverse_across = (  # Taylor coefficients, constant term first
+    1.0, -0.1, -0.0032142857142857142,
+    -0.00018253968253968255, -1.2201092558235416e-05, -8.811723990295419e-07,
+    -6.656956359337311e-08, -5.178834122911754e-09,
+)
+_SERIES_R_1_x = (  # Taylor coefficients, constant term first
+    -0.15, 0.0014285714285714286, 0.00011904761904761905,
+    9.9721706864564e-06, 8.415195915195915e-07, 7.14700076944975e-08,
+    6.10180260915555e-09, 5.231710865271535e-10, 4.5014331338784364e-11,
+    3.884404382527373e-12, 3.360206298123931e-13, 2.912852457999748e-14,
+    2.5296275904133537e-15, 2.2002829132536273e-16, 1.9164647128732757e-17,
+    1.6712992943913682e-18, 1.4590852718839616e-19,
+)
+_SERIES_R_2_x = (  # Taylor coefficients, constant term first
+    -0.025, -0.0010714285714285715, -6.845238095238096e-05,
+    -4.880437023294166e-06, -3.671551662623091e-07, -2.852981296858848e-08,
+    -2.2657399287738925e-09, -1.82786662181949e-10, -1.4922439654526148e-11,
+    -1.2296404066927483e-12, -1.0208698466596667e-13, -8.527828450903873e-15,
+    -7.160541684001784e-16, -6.03885929516599e-17, -5.112093930302394e-18,
+    -4.341734551994152e-19, -3.6980551434799796e-20, -3.1578003265100976e-21,
+    -2.70256607423881e-22, -2.3176419769991988e-23, -1.9911676878064524e-24,
+    -1.713507963984835e-25,
+)
+_SERIES_H_0_x = (  # Taylor coefficients, constant term first
+    0.05, 0.007142857142857143, 0.0008333333333333334,
+    8.974953617810761e-05, 9.256715506715507e-06, 9.291101000284673e-07,
+    9.152703913733326e-08, 8.893908470961609e-09, 8.552722954369029e-10,
+    8.157249203307483e-11, 7.72847448568504e-12, 7.28213114499937e-13,
+    6.829994494116056e-14, 6.3808204484355186e-15, 5.941040609907155e-16,
+    5.515287671491515e-17, 5.106798451593866e-18, 4.717726508806865e-19,
+    4.349386634459199e-20, 4.002447216098616e-21, 3.6770822088331955e-22,
+    3.373091494469352e-23,
+)
+_SERIES_H_2_x = (  # Taylor coefficients, constant term first
+    0.002857142857142857, 0.0004761904761904762, 5.983302411873841e-05,
+    6.732156732156732e-06, 7.147000769449749e-07, 7.32216313098666e-08,
+    7.324395211380149e-09, 7.202293014205498e-10, 6.991927888549271e-11,
+    6.7204125962478614e-12, 6.408275407599445e-13, 6.07110621699205e-14,
+    5.720735574459431e-15, 5.366101196045172e-16, 5.0138978831741045e-17,
+    4.669072870028677e-18, 4.33520814322793e-19, 4.0148184318084914e-20,
+    3.7095852246767656e-21, 3.420541589612275e-22, 3.1482187281713954e-23,
+    2.892762495883202e-24,
+)
+_SERIES_H_inverse_0_x = (  # Taylor coefficients, constant term first
+    -0.05, -0.002142857142857143, -0.0001369047619047619,
+    -9.760874046588332e-06, -7.343103325246182e-07, -5.705962593717696e-08,
+    -4.531479857547785e-09, -3.65573324363898e-10, -2.9844879309052296e-11,
+    -2.4592808133854965e-12, -2.0417396933193335e-13, -1.7055656901807745e-14,
+    -1.4321083368003567e-15, -1.207771859033198e-16, -1.0224187860604788e-17,
+    -8.683469103988305e-19, -7.396110286959959e-20, -6.315600653020195e-21,
+    -5.40513214847762e-22, -4.6352839539983977e-23, -3.982335375612905e-24,
+    -3.42701592796967e-25,
+)
+_SERIES_H_inverse_2_x = (  # Taylor coefficients, constant term first
+    0.002142857142857143, 0.0002738095238095238, 2.9282622139764997e-05,
+    2.937241330098473e-06, 2.852981296858848e-07, 2.7188879145286708e-08,
+    2.559013270547286e-09, 2.3875903447241837e-10, 2.213352732046947e-11,
+    2.0417396933193335e-12, 1.8761222591988522e-13, 1.718530004160428e-14,
+    1.5701034167431574e-15, 1.4313863004846702e-16, 1.3025203655982459e-17,
+    1.1833776459135935e-18, 1.0736521110134332e-19, 9.729237867259716e-21,
+    8.807039512596957e-22, 7.96467075122581e-23, 7.196733448736306e-24,
+    6.497844255354877e-25,
+)
+_SERIES_e_0 = (  # Taylor coefficients, constant term first
+    1.0, -0.125, -0.0015625,
+    -6.138392857142858e-05, -3.189329117063492e-06, -1.8955121406990826e-07,
+    -1.2203463534465907e-08, -8.286380574805527e-10,
+)
+_SERIES_ratio = (  # Taylor coefficients, constant term first
+    0.0, -0.016666666666666666, 0.00011904761904761905,
+    0.0, 2.863098101193339e-09, 1.0461319985129509e-11,
+    -1.6124590954522927e-13, -5.032990449379227e-15, -7.540360750643117e-17,
+    -6.676229535883005e-19, -1.2859517762333714e-22, 1.235992150768613e-22,
+    2.66943145680867e-24, 3.3177115067548803e-26,
+)
+_SERIES_slope = (  # Taylor coefficients, constant term first
+    1.0, -0.05, 0.0005952380952380953,
+    0.0, 2.5767882910740054e-08, 1.150745198364246e-10,
+    -2.0961968240879805e-12, -7.549485674068841e-14, -1.2818613276093299e-15,
+    -1.2684836118177708e-17,
+)
+_SERIES_angle_start = (  # Taylor coefficients, constant term first
+    1.0, 0.016666666666666666, 0.0007142857142857143,
+    3.968253968253968e-05, 2.4930426716141e-06, 1.683039183039183e-07,
+    1.1911667949082915e-08, 8.716860870222215e-10,
+)
+_SERIES_angle_far = (  # Taylor coefficients, constant term first
+    3.4262488119907286, 3.078435146612714, -0.27270647771411743,
+    0.058935024871047986, -0.01092341396124625, 0.003881973729847049,
+    -0.0009251648317959207, 0.00030749343680560177, -9.057404840855562e-05,
+    2.9515258898711766e-05, -9.371131981585395e-06, 3.1093060613898743e-06,
+    -1.0246803513530182e-06, 3.452715616234165e-07, -1.1650659674300742e-07,
+    3.978329879961088e-08, -1.3631401940270963e-08, 4.7095346659018245e-09,
+    -1.6292939581260258e-09, 5.702343301346788e-10, -1.971054960712895e-10,
+    7.098545744185871e-11, -2.3537557740900345e-11, 9.169395645513856e-12,
+    -2.3596965627293182e-12,
+)
+_SERIES_scale = (  # Taylor coefficients, constant term first
+    2.0, 0.05, 0.0012797619047619049,
+    3.348214285714286e-05, 8.677535881776953e-07, 2.2216922909817254e-08,
+    5.645976592827012e-10, 1.430275196509799e-11, 3.620429902548073e-13,
+    9.165622812957786e-15, 2.3211137300576825e-16, 5.879215449421489e-18,
+)
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -6.473542653639692e-10 + 0.0 * x
-    series = -9.50993765619616e-09 + t * series
-    series = -1.4686206650492366e-07 + t * series
-    series = -2.440218511647083e-06 + t * series
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_p_prime, 8, t, x)
     x = _where(small, 0.1103124080629894, x)
     sin_half = _where(small, 0.1656068549609148, sin_half)
     closed = 4*sin_half**2/x
@@ -173,14 +341,7 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
 def _nu_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -9.035261398610608e-10 + 0.0 * x
-    series = -1.244209181073502e-08 + t * series
-    series = -1.7778215165910478e-07 + t * series
-    series = -2.680413429576376e-06 + t * series
-    series = -4.402281746031746e-05 + t * series
-    series = -0.0008482142857142857 + t * series
-    series = -0.025 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_nu, 8, t, x)
     s = _where(small, 0.33213311798583023, s)
     sin_half = _where(small, 0.1656068549609148, sin_half)
     closed = 2*sin_half/s
@@ -190,14 +351,7 @@ def _nu_64(x, phi, s, d, sin_half, cos_half):
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.05752053308030299
     t = _where(small, x, 0.0)
-    series = 7.141710355470859e-07 + 0.0 * x
-    series = 5.063042332919034e-06 + t * series
-    series = 3.592768342768343e-05 + t * series
-    series = 0.0002554692331478046 + t * series
-    series = 0.0018253968253968255 + t * series
-    series = 0.013214285714285715 + t * series
-    series = 0.1 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_epsilon, 8, t, x)
     phi = _where(small, 0.24006487875616042, phi)
     s = _where(small, 0.2398343867761731, s)
     closed = 2*_xp.tan((0.5)*phi)/s
@@ -207,14 +361,7 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half):
 def _mu_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 1.3075291305333323e-08 + 0.0 * x
-    series = 1.548516833380779e-07 + t * series
-    series = 1.8513431013431014e-06 + t * series
-    series = 2.2437384044526902e-05 + t * series
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_mu, 8, t, x)
     x = _where(small, 0.1103124080629894, x)
     sin_half = _where(small, 0.1656068549609148, sin_half)
     closed = (0.25)*x/sin_half**2
@@ -231,14 +378,7 @@ _R_0_64 = _det_H_64  # the same code
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 8.716860870222215e-10 + 0.0 * x
-    series = 1.1911667949082915e-08 + t * series
-    series = 1.683039183039183e-07 + t * series
-    series = 2.4930426716141e-06 + t * series
-    series = 3.968253968253968e-05 + t * series
-    series = 0.0007142857142857143 + t * series
-    series = -0.15 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_R_1, 8, t, x)
     s = _where(small, 0.33213311798583023, s)
     sin_half = _where(small, 0.1656068549609148, sin_half)
     cos_half = _where(small, 0.9861918523238541, cos_half)
@@ -249,14 +389,7 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -3.236771326819846e-10 + 0.0 * x
-    series = -4.75496882809808e-09 + t * series
-    series = -7.343103325246183e-08 + t * series
-    series = -1.2201092558235415e-06 + t * series
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_R_2, 8, t, x)
     x = _where(small, 0.1103124080629894, x)
     sin_half = _where(small, 0.1656068549609148, sin_half)
     closed = 2*sin_half**2/x
@@ -272,24 +405,7 @@ _H_1_64 = _R_2_64  # the same code
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 2.5501224371929e-20 + 0.0 * x
-    series = 2.918170543767923e-19 + t * series
-    series = 3.3425985887827363e-18 + t * series
-    series = 3.8329294257465515e-17 + t * series
-    series = 4.4005658265072545e-16 + t * series
-    series = 5.0592551808267075e-15 + t * series
-    series = 5.825704915999495e-14 + t * series
-    series = 6.720412596247862e-13 + t * series
-    series = 7.768808765054745e-12 + t * series
-    series = 9.002866267756873e-11 + t * series
-    series = 1.046342173054307e-09 + t * series
-    series = 1.22036052183111e-08 + t * series
-    series = 1.42940015388995e-07 + t * series
-    series = 1.683039183039183e-06 + t * series
-    series = 1.99443413729128e-05 + t * series
-    series = 0.0002380952380952381 + t * series
-    series = 0.002857142857142857 + t * series
-    series = 0.2 + t * series
+    series = _horner(_SERIES_H_2, 18, t, x)
     s = _where(small, 1.197614799937078, s)
     x = _where(small, 1.4342812090283275, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
@@ -308,28 +424,7 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 2.6302227241416043
     t = _where(small, x, 0.0)
-    series = 3.42701592796967e-25 + 0.0 * x
-    series = 3.982335375612905e-24 + t * series
-    series = 4.6352839539983977e-23 + t * series
-    series = 5.40513214847762e-22 + t * series
-    series = 6.315600653020195e-21 + t * series
-    series = 7.396110286959959e-20 + t * series
-    series = 8.683469103988305e-19 + t * series
-    series = 1.0224187860604788e-17 + t * series
-    series = 1.207771859033198e-16 + t * series
-    series = 1.4321083368003567e-15 + t * series
-    series = 1.7055656901807745e-14 + t * series
-    series = 2.0417396933193335e-13 + t * series
-    series = 2.4592808133854965e-12 + t * series
-    series = 2.9844879309052296e-11 + t * series
-    series = 3.65573324363898e-10 + t * series
-    series = 4.531479857547785e-09 + t * series
-    series = 5.705962593717696e-08 + t * series
-    series = 7.343103325246182e-07 + t * series
-    series = 9.760874046588332e-06 + t * series
-    series = 0.0001369047619047619 + t * series
-    series = 0.002142857142857143 + t * series
-    series = 0.05 + t * series
+    series = _horner(_SERIES_H_inverse_2, 22, t, x)
     phi = _where(small, 1.7023118078717785, phi)
     s = _where(small, 1.6217961413635205, s)
     x = _where(small, 2.6302227241416043, x)
@@ -346,14 +441,7 @@ _G_0_64 = _det_H_64  # the same code
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -4.517630699305304e-10 + 0.0 * x
-    series = -6.22104590536751e-09 + t * series
-    series = -8.889107582955239e-08 + t * series
-    series = -1.340206714788188e-06 + t * series
-    series = -2.201140873015873e-05 + t * series
-    series = -0.00042410714285714285 + t * series
-    series = -0.0125 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_G_1, 8, t, x)
     s = _where(small, 0.33213311798583023, s)
     sin_half = _where(small, 0.1656068549609148, sin_half)
     closed = sin_half/s
@@ -363,14 +451,7 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 5.844969408074523e-11 + 0.0 * x
-    series = 8.286380574805527e-10 + t * series
-    series = 1.2203463534465907e-08 + t * series
-    series = 1.8955121406990826e-07 + t * series
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 8, t, x)
     phi = _where(small, 0.33274666277661247, phi)
     x = _where(small, 0.1103124080629894, x)
     closed = 2*_xp.sin((0.25)*phi)**2/x
@@ -380,14 +461,7 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half):
 def _K_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = 6.5376456526666615e-09 + 0.0 * x
-    series = 7.742584166903895e-08 + t * series
-    series = 9.256715506715507e-07 + t * series
-    series = 1.1218692022263451e-05 + t * series
-    series = 0.0001388888888888889 + t * series
-    series = 0.0017857142857142857 + t * series
-    series = 0.025 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_K_0, 8, t, x)
     x = _where(small, 0.1103124080629894, x)
     sin_half = _where(small, 0.1656068549609148, sin_half)
     closed = (0.125)*x/sin_half**2
@@ -400,24 +474,7 @@ _K_1_64 = _G_2_64  # the same code
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 1.3462827495637501e-20 + 0.0 * x
-    series = 1.5454156215361094e-19 + t * series
-    series = 1.7764157194142527e-18 + t * series
-    series = 2.0451064003372294e-17 + t * series
-    series = 2.3586252560910385e-16 + t * series
-    series = 2.725820183855303e-15 + t * series
-    series = 3.157810155130715e-14 + t * series
-    series = 3.6688033619582197e-13 + t * series
-    series = 4.277333653830018e-12 + t * series
-    series = 5.008208696060211e-11 + t * series
-    series = 5.895736922222117e-10 + t * series
-    series = 6.9894087225971915e-09 + t * series
-    series = 8.364688757440645e-08 + t * series
-    series = 1.0145626265011032e-06 + t * series
-    series = 1.2558898737051639e-05 + t * series
-    series = 0.0001609002976190476 + t * series
-    series = 0.0022098214285714286 + t * series
-    series = 0.0375 + t * series
+    series = _horner(_SERIES_K_2, 18, t, x)
     s = _where(small, 1.197614799937078, s)
     x = _where(small, 1.4342812090283275, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
@@ -431,14 +488,7 @@ _H_across_64 = _R_1_64  # the same code
 def _H_inverse_across_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -5.178834122911754e-09 + 0.0 * x
-    series = -6.656956359337311e-08 + t * series
-    series = -8.811723990295419e-07 + t * series
-    series = -1.2201092558235416e-05 + t * series
-    series = -0.00018253968253968255 + t * series
-    series = -0.0032142857142857142 + t * series
-    series = -0.1 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_H_inverse_across, 8, t, x)
     s = _where(small, 0.33213311798583023, s)
     x = _where(small, 0.1103124080629894, x)
     sin_half = _where(small, 0.1656068549609148, sin_half)
@@ -458,23 +508,7 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 1.4590852718839616e-19 + 0.0 * x
-    series = 1.6712992943913682e-18 + t * series
-    series = 1.9164647128732757e-17 + t * series
-    series = 2.2002829132536273e-16 + t * series
-    series = 2.5296275904133537e-15 + t * series
-    series = 2.912852457999748e-14 + t * series
-    series = 3.360206298123931e-13 + t * series
-    series = 3.884404382527373e-12 + t * series
-    series = 4.5014331338784364e-11 + t * series
-    series = 5.231710865271535e-10 + t * series
-    series = 6.10180260915555e-09 + t * series
-    series = 7.14700076944975e-08 + t * series
-    series = 8.415195915195915e-07 + t * series
-    series = 9.9721706864564e-06 + t * series
-    series = 0.00011904761904761905 + t * series
-    series = 0.0014285714285714286 + t * series
-    series = -0.15 + t * series
+    series = _horner(_SERIES_R_1_x, 17, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     w0 = sin_half**2
@@ -486,28 +520,7 @@ def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 2.6302227241416043
     t = _where(small, x, 0.0)
-    series = -1.713507963984835e-25 + 0.0 * x
-    series = -1.9911676878064524e-24 + t * series
-    series = -2.3176419769991988e-23 + t * series
-    series = -2.70256607423881e-22 + t * series
-    series = -3.1578003265100976e-21 + t * series
-    series = -3.6980551434799796e-20 + t * series
-    series = -4.341734551994152e-19 + t * series
-    series = -5.112093930302394e-18 + t * series
-    series = -6.03885929516599e-17 + t * series
-    series = -7.160541684001784e-16 + t * series
-    series = -8.527828450903873e-15 + t * series
-    series = -1.0208698466596667e-13 + t * series
-    series = -1.2296404066927483e-12 + t * series
-    series = -1.4922439654526148e-11 + t * series
-    series = -1.82786662181949e-10 + t * series
-    series = -2.2657399287738925e-09 + t * series
-    series = -2.852981296858848e-08 + t * series
-    series = -3.671551662623091e-07 + t * series
-    series = -4.880437023294166e-06 + t * series
-    series = -6.845238095238096e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.025 + t * series
+    series = _horner(_SERIES_R_2_x, 22, t, x)
     phi = _where(small, 1.7023118078717785, phi)
     sin_half = _where(small, 0.7520427801883164, sin_half)
     cos_half = _where(small, 0.6591142971948246, cos_half)
@@ -520,26 +533,7 @@ def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
 def _H_0_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 4.002447216098616e-21 + 0.0 * x
-    series = 4.349386634459199e-20 + t * series
-    series = 4.717726508806865e-19 + t * series
-    series = 5.106798451593866e-18 + t * series
-    series = 5.515287671491515e-17 + t * series
-    series = 5.941040609907155e-16 + t * series
-    series = 6.3808204484355186e-15 + t * series
-    series = 6.829994494116056e-14 + t * series
-    series = 7.28213114499937e-13 + t * series
-    series = 7.72847448568504e-12 + t * series
-    series = 8.157249203307483e-11 + t * series
-    series = 8.552722954369029e-10 + t * series
-    series = 8.893908470961609e-09 + t * series
-    series = 9.152703913733326e-08 + t * series
-    series = 9.291101000284673e-07 + t * series
-    series = 9.256715506715507e-06 + t * series
-    series = 8.974953617810761e-05 + t * series
-    series = 0.0008333333333333334 + t * series
-    series = 0.007142857142857143 + t * series
-    series = 0.05 + t * series
+    series = _horner(_SERIES_H_0_x, 20, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     cos_half = _where(small, 0.8173046507362676, cos_half)
@@ -554,26 +548,7 @@ _H_1_x_64 = _R_2_x_64  # the same code
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812090283275
     t = _where(small, x, 0.0)
-    series = 3.420541589612275e-22 + 0.0 * x
-    series = 3.7095852246767656e-21 + t * series
-    series = 4.0148184318084914e-20 + t * series
-    series = 4.33520814322793e-19 + t * series
-    series = 4.669072870028677e-18 + t * series
-    series = 5.0138978831741045e-17 + t * series
-    series = 5.366101196045172e-16 + t * series
-    series = 5.720735574459431e-15 + t * series
-    series = 6.07110621699205e-14 + t * series
-    series = 6.408275407599445e-13 + t * series
-    series = 6.7204125962478614e-12 + t * series
-    series = 6.991927888549271e-11 + t * series
-    series = 7.202293014205498e-10 + t * series
-    series = 7.324395211380149e-09 + t * series
-    series = 7.32216313098666e-08 + t * series
-    series = 7.147000769449749e-07 + t * series
-    series = 6.732156732156732e-06 + t * series
-    series = 5.983302411873841e-05 + t * series
-    series = 0.0004761904761904762 + t * series
-    series = 0.002857142857142857 + t * series
+    series = _horner(_SERIES_H_2_x, 20, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     w0 = sin_half**(-2.0)
@@ -589,28 +564,7 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_0_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 2.6302227241416043
     t = _where(small, x, 0.0)
-    series = -3.42701592796967e-25 + 0.0 * x
-    series = -3.982335375612905e-24 + t * series
-    series = -4.6352839539983977e-23 + t * series
-    series = -5.40513214847762e-22 + t * series
-    series = -6.315600653020195e-21 + t * series
-    series = -7.396110286959959e-20 + t * series
-    series = -8.683469103988305e-19 + t * series
-    series = -1.0224187860604788e-17 + t * series
-    series = -1.207771859033198e-16 + t * series
-    series = -1.4321083368003567e-15 + t * series
-    series = -1.7055656901807745e-14 + t * series
-    series = -2.0417396933193335e-13 + t * series
-    series = -2.4592808133854965e-12 + t * series
-    series = -2.9844879309052296e-11 + t * series
-    series = -3.65573324363898e-10 + t * series
-    series = -4.531479857547785e-09 + t * series
-    series = -5.705962593717696e-08 + t * series
-    series = -7.343103325246182e-07 + t * series
-    series = -9.760874046588332e-06 + t * series
-    series = -0.0001369047619047619 + t * series
-    series = -0.002142857142857143 + t * series
-    series = -0.05 + t * series
+    series = _horner(_SERIES_H_inverse_0_x, 22, t, x)
     phi = _where(small, 1.7023118078717785, phi)
     sin_half = _where(small, 0.7520427801883164, sin_half)
     cos_half = _where(small, 0.6591142971948246, cos_half)
@@ -626,28 +580,7 @@ _H_inverse_1_x_64 = _R_0_x_64  # the same code
 def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 2.6302227241416043
     t = _where(small, x, 0.0)
-    series = 6.497844255354877e-25 + 0.0 * x
-    series = 7.196733448736306e-24 + t * series
-    series = 7.96467075122581e-23 + t * series
-    series = 8.807039512596957e-22 + t * series
-    series = 9.729237867259716e-21 + t * series
-    series = 1.0736521110134332e-19 + t * series
-    series = 1.1833776459135935e-18 + t * series
-    series = 1.3025203655982459e-17 + t * series
-    series = 1.4313863004846702e-16 + t * series
-    series = 1.5701034167431574e-15 + t * series
-    series = 1.718530004160428e-14 + t * series
-    series = 1.8761222591988522e-13 + t * series
-    series = 2.0417396933193335e-12 + t * series
-    series = 2.213352732046947e-11 + t * series
-    series = 2.3875903447241837e-10 + t * series
-    series = 2.559013270547286e-09 + t * series
-    series = 2.7188879145286708e-08 + t * series
-    series = 2.852981296858848e-07 + t * series
-    series = 2.937241330098473e-06 + t * series
-    series = 2.9282622139764997e-05 + t * series
-    series = 0.0002738095238095238 + t * series
-    series = 0.002142857142857143 + t * series
+    series = _horner(_SERIES_H_inverse_2_x, 22, t, x)
     phi = _where(small, 1.7023118078717785, phi)
     sin_half = _where(small, 0.7520427801883164, sin_half)
     cos_half = _where(small, 0.6591142971948246, cos_half)
@@ -664,14 +597,7 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.1103124080629894
     t = _where(small, x, 0.0)
-    series = -8.286380574805527e-10 + 0.0 * x
-    series = -1.2203463534465907e-08 + t * series
-    series = -1.8955121406990826e-07 + t * series
-    series = -3.189329117063492e-06 + t * series
-    series = -6.138392857142858e-05 + t * series
-    series = -0.0015625 + t * series
-    series = -0.125 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 8, t, x)
     cos_half = _where(small, 0.9861918523238541, cos_half)
     closed = cos_half
     return _where(small, series, closed)
@@ -680,20 +606,7 @@ def _e_0_64(x, phi, s, d, sin_half, cos_half):
 def _ratio_64(t, phi):
     small = t < 5.5673482008975155
     t = _where(small, t, 0.0)
-    series = 3.3177115067548803e-26 + 0.0 * t
-    series = 2.66943145680867e-24 + t * series
-    series = 1.235992150768613e-22 + t * series
-    series = -1.2859517762333714e-22 + t * series
-    series = -6.676229535883005e-19 + t * series
-    series = -7.540360750643117e-17 + t * series
-    series = -5.032990449379227e-15 + t * series
-    series = -1.6124590954522927e-13 + t * series
-    series = 1.0461319985129509e-11 + t * series
-    series = 2.863098101193339e-09 + t * series
-    series = t * series
-    series = 0.00011904761904761905 + t * series
-    series = -0.016666666666666666 + t * series
-    series = t * series
+    series = _horner(_SERIES_ratio, 14, t, t)
     phi = _where(small, 2.3595228756885396, phi)
     w0 = (0.5)*phi
     closed = -1 + _cbrt(6*phi - 12*_xp.sin(w0)*_xp.cos(w0))/phi
@@ -703,16 +616,7 @@ def _ratio_64(t, phi):
 def _slope_64(t, phi):
     small = t < 1.5083706105984371
     t = _where(small, t, 0.0)
-    series = -1.2684836118177708e-17 + 0.0 * t
-    series = -1.2818613276093299e-15 + t * series
-    series = -7.549485674068841e-14 + t * series
-    series = -2.0961968240879805e-12 + t * series
-    series = 1.150745198364246e-10 + t * series
-    series = 2.5767882910740054e-08 + t * series
-    series = t * series
-    series = 0.0005952380952380953 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_slope, 10, t, t)
     phi = _where(small, 1.2281574046507382, phi)
     closed = 2*(1 - _xp.cos(phi))/_cbrt(6*phi - 6*_xp.sin(phi))**2
     return _where(small, series, closed)
@@ -720,43 +624,10 @@ def _slope_64(t, phi):
 
 def _newton_64(s):
     s2 = s * s
-    start = 8.716860870222215e-10 + 0.0 * s
-    start = 1.1911667949082915e-08 + s2 * start
-    start = 1.683039183039183e-07 + s2 * start
-    start = 2.4930426716141e-06 + s2 * start
-    start = 3.968253968253968e-05 + s2 * start
-    start = 0.0007142857142857143 + s2 * start
-    start = 0.016666666666666666 + s2 * start
-    start = 1.0 + s2 * start
+    start = _horner(_SERIES_angle_start, 8, s2, s)
     v = 1.0 - _cbrt(_xp.clip(1.0 - s / 3.3530783864394875, 0.0, None))
     y = 2.0 * v - 1.0
-    b1 = 0.0 * y
-    b2 = 0.0 * y
-    b1, b2 = -2.3596965627293182e-12 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 9.169395645513856e-12 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -2.3537557740900345e-11 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 7.098545744185871e-11 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.971054960712895e-10 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 5.702343301346788e-10 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.6292939581260258e-09 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 4.7095346659018245e-09 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.3631401940270963e-08 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.978329879961088e-08 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.1650659674300742e-07 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.452715616234165e-07 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.0246803513530182e-06 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.1093060613898743e-06 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -9.371131981585395e-06 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 2.9515258898711766e-05 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -9.057404840855562e-05 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 0.00030749343680560177 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -0.0009251648317959207 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 0.003881973729847049 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -0.01092341396124625 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 0.058935024871047986 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -0.27270647771411743 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
-    far = 3.4262488119907286 + y * b1 - b2
+    far = _clenshaw(_SERIES_angle_far, y)
     phi = _where(s < 0.6986294588918609, s * start, far)
     phi = _xp.clip(phi, 0.0, 6.283157890564791)
     low = 0.0 * s
@@ -781,18 +652,7 @@ def _scale_64(e0, e_norm):
     t = phi * phi
     small = t < 1.5011636131873347
     t = _where(small, t, 0.0)
-    series = 5.879215449421489e-18 + 0.0 * t
-    series = 2.3211137300576825e-16 + t * series
-    series = 9.165622812957786e-15 + t * series
-    series = 3.620429902548073e-13 + t * series
-    series = 1.430275196509799e-11 + t * series
-    series = 5.645976592827012e-10 + t * series
-    series = 2.2216922909817254e-08 + t * series
-    series = 8.677535881776953e-07 + t * series
-    series = 3.348214285714286e-05 + t * series
-    series = 0.0012797619047619049 + t * series
-    series = 0.05 + t * series
-    series = 2.0 + t * series
+    series = _horner(_SERIES_scale, 12, t, t)
     phi = _where(small, 1.2252198223940611, phi)
     w0 = (0.5)*phi
     w1 = _xp.sin(w0)
@@ -803,13 +663,7 @@ def _scale_64(e0, e_norm):
 def _p_prime_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -9.50993765619616e-09 + 0.0 * x
-    series = -1.4686206650492366e-07 + t * series
-    series = -2.440218511647083e-06 + t * series
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_p_prime, 7, t, x)
     x = _where(small, 1.4342812011199078, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = 4*sin_half**2/x
@@ -819,13 +673,7 @@ def _p_prime_32(x, phi, s, d, sin_half, cos_half):
 def _nu_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -1.244209181073502e-08 + 0.0 * x
-    series = -1.7778215165910478e-07 + t * series
-    series = -2.680413429576376e-06 + t * series
-    series = -4.402281746031746e-05 + t * series
-    series = -0.0008482142857142857 + t * series
-    series = -0.025 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_nu, 7, t, x)
     s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = 2*sin_half/s
@@ -835,14 +683,7 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.7648242161335777
     t = _where(small, x, 0.0)
-    series = 7.141710355470859e-07 + 0.0 * x
-    series = 5.063042332919034e-06 + t * series
-    series = 3.592768342768343e-05 + t * series
-    series = 0.0002554692331478046 + t * series
-    series = 0.0018253968253968255 + t * series
-    series = 0.013214285714285715 + t * series
-    series = 0.1 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_epsilon, 8, t, x)
     phi = _where(small, 0.886071872158482, phi)
     s = _where(small, 0.8745422895055319, s)
     closed = 2*_xp.tan((0.5)*phi)/s
@@ -852,14 +693,7 @@ def _epsilon_32(x, phi, s, d, sin_half, cos_half):
 def _mu_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 1.3075291305333323e-08 + 0.0 * x
-    series = 1.548516833380779e-07 + t * series
-    series = 1.8513431013431014e-06 + t * series
-    series = 2.2437384044526902e-05 + t * series
-    series = 0.0002777777777777778 + t * series
-    series = 0.0035714285714285713 + t * series
-    series = 0.05 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_mu, 8, t, x)
     x = _where(small, 1.4342812011199078, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = (0.25)*x/sin_half**2
@@ -875,13 +709,7 @@ _R_0_32 = _det_H_64  # the same code
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 1.1911667949082915e-08 + 0.0 * x
-    series = 1.683039183039183e-07 + t * series
-    series = 2.4930426716141e-06 + t * series
-    series = 3.968253968253968e-05 + t * series
-    series = 0.0007142857142857143 + t * series
-    series = -0.15 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_R_1, 7, t, x)
     s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     cos_half = _where(small, 0.8173046507362676, cos_half)
@@ -892,13 +720,7 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -4.75496882809808e-09 + 0.0 * x
-    series = -7.343103325246183e-08 + t * series
-    series = -1.2201092558235415e-06 + t * series
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_R_2, 7, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     x = _where(small, 1.4342812011199078, x)
     closed = (1 - _xp.cos(phi))/x
@@ -911,13 +733,7 @@ _H_0_32 = _mu_32  # the same code
 def _H_1_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -4.75496882809808e-09 + 0.0 * x
-    series = -7.343103325246183e-08 + t * series
-    series = -1.2201092558235415e-06 + t * series
-    series = -2.281746031746032e-05 + t * series
-    series = -0.0005357142857142857 + t * series
-    series = -0.025 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_R_2, 7, t, x)
     x = _where(small, 1.4342812011199078, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = 2*sin_half**2/x
@@ -927,24 +743,7 @@ def _H_1_32(x, phi, s, d, sin_half, cos_half):
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = 2.5501224371929e-20 + 0.0 * x
-    series = 2.918170543767923e-19 + t * series
-    series = 3.3425985887827363e-18 + t * series
-    series = 3.8329294257465515e-17 + t * series
-    series = 4.4005658265072545e-16 + t * series
-    series = 5.0592551808267075e-15 + t * series
-    series = 5.825704915999495e-14 + t * series
-    series = 6.720412596247862e-13 + t * series
-    series = 7.768808765054745e-12 + t * series
-    series = 9.002866267756873e-11 + t * series
-    series = 1.046342173054307e-09 + t * series
-    series = 1.22036052183111e-08 + t * series
-    series = 1.42940015388995e-07 + t * series
-    series = 1.683039183039183e-06 + t * series
-    series = 1.99443413729128e-05 + t * series
-    series = 0.0002380952380952381 + t * series
-    series = 0.002857142857142857 + t * series
-    series = 0.2 + t * series
+    series = _horner(_SERIES_H_2, 18, t, x)
     s = _where(small, 2.149297813514097, s)
     x = _where(small, 4.619481091176478, x)
     sin_half = _where(small, 0.9245151118510668, sin_half)
@@ -956,13 +755,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -9.50993765619616e-09 + 0.0 * x
-    series = -1.4686206650492366e-07 + t * series
-    series = -2.440218511647083e-06 + t * series
-    series = -4.563492063492064e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_p_prime, 7, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     x = _where(small, 1.4342812011199078, x)
     closed = 2*(1 - _xp.cos(phi))/x
@@ -975,24 +768,7 @@ _H_inverse_1_32 = _H_inverse_1_64  # the same code
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = 6.315600653020195e-21 + 0.0 * x
-    series = 7.396110286959959e-20 + t * series
-    series = 8.683469103988305e-19 + t * series
-    series = 1.0224187860604788e-17 + t * series
-    series = 1.207771859033198e-16 + t * series
-    series = 1.4321083368003567e-15 + t * series
-    series = 1.7055656901807745e-14 + t * series
-    series = 2.0417396933193335e-13 + t * series
-    series = 2.4592808133854965e-12 + t * series
-    series = 2.9844879309052296e-11 + t * series
-    series = 3.65573324363898e-10 + t * series
-    series = 4.531479857547785e-09 + t * series
-    series = 5.705962593717696e-08 + t * series
-    series = 7.343103325246182e-07 + t * series
-    series = 9.760874046588332e-06 + t * series
-    series = 0.0001369047619047619 + t * series
-    series = 0.002142857142857143 + t * series
-    series = 0.05 + t * series
+    series = _horner(_SERIES_H_inverse_2, 18, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     s = _where(small, 2.149297813514097, s)
     sin_half = _where(small, 0.9245151118510668, sin_half)
@@ -1008,13 +784,7 @@ _G_0_32 = _det_H_64  # the same code
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -6.22104590536751e-09 + 0.0 * x
-    series = -8.889107582955239e-08 + t * series
-    series = -1.340206714788188e-06 + t * series
-    series = -2.201140873015873e-05 + t * series
-    series = -0.00042410714285714285 + t * series
-    series = -0.0125 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_G_1, 7, t, x)
     s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = sin_half/s
@@ -1024,13 +794,7 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 8.286380574805527e-10 + 0.0 * x
-    series = 1.2203463534465907e-08 + t * series
-    series = 1.8955121406990826e-07 + t * series
-    series = 3.189329117063492e-06 + t * series
-    series = 6.138392857142858e-05 + t * series
-    series = 0.0015625 + t * series
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 7, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     x = _where(small, 1.4342812011199078, x)
     closed = 2*_xp.sin((0.25)*phi)**2/x
@@ -1040,14 +804,7 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half):
 def _K_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = 6.5376456526666615e-09 + 0.0 * x
-    series = 7.742584166903895e-08 + t * series
-    series = 9.256715506715507e-07 + t * series
-    series = 1.1218692022263451e-05 + t * series
-    series = 0.0001388888888888889 + t * series
-    series = 0.0017857142857142857 + t * series
-    series = 0.025 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_K_0, 8, t, x)
     x = _where(small, 1.4342812011199078, x)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = (0.125)*x/sin_half**2
@@ -1060,25 +817,7 @@ _K_1_32 = _G_2_32  # the same code
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = 1.1742209353136828e-21 + 0.0 * x
-    series = 1.3462827495637501e-20 + t * series
-    series = 1.5454156215361094e-19 + t * series
-    series = 1.7764157194142527e-18 + t * series
-    series = 2.0451064003372294e-17 + t * series
-    series = 2.3586252560910385e-16 + t * series
-    series = 2.725820183855303e-15 + t * series
-    series = 3.157810155130715e-14 + t * series
-    series = 3.6688033619582197e-13 + t * series
-    series = 4.277333653830018e-12 + t * series
-    series = 5.008208696060211e-11 + t * series
-    series = 5.895736922222117e-10 + t * series
-    series = 6.9894087225971915e-09 + t * series
-    series = 8.364688757440645e-08 + t * series
-    series = 1.0145626265011032e-06 + t * series
-    series = 1.2558898737051639e-05 + t * series
-    series = 0.0001609002976190476 + t * series
-    series = 0.0022098214285714286 + t * series
-    series = 0.0375 + t * series
+    series = _horner(_SERIES_K_2, 19, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -1094,14 +833,7 @@ _H_across_32 = _R_1_32  # the same code
 def _H_inverse_across_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -5.178834122911754e-09 + 0.0 * x
-    series = -6.656956359337311e-08 + t * series
-    series = -8.811723990295419e-07 + t * series
-    series = -1.2201092558235416e-05 + t * series
-    series = -0.00018253968253968255 + t * series
-    series = -0.0032142857142857142 + t * series
-    series = -0.1 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_H_inverse_across, 8, t, x)
     s = _where(small, 1.1976147966353403, s)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     cos_half = _where(small, 0.8173046507362676, cos_half)
@@ -1118,17 +850,7 @@ _R_0_x_32 = _R_0_x_64  # the same code
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 2.630222574480542
     t = _where(small, x, 0.0)
-    series = 3.360206298123931e-13 + 0.0 * x
-    series = 3.884404382527373e-12 + t * series
-    series = 4.5014331338784364e-11 + t * series
-    series = 5.231710865271535e-10 + t * series
-    series = 6.10180260915555e-09 + t * series
-    series = 7.14700076944975e-08 + t * series
-    series = 8.415195915195915e-07 + t * series
-    series = 9.9721706864564e-06 + t * series
-    series = 0.00011904761904761905 + t * series
-    series = 0.0014285714285714286 + t * series
-    series = -0.15 + t * series
+    series = _horner(_SERIES_R_1_x, 11, t, x)
     phi = _where(small, 1.7023118078717785, phi)
     sin_half = _where(small, 0.7520427801883164, sin_half)
     w0 = sin_half**2
@@ -1140,24 +862,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = -3.1578003265100976e-21 + 0.0 * x
-    series = -3.6980551434799796e-20 + t * series
-    series = -4.341734551994152e-19 + t * series
-    series = -5.112093930302394e-18 + t * series
-    series = -6.03885929516599e-17 + t * series
-    series = -7.160541684001784e-16 + t * series
-    series = -8.527828450903873e-15 + t * series
-    series = -1.0208698466596667e-13 + t * series
-    series = -1.2296404066927483e-12 + t * series
-    series = -1.4922439654526148e-11 + t * series
-    series = -1.82786662181949e-10 + t * series
-    series = -2.2657399287738925e-09 + t * series
-    series = -2.852981296858848e-08 + t * series
-    series = -3.671551662623091e-07 + t * series
-    series = -4.880437023294166e-06 + t * series
-    series = -6.845238095238096e-05 + t * series
-    series = -0.0010714285714285715 + t * series
-    series = -0.025 + t * series
+    series = _horner(_SERIES_R_2_x, 18, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -1170,28 +875,7 @@ def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _H_0_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = 3.373091494469352e-23 + 0.0 * x
-    series = 3.6770822088331955e-22 + t * series
-    series = 4.002447216098616e-21 + t * series
-    series = 4.349386634459199e-20 + t * series
-    series = 4.717726508806865e-19 + t * series
-    series = 5.106798451593866e-18 + t * series
-    series = 5.515287671491515e-17 + t * series
-    series = 5.941040609907155e-16 + t * series
-    series = 6.3808204484355186e-15 + t * series
-    series = 6.829994494116056e-14 + t * series
-    series = 7.28213114499937e-13 + t * series
-    series = 7.72847448568504e-12 + t * series
-    series = 8.157249203307483e-11 + t * series
-    series = 8.552722954369029e-10 + t * series
-    series = 8.893908470961609e-09 + t * series
-    series = 9.152703913733326e-08 + t * series
-    series = 9.291101000284673e-07 + t * series
-    series = 9.256715506715507e-06 + t * series
-    series = 8.974953617810761e-05 + t * series
-    series = 0.0008333333333333334 + t * series
-    series = 0.007142857142857143 + t * series
-    series = 0.05 + t * series
+    series = _horner(_SERIES_H_0_x, 22, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -1206,28 +890,7 @@ _H_1_x_32 = _R_2_x_32  # the same code
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = 2.892762495883202e-24 + 0.0 * x
-    series = 3.1482187281713954e-23 + t * series
-    series = 3.420541589612275e-22 + t * series
-    series = 3.7095852246767656e-21 + t * series
-    series = 4.0148184318084914e-20 + t * series
-    series = 4.33520814322793e-19 + t * series
-    series = 4.669072870028677e-18 + t * series
-    series = 5.0138978831741045e-17 + t * series
-    series = 5.366101196045172e-16 + t * series
-    series = 5.720735574459431e-15 + t * series
-    series = 6.07110621699205e-14 + t * series
-    series = 6.408275407599445e-13 + t * series
-    series = 6.7204125962478614e-12 + t * series
-    series = 6.991927888549271e-11 + t * series
-    series = 7.202293014205498e-10 + t * series
-    series = 7.324395211380149e-09 + t * series
-    series = 7.32216313098666e-08 + t * series
-    series = 7.147000769449749e-07 + t * series
-    series = 6.732156732156732e-06 + t * series
-    series = 5.983302411873841e-05 + t * series
-    series = 0.0004761904761904762 + t * series
-    series = 0.002857142857142857 + t * series
+    series = _horner(_SERIES_H_2_x, 22, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -1245,24 +908,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_0_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = -6.315600653020195e-21 + 0.0 * x
-    series = -7.396110286959959e-20 + t * series
-    series = -8.683469103988305e-19 + t * series
-    series = -1.0224187860604788e-17 + t * series
-    series = -1.207771859033198e-16 + t * series
-    series = -1.4321083368003567e-15 + t * series
-    series = -1.7055656901807745e-14 + t * series
-    series = -2.0417396933193335e-13 + t * series
-    series = -2.4592808133854965e-12 + t * series
-    series = -2.9844879309052296e-11 + t * series
-    series = -3.65573324363898e-10 + t * series
-    series = -4.531479857547785e-09 + t * series
-    series = -5.705962593717696e-08 + t * series
-    series = -7.343103325246182e-07 + t * series
-    series = -9.760874046588332e-06 + t * series
-    series = -0.0001369047619047619 + t * series
-    series = -0.002142857142857143 + t * series
-    series = -0.05 + t * series
+    series = _horner(_SERIES_H_inverse_0_x, 18, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -1278,28 +924,7 @@ _H_inverse_1_x_32 = _R_0_x_64  # the same code
 def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 4.619481091176478
     t = _where(small, x, 0.0)
-    series = 6.497844255354877e-25 + 0.0 * x
-    series = 7.196733448736306e-24 + t * series
-    series = 7.96467075122581e-23 + t * series
-    series = 8.807039512596957e-22 + t * series
-    series = 9.729237867259716e-21 + t * series
-    series = 1.0736521110134332e-19 + t * series
-    series = 1.1833776459135935e-18 + t * series
-    series = 1.3025203655982459e-17 + t * series
-    series = 1.4313863004846702e-16 + t * series
-    series = 1.5701034167431574e-15 + t * series
-    series = 1.718530004160428e-14 + t * series
-    series = 1.8761222591988522e-13 + t * series
-    series = 2.0417396933193335e-12 + t * series
-    series = 2.213352732046947e-11 + t * series
-    series = 2.3875903447241837e-10 + t * series
-    series = 2.559013270547286e-09 + t * series
-    series = 2.7188879145286708e-08 + t * series
-    series = 2.852981296858848e-07 + t * series
-    series = 2.937241330098473e-06 + t * series
-    series = 2.9282622139764997e-05 + t * series
-    series = 0.0002738095238095238 + t * series
-    series = 0.002142857142857143 + t * series
+    series = _horner(_SERIES_H_inverse_2_x, 22, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -1316,13 +941,7 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 1.4342812011199078
     t = _where(small, x, 0.0)
-    series = -1.2203463534465907e-08 + 0.0 * x
-    series = -1.8955121406990826e-07 + t * series
-    series = -3.189329117063492e-06 + t * series
-    series = -6.138392857142858e-05 + t * series
-    series = -0.0015625 + t * series
-    series = -0.125 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 7, t, x)
     cos_half = _where(small, 0.8173046507362676, cos_half)
     closed = cos_half
     return _where(small, series, closed)
@@ -1331,12 +950,7 @@ def _e_0_32(x, phi, s, d, sin_half, cos_half):
 def _ratio_32(t, phi):
     small = t < 5.567347935831094
     t = _where(small, t, 0.0)
-    series = 1.0461319985129509e-11 + 0.0 * t
-    series = 2.863098101193339e-09 + t * series
-    series = t * series
-    series = 0.00011904761904761905 + t * series
-    series = -0.016666666666666666 + t * series
-    series = t * series
+    series = _horner(_SERIES_ratio, 6, t, t)
     phi = _where(small, 2.3595228756885396, phi)
     w0 = (0.5)*phi
     closed = -1 + _cbrt(6*phi - 12*_xp.sin(w0)*_xp.cos(w0))/phi
@@ -1346,13 +960,7 @@ def _ratio_32(t, phi):
 def _slope_32(t, phi):
     small = t < 5.567347935831094
     t = _where(small, t, 0.0)
-    series = -2.0961968240879805e-12 + 0.0 * t
-    series = 1.150745198364246e-10 + t * series
-    series = 2.5767882910740054e-08 + t * series
-    series = t * series
-    series = 0.0005952380952380953 + t * series
-    series = -0.05 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_slope, 7, t, t)
     phi = _where(small, 2.3595228756885396, phi)
     w0 = (0.5)*phi
     w1 = _xp.sin(w0)
@@ -1362,43 +970,10 @@ def _slope_32(t, phi):
 
 def _newton_32(s):
     s2 = s * s
-    start = 8.716860870222215e-10 + 0.0 * s
-    start = 1.1911667949082915e-08 + s2 * start
-    start = 1.683039183039183e-07 + s2 * start
-    start = 2.4930426716141e-06 + s2 * start
-    start = 3.968253968253968e-05 + s2 * start
-    start = 0.0007142857142857143 + s2 * start
-    start = 0.016666666666666666 + s2 * start
-    start = 1.0 + s2 * start
+    start = _horner(_SERIES_angle_start, 8, s2, s)
     v = 1.0 - _cbrt(_xp.clip(1.0 - s / 3.3530783864394875, 0.0, None))
     y = 2.0 * v - 1.0
-    b1 = 0.0 * y
-    b2 = 0.0 * y
-    b1, b2 = -2.3596965627293182e-12 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 9.169395645513856e-12 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -2.3537557740900345e-11 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 7.098545744185871e-11 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.971054960712895e-10 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 5.702343301346788e-10 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.6292939581260258e-09 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 4.7095346659018245e-09 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.3631401940270963e-08 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.978329879961088e-08 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.1650659674300742e-07 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.452715616234165e-07 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -1.0246803513530182e-06 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.1093060613898743e-06 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -9.371131981585395e-06 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 2.9515258898711766e-05 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -9.057404840855562e-05 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 0.00030749343680560177 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -0.0009251648317959207 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 0.003881973729847049 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -0.01092341396124625 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 0.058935024871047986 + 2.0 * y * b1 - b2, b1
-    b1, b2 = -0.27270647771411743 + 2.0 * y * b1 - b2, b1
-    b1, b2 = 3.078435146612714 + 2.0 * y * b1 - b2, b1
-    far = 3.4262488119907286 + y * b1 - b2
+    far = _clenshaw(_SERIES_angle_far, y)
     phi = _where(s < 0.6986294588918609, s * start, far)
     phi = _xp.clip(phi, 0.0, 6.25897216796875)
     low = 0.0 * s
@@ -1423,12 +998,7 @@ def _scale_32(e0, e_norm):
     t = phi * phi
     small = t < 1.5011636704730478
     t = _where(small, t, 0.0)
-    series = 2.2216922909817254e-08 + 0.0 * t
-    series = 8.677535881776953e-07 + t * series
-    series = 3.348214285714286e-05 + t * series
-    series = 0.0012797619047619049 + t * series
-    series = 0.05 + t * series
-    series = 2.0 + t * series
+    series = _horner(_SERIES_scale, 6, t, t)
     phi = _where(small, 1.2252198223940611, phi)
     closed = _cbrt(6*phi - 6*_xp.sin(phi))/_xp.sin((0.5)*phi)
     return _narrow(_where(small, series, closed), e0)
@@ -1598,6 +1168,27 @@ def _complement(p, x):
             high = total
         value = high + low
     return _stop(value) + (_stop(x) - x)
+
+
+def _horner(coefficients, terms, t, like):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner, with the shape of ``like``; a
+    zero term only multiplies."""
+    series = coefficients[terms - 1] + 0.0 * like
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = 0.0 * y
+    b2 = 0.0 * y
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
 
 
 def _length(p, x, suffix):

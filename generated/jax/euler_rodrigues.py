@@ -149,6 +149,11 @@ def _implicit_angle(newton, slope):
 
 P_MAX = 2.0
 P_MAX_SQUARED = 4.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
+_SERIES_K_2 = (  # Taylor coefficients, constant term first
+    0.0625, 0.01171875, 0.00244140625,
+    0.0005340576171875, 0.0001201629638671875, 2.753734588623047e-05,
+    6.3925981521606445e-06, 1.498265191912651e-06,
+)
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
@@ -220,14 +225,7 @@ _K_1_64 = _G_2_64  # the same code
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.03462813501506714
     t = _where(small, x, 0.0)
-    series = 1.498265191912651e-06 + 0.0 * x
-    series = 6.3925981521606445e-06 + t * series
-    series = 2.753734588623047e-05 + t * series
-    series = 0.0001201629638671875 + t * series
-    series = 0.0005340576171875 + t * series
-    series = 0.00244140625 + t * series
-    series = 0.01171875 + t * series
-    series = 0.0625 + t * series
+    series = _horner(_SERIES_K_2, 8, t, x)
     d = _where(small, 3.9653718649849328, d)
     w0 = _sqrt(d)
     closed = (0.25)/(w0*((0.5)*w0 + 1))
@@ -355,14 +353,7 @@ _K_1_32 = _G_2_32  # the same code
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.412709807020161
     t = _where(small, x, 0.0)
-    series = 1.498265191912651e-06 + 0.0 * x
-    series = 6.3925981521606445e-06 + t * series
-    series = 2.753734588623047e-05 + t * series
-    series = 0.0001201629638671875 + t * series
-    series = 0.0005340576171875 + t * series
-    series = 0.00244140625 + t * series
-    series = 0.01171875 + t * series
-    series = 0.0625 + t * series
+    series = _horner(_SERIES_K_2, 8, t, x)
     d = _where(small, 3.587290192979839, d)
     w0 = _sqrt(d)
     closed = (0.25)/(w0*((0.5)*w0 + 1))
@@ -588,6 +579,27 @@ def _complement(p, x):
             high = total
         value = high + low
     return _stop(value) + (_stop(x) - x)
+
+
+def _horner(coefficients, terms, t, like):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner, with the shape of ``like``; a
+    zero term only multiplies."""
+    series = coefficients[terms - 1] + 0.0 * like
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = 0.0 * y
+    b2 = 0.0 * y
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
 
 
 def _length(p, x, suffix):

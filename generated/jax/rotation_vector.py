@@ -149,6 +149,96 @@ def _implicit_angle(newton, slope):
 
 P_MAX = 6.283185307179586
 P_MAX_SQUARED = 39.47841760435743  # fl(p_max^2); inside the range: x = |p|^2 <= P_MAX_SQUARED
+_SERIES_nu = (  # Taylor coefficients, constant term first
+    1.0, -0.041666666666666664, 0.0005208333333333333,
+    -3.1001984126984127e-06, 1.076457782186949e-08, -2.446494959515793e-11,
+    3.920664999224027e-14, -4.667458332409556e-17,
+)
+_SERIES_epsilon = (  # Taylor coefficients, constant term first
+    1.0, 0.08333333333333333, 0.008333333333333333,
+    0.0008432539682539683, 8.542768959435626e-05, 8.655503447170115e-06,
+    8.769843839288284e-07, 8.885707928780019e-08,
+)
+_SERIES_det_H = (  # Taylor coefficients, constant term first
+    1.0, -0.08333333333333333, 0.002777777777777778,
+    -4.96031746031746e-05, 5.511463844797178e-07, -4.17535139757362e-09,
+    2.294149119545945e-11, -9.55895466477477e-14,
+)
+_SERIES_R_1 = (  # Taylor coefficients, constant term first
+    1.0, -0.16666666666666666, 0.008333333333333333,
+    -0.0001984126984126984, 2.7557319223985893e-06, -2.505210838544172e-08,
+    1.6059043836821613e-10, -7.647163731819816e-13,
+)
+_SERIES_R_2 = (  # Taylor coefficients, constant term first
+    0.5, -0.041666666666666664, 0.001388888888888889,
+    -2.48015873015873e-05, 2.755731922398589e-07, -2.08767569878681e-09,
+    1.1470745597729725e-11, -4.779477332387385e-14,
+)
+_SERIES_H_2 = (  # Taylor coefficients, constant term first
+    0.16666666666666666, -0.008333333333333333, 0.0001984126984126984,
+    -2.7557319223985893e-06, 2.505210838544172e-08, -1.6059043836821613e-10,
+    7.647163731819816e-13, -2.8114572543455206e-15,
+)
+_SERIES_H_inverse_2 = (  # Taylor coefficients, constant term first
+    0.08333333333333333, 0.001388888888888889, 3.306878306878307e-05,
+    8.267195767195768e-07, 2.08767569878681e-08, 5.284190138687493e-10,
+    1.3382536530684679e-11, 3.3896802963225827e-13, 8.586062056277845e-15,
+    2.174868698558062e-16, 5.5090028283602295e-18, 1.3954464685812522e-19,
+    3.534707039629467e-21, 8.953517427037546e-23, 2.267952452337683e-24,
+    5.744790668872202e-26, 1.455172475614865e-27, 3.6859949406653103e-29,
+    9.336734257095045e-31,
+)
+_SERIES_G_1 = (  # Taylor coefficients, constant term first
+    0.5, -0.020833333333333332, 0.00026041666666666666,
+    -1.5500992063492063e-06, 5.382288910934745e-09, -1.2232474797578965e-11,
+    1.9603324996120133e-14, -2.333729166204778e-17,
+)
+_SERIES_G_2 = (  # Taylor coefficients, constant term first
+    0.125, -0.0026041666666666665, 2.170138888888889e-05,
+    -9.68812003968254e-08, 2.691144455467372e-10, -5.096864498991235e-13,
+    7.001187498614334e-16, -7.292903644389931e-19,
+)
+_SERIES_K_2 = (  # Taylor coefficients, constant term first
+    0.020833333333333332, -0.00026041666666666666, 1.5500992063492063e-06,
+    -5.382288910934745e-09, 1.2232474797578965e-11, -1.9603324996120133e-14,
+    2.333729166204778e-17, -2.1449716601146855e-20, 1.5679617398499164e-23,
+)
+_SERIES_R_1_x = (  # Taylor coefficients, constant term first
+    -0.16666666666666666, 0.016666666666666666, -0.0005952380952380953,
+    1.1022927689594357e-05, -1.252605419272086e-07, 9.635426302092969e-10,
+    -5.353014612273871e-12, 2.2491658034764165e-14, -7.398571721961897e-17,
+)
+_SERIES_R_2_x = (  # Taylor coefficients, constant term first
+    -0.041666666666666664, 0.002777777777777778, -7.440476190476191e-05,
+    1.1022927689594355e-06, -1.043837849393405e-08, 6.882447358637835e-11,
+    -3.3456341326711696e-13, 1.249536557486898e-15, -3.6992858609809485e-18,
+    8.896791392450573e-21, -1.77291132820573e-23, 2.975515515869757e-26,
+)
+_SERIES_H_2_x = (  # Taylor coefficients, constant term first
+    -0.008333333333333333, 0.0003968253968253968, -8.267195767195768e-06,
+    1.0020843354176688e-07, -8.029521918410807e-10, 4.58829823909189e-12,
+    -1.9680200780418645e-14, 6.576508197299464e-17, -1.7615646957052136e-19,
+    3.868170170630684e-22, -7.091645312822921e-25,
+)
+_SERIES_H_inverse_2_x = (  # Taylor coefficients, constant term first
+    0.001388888888888889, 6.613756613756614e-05, 2.48015873015873e-06,
+    8.35070279514724e-08, 2.6420950693437467e-09, 8.029521918410807e-11,
+    2.372776207425808e-12, 6.868849645022276e-14, 1.9573818287022555e-15,
+    5.5090028283602297e-17, 1.5349911154393775e-18, 4.241648447555361e-20,
+    1.163957265514881e-21, 3.1751334332727565e-23, 8.617186003308303e-25,
+    2.328275960983784e-26, 6.266191399131027e-28, 1.6806121662771081e-29,
+    4.4935425898311966e-31, 1.1981343524964268e-32, 3.1866552573834097e-34,
+)
+_SERIES_e_0 = (  # Taylor coefficients, constant term first
+    1.0, -0.125, 0.0026041666666666665,
+    -2.170138888888889e-05, 9.68812003968254e-08, -2.691144455467372e-10,
+    5.096864498991235e-13, -7.001187498614334e-16,
+)
+_SERIES_scale = (  # Taylor coefficients, constant term first
+    2.0, 0.08333333333333333, 0.0024305555555555556,
+    6.407076719576719e-05, 1.6405216600529101e-06, 4.1671964143752336e-08,
+    1.0563219935442674e-09, 2.676180584053667e-11,
+)
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
@@ -158,14 +248,7 @@ def _p_prime_64(x, phi, s, d, sin_half, cos_half):
 def _nu_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.5083706105984371
     t = _where(small, x, 0.0)
-    series = -4.667458332409556e-17 + 0.0 * x
-    series = 3.920664999224027e-14 + t * series
-    series = -2.446494959515793e-11 + t * series
-    series = 1.076457782186949e-08 + t * series
-    series = -3.1001984126984127e-06 + t * series
-    series = 0.0005208333333333333 + t * series
-    series = -0.041666666666666664 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_nu, 8, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = 2*sin_half/phi
@@ -175,14 +258,7 @@ def _nu_64(x, phi, s, d, sin_half, cos_half):
 def _epsilon_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.057631146012210005
     t = _where(small, x, 0.0)
-    series = 8.885707928780019e-08 + 0.0 * x
-    series = 8.769843839288284e-07 + t * series
-    series = 8.655503447170115e-06 + t * series
-    series = 8.542768959435626e-05 + t * series
-    series = 0.0008432539682539683 + t * series
-    series = 0.008333333333333333 + t * series
-    series = 0.08333333333333333 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_epsilon, 8, t, x)
     phi = _where(small, 0.24006487875616042, phi)
     closed = 2*_xp.tan((0.5)*phi)/phi
     return _where(small, series, closed)
@@ -194,14 +270,7 @@ _mu_64 = _p_prime_64  # the same code
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.7851233626304374
     t = _where(small, x, 0.0)
-    series = -9.55895466477477e-14 + 0.0 * x
-    series = 2.294149119545945e-11 + t * series
-    series = -4.17535139757362e-09 + t * series
-    series = 5.511463844797178e-07 + t * series
-    series = -4.96031746031746e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.08333333333333333 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_det_H, 8, t, x)
     phi = _where(small, 0.886071872158482, phi)
     sin_half = _where(small, 0.42868426614277505, sin_half)
     closed = 4*sin_half**2/phi**2
@@ -214,14 +283,7 @@ _R_0_64 = _p_prime_64  # the same code
 def _R_1_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.4086652777619188
     t = _where(small, x, 0.0)
-    series = -7.647163731819816e-13 + 0.0 * x
-    series = 1.6059043836821613e-10 + t * series
-    series = -2.505210838544172e-08 + t * series
-    series = 2.7557319223985893e-06 + t * series
-    series = -0.0001984126984126984 + t * series
-    series = 0.008333333333333333 + t * series
-    series = -0.16666666666666666 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_R_1, 8, t, x)
     phi = _where(small, 0.6392693311601291, phi)
     sin_half = _where(small, 0.3142197512605053, sin_half)
     cos_half = _where(small, 0.9493502767249747, cos_half)
@@ -232,14 +294,7 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half):
 def _R_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.7851233626304374
     t = _where(small, x, 0.0)
-    series = -4.779477332387385e-14 + 0.0 * x
-    series = 1.1470745597729725e-11 + t * series
-    series = -2.08767569878681e-09 + t * series
-    series = 2.755731922398589e-07 + t * series
-    series = -2.48015873015873e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = -0.041666666666666664 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_R_2, 8, t, x)
     phi = _where(small, 0.886071872158482, phi)
     sin_half = _where(small, 0.42868426614277505, sin_half)
     closed = 2*sin_half**2/phi**2
@@ -255,14 +310,7 @@ _H_1_64 = _R_2_64  # the same code
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.7851233626304374
     t = _where(small, x, 0.0)
-    series = -2.8114572543455206e-15 + 0.0 * x
-    series = 7.647163731819816e-13 + t * series
-    series = -1.6059043836821613e-10 + t * series
-    series = 2.505210838544172e-08 + t * series
-    series = -2.7557319223985893e-06 + t * series
-    series = 0.0001984126984126984 + t * series
-    series = -0.008333333333333333 + t * series
-    series = 0.16666666666666666 + t * series
+    series = _horner(_SERIES_H_2, 8, t, x)
     phi = _where(small, 0.886071872158482, phi)
     closed = (phi - _xp.sin(phi))/phi**3
     return _where(small, series, closed)
@@ -278,25 +326,7 @@ def _H_inverse_1_64(x, phi, s, d, sin_half, cos_half):
 def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 5.5673482008975155
     t = _where(small, x, 0.0)
-    series = 9.336734257095045e-31 + 0.0 * x
-    series = 3.6859949406653103e-29 + t * series
-    series = 1.455172475614865e-27 + t * series
-    series = 5.744790668872202e-26 + t * series
-    series = 2.267952452337683e-24 + t * series
-    series = 8.953517427037546e-23 + t * series
-    series = 3.534707039629467e-21 + t * series
-    series = 1.3954464685812522e-19 + t * series
-    series = 5.5090028283602295e-18 + t * series
-    series = 2.174868698558062e-16 + t * series
-    series = 8.586062056277845e-15 + t * series
-    series = 3.3896802963225827e-13 + t * series
-    series = 1.3382536530684679e-11 + t * series
-    series = 5.284190138687493e-10 + t * series
-    series = 2.08767569878681e-08 + t * series
-    series = 8.267195767195768e-07 + t * series
-    series = 3.306878306878307e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = 0.08333333333333333 + t * series
+    series = _horner(_SERIES_H_inverse_2, 19, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -310,14 +340,7 @@ _G_0_64 = _p_prime_64  # the same code
 def _G_1_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.5083706105984371
     t = _where(small, x, 0.0)
-    series = -2.333729166204778e-17 + 0.0 * x
-    series = 1.9603324996120133e-14 + t * series
-    series = -1.2232474797578965e-11 + t * series
-    series = 5.382288910934745e-09 + t * series
-    series = -1.5500992063492063e-06 + t * series
-    series = 0.00026041666666666666 + t * series
-    series = -0.020833333333333332 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_G_1, 8, t, x)
     phi = _where(small, 1.2281574046507382, phi)
     sin_half = _where(small, 0.5762057860563947, sin_half)
     closed = sin_half/phi
@@ -327,14 +350,7 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 2.897865491219683
     t = _where(small, x, 0.0)
-    series = -7.292903644389931e-19 + 0.0 * x
-    series = 7.001187498614334e-16 + t * series
-    series = -5.096864498991235e-13 + t * series
-    series = 2.691144455467372e-10 + t * series
-    series = -9.68812003968254e-08 + t * series
-    series = 2.170138888888889e-05 + t * series
-    series = -0.0026041666666666665 + t * series
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 8, t, x)
     phi = _where(small, 1.7023118078717785, phi)
     closed = 2*_xp.sin((0.25)*phi)**2/phi**2
     return _where(small, series, closed)
@@ -350,15 +366,7 @@ _K_1_64 = _G_2_64  # the same code
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 5.5673482008975155
     t = _where(small, x, 0.0)
-    series = 1.5679617398499164e-23 + 0.0 * x
-    series = -2.1449716601146855e-20 + t * series
-    series = 2.333729166204778e-17 + t * series
-    series = -1.9603324996120133e-14 + t * series
-    series = 1.2232474797578965e-11 + t * series
-    series = -5.382288910934745e-09 + t * series
-    series = 1.5500992063492063e-06 + t * series
-    series = -0.00026041666666666666 + t * series
-    series = 0.020833333333333332 + t * series
+    series = _horner(_SERIES_K_2, 9, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     closed = (0.5)*(phi - 2*sin_half)/phi**3
@@ -372,15 +380,7 @@ def _R_0_x_64(x, phi, s, d, sin_half, cos_half):
 def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.7851233626304374
     t = _where(small, x, 0.0)
-    series = -7.398571721961897e-17 + 0.0 * x
-    series = 2.2491658034764165e-14 + t * series
-    series = -5.353014612273871e-12 + t * series
-    series = 9.635426302092969e-10 + t * series
-    series = -1.252605419272086e-07 + t * series
-    series = 1.1022927689594357e-05 + t * series
-    series = -0.0005952380952380953 + t * series
-    series = 0.016666666666666666 + t * series
-    series = -0.16666666666666666 + t * series
+    series = _horner(_SERIES_R_1_x, 9, t, x)
     phi = _where(small, 0.886071872158482, phi)
     closed = (0.5)*(_xp.cos(phi) - _xp.sin(phi)/phi)/phi**2
     return _where(small, series, closed)
@@ -389,18 +389,7 @@ def _R_1_x_64(x, phi, s, d, sin_half, cos_half):
 def _R_2_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 5.5673482008975155
     t = _where(small, x, 0.0)
-    series = 2.975515515869757e-26 + 0.0 * x
-    series = -1.77291132820573e-23 + t * series
-    series = 8.896791392450573e-21 + t * series
-    series = -3.6992858609809485e-18 + t * series
-    series = 1.249536557486898e-15 + t * series
-    series = -3.3456341326711696e-13 + t * series
-    series = 6.882447358637835e-11 + t * series
-    series = -1.043837849393405e-08 + t * series
-    series = 1.1022927689594355e-06 + t * series
-    series = -7.440476190476191e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.041666666666666664 + t * series
+    series = _horner(_SERIES_R_2_x, 12, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -417,17 +406,7 @@ _H_1_x_64 = _R_2_x_64  # the same code
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 5.5673482008975155
     t = _where(small, x, 0.0)
-    series = -7.091645312822921e-25 + 0.0 * x
-    series = 3.868170170630684e-22 + t * series
-    series = -1.7615646957052136e-19 + t * series
-    series = 6.576508197299464e-17 + t * series
-    series = -1.9680200780418645e-14 + t * series
-    series = 4.58829823909189e-12 + t * series
-    series = -8.029521918410807e-10 + t * series
-    series = 1.0020843354176688e-07 + t * series
-    series = -8.267195767195768e-06 + t * series
-    series = 0.0003968253968253968 + t * series
-    series = -0.008333333333333333 + t * series
+    series = _horner(_SERIES_H_2_x, 11, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     closed = (0.5)*(-_xp.cos(phi) + 1 - 3*(phi - _xp.sin(phi))/phi)/phi**4
     return _where(small, series, closed)
@@ -442,27 +421,7 @@ _H_inverse_1_x_64 = _R_0_x_64  # the same code
 def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 5.5673482008975155
     t = _where(small, x, 0.0)
-    series = 3.1866552573834097e-34 + 0.0 * x
-    series = 1.1981343524964268e-32 + t * series
-    series = 4.4935425898311966e-31 + t * series
-    series = 1.6806121662771081e-29 + t * series
-    series = 6.266191399131027e-28 + t * series
-    series = 2.328275960983784e-26 + t * series
-    series = 8.617186003308303e-25 + t * series
-    series = 3.1751334332727565e-23 + t * series
-    series = 1.163957265514881e-21 + t * series
-    series = 4.241648447555361e-20 + t * series
-    series = 1.5349911154393775e-18 + t * series
-    series = 5.5090028283602297e-17 + t * series
-    series = 1.9573818287022555e-15 + t * series
-    series = 6.868849645022276e-14 + t * series
-    series = 2.372776207425808e-12 + t * series
-    series = 8.029521918410807e-11 + t * series
-    series = 2.6420950693437467e-09 + t * series
-    series = 8.35070279514724e-08 + t * series
-    series = 2.48015873015873e-06 + t * series
-    series = 6.613756613756614e-05 + t * series
-    series = 0.001388888888888889 + t * series
+    series = _horner(_SERIES_H_inverse_2_x, 21, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -474,14 +433,7 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 1.5083706105984371
     t = _where(small, x, 0.0)
-    series = -7.001187498614334e-16 + 0.0 * x
-    series = 5.096864498991235e-13 + t * series
-    series = -2.691144455467372e-10 + t * series
-    series = 9.68812003968254e-08 + t * series
-    series = -2.170138888888889e-05 + t * series
-    series = 0.0026041666666666665 + t * series
-    series = -0.125 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 8, t, x)
     cos_half = _where(small, 0.8173046507362676, cos_half)
     closed = cos_half
     return _where(small, series, closed)
@@ -492,14 +444,7 @@ def _scale_64(e0, e_norm):
     t = phi * phi
     small = t < 0.22832695303370731
     t = _where(small, t, 0.0)
-    series = 2.676180584053667e-11 + 0.0 * t
-    series = 1.0563219935442674e-09 + t * series
-    series = 4.1671964143752336e-08 + t * series
-    series = 1.6405216600529101e-06 + t * series
-    series = 6.407076719576719e-05 + t * series
-    series = 0.0024305555555555556 + t * series
-    series = 0.08333333333333333 + t * series
-    series = 2.0 + t * series
+    series = _horner(_SERIES_scale, 8, t, t)
     phi = _where(small, 0.4778356966926051, phi)
     closed = phi/_xp.sin((0.5)*phi)
     return _where(small, series, closed)
@@ -511,12 +456,7 @@ _p_prime_32 = _p_prime_64  # the same code
 def _nu_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = -2.446494959515793e-11 + 0.0 * x
-    series = 1.076457782186949e-08 + t * series
-    series = -3.1001984126984127e-06 + t * series
-    series = 0.0005208333333333333 + t * series
-    series = -0.041666666666666664 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_nu, 6, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     closed = 2*sin_half/phi
@@ -526,13 +466,7 @@ def _nu_32(x, phi, s, d, sin_half, cos_half):
 def _epsilon_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.7851233424843009
     t = _where(small, x, 0.0)
-    series = 8.769843839288284e-07 + 0.0 * x
-    series = 8.655503447170115e-06 + t * series
-    series = 8.542768959435626e-05 + t * series
-    series = 0.0008432539682539683 + t * series
-    series = 0.008333333333333333 + t * series
-    series = 0.08333333333333333 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_epsilon, 7, t, x)
     phi = _where(small, 0.886071872158482, phi)
     closed = 2*_xp.tan((0.5)*phi)/phi
     return _where(small, series, closed)
@@ -544,13 +478,7 @@ _mu_32 = _p_prime_64  # the same code
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = 2.294149119545945e-11 + 0.0 * x
-    series = -4.17535139757362e-09 + t * series
-    series = 5.511463844797178e-07 + t * series
-    series = -4.96031746031746e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.08333333333333333 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_det_H, 7, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     closed = 4*sin_half**2/phi**2
@@ -563,14 +491,7 @@ _R_0_32 = _p_prime_64  # the same code
 def _R_1_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = -7.647163731819816e-13 + 0.0 * x
-    series = 1.6059043836821613e-10 + t * series
-    series = -2.505210838544172e-08 + t * series
-    series = 2.7557319223985893e-06 + t * series
-    series = -0.0001984126984126984 + t * series
-    series = 0.008333333333333333 + t * series
-    series = -0.16666666666666666 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_R_1, 8, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -581,13 +502,7 @@ def _R_1_32(x, phi, s, d, sin_half, cos_half):
 def _R_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = 1.1470745597729725e-11 + 0.0 * x
-    series = -2.08767569878681e-09 + t * series
-    series = 2.755731922398589e-07 + t * series
-    series = -2.48015873015873e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = -0.041666666666666664 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_R_2, 7, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     closed = 2*sin_half**2/phi**2
@@ -603,13 +518,7 @@ _H_1_32 = _R_2_32  # the same code
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = 7.647163731819816e-13 + 0.0 * x
-    series = -1.6059043836821613e-10 + t * series
-    series = 2.505210838544172e-08 + t * series
-    series = -2.7557319223985893e-06 + t * series
-    series = 0.0001984126984126984 + t * series
-    series = -0.008333333333333333 + t * series
-    series = 0.16666666666666666 + t * series
+    series = _horner(_SERIES_H_2, 7, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     closed = (phi - _xp.sin(phi))/phi**3
     return _where(small, series, closed)
@@ -624,15 +533,7 @@ _H_inverse_1_32 = _H_inverse_1_64  # the same code
 def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = 8.586062056277845e-15 + 0.0 * x
-    series = 3.3896802963225827e-13 + t * series
-    series = 1.3382536530684679e-11 + t * series
-    series = 5.284190138687493e-10 + t * series
-    series = 2.08767569878681e-08 + t * series
-    series = 8.267195767195768e-07 + t * series
-    series = 3.306878306878307e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = 0.08333333333333333 + t * series
+    series = _horner(_SERIES_H_inverse_2, 9, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -646,12 +547,7 @@ _G_0_32 = _p_prime_64  # the same code
 def _G_1_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = -1.2232474797578965e-11 + 0.0 * x
-    series = 5.382288910934745e-09 + t * series
-    series = -1.5500992063492063e-06 + t * series
-    series = 0.00026041666666666666 + t * series
-    series = -0.020833333333333332 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_G_1, 6, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     closed = sin_half/phi
@@ -661,11 +557,7 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = 2.691144455467372e-10 + 0.0 * x
-    series = -9.68812003968254e-08 + t * series
-    series = 2.170138888888889e-05 + t * series
-    series = -0.0026041666666666665 + t * series
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 5, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     closed = 2*_xp.sin((0.25)*phi)**2/phi**2
     return _where(small, series, closed)
@@ -680,11 +572,7 @@ _K_1_32 = _G_2_32  # the same code
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = 1.2232474797578965e-11 + 0.0 * x
-    series = -5.382288910934745e-09 + t * series
-    series = 1.5500992063492063e-06 + t * series
-    series = -0.00026041666666666666 + t * series
-    series = 0.020833333333333332 + t * series
+    series = _horner(_SERIES_K_2, 5, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     closed = (0.5)*(phi - 2*sin_half)/phi**3
@@ -697,13 +585,7 @@ _R_0_x_32 = _R_0_x_64  # the same code
 def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = -5.353014612273871e-12 + 0.0 * x
-    series = 9.635426302092969e-10 + t * series
-    series = -1.252605419272086e-07 + t * series
-    series = 1.1022927689594357e-05 + t * series
-    series = -0.0005952380952380953 + t * series
-    series = 0.016666666666666666 + t * series
-    series = -0.16666666666666666 + t * series
+    series = _horner(_SERIES_R_1_x, 7, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -714,13 +596,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half):
 def _R_2_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = -3.3456341326711696e-13 + 0.0 * x
-    series = 6.882447358637835e-11 + t * series
-    series = -1.043837849393405e-08 + t * series
-    series = 1.1022927689594355e-06 + t * series
-    series = -7.440476190476191e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.041666666666666664 + t * series
+    series = _horner(_SERIES_R_2_x, 7, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -737,13 +613,7 @@ _H_1_x_32 = _R_2_x_32  # the same code
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = -1.9680200780418645e-14 + 0.0 * x
-    series = 4.58829823909189e-12 + t * series
-    series = -8.029521918410807e-10 + t * series
-    series = 1.0020843354176688e-07 + t * series
-    series = -8.267195767195768e-06 + t * series
-    series = 0.0003968253968253968 + t * series
-    series = -0.008333333333333333 + t * series
+    series = _horner(_SERIES_H_2_x, 7, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -760,17 +630,7 @@ _H_inverse_1_x_32 = _R_0_x_64  # the same code
 def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = 1.5349911154393775e-18 + 0.0 * x
-    series = 5.5090028283602297e-17 + t * series
-    series = 1.9573818287022555e-15 + t * series
-    series = 6.868849645022276e-14 + t * series
-    series = 2.372776207425808e-12 + t * series
-    series = 8.029521918410807e-11 + t * series
-    series = 2.6420950693437467e-09 + t * series
-    series = 8.35070279514724e-08 + t * series
-    series = 2.48015873015873e-06 + t * series
-    series = 6.613756613756614e-05 + t * series
-    series = 0.001388888888888889 + t * series
+    series = _horner(_SERIES_H_inverse_2_x, 11, t, x)
     phi = _where(small, 2.3595228756885396, phi)
     sin_half = _where(small, 0.9245151118510668, sin_half)
     cos_half = _where(small, 0.3811453895287326, cos_half)
@@ -782,12 +642,7 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 5.567347935831094
     t = _where(small, x, 0.0)
-    series = -2.691144455467372e-10 + 0.0 * x
-    series = 9.68812003968254e-08 + t * series
-    series = -2.170138888888889e-05 + t * series
-    series = 0.0026041666666666665 + t * series
-    series = -0.125 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 6, t, x)
     cos_half = _where(small, 0.3811453895287326, cos_half)
     closed = cos_half
     return _where(small, series, closed)
@@ -798,12 +653,7 @@ def _scale_32(e0, e_norm):
     t = phi * phi
     small = t < 1.5011636704730478
     t = _where(small, t, 0.0)
-    series = 4.1671964143752336e-08 + 0.0 * t
-    series = 1.6405216600529101e-06 + t * series
-    series = 6.407076719576719e-05 + t * series
-    series = 0.0024305555555555556 + t * series
-    series = 0.08333333333333333 + t * series
-    series = 2.0 + t * series
+    series = _horner(_SERIES_scale, 6, t, t)
     phi = _where(small, 1.2252198223940611, phi)
     closed = phi/_xp.sin((0.5)*phi)
     return _narrow(_where(small, series, closed), e0)
@@ -969,6 +819,27 @@ def _complement(p, x):
             high = total
         value = high + low
     return _stop(value) + (_stop(x) - x)
+
+
+def _horner(coefficients, terms, t, like):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner, with the shape of ``like``; a
+    zero term only multiplies."""
+    series = coefficients[terms - 1] + 0.0 * like
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = 0.0 * y
+    b2 = 0.0 * y
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
 
 
 def _length(p, x, suffix):

@@ -577,6 +577,27 @@ def _complement(p, x):
     return _stop(value) + (_stop(x) - x)
 
 
+def _horner(coefficients, terms, t, like):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner, with the shape of ``like``; a
+    zero term only multiplies."""
+    series = coefficients[terms - 1] + 0.0 * like
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = 0.0 * y
+    b2 = 0.0 * y
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
+
+
 def _length(p, x, suffix):
     """|p| from x = |p|^2, or without underflow or overflow where x is extreme."""
     normal = (x >= _TINY[suffix]) & (x <= _HUGE[suffix])

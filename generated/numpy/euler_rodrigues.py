@@ -34,6 +34,9 @@ import numpy
 
 P_MAX = 2.0
 P_MAX_SQUARED = 4.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
+_SERIES_K_2 = (  # Taylor coefficients, constant term first
+    0.0625, 0.01171875,
+)
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -115,8 +118,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.01171875
-    series = 0.0625 + t * series
+    series = _horner(_SERIES_K_2, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -504,6 +506,26 @@ def _complement(p):
         low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
         high = total
     return high + low
+
+
+def _horner(coefficients, terms, t):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner; a zero term only multiplies."""
+    series = coefficients[terms - 1]
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = numpy.zeros_like(y)
+    b2 = numpy.zeros_like(y)
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
 
 
 def _squared_norm(p):

@@ -34,6 +34,34 @@ import numpy
 
 P_MAX = 1.0
 P_MAX_SQUARED = 1.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
+_SERIES_det_H = (  # Taylor coefficients, constant term first
+    1.0, 0.75,
+)
+_SERIES_H_2 = (  # Taylor coefficients, constant term first
+    0.5, 0.375,
+)
+_SERIES_G_2 = (  # Taylor coefficients, constant term first
+    0.125, 0.0390625, 0.0205078125,
+    0.013092041015625, 0.009273529052734375, 0.0070078372955322266,
+    0.005535036325454712, 0.004514514002948999, 0.003773159987758845,
+    0.0032146330158866476, 0.002781492528356466, 0.00243758516411674,
+    0.002159137935754174, 0.0019299437302723321, 0.0017386131018401613,
+    0.0015769325991740776,
+)
+_SERIES_K_2 = (  # Taylor coefficients, constant term first
+    0.1875, 0.16015625, 0.14013671875,
+    0.1258087158203125, 0.11503791809082031, 0.10659372806549072,
+    0.09975479543209076, 0.09407413308508694, 0.08926001159125008,
+    0.08511350962908182, 0.0814939567046622, 0.07829879884435087,
+    0.07545132272815369, 0.07289287133907002, 0.07057773738575546,
+    0.06846971320104332, 0.06653969900370939,
+)
+_SERIES_H_2_x = (  # Taylor coefficients, constant term first
+    0.375, 0.625,
+)
+_SERIES_e_0 = (  # Taylor coefficients, constant term first
+    1.0, -0.125,
+)
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -64,8 +92,7 @@ def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.75
-    series = 1.0 + t * series
+    series = _horner(_SERIES_det_H, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -102,8 +129,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.375
-    series = 0.5 + t * series
+    series = _horner(_SERIES_H_2, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -140,22 +166,7 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.0015769325991740776
-    series = 0.0017386131018401613 + t * series
-    series = 0.0019299437302723321 + t * series
-    series = 0.002159137935754174 + t * series
-    series = 0.00243758516411674 + t * series
-    series = 0.002781492528356466 + t * series
-    series = 0.0032146330158866476 + t * series
-    series = 0.003773159987758845 + t * series
-    series = 0.004514514002948999 + t * series
-    series = 0.005535036325454712 + t * series
-    series = 0.0070078372955322266 + t * series
-    series = 0.009273529052734375 + t * series
-    series = 0.013092041015625 + t * series
-    series = 0.0205078125 + t * series
-    series = 0.0390625 + t * series
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 16, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -181,23 +192,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.06653969900370939
-    series = 0.06846971320104332 + t * series
-    series = 0.07057773738575546 + t * series
-    series = 0.07289287133907002 + t * series
-    series = 0.07545132272815369 + t * series
-    series = 0.07829879884435087 + t * series
-    series = 0.0814939567046622 + t * series
-    series = 0.08511350962908182 + t * series
-    series = 0.08926001159125008 + t * series
-    series = 0.09407413308508694 + t * series
-    series = 0.09975479543209076 + t * series
-    series = 0.10659372806549072 + t * series
-    series = 0.11503791809082031 + t * series
-    series = 0.1258087158203125 + t * series
-    series = 0.14013671875 + t * series
-    series = 0.16015625 + t * series
-    series = 0.1875 + t * series
+    series = _horner(_SERIES_K_2, 17, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -246,8 +241,7 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.625
-    series = 0.375 + t * series
+    series = _horner(_SERIES_H_2_x, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -277,8 +271,7 @@ def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.125
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -396,8 +389,7 @@ def _G_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.0390625
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -425,22 +417,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.06846971320104332
-    series = 0.07057773738575546 + t * series
-    series = 0.07289287133907002 + t * series
-    series = 0.07545132272815369 + t * series
-    series = 0.07829879884435087 + t * series
-    series = 0.0814939567046622 + t * series
-    series = 0.08511350962908182 + t * series
-    series = 0.08926001159125008 + t * series
-    series = 0.09407413308508694 + t * series
-    series = 0.09975479543209076 + t * series
-    series = 0.10659372806549072 + t * series
-    series = 0.11503791809082031 + t * series
-    series = 0.1258087158203125 + t * series
-    series = 0.14013671875 + t * series
-    series = 0.16015625 + t * series
-    series = 0.1875 + t * series
+    series = _horner(_SERIES_K_2, 16, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -494,8 +471,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.625
-    series = 0.375 + t * series
+    series = _horner(_SERIES_H_2_x, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -726,6 +702,26 @@ def _complement(p):
         low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
         high = total
     return high + low
+
+
+def _horner(coefficients, terms, t):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner; a zero term only multiplies."""
+    series = coefficients[terms - 1]
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = numpy.zeros_like(y)
+    b2 = numpy.zeros_like(y)
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
 
 
 def _squared_norm(p):

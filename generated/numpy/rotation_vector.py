@@ -34,6 +34,78 @@ import numpy
 
 P_MAX = 6.283185307179586
 P_MAX_SQUARED = 39.47841760435743  # fl(p_max^2); inside the range: x = |p|^2 <= P_MAX_SQUARED
+_SERIES_nu = (  # Taylor coefficients, constant term first
+    1.0, -0.041666666666666664,
+)
+_SERIES_epsilon = (  # Taylor coefficients, constant term first
+    1.0, 0.08333333333333333,
+)
+_SERIES_det_H = (  # Taylor coefficients, constant term first
+    1.0, -0.08333333333333333,
+)
+_SERIES_R_1 = (  # Taylor coefficients, constant term first
+    1.0, -0.16666666666666666,
+)
+_SERIES_R_2 = (  # Taylor coefficients, constant term first
+    0.5, -0.041666666666666664,
+)
+_SERIES_H_2 = (  # Taylor coefficients, constant term first
+    0.16666666666666666, -0.008333333333333333, 0.0001984126984126984,
+    -2.7557319223985893e-06, 2.505210838544172e-08, -1.6059043836821613e-10,
+    7.647163731819816e-13, -2.8114572543455206e-15,
+)
+_SERIES_H_inverse_2 = (  # Taylor coefficients, constant term first
+    0.08333333333333333, 0.001388888888888889, 3.306878306878307e-05,
+    8.267195767195768e-07, 2.08767569878681e-08, 5.284190138687493e-10,
+    1.3382536530684679e-11, 3.3896802963225827e-13, 8.586062056277845e-15,
+    2.174868698558062e-16, 5.5090028283602295e-18, 1.3954464685812522e-19,
+    3.534707039629467e-21, 8.953517427037546e-23, 2.267952452337683e-24,
+    5.744790668872202e-26, 1.455172475614865e-27, 3.6859949406653103e-29,
+    9.336734257095045e-31,
+)
+_SERIES_G_1 = (  # Taylor coefficients, constant term first
+    0.5, -0.020833333333333332,
+)
+_SERIES_G_2 = (  # Taylor coefficients, constant term first
+    0.125, -0.0026041666666666665,
+)
+_SERIES_K_2 = (  # Taylor coefficients, constant term first
+    0.020833333333333332, -0.00026041666666666666, 1.5500992063492063e-06,
+    -5.382288910934745e-09, 1.2232474797578965e-11, -1.9603324996120133e-14,
+    2.333729166204778e-17, -2.1449716601146855e-20, 1.5679617398499164e-23,
+)
+_SERIES_R_1_x = (  # Taylor coefficients, constant term first
+    -0.16666666666666666, 0.016666666666666666, -0.0005952380952380953,
+    1.1022927689594357e-05, -1.252605419272086e-07, 9.635426302092969e-10,
+    -5.353014612273871e-12, 2.2491658034764165e-14, -7.398571721961897e-17,
+)
+_SERIES_R_2_x = (  # Taylor coefficients, constant term first
+    -0.041666666666666664, 0.002777777777777778, -7.440476190476191e-05,
+    1.1022927689594355e-06, -1.043837849393405e-08, 6.882447358637835e-11,
+    -3.3456341326711696e-13, 1.249536557486898e-15, -3.6992858609809485e-18,
+    8.896791392450573e-21, -1.77291132820573e-23, 2.975515515869757e-26,
+)
+_SERIES_H_2_x = (  # Taylor coefficients, constant term first
+    -0.008333333333333333, 0.0003968253968253968, -8.267195767195768e-06,
+    1.0020843354176688e-07, -8.029521918410807e-10, 4.58829823909189e-12,
+    -1.9680200780418645e-14, 6.576508197299464e-17, -1.7615646957052136e-19,
+    3.868170170630684e-22, -7.091645312822921e-25,
+)
+_SERIES_H_inverse_2_x = (  # Taylor coefficients, constant term first
+    0.001388888888888889, 6.613756613756614e-05, 2.48015873015873e-06,
+    8.35070279514724e-08, 2.6420950693437467e-09, 8.029521918410807e-11,
+    2.372776207425808e-12, 6.868849645022276e-14, 1.9573818287022555e-15,
+    5.5090028283602297e-17, 1.5349911154393775e-18, 4.241648447555361e-20,
+    1.163957265514881e-21, 3.1751334332727565e-23, 8.617186003308303e-25,
+    2.328275960983784e-26, 6.266191399131027e-28, 1.6806121662771081e-29,
+    4.4935425898311966e-31, 1.1981343524964268e-32, 3.1866552573834097e-34,
+)
+_SERIES_e_0 = (  # Taylor coefficients, constant term first
+    1.0, -0.125,
+)
+_SERIES_scale = (  # Taylor coefficients, constant term first
+    2.0, 0.08333333333333333,
+)
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half, span=None):
@@ -52,8 +124,7 @@ def _nu_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.041666666666666664
-    series = 1.0 + t * series
+    series = _horner(_SERIES_nu, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -72,8 +143,7 @@ def _epsilon_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 0.08333333333333333
-    series = 1.0 + t * series
+    series = _horner(_SERIES_epsilon, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -95,8 +165,7 @@ def _det_H_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.08333333333333333
-    series = 1.0 + t * series
+    series = _horner(_SERIES_det_H, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -118,8 +187,7 @@ def _R_1_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.16666666666666666
-    series = 1.0 + t * series
+    series = _horner(_SERIES_R_1, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -138,8 +206,7 @@ def _R_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.041666666666666664
-    series = 0.5 + t * series
+    series = _horner(_SERIES_R_2, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -164,14 +231,7 @@ def _H_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -2.8114572543455206e-15
-    series = 7.647163731819816e-13 + t * series
-    series = -1.6059043836821613e-10 + t * series
-    series = 2.505210838544172e-08 + t * series
-    series = -2.7557319223985893e-06 + t * series
-    series = 0.0001984126984126984 + t * series
-    series = -0.008333333333333333 + t * series
-    series = 0.16666666666666666 + t * series
+    series = _horner(_SERIES_H_2, 8, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -197,25 +257,7 @@ def _H_inverse_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 9.336734257095045e-31
-    series = 3.6859949406653103e-29 + t * series
-    series = 1.455172475614865e-27 + t * series
-    series = 5.744790668872202e-26 + t * series
-    series = 2.267952452337683e-24 + t * series
-    series = 8.953517427037546e-23 + t * series
-    series = 3.534707039629467e-21 + t * series
-    series = 1.3954464685812522e-19 + t * series
-    series = 5.5090028283602295e-18 + t * series
-    series = 2.174868698558062e-16 + t * series
-    series = 8.586062056277845e-15 + t * series
-    series = 3.3896802963225827e-13 + t * series
-    series = 1.3382536530684679e-11 + t * series
-    series = 5.284190138687493e-10 + t * series
-    series = 2.08767569878681e-08 + t * series
-    series = 8.267195767195768e-07 + t * series
-    series = 3.306878306878307e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = 0.08333333333333333 + t * series
+    series = _horner(_SERIES_H_inverse_2, 19, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -237,8 +279,7 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.020833333333333332
-    series = 0.5 + t * series
+    series = _horner(_SERIES_G_1, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -257,8 +298,7 @@ def _G_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.0026041666666666665
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -284,15 +324,7 @@ def _K_2_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 1.5679617398499164e-23
-    series = -2.1449716601146855e-20 + t * series
-    series = 2.333729166204778e-17 + t * series
-    series = -1.9603324996120133e-14 + t * series
-    series = 1.2232474797578965e-11 + t * series
-    series = -5.382288910934745e-09 + t * series
-    series = 1.5500992063492063e-06 + t * series
-    series = -0.00026041666666666666 + t * series
-    series = 0.020833333333333332 + t * series
+    series = _horner(_SERIES_K_2, 9, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -315,15 +347,7 @@ def _R_1_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -7.398571721961897e-17
-    series = 2.2491658034764165e-14 + t * series
-    series = -5.353014612273871e-12 + t * series
-    series = 9.635426302092969e-10 + t * series
-    series = -1.252605419272086e-07 + t * series
-    series = 1.1022927689594357e-05 + t * series
-    series = -0.0005952380952380953 + t * series
-    series = 0.016666666666666666 + t * series
-    series = -0.16666666666666666 + t * series
+    series = _horner(_SERIES_R_1_x, 9, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -342,18 +366,7 @@ def _R_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 2.975515515869757e-26
-    series = -1.77291132820573e-23 + t * series
-    series = 8.896791392450573e-21 + t * series
-    series = -3.6992858609809485e-18 + t * series
-    series = 1.249536557486898e-15 + t * series
-    series = -3.3456341326711696e-13 + t * series
-    series = 6.882447358637835e-11 + t * series
-    series = -1.043837849393405e-08 + t * series
-    series = 1.1022927689594355e-06 + t * series
-    series = -7.440476190476191e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.041666666666666664 + t * series
+    series = _horner(_SERIES_R_2_x, 12, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -378,17 +391,7 @@ def _H_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -7.091645312822921e-25
-    series = 3.868170170630684e-22 + t * series
-    series = -1.7615646957052136e-19 + t * series
-    series = 6.576508197299464e-17 + t * series
-    series = -1.9680200780418645e-14 + t * series
-    series = 4.58829823909189e-12 + t * series
-    series = -8.029521918410807e-10 + t * series
-    series = 1.0020843354176688e-07 + t * series
-    series = -8.267195767195768e-06 + t * series
-    series = 0.0003968253968253968 + t * series
-    series = -0.008333333333333333 + t * series
+    series = _horner(_SERIES_H_2_x, 11, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -414,27 +417,7 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 3.1866552573834097e-34
-    series = 1.1981343524964268e-32 + t * series
-    series = 4.4935425898311966e-31 + t * series
-    series = 1.6806121662771081e-29 + t * series
-    series = 6.266191399131027e-28 + t * series
-    series = 2.328275960983784e-26 + t * series
-    series = 8.617186003308303e-25 + t * series
-    series = 3.1751334332727565e-23 + t * series
-    series = 1.163957265514881e-21 + t * series
-    series = 4.241648447555361e-20 + t * series
-    series = 1.5349911154393775e-18 + t * series
-    series = 5.5090028283602297e-17 + t * series
-    series = 1.9573818287022555e-15 + t * series
-    series = 6.868849645022276e-14 + t * series
-    series = 2.372776207425808e-12 + t * series
-    series = 8.029521918410807e-11 + t * series
-    series = 2.6420950693437467e-09 + t * series
-    series = 8.35070279514724e-08 + t * series
-    series = 2.48015873015873e-06 + t * series
-    series = 6.613756613756614e-05 + t * series
-    series = 0.001388888888888889 + t * series
+    series = _horner(_SERIES_H_inverse_2_x, 21, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -453,8 +436,7 @@ def _e_0_64(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -0.125
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 2, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -472,8 +454,7 @@ def _scale_64(e0, e_norm):
     out = numpy.empty_like(t)
     if small.any():
         t = t[small]
-        series = 0.08333333333333333
-        series = 2.0 + t * series
+        series = _horner(_SERIES_scale, 2, t)
         out[small] = series
     if not small.all():
         big = ~small
@@ -574,11 +555,7 @@ def _H_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 2.505210838544172e-08
-    series = -2.7557319223985893e-06 + t * series
-    series = 0.0001984126984126984 + t * series
-    series = -0.008333333333333333 + t * series
-    series = 0.16666666666666666 + t * series
+    series = _horner(_SERIES_H_2, 5, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -603,15 +580,7 @@ def _H_inverse_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 8.586062056277845e-15
-    series = 3.3896802963225827e-13 + t * series
-    series = 1.3382536530684679e-11 + t * series
-    series = 5.284190138687493e-10 + t * series
-    series = 2.08767569878681e-08 + t * series
-    series = 8.267195767195768e-07 + t * series
-    series = 3.306878306878307e-05 + t * series
-    series = 0.001388888888888889 + t * series
-    series = 0.08333333333333333 + t * series
+    series = _horner(_SERIES_H_inverse_2, 9, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -665,11 +634,7 @@ def _K_2_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 1.2232474797578965e-11
-    series = -5.382288910934745e-09 + t * series
-    series = 1.5500992063492063e-06 + t * series
-    series = -0.00026041666666666666 + t * series
-    series = 0.020833333333333332 + t * series
+    series = _horner(_SERIES_K_2, 5, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -691,12 +656,7 @@ def _R_1_x_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 9.635426302092969e-10
-    series = -1.252605419272086e-07 + t * series
-    series = 1.1022927689594357e-05 + t * series
-    series = -0.0005952380952380953 + t * series
-    series = 0.016666666666666666 + t * series
-    series = -0.16666666666666666 + t * series
+    series = _horner(_SERIES_R_1_x, 6, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -715,13 +675,7 @@ def _R_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -3.3456341326711696e-13
-    series = 6.882447358637835e-11 + t * series
-    series = -1.043837849393405e-08 + t * series
-    series = 1.1022927689594355e-06 + t * series
-    series = -7.440476190476191e-05 + t * series
-    series = 0.002777777777777778 + t * series
-    series = -0.041666666666666664 + t * series
+    series = _horner(_SERIES_R_2_x, 7, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -746,13 +700,7 @@ def _H_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = -1.9680200780418645e-14
-    series = 4.58829823909189e-12 + t * series
-    series = -8.029521918410807e-10 + t * series
-    series = 1.0020843354176688e-07 + t * series
-    series = -8.267195767195768e-06 + t * series
-    series = 0.0003968253968253968 + t * series
-    series = -0.008333333333333333 + t * series
+    series = _horner(_SERIES_H_2_x, 7, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -778,17 +726,7 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half, span=None):
         if not small.any():
             return out
         t = x[small]
-    series = 1.5349911154393775e-18
-    series = 5.5090028283602297e-17 + t * series
-    series = 1.9573818287022555e-15 + t * series
-    series = 6.868849645022276e-14 + t * series
-    series = 2.372776207425808e-12 + t * series
-    series = 8.029521918410807e-11 + t * series
-    series = 2.6420950693437467e-09 + t * series
-    series = 8.35070279514724e-08 + t * series
-    series = 2.48015873015873e-06 + t * series
-    series = 6.613756613756614e-05 + t * series
-    series = 0.001388888888888889 + t * series
+    series = _horner(_SERIES_H_inverse_2_x, 11, t)
     if polynomial:
         return numpy.asarray(series, dtype=x.dtype)
     out[small] = series
@@ -1008,6 +946,26 @@ def _complement(p):
         low = low + ((high - total) - square) - error  # Fast2Sum, exact in range (c_writer)
         high = total
     return high + low
+
+
+def _horner(coefficients, terms, t):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner; a zero term only multiplies."""
+    series = coefficients[terms - 1]
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = numpy.zeros_like(y)
+    b2 = numpy.zeros_like(y)
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
 
 
 def _squared_norm(p):

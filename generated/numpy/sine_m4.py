@@ -513,6 +513,26 @@ def _complement(p):
     return high + low
 
 
+def _horner(coefficients, terms, t):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner; a zero term only multiplies."""
+    series = coefficients[terms - 1]
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = numpy.zeros_like(y)
+    b2 = numpy.zeros_like(y)
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
+
+
 def _squared_norm(p):
     """x = |p|^2 = (p0^2 + p2^2) + p1^2: the one definition of x used by every validity test (the
     summation order of NumPy's einsum on x86-64, used before; written out, it is 3 to 4 times

@@ -199,6 +199,42 @@ def _implicit_angle(newton, slope):
 
 P_MAX = 1.0
 P_MAX_SQUARED = 1.0  # fl(p_max^2); inside the range: x = |p|^2 < P_MAX_SQUARED
+_SERIES_det_H = (  # Taylor coefficients, constant term first
+    1.0, 0.75, 0.625,
+    0.546875, 0.4921875, 0.451171875,
+    0.4189453125, 0.39276123046875,
+)
+_SERIES_H_2 = (  # Taylor coefficients, constant term first
+    0.5, 0.375, 0.3125,
+    0.2734375, 0.24609375, 0.2255859375,
+    0.20947265625, 0.196380615234375,
+)
+_SERIES_G_2 = (  # Taylor coefficients, constant term first
+    0.125, 0.0390625, 0.0205078125,
+    0.013092041015625, 0.009273529052734375, 0.0070078372955322266,
+    0.005535036325454712, 0.004514514002948999, 0.003773159987758845,
+    0.0032146330158866476, 0.002781492528356466, 0.00243758516411674,
+    0.002159137935754174, 0.0019299437302723321, 0.0017386131018401613,
+    0.0015769325991740776,
+)
+_SERIES_K_2 = (  # Taylor coefficients, constant term first
+    0.1875, 0.16015625, 0.14013671875,
+    0.1258087158203125, 0.11503791809082031, 0.10659372806549072,
+    0.09975479543209076, 0.09407413308508694, 0.08926001159125008,
+    0.08511350962908182, 0.0814939567046622, 0.07829879884435087,
+    0.07545132272815369, 0.07289287133907002, 0.07057773738575546,
+    0.06846971320104332, 0.06653969900370939,
+)
+_SERIES_H_2_x = (  # Taylor coefficients, constant term first
+    0.375, 0.625, 0.8203125,
+    0.984375, 1.1279296875, 1.2568359375,
+    1.374664306640625, 1.4837646484375,
+)
+_SERIES_e_0 = (  # Taylor coefficients, constant term first
+    1.0, -0.125, -0.0390625,
+    -0.0205078125, -0.013092041015625, -0.009273529052734375,
+    -0.0070078372955322266, -0.005535036325454712,
+)
 
 
 def _p_prime_64(x, phi, s, d, sin_half, cos_half):
@@ -220,14 +256,7 @@ def _mu_64(x, phi, s, d, sin_half, cos_half):
 def _det_H_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.005951203046330052
     t = _where(small, x, 0.0)
-    series = 0.39276123046875 + 0.0 * x
-    series = 0.4189453125 + t * series
-    series = 0.451171875 + t * series
-    series = 0.4921875 + t * series
-    series = 0.546875 + t * series
-    series = 0.625 + t * series
-    series = 0.75 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_det_H, 8, t, x)
     cos_half = _where(small, 0.9992547118107894, cos_half)
     d = _where(small, 0.99404879695367, d)
     closed = 1/(cos_half**2*_sqrt(d))
@@ -254,14 +283,7 @@ _H_1_64 = _R_2_64  # the same code
 def _H_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.005951203046330052
     t = _where(small, x, 0.0)
-    series = 0.196380615234375 + 0.0 * x
-    series = 0.20947265625 + t * series
-    series = 0.2255859375 + t * series
-    series = 0.24609375 + t * series
-    series = 0.2734375 + t * series
-    series = 0.3125 + t * series
-    series = 0.375 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_H_2, 8, t, x)
     d = _where(small, 0.99404879695367, d)
     w0 = _sqrt(d)
     closed = 1/(w0*(w0 + 1))
@@ -289,22 +311,7 @@ def _G_1_64(x, phi, s, d, sin_half, cos_half):
 def _G_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.116472206314816
     t = _where(small, x, 0.0)
-    series = 0.0015769325991740776 + 0.0 * x
-    series = 0.0017386131018401613 + t * series
-    series = 0.0019299437302723321 + t * series
-    series = 0.002159137935754174 + t * series
-    series = 0.00243758516411674 + t * series
-    series = 0.002781492528356466 + t * series
-    series = 0.0032146330158866476 + t * series
-    series = 0.003773159987758845 + t * series
-    series = 0.004514514002948999 + t * series
-    series = 0.005535036325454712 + t * series
-    series = 0.0070078372955322266 + t * series
-    series = 0.009273529052734375 + t * series
-    series = 0.013092041015625 + t * series
-    series = 0.0205078125 + t * series
-    series = 0.0390625 + t * series
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 16, t, x)
     phi = _where(small, 0.34827858083060304, phi)
     x = _where(small, 0.116472206314816, x)
     closed = 2*_xp.sin((0.25)*phi)**2/x
@@ -321,23 +328,7 @@ _K_1_64 = _G_2_64  # the same code
 def _K_2_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.116472206314816
     t = _where(small, x, 0.0)
-    series = 0.06653969900370939 + 0.0 * x
-    series = 0.06846971320104332 + t * series
-    series = 0.07057773738575546 + t * series
-    series = 0.07289287133907002 + t * series
-    series = 0.07545132272815369 + t * series
-    series = 0.07829879884435087 + t * series
-    series = 0.0814939567046622 + t * series
-    series = 0.08511350962908182 + t * series
-    series = 0.08926001159125008 + t * series
-    series = 0.09407413308508694 + t * series
-    series = 0.09975479543209076 + t * series
-    series = 0.10659372806549072 + t * series
-    series = 0.11503791809082031 + t * series
-    series = 0.1258087158203125 + t * series
-    series = 0.14013671875 + t * series
-    series = 0.16015625 + t * series
-    series = 0.1875 + t * series
+    series = _horner(_SERIES_K_2, 17, t, x)
     x = _where(small, 0.116472206314816, x)
     cos_half = _where(small, 0.9848760306762097, cos_half)
     d = _where(small, 0.883527793685184, d)
@@ -376,14 +367,7 @@ _H_1_x_64 = _R_2_x_64  # the same code
 def _H_2_x_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.005951203046330052
     t = _where(small, x, 0.0)
-    series = 1.4837646484375 + 0.0 * x
-    series = 1.374664306640625 + t * series
-    series = 1.2568359375 + t * series
-    series = 1.1279296875 + t * series
-    series = 0.984375 + t * series
-    series = 0.8203125 + t * series
-    series = 0.625 + t * series
-    series = 0.375 + t * series
+    series = _horner(_SERIES_H_2_x, 8, t, x)
     d = _where(small, 0.99404879695367, d)
     w0 = _sqrt(d)
     w1 = (w0 + 1)**(-1.0)
@@ -405,14 +389,7 @@ def _H_inverse_2_x_64(x, phi, s, d, sin_half, cos_half):
 def _e_0_64(x, phi, s, d, sin_half, cos_half):
     small = x < 0.010853448794044025
     t = _where(small, x, 0.0)
-    series = -0.005535036325454712 + 0.0 * x
-    series = -0.0070078372955322266 + t * series
-    series = -0.009273529052734375 + t * series
-    series = -0.013092041015625 + t * series
-    series = -0.0205078125 + t * series
-    series = -0.0390625 + t * series
-    series = -0.125 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 8, t, x)
     cos_half = _where(small, 0.9986386910392633, cos_half)
     closed = cos_half
     return _where(small, series, closed)
@@ -449,14 +426,7 @@ def _mu_32(x, phi, s, d, sin_half, cos_half):
 def _det_H_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.11647220712673427
     t = _where(small, x, 0.0)
-    series = 0.39276123046875 + 0.0 * x
-    series = 0.4189453125 + t * series
-    series = 0.451171875 + t * series
-    series = 0.4921875 + t * series
-    series = 0.546875 + t * series
-    series = 0.625 + t * series
-    series = 0.75 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_det_H, 8, t, x)
     cos_half = _where(small, 0.9848760306762097, cos_half)
     d = _where(small, 0.8835277928732658, d)
     closed = 1/(cos_half**2*_sqrt(d))
@@ -484,14 +454,7 @@ _H_1_32 = _R_2_32  # the same code
 def _H_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.11647220712673427
     t = _where(small, x, 0.0)
-    series = 0.196380615234375 + 0.0 * x
-    series = 0.20947265625 + t * series
-    series = 0.2255859375 + t * series
-    series = 0.24609375 + t * series
-    series = 0.2734375 + t * series
-    series = 0.3125 + t * series
-    series = 0.375 + t * series
-    series = 0.5 + t * series
+    series = _horner(_SERIES_H_2, 8, t, x)
     d = _where(small, 0.8835277928732658, d)
     w0 = _sqrt(d)
     closed = 1/(w0*(w0 + 1))
@@ -522,13 +485,7 @@ def _G_1_32(x, phi, s, d, sin_half, cos_half):
 def _G_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.11647220712673427
     t = _where(small, x, 0.0)
-    series = 0.005535036325454712 + 0.0 * x
-    series = 0.0070078372955322266 + t * series
-    series = 0.009273529052734375 + t * series
-    series = 0.013092041015625 + t * series
-    series = 0.0205078125 + t * series
-    series = 0.0390625 + t * series
-    series = 0.125 + t * series
+    series = _horner(_SERIES_G_2, 7, t, x)
     phi = _where(small, 0.34827858083060304, phi)
     x = _where(small, 0.11647220712673427, x)
     closed = 2*_xp.sin((0.25)*phi)**2/x
@@ -547,22 +504,7 @@ _K_1_32 = _G_2_32  # the same code
 def _K_2_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.35302036314032237
     t = _where(small, x, 0.0)
-    series = 0.06846971320104332 + 0.0 * x
-    series = 0.07057773738575546 + t * series
-    series = 0.07289287133907002 + t * series
-    series = 0.07545132272815369 + t * series
-    series = 0.07829879884435087 + t * series
-    series = 0.0814939567046622 + t * series
-    series = 0.08511350962908182 + t * series
-    series = 0.08926001159125008 + t * series
-    series = 0.09407413308508694 + t * series
-    series = 0.09975479543209076 + t * series
-    series = 0.10659372806549072 + t * series
-    series = 0.11503791809082031 + t * series
-    series = 0.1258087158203125 + t * series
-    series = 0.14013671875 + t * series
-    series = 0.16015625 + t * series
-    series = 0.1875 + t * series
+    series = _horner(_SERIES_K_2, 16, t, x)
     sin_half = _where(small, 0.3127695234097699, sin_half)
     cos_half = _where(small, 0.9498290505275281, cos_half)
     d = _where(small, 0.6469796368596776, d)
@@ -606,13 +548,7 @@ _H_1_x_32 = _R_2_x_32  # the same code
 def _H_2_x_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.06494452598491793
     t = _where(small, x, 0.0)
-    series = 1.374664306640625 + 0.0 * x
-    series = 1.2568359375 + t * series
-    series = 1.1279296875 + t * series
-    series = 0.984375 + t * series
-    series = 0.8203125 + t * series
-    series = 0.625 + t * series
-    series = 0.375 + t * series
+    series = _horner(_SERIES_H_2_x, 7, t, x)
     d = _where(small, 0.935055474015082, d)
     w0 = _sqrt(d)
     w1 = (w0 + 1)**(-1.0)
@@ -638,14 +574,7 @@ def _H_inverse_2_x_32(x, phi, s, d, sin_half, cos_half):
 def _e_0_32(x, phi, s, d, sin_half, cos_half):
     small = x < 0.20569006626255124
     t = _where(small, x, 0.0)
-    series = -0.005535036325454712 + 0.0 * x
-    series = -0.0070078372955322266 + t * series
-    series = -0.009273529052734375 + t * series
-    series = -0.013092041015625 + t * series
-    series = -0.0205078125 + t * series
-    series = -0.0390625 + t * series
-    series = -0.125 + t * series
-    series = 1.0 + t * series
+    series = _horner(_SERIES_e_0, 8, t, x)
     cos_half = _where(small, 0.9724301198924676, cos_half)
     closed = cos_half
     return _where(small, series, closed)
@@ -822,6 +751,27 @@ def _complement(p, x):
             high = total
         value = high + low
     return _stop(value) + (_stop(x) - x)
+
+
+def _horner(coefficients, terms, t, like):
+    """The polynomial of the first ``terms`` coefficients (constant term first) at t, by Horner's
+    rule from the highest term down, as the plan's Branch.horner, with the shape of ``like``; a
+    zero term only multiplies."""
+    series = coefficients[terms - 1] + 0.0 * like
+    for k in range(terms - 2, -1, -1):
+        c = coefficients[k]
+        series = c + t * series if c != 0 else t * series
+    return series
+
+
+def _clenshaw(coefficients, y):
+    """The Chebyshev series sum_j coefficients[j] T_j(y) by Clenshaw's recurrence (its monomial
+    form loses every digit in float32)."""
+    b1 = 0.0 * y
+    b2 = 0.0 * y
+    for c in coefficients[:0:-1]:
+        b1, b2 = c + 2.0 * y * b1 - b2, b1
+    return coefficients[0] + y * b1 - b2
 
 
 def _length(p, x, suffix):

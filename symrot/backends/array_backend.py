@@ -39,6 +39,7 @@ from symrot.backends.numpy_backend import (
     uses_phi,
 )
 from symrot.backends.runtime import runtime_text
+from symrot.backends.series_tables import SeriesTables
 from symrot.backends.subexpressions import alias_repeated, common_subexpressions
 from symrot.backends.templating import render
 from symrot.core.atomic import write_atomic
@@ -101,7 +102,8 @@ def _mp_float(expression: Any) -> str:
 
 
 def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
-                 half_angles: bool = False, corrected: bool = False) -> list[str]:
+                 half_angles: bool = False, corrected: bool = False,
+                 tables: SeriesTables | None = None, owner: str = "") -> list[str]:
     """Statements returning the Branch value from ``variable`` (t) and the state, branch-free.
 
     Polynomial below ``branch.threshold`` on t (t replaced by 0 above it), closed form above it on
@@ -112,9 +114,13 @@ def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
     lines = [f"small = {variable} < {switch!r}"]
     if len(horner) > 1:
         lines.append(f"t = _where(small, {variable}, 0.0)")
-    lines.append(f"series = {_literal(horner[-1])} + 0.0 * {variable}")
-    for c in reversed(horner[:-1]):
-        lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
+    if tables is not None and len(horner) > 1:  # the coefficients from the module's tuple
+        table = tables.reference(owner, [_literal(c) for c in horner])
+        lines.append(f"series = _horner({table}, {len(horner)}, t, {variable})")
+    else:
+        lines.append(f"series = {_literal(horner[-1])} + 0.0 * {variable}")
+        for c in reversed(horner[:-1]):
+            lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
     closed = half_angle(branch.closed) if corrected else branch.closed
     if half_angles:
         closed = closed.xreplace({sp.sin(PHI / 2): SIN_HALF, sp.cos(PHI / 2): COS_HALF})
@@ -138,15 +144,15 @@ def branch_lines(branch: Branch, variable: str, complement: sp.Rational | None,
     return lines
 
 
-def newton_lines(angle: NewtonAngle, suffix: str) -> list[str]:
-    """The fixed-count safeguarded Newton iteration φ(s) (its derivative is the module's)."""
+def newton_lines(angle: NewtonAngle, suffix: str, tables: SeriesTables) -> list[str]:
+    """The fixed-count safeguarded Newton iteration φ(s) (its derivative is the module's), from
+    the start's and the far series' coefficients in the module's tuples."""
     ratio = f"_ratio_{suffix}(phi * phi, phi)"
-    start_lines = [f"start = {_literal(angle.start[-1])} + 0.0 * s"]
-    start_lines += [f"start = {_literal(c)} + s2 * start" for c in reversed(angle.start[:-1])]
     far = angle.far
-    far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", "b1 = 0.0 * y", "b2 = 0.0 * y"]
-    far_lines += [f"b1, b2 = {c!r} + 2.0 * y * b1 - b2, b1" for c in far.chebyshev[:0:-1]]
-    far_lines.append(f"far = {far.chebyshev[0]!r} + y * b1 - b2")
+    start = tables.reference("angle_start", [_literal(c) for c in angle.start])
+    chebyshev = tables.reference("angle_far", [_literal(c) for c in far.chebyshev])
+    start_lines = [f"start = _horner({start}, {len(angle.start)}, s2, s)"]
+    far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", f"far = _clenshaw({chebyshev}, y)"]
     return [
         "s2 = s * s",
         *start_lines,
@@ -187,7 +193,7 @@ def _far_variable(far: FarStart) -> str:
 
 
 def _coefficient_lines(coefficient: Any, suffix: str, complement: sp.Rational | None,
-                       corrected: bool) -> list[str]:
+                       corrected: bool, tables: SeriesTables, owner: str) -> list[str]:
     if isinstance(coefficient, Constant):
         return [f"return _xp.full_like(x, {_literal(coefficient.value)})"]
     if isinstance(coefficient, Algebraic):
@@ -201,10 +207,11 @@ def _coefficient_lines(coefficient: Any, suffix: str, complement: sp.Rational | 
             value = f"({value}) + 0.0 * x"
         body.append(f"return _narrow({value}, s)" if suffix == "32" else f"return {value}")
         return body
-    return branch_lines(coefficient, "x", complement, half_angles=True, corrected=corrected)
+    return branch_lines(coefficient, "x", complement, half_angles=True, corrected=corrected,
+                        tables=tables, owner=owner)
 
 
-def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
+def _scale_lines(scale: QuaternionScale, suffix: str, tables: SeriesTables) -> list[str]:
     """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.plan.quaternion)."""
     if scale.algebraic is not None:
         expression = scale.algebraic.subs(E0, sp.Symbol("e0"))
@@ -212,7 +219,7 @@ def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
         value = f"({print_array(expression)}) + 0.0 * e0"
         return [*lines, f"return _narrow({value}, e_norm)" if suffix == "32" else f"return {value}"]
     assert isinstance(scale.branch, Branch)
-    lines = branch_lines(scale.branch, "t", None)
+    lines = branch_lines(scale.branch, "t", None, tables=tables, owner="scale")
     if suffix == "64":
         return ["phi = 2.0 * _atan2(e_norm, e0)", "t = phi * phi", *lines]
     # float32: φ and σ wide, rounded once (as the NumPy backend's _scale_lines)
@@ -227,19 +234,20 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
     functions: list[dict[str, Any]] = []
     newton: list[str] = []
     closed_angles: dict[str, list[str]] = {}
+    tables = SeriesTables()
     for label, precision in plan.precisions.items():
         suffix = SUFFIX[label]
         for name, coefficient in precision.coefficients.items():
             functions.append({"name": f"_{name}_{suffix}", "args": "x, phi, s, d, sin_half, cos_half",
                               "body": _coefficient_lines(coefficient, suffix, plan.complement,
-                                                         label in plan.angle_correction())})
+                                                         label in plan.angle_correction(), tables, name)})
         angle = precision.angle
         if isinstance(angle, NewtonAngle):
             for helper, branch in (("_ratio", angle.ratio), ("_slope", angle.slope)):
                 functions.append({"name": f"{helper}_{suffix}", "args": "t, phi",
-                                  "body": branch_lines(branch, "t", None)})
+                                  "body": branch_lines(branch, "t", None, tables=tables, owner=helper[1:])})
             functions.append({"name": f"_newton_{suffix}", "args": "s",
-                              "body": newton_lines(angle, suffix)})
+                              "body": newton_lines(angle, suffix, tables)})
             if label in plan.angle_correction().values():
                 functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi",
                                   "body": angle_low_lines(angle, suffix)})
@@ -252,12 +260,12 @@ def module_context(plan: EvaluationPlan, framework: str) -> dict[str, Any]:
                 functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi",
                                   "body": [f"return _angle_{suffix}(s, None) - phi"]})
         functions.append({"name": f"_scale_{suffix}", "args": "e0, e_norm",
-                          "body": _scale_lines(precision.quaternion_scale, suffix)})
+                          "body": _scale_lines(precision.quaternion_scale, suffix, tables)})
     squared, inclusive = plan.boundary(53)
     finite_p_max = math.isfinite(plan.p_max)
     return {"framework": framework, "runtime": runtime_text("array_runtime"),
             "framework_runtime": runtime_text(f"{framework}_runtime"), "name": plan.name,
-            "p_text": str(plan.p), "functions": alias_repeated(functions),
+            "p_text": str(plan.p), "functions": alias_repeated(functions), "series_tables": tables.context(),
             "newton": newton, "closed_angles": closed_angles,
             "angle_low": angle_low_helpers(plan),
             "names": list(plan.precisions["float64"].coefficients),

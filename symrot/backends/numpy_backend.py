@@ -30,6 +30,7 @@ from sympy.printing.numpy import NumPyPrinter
 
 from symrot.backends.numpy_derivatives import derivative_lines, rate_lines
 from symrot.backends.runtime import runtime_text
+from symrot.backends.series_tables import SeriesTables
 from symrot.backends.subexpressions import alias_repeated, common_subexpressions
 from symrot.backends.templating import render
 from symrot.core.atomic import write_atomic
@@ -104,7 +105,7 @@ def branch_switch(coefficient: Any) -> float:
 
 
 def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = False,
-                  corrected: bool = False) -> list[str]:
+                  corrected: bool = False, tables: SeriesTables | None = None, owner: str = "") -> list[str]:
     """Statements returning the Branch value from ``variable`` (t) and ``phi``: the Horner
     polynomial on the lanes with t < threshold, the closed form on the others (each computed on
     its own lanes only, so neither can divide by zero and no work is wasted). The switch is the
@@ -115,7 +116,9 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
     block whose lanes are all inside the range (None otherwise, see the template's _span) lets a
     block on one side of the switch take its branch on all lanes, without masks or indexing.
     ``corrected``: the angle's half-angle sine and cosine carry λ (``EvaluationPlan.angle_correction``),
-    and sin φ, cos φ are printed through them (:func:`symrot.plan.forms.half_angle`)."""
+    and sin φ, cos φ are printed through them (:func:`symrot.plan.forms.half_angle`). ``tables``:
+    the polynomial reads its coefficients from the module's tuples (``_horner``, named after
+    ``owner``) instead of one statement per term."""
     threshold, horner = branch.smallest_switch
     closed = half_angle(branch.closed) if corrected else branch.closed
     if half_angles:  # sin(φ/2), cos(φ/2) come precomputed, shared by the coefficients of a tensor
@@ -125,8 +128,12 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
     replacements, (reduced,) = common_subexpressions([closed], "w")
     closed_lines = [f"{symbol} = {print_expression(value)}" for symbol, value in replacements]
     series_lines = [f"series = {_literal(horner[-1])}"]
-    for c in reversed(horner[:-1]):
-        series_lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
+    if tables is not None and len(horner) > 1:
+        table = tables.reference(owner, [_literal(c) for c in horner])
+        series_lines = [f"series = _horner({table}, {len(horner)}, t)"]
+    else:
+        for c in reversed(horner[:-1]):
+            series_lines.append(f"series = {_literal(c)} + t * series" if c != 0 else "series = t * series")
     lines: list[str] = []
     if half_angles:
         # one Horner polynomial for both paths: on every lane (the block is below the switch) or on
@@ -174,18 +181,27 @@ def _branch_lines(branch: Branch, variable: str, phi: str, half_angles: bool = F
     return lines
 
 
-def _angle_lines(angle: ClosedAngle | NewtonAngle) -> list[str]:
+def _angle_lines(angle: ClosedAngle | NewtonAngle, tables: SeriesTables | None = None) -> list[str]:
+    """φ(s): the closed inverse, or eq 35's Newton iteration from its start (the Taylor polynomial
+    s·start(s²) below the far switch, a Chebyshev series above it). ``tables``: the start's and
+    the far series' coefficients from the module's tuples (``_horner``, ``_clenshaw``)."""
     if isinstance(angle, ClosedAngle):
         expression = angle.expression.subs(S, sp.Symbol("s"))
         return [f"return {print_expression(expression)} + 0.0 * s"]
-    start_lines = [f"start = {_literal(angle.start[-1])}"]
-    start_lines += [f"start = {_literal(c)} + s2 * start" for c in reversed(angle.start[:-1])]
     far = angle.far
-    # Clenshaw's recurrence for Σ c_j T_j(y) (the monomial form loses every digit in float32)
-    far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", "b1 = numpy.zeros_like(y)",
-                 "b2 = numpy.zeros_like(y)"]
-    far_lines += [f"b1, b2 = {c!r} + 2.0 * y * b1 - b2, b1" for c in far.chebyshev[:0:-1]]
-    far_lines.append(f"far = {far.chebyshev[0]!r} + y * b1 - b2")
+    if tables is not None:
+        start = tables.reference("angle_start", [_literal(c) for c in angle.start])
+        chebyshev = tables.reference("angle_far", [_literal(c) for c in far.chebyshev])
+        start_lines = [f"start = _horner({start}, {len(angle.start)}, s2)"]
+        far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", f"far = _clenshaw({chebyshev}, y)"]
+    else:
+        start_lines = [f"start = {_literal(angle.start[-1])}"]
+        start_lines += [f"start = {_literal(c)} + s2 * start" for c in reversed(angle.start[:-1])]
+        # Clenshaw's recurrence for Σ c_j T_j(y) (the monomial form loses every digit in float32)
+        far_lines = [f"v = {_far_variable(far)}", "y = 2.0 * v - 1.0", "b1 = numpy.zeros_like(y)",
+                     "b2 = numpy.zeros_like(y)"]
+        far_lines += [f"b1, b2 = {c!r} + 2.0 * y * b1 - b2, b1" for c in far.chebyshev[:0:-1]]
+        far_lines.append(f"far = {far.chebyshev[0]!r} + y * b1 - b2")
     return [
         "s2 = s * s",
         *start_lines,
@@ -280,8 +296,9 @@ def _far_variable(far: FarStart) -> str:
 
 def module_context(plan: EvaluationPlan) -> dict[str, Any]:
     functions: list[dict[str, Any]] = []
+    tables = SeriesTables()
     for label, precision in plan.precisions.items():
-        functions.extend(module_context_functions(precision, SUFFIX[label], angle_low_helpers(plan)))
+        functions.extend(module_context_functions(precision, SUFFIX[label], angle_low_helpers(plan), tables))
     p_max = plan.p_max
     e0_min = repr(plan.e0_min) if plan.e0_min is not None else None
     squared, inclusive = plan.boundary(53)  # float32 x compares exactly against the double bound
@@ -304,7 +321,8 @@ def module_context(plan: EvaluationPlan) -> dict[str, Any]:
             "rotation_tolerance_power": {SUFFIX[label]: ROTATION_TOLERANCE_POWER[label]
                                          for label in plan.precisions},
             "derivative_lines": derivative_lines(), "rate_lines": rate_lines(),
-            "runtime": runtime_text("numpy_runtime"),
+            "runtime": runtime_text("numpy_runtime") + "\n\n" + runtime_text("numpy_operations"),
+            "series_tables": tables.context(),
             "angle_low": angle_low_helpers(plan),
             "uses_phi": {SUFFIX[label]: {n: uses_phi(c) for n, c in precision.coefficients.items()}
                          for label, precision in plan.precisions.items()},
@@ -326,8 +344,8 @@ def uses_phi(coefficient: Any) -> bool:
     return uses_angle(coefficient)
 
 
-def module_context_functions(precision: Any, suffix: str,
-                             angle_low: dict[str, dict[str, str]]) -> list[dict[str, Any]]:
+def module_context_functions(precision: Any, suffix: str, angle_low: dict[str, dict[str, str]],
+                             tables: SeriesTables) -> list[dict[str, Any]]:
     functions = []
     for name, coefficient in precision.coefficients.items():
         if isinstance(coefficient, Constant):
@@ -343,36 +361,38 @@ def module_context_functions(precision: Any, suffix: str,
                 value = f"({value}) + 0.0 * x"
             body.append(f"return numpy.asarray({value}).astype(numpy.float{suffix}, copy=False)")
         else:
-            body = _branch_lines(coefficient, "x", "phi", half_angles=True, corrected=suffix in angle_low)
+            body = _branch_lines(coefficient, "x", "phi", half_angles=True, corrected=suffix in angle_low,
+                                 tables=tables, owner=name)
         functions.append({"name": f"_{name}_{suffix}",
                           "args": "x, phi, s, d, sin_half, cos_half, span=None", "body": body})
     angle = precision.angle
     if isinstance(angle, NewtonAngle):
         for helper, branch in (("_ratio", angle.ratio), ("_slope", angle.slope)):
             functions.append({"name": f"{helper}_{suffix}", "args": "t, phi",
-                              "body": _branch_lines(branch, "t", "phi")})
+                              "body": _branch_lines(branch, "t", "phi", tables=tables, owner=helper[1:])})
     def helpers(lines: list[str]) -> list[str]:
         return [line.replace("_ratio(phi * phi)", f"_ratio_{suffix}(phi * phi, phi)")
                 .replace("_slope(", f"_slope_{suffix}(") for line in lines]
 
-    functions.append({"name": f"_angle_{suffix}", "args": "s, d", "body": helpers(_angle_lines(angle))})
+    functions.append({"name": f"_angle_{suffix}", "args": "s, d",
+                      "body": helpers(_angle_lines(angle, tables))})
     if any(low["helper"] == f"_angle_low_{suffix}" for low in angle_low.values()):
         body = (helpers(_angle_low_lines(angle)) if isinstance(angle, NewtonAngle)
                 else [f"return _angle_{suffix}(s, None) - phi"])  # a closed angle serving float32
         functions.append({"name": f"_angle_low_{suffix}", "args": "s, phi", "body": body})
     functions.append({"name": f"_scale_{suffix}", "args": "e0, e_norm",
-                      "body": _scale_lines(precision.quaternion_scale, suffix)})
+                      "body": _scale_lines(precision.quaternion_scale, suffix, tables)})
     return functions
 
 
-def _scale_lines(scale: QuaternionScale, suffix: str) -> list[str]:
+def _scale_lines(scale: QuaternionScale, suffix: str, tables: SeriesTables) -> list[str]:
     """σ(e₀, |e|) with p = σ e on the hemisphere e₀ ≥ 0 (see symrot.plan.quaternion)."""
     if scale.algebraic is not None:
         expression = scale.algebraic.subs(E0, sp.Symbol("e0"))
         return ["e0 = e0.astype(numpy.float64)",
                 f"return (({print_expression(expression)}) + 0.0 * e0).astype(numpy.float{suffix})"]
     assert isinstance(scale.branch, Branch)
-    lines = _branch_lines(scale.branch, "t", "phi")
+    lines = _branch_lines(scale.branch, "t", "phi", tables=tables, owner="scale")
     if suffix == "64":
         return ["phi = (2.0 * numpy.arctan2(e_norm, e0)).astype(e0.dtype)", "t = phi * phi", *lines]
     # float32: φ and σ in float64, rounded once. Next to a pole at φ_max, rounding φ to float32
