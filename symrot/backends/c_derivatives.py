@@ -25,7 +25,8 @@ import sympy as sp
 
 from symrot.backends.c_functions import P, vector_entries
 from symrot.backends.c_printer import Precision
-from symrot.backends.c_writer import FunctionWriter, Statement, ops_of
+from symrot.backends.c_statements import Statement, ops_of
+from symrot.backends.c_writer import FunctionWriter
 from symrot.backends.subexpressions import common_subexpressions
 from symrot.core.derivatives import SLOPES, VALUES, rate_value, rate_vector, slope_name, tensor_derivative
 from symrot.plan.ir import EvaluationPlan

@@ -27,15 +27,8 @@ from typing import Any
 
 import sympy as sp
 
-from symrot.backends.c_writer import (
-    LARGEST,
-    PHI_SYMBOL,
-    PLAN_LABEL,
-    T_SYMBOL,
-    FunctionWriter,
-    Statement,
-    ops_of,
-)
+from symrot.backends.c_statements import LARGEST, PHI_SYMBOL, PLAN_LABEL, T_SYMBOL, Statement, ops_of
+from symrot.backends.c_writer import FunctionWriter
 from symrot.core.parsing import PHI
 from symrot.plan.ir import Branch
 from symrot.plan.quaternion import E0, ROTATION_TOLERANCE_POWER
