@@ -17,6 +17,7 @@ import sympy as sp
 
 from symrot.backends.c_functions import P
 from symrot.backends.c_printer import MANTISSA_BITS, Precision, SymrotCPrinter
+from symrot.backends.templating import macro
 from symrot.core.errors import NonFiniteLiteral
 from symrot.plan.ir import EvaluationPlan, PrecisionPlan
 
@@ -185,3 +186,12 @@ class PlanWriter:
         return [f"Valid for every p with |p|^2 < {bound} (|phi| < {plan.phi_max:.17g}), the largest power",
                 "of two up to which every printed form was checked against 50+ digits; otherwise, and for",
                 "non-finite p, every output is NaN."]
+
+    def shared(self, function: str, *extra: str) -> dict[str, Any]:
+        """Public ``function`` printed from its macro in ``templates/c/shared.h.j2``: a function
+        whose text is the same in every header but for the prefix symrot_NAME and the precision
+        (``extra``: the macro's further arguments). The header prints its ``source`` as it is."""
+        f = "" if self.ctype == "double" else "f"
+        source = macro("c/shared.h.j2", function, f"symrot_{self.header}", self.suffix, self.ctype, f,
+                       self.nan, *extra)
+        return {"c_name": f"symrot_{self.header}_{function}{self.suffix}", "source": source}
