@@ -61,7 +61,17 @@ class FunctionWriter(AngleWriter):
 
     # -- coefficients ----------------------------------------------------------------------------
     def coefficients(self, names: list[str]) -> tuple[list[Statement], dict[str, sp.Expr]]:
-        """Statements computing ``names`` and the expression standing for each in the outputs."""
+        """Statements computing ``names`` and the expression standing for each in the outputs. Each
+        statement is marked ``block: coefficients`` with the names it leaves: where functions of a
+        header compute the same block, :func:`symrot.backends.c_shared.share_coefficients` prints
+        it once, as a helper they call."""
+        statements, values = self.coefficient_statements(names)
+        computed = [f"c_{name}" for name in names if isinstance(values[name], sp.Symbol)]
+        marked = [{**statement, "block": "coefficients", "computed": computed} for statement in statements]
+        return marked, values
+
+    def coefficient_statements(self, names: list[str]) -> tuple[list[Statement], dict[str, sp.Expr]]:
+        """The statements of :meth:`coefficients`, unmarked."""
         plan = self.precision_plan.coefficients
         values: dict[str, sp.Expr] = {}
         statements: list[Statement] = []
