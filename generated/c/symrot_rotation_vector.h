@@ -83,6 +83,66 @@ static inline double symrot_rotation_vector__phi(double s)
     return s;
 }
 
+/* symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x: internal: the coefficients R_1, R_2, R_1_x, R_2_x of x, shared by the functions that need them (eq 11).
+ * The same statements in every caller: computed once here, called where needed.
+ * ops: 102 */
+static inline void symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x(double x, double *c_R_1_out, double *c_R_2_out, double *c_R_1_x_out, double *c_R_2_x_out)
+{
+    double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 0.4086652777619188) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
+        c_R_2 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0;
+        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = 1.0/phi;
+        const double w1 = (1.0/2.0)*phi;
+        const double w2 = sin(w1);
+        const double w3 = 2*w2*cos(w1);
+        const double w4 = 1.0/(phi*phi);
+        const double w5 = (w2*w2);
+        c_R_1 = w0*w3;
+        c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*w4*w5;
+        c_R_1_x = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0 : (1.0/2.0)*w4*(-w0*sin(phi) + cos(phi));
+        c_R_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*(-4*w0*w5 + w3)/(phi*phi*phi);
+    }
+    *c_R_1_out = c_R_1;
+    *c_R_2_out = c_R_2;
+    *c_R_1_x_out = c_R_1_x;
+    *c_R_2_x_out = c_R_2_x;
+}
+
+/* symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x: internal: the coefficients H_1, H_2, H_1_x, H_2_x of x, shared by the functions that need them (eq 11).
+ * The same statements in every caller: computed once here, called where needed.
+ * ops: 109 */
+static inline void symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x(double x, double *c_H_1_out, double *c_H_2_out, double *c_H_1_x_out, double *c_H_2_x_out)
+{
+    double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 0.7851233626304374) {
+        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
+        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
+        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0;
+    } else {
+        const double phi = symrot_rotation_vector__phi(sqrt(x));
+        const double w0 = (1.0/2.0)*phi;
+        const double w1 = sin(w0);
+        const double w2 = (w1*w1);
+        const double w3 = 1.0/(phi*phi*phi);
+        const double w4 = phi - sin(phi);
+        const double w5 = 1.0/phi;
+        c_H_1 = 2*w2/(phi*phi);
+        c_H_2 = w3*w4;
+        c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
+        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(-3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
+    }
+    *c_H_1_out = c_H_1;
+    *c_H_2_out = c_H_2;
+    *c_H_1_x_out = c_H_1_x;
+    *c_H_2_x_out = c_H_2_x;
+}
+
 /* symrot_rotation_vector_angle: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * phi = s (closed inverse of p(phi))
@@ -1087,24 +1147,7 @@ static inline void symrot_rotation_vector_rotation_derivative(const double p[3],
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
-    if (x < 0.4086652777619188) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0;
-        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
-    } else {
-        const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = 1.0/phi;
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = 2*w2*cos(w1);
-        const double w4 = 1.0/(phi*phi);
-        const double w5 = (w2*w2);
-        c_R_1 = w0*w3;
-        c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*w4*w5;
-        c_R_1_x = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0 : (1.0/2.0)*w4*(-w0*sin(phi) + cos(phi));
-        c_R_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*(-4*w0*w5 + w3)/(phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -1177,24 +1220,7 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative(const do
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
-    if (x < 0.4086652777619188) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1.0/6227020800.0 + (-1.0/1307674368000.0)*x) - 1.0/39916800.0) + 1.0/362880.0) - 1.0/5040.0) + 1.0/120.0) - 1.0/6.0) + 1;
-        c_R_2 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
-        c_R_1_x = x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0;
-        c_R_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
-    } else {
-        const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = 1.0/phi;
-        const double w1 = (1.0/2.0)*phi;
-        const double w2 = sin(w1);
-        const double w3 = 2*w2*cos(w1);
-        const double w4 = 1.0/(phi*phi);
-        const double w5 = (w2*w2);
-        c_R_1 = w0*w3;
-        c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*w4*w5;
-        c_R_1_x = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(x*(1.0/44460928512000.0 + (-7.398571721961897e-17)*x) - 1.0/186810624000.0) + 1.0/1037836800.0) - 1.0/7983360.0) + 1.0/90720.0) - 1.0/1680.0) + 1.0/60.0) - 1.0/6.0 : (1.0/2.0)*w4*(-w0*sin(phi) + cos(phi));
-        c_R_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*(-4*w0*w5 + w3)/(phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -1265,24 +1291,7 @@ static inline void symrot_rotation_vector_tangent_derivative(const double p[3], 
         return;
     }
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.7851233626304374) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
-        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
-        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0;
-    } else {
-        const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 1.0/(phi*phi*phi);
-        const double w4 = phi - sin(phi);
-        const double w5 = 1.0/phi;
-        c_H_1 = 2*w2/(phi*phi);
-        c_H_2 = w3*w4;
-        c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
-        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(-3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -1355,24 +1364,7 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative(const dou
         return;
     }
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.7851233626304374) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
-        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
-        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0;
-    } else {
-        const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 1.0/(phi*phi*phi);
-        const double w4 = phi - sin(phi);
-        const double w5 = 1.0/phi;
-        c_H_1 = 2*w2/(phi*phi);
-        c_H_2 = w3*w4;
-        c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
-        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(-3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
     const double dw0 = a[1]*p[1];
     const double dw1 = a[2]*p[2];
     const double dw2 = a[1]*p[2];
@@ -1515,24 +1507,7 @@ static inline void symrot_rotation_vector_angular_acceleration(const double p[3]
         return;
     }
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 0.7851233626304374) {
-        c_H_1 = x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0;
-        c_H_2 = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
-        c_H_1_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0;
-        c_H_2_x = x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0;
-    } else {
-        const double phi = symrot_rotation_vector__phi(sqrt(x));
-        const double w0 = (1.0/2.0)*phi;
-        const double w1 = sin(w0);
-        const double w2 = (w1*w1);
-        const double w3 = 1.0/(phi*phi*phi);
-        const double w4 = phi - sin(phi);
-        const double w5 = 1.0/phi;
-        c_H_1 = 2*w2/(phi*phi);
-        c_H_2 = w3*w4;
-        c_H_1_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.975515515869757e-26)*x - 1.77291132820573e-23) + 8.896791392450573e-21) - 3.6992858609809485e-18) + 1.0/800296713216000.0) - 1.0/2988969984000.0) + 1.0/14529715200.0) - 1.0/95800320.0) + 1.0/907200.0) - 1.0/13440.0) + 1.0/360.0) - 1.0/24.0 : (1.0/2.0)*w3*(2*w1*cos(w0) - 4*w2*w5);
-        c_H_2_x = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(3.868170170630684e-22 + (-7.091645312822921e-25)*x) - 1.7615646957052136e-19) + 6.576508197299464e-17) - 1.0/50812489728000.0) + 1.0/217945728000.0) - 1.0/1245404160.0) + 1.0/9979200.0) - 1.0/120960.0) + 1.0/2520.0) - 1.0/120.0 : (1.0/2.0)*(-3*w4*w5 - cos(phi) + 1)/(phi*phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
     const double w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const double w1 = -p[0]*pddot[2] + p[2]*pddot[0];
     const double w2 = p[0]*pddot[1] - p[1]*pddot[0];
@@ -1679,6 +1654,69 @@ static inline int symrot_rotation_vector_rescale_jacobian(const double p[3], dou
 static inline float symrot_rotation_vector__phi_f(float s)
 {
     return s;
+}
+
+/* symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x_f: internal: the coefficients R_1, R_2, R_1_x, R_2_x of x, shared by the functions that need them (eq 11).
+ * The same statements in every caller: computed once here, called where needed.
+ * ops: 78 */
+static inline void symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x_f(float x, float *c_R_1_out, float *c_R_2_out, float *c_R_1_x_out, float *c_R_2_x_out)
+{
+    float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
+    if (x < 5.567348F) {
+        c_R_1 = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
+        c_R_2 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_R_1_x = x*(x*(x*(x*(x*(9.635426e-10F + (-5.3530145e-12F)*x) - 1.0F/7983360.0F) + 1.0F/90720.0F) - 1.0F/1680.0F) + 1.0F/60.0F) - 1.0F/6.0F;
+        c_R_2_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = 1.0F/phi;
+        const float w1 = (1.0F/2.0F)*phi;
+        const float w2 = sinf(w1);
+        const float w3 = 2*w2*cosf(w1);
+        const float w4 = w0*w3;
+        const float w5 = 1.0F/(phi*phi);
+        const float w6 = (w2*w2);
+        const float w7 = 2*w6;
+        c_R_1 = w4;
+        c_R_2 = w5*w7;
+        c_R_1_x = (1.0F/2.0F)*w5*(-w4 - w7 + 1);
+        c_R_2_x = (1.0F/2.0F)*(-4*w0*w6 + w3)/(phi*phi*phi);
+    }
+    *c_R_1_out = c_R_1;
+    *c_R_2_out = c_R_2;
+    *c_R_1_x_out = c_R_1_x;
+    *c_R_2_x_out = c_R_2_x;
+}
+
+/* symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x_f: internal: the coefficients H_1, H_2, H_1_x, H_2_x of x, shared by the functions that need them (eq 11).
+ * The same statements in every caller: computed once here, called where needed.
+ * ops: 75 */
+static inline void symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x_f(float x, float *c_H_1_out, float *c_H_2_out, float *c_H_1_x_out, float *c_H_2_x_out)
+{
+    float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
+    if (x < 5.567348F) {
+        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
+        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+        c_H_1_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
+        c_H_2_x = x*(x*(x*(x*(x*(4.588298e-12F + (-1.96802e-14F)*x) - 8.029522e-10F) + 1.0F/9979200.0F) - 1.0F/120960.0F) + 1.0F/2520.0F) - 1.0F/120.0F;
+    } else {
+        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
+        const float w0 = (1.0F/2.0F)*phi;
+        const float w1 = sinf(w0);
+        const float w2 = (w1*w1);
+        const float w3 = 2*w2;
+        const float w4 = 1.0F/(phi*phi*phi);
+        const float w5 = 2*w1*cosf(w0);
+        const float w6 = 1.0F/phi;
+        c_H_1 = w3/(phi*phi);
+        c_H_2 = w4*(phi - sinf(phi));
+        c_H_1_x = (1.0F/2.0F)*w4*(-4*w2*w6 + w5);
+        c_H_2_x = (1.0F/2.0F)*(w3 - 3*w6*(phi - w5))/(phi*phi*phi*phi);
+    }
+    *c_H_1_out = c_H_1;
+    *c_H_2_out = c_H_2;
+    *c_H_1_x_out = c_H_1_x;
+    *c_H_2_x_out = c_H_2_x;
 }
 
 /* symrot_rotation_vector_angle_f: rotation angle phi = |phi(p)|, the inverse of p(phi) (eq 11).
@@ -2683,26 +2721,7 @@ static inline void symrot_rotation_vector_rotation_derivative_f(const float p[3]
         return;
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
-    if (x < 5.567348F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(9.635426e-10F + (-5.3530145e-12F)*x) - 1.0F/7983360.0F) + 1.0F/90720.0F) - 1.0F/1680.0F) + 1.0F/60.0F) - 1.0F/6.0F;
-        c_R_2_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
-    } else {
-        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = 1.0F/phi;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = 2*w2*cosf(w1);
-        const float w4 = w0*w3;
-        const float w5 = 1.0F/(phi*phi);
-        const float w6 = (w2*w2);
-        const float w7 = 2*w6;
-        c_R_1 = w4;
-        c_R_2 = w5*w7;
-        c_R_1_x = (1.0F/2.0F)*w5*(-w4 - w7 + 1);
-        c_R_2_x = (1.0F/2.0F)*(-4*w0*w6 + w3)/(phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x_f(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -2775,26 +2794,7 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative_f(const 
         return;
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
-    if (x < 5.567348F) {
-        c_R_1 = x*(x*(x*(x*(x*(x*(1.6059044e-10F + (-7.6471636e-13F)*x) - 2.5052108e-08F) + 1.0F/362880.0F) - 1.0F/5040.0F) + 1.0F/120.0F) - 1.0F/6.0F) + 1;
-        c_R_2 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
-        c_R_1_x = x*(x*(x*(x*(x*(9.635426e-10F + (-5.3530145e-12F)*x) - 1.0F/7983360.0F) + 1.0F/90720.0F) - 1.0F/1680.0F) + 1.0F/60.0F) - 1.0F/6.0F;
-        c_R_2_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
-    } else {
-        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = 1.0F/phi;
-        const float w1 = (1.0F/2.0F)*phi;
-        const float w2 = sinf(w1);
-        const float w3 = 2*w2*cosf(w1);
-        const float w4 = w0*w3;
-        const float w5 = 1.0F/(phi*phi);
-        const float w6 = (w2*w2);
-        const float w7 = 2*w6;
-        c_R_1 = w4;
-        c_R_2 = w5*w7;
-        c_R_1_x = (1.0F/2.0F)*w5*(-w4 - w7 + 1);
-        c_R_2_x = (1.0F/2.0F)*(-4*w0*w6 + w3)/(phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x_f(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -2865,25 +2865,7 @@ static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3],
         return;
     }
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 5.567348F) {
-        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
-        c_H_1_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
-        c_H_2_x = x*(x*(x*(x*(x*(4.588298e-12F + (-1.96802e-14F)*x) - 8.029522e-10F) + 1.0F/9979200.0F) - 1.0F/120960.0F) + 1.0F/2520.0F) - 1.0F/120.0F;
-    } else {
-        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 2*w2;
-        const float w4 = 1.0F/(phi*phi*phi);
-        const float w5 = 2*w1*cosf(w0);
-        const float w6 = 1.0F/phi;
-        c_H_1 = w3/(phi*phi);
-        c_H_2 = w4*(phi - sinf(phi));
-        c_H_1_x = (1.0F/2.0F)*w4*(-4*w2*w6 + w5);
-        c_H_2_x = (1.0F/2.0F)*(w3 - 3*w6*(phi - w5))/(phi*phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x_f(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -2956,25 +2938,7 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const f
         return;
     }
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 5.567348F) {
-        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
-        c_H_1_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
-        c_H_2_x = x*(x*(x*(x*(x*(4.588298e-12F + (-1.96802e-14F)*x) - 8.029522e-10F) + 1.0F/9979200.0F) - 1.0F/120960.0F) + 1.0F/2520.0F) - 1.0F/120.0F;
-    } else {
-        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 2*w2;
-        const float w4 = 1.0F/(phi*phi*phi);
-        const float w5 = 2*w1*cosf(w0);
-        const float w6 = 1.0F/phi;
-        c_H_1 = w3/(phi*phi);
-        c_H_2 = w4*(phi - sinf(phi));
-        c_H_1_x = (1.0F/2.0F)*w4*(-4*w2*w6 + w5);
-        c_H_2_x = (1.0F/2.0F)*(w3 - 3*w6*(phi - w5))/(phi*phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x_f(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
     const float dw0 = a[1]*p[1];
     const float dw1 = a[2]*p[2];
     const float dw2 = a[1]*p[2];
@@ -3117,25 +3081,7 @@ static inline void symrot_rotation_vector_angular_acceleration_f(const float p[3
         return;
     }
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
-    if (x < 5.567348F) {
-        c_H_1 = x*(x*(x*(x*(x*((1.1470745e-11F)*x - 2.0876756e-09F) + 1.0F/3628800.0F) - 1.0F/40320.0F) + 1.0F/720.0F) - 1.0F/24.0F) + 1.0F/2.0F;
-        c_H_2 = x*(x*(x*(x*(x*((7.6471636e-13F)*x - 1.6059044e-10F) + 2.5052108e-08F) - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
-        c_H_1_x = x*(x*(x*(x*(x*(6.8824474e-11F + (-3.345634e-13F)*x) - 1.0438378e-08F) + 1.0F/907200.0F) - 1.0F/13440.0F) + 1.0F/360.0F) - 1.0F/24.0F;
-        c_H_2_x = x*(x*(x*(x*(x*(4.588298e-12F + (-1.96802e-14F)*x) - 8.029522e-10F) + 1.0F/9979200.0F) - 1.0F/120960.0F) + 1.0F/2520.0F) - 1.0F/120.0F;
-    } else {
-        const float phi = symrot_rotation_vector__phi_f(sqrtf(x));
-        const float w0 = (1.0F/2.0F)*phi;
-        const float w1 = sinf(w0);
-        const float w2 = (w1*w1);
-        const float w3 = 2*w2;
-        const float w4 = 1.0F/(phi*phi*phi);
-        const float w5 = 2*w1*cosf(w0);
-        const float w6 = 1.0F/phi;
-        c_H_1 = w3/(phi*phi);
-        c_H_2 = w4*(phi - sinf(phi));
-        c_H_1_x = (1.0F/2.0F)*w4*(-4*w2*w6 + w5);
-        c_H_2_x = (1.0F/2.0F)*(w3 - 3*w6*(phi - w5))/(phi*phi*phi*phi);
-    }
+    symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x_f(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
     const float w0 = p[1]*pddot[2] - p[2]*pddot[1];
     const float w1 = -p[0]*pddot[2] + p[2]*pddot[0];
     const float w2 = p[0]*pddot[1] - p[1]*pddot[0];

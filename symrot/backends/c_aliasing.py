@@ -45,7 +45,10 @@ def clobbers(tail: list[Statement], inputs: list[str]) -> bool:
 
 def stored_last(function: dict[str, Any]) -> dict[str, Any]:
     """``function`` with its trailing stores of output entries computed into locals first, where
-    a store could overwrite an input entry that a later one reads (otherwise unchanged)."""
+    a store could overwrite an input entry that a later one reads (otherwise unchanged). A function
+    printed whole from ``templates/c/shared.h.j2`` (a ``source``) is written to read first."""
+    if "source" in function:
+        return function
     inputs, outputs = parameters(function["signature"])
     statements: list[Statement] = function["statements"]
     start = len(statements)

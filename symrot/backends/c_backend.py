@@ -25,6 +25,7 @@ from symrot.backends.c_derivatives import DerivativeWriter
 from symrot.backends.c_functions import FUNCTIONS, CFunction
 from symrot.backends.c_operations import OperationWriter
 from symrot.backends.c_printer import PRECISIONS, Precision
+from symrot.backends.c_shared import share_coefficients
 from symrot.backends.c_sincos import NEAREST
 from symrot.backends.c_writer import FunctionWriter
 from symrot.backends.templating import render
@@ -75,22 +76,24 @@ def _uses_nearest(functions: list[dict[str, Any]]) -> bool:
 
 def _precision_functions(plan: EvaluationPlan, name: str, precision: Precision) -> list[dict[str, Any]]:
     """The functions of one precision, in header order: angle, public functions with their batch
-    kernels, operations, derivatives; each stores its outputs after reading its inputs
-    (:func:`~symrot.backends.c_aliasing.stored_last`)."""
+    kernels, operations, derivatives, with the coefficient blocks several of them compute alike
+    printed once as helpers after the angle's (:mod:`symrot.backends.c_shared`); each stores its
+    outputs after reading its inputs (:func:`~symrot.backends.c_aliasing.stored_last`)."""
     writer = FunctionWriter(plan, name, precision)
     batch = BatchWriter(writer)
-    functions = []
+    angle = []
     if plan.complement is not None:
-        functions.append(writer.complement_function())
-    functions.append(writer.angle_function())
-    functions += writer.angle_low_functions
+        angle.append(writer.complement_function())
+    angle.append(writer.angle_function())
+    angle += writer.angle_low_functions
     public = [writer.function(spec) for spec in FUNCTIONS]
     for spec, function in zip(FUNCTIONS, public, strict=True):
         if function["batch_signature"]:
             function["batch_statements"], function["batch_notes"] = batch.kernel(spec)
-    functions += public
-    functions += OperationWriter(plan, name, precision).all()
-    functions += DerivativeWriter(plan, name, precision).all()
+    operations = OperationWriter(plan, name, precision).all()
+    derivatives = DerivativeWriter(plan, name, precision).all()
+    callers, helpers = share_coefficients([*public, *operations, *derivatives], writer)
+    functions = [*angle, *helpers, *callers]  # the shared coefficients after phi, before their callers
     return [stored_last(function) for function in functions]  # outputs may alias inputs
 
 

@@ -51,7 +51,8 @@ from symrot.backends.c_functions import (
 )
 from symrot.backends.c_printer import MAX_EXPANDED_POWER, SymrotCPrinter, horner
 from symrot.backends.c_sincos import TRIG, SinCosWriter
-from symrot.backends.c_writer import HALF_LOW, PHI_SYMBOL, X_SYMBOL, FunctionWriter, Statement
+from symrot.backends.c_statements import HALF_LOW, PHI_SYMBOL, X_SYMBOL, Statement
+from symrot.backends.c_writer import FunctionWriter
 from symrot.backends.subexpressions import common_subexpressions
 from symrot.core.functions import BoundedPower
 from symrot.core.parsing import PHI

@@ -25,7 +25,8 @@ import sympy as sp
 
 from symrot.backends.c_functions import P, vector_entries
 from symrot.backends.c_printer import Precision
-from symrot.backends.c_writer import FunctionWriter, Statement, ops_of
+from symrot.backends.c_statements import Statement, ops_of
+from symrot.backends.c_writer import FunctionWriter
 from symrot.backends.subexpressions import common_subexpressions
 from symrot.core.derivatives import SLOPES, VALUES, rate_value, rate_vector, slope_name, tensor_derivative
 from symrot.plan.ir import EvaluationPlan
@@ -40,10 +41,6 @@ DERIVATIVES = {"rotation_derivative": ("R", 1, "d(R a)/dp"),
 
 def _vector(name: str) -> sp.Matrix:
     return sp.Matrix([sp.Symbol(f"{name}[{i}]", real=True) for i in range(3)])
-
-
-def _product(left: str, right: str, i: int, j: int) -> str:
-    return " + ".join(f"{left}[{3 * i + k}] * {right}[{3 * k + j}]" for k in range(3))
 
 
 class DerivativeWriter(FunctionWriter):
@@ -127,55 +124,14 @@ class DerivativeWriter(FunctionWriter):
         return self.entry("angular_acceleration", "angular acceleration", signature, statements, notes)
 
     def compose_jacobians(self) -> dict[str, Any]:
-        t = self.ctype
-        statements: list[Statement] = [
-            {"kind": "declare", "type": t, "names": ["p3[3]", "Hinv3[9]", "R2[9]", "H1[9]", "H2[9]", "M[9]"]},
-            {"kind": "let", "type": "int", "name": "status", "value": f"{self.name('compose')}(p1, p2, p3)"},
-            {"kind": "if", "condition": "status != 0",
-             "then": [*self.nan_out("J1", 9)[:-1], *self.nan_out("J2", 9, "1")], "otherwise": []},
-            {"kind": "call", "value": f"{self.name('tangent_inverse')}(p3, Hinv3)"},
-            {"kind": "call", "value": f"{self.name('rotation_matrix')}(p2, R2)"},
-            {"kind": "call", "value": f"{self.name('tangent')}(p1, H1)"},
-            {"kind": "call", "value": f"{self.name('tangent')}(p2, H2)"},
-        ]
-        statements += [self.set(f"M[{3 * i + j}]", _product("R2", "H1", i, j), 5)
-                       for i in range(3) for j in range(3)]
-        statements += [self.set(f"J1[{3 * i + j}]", _product("Hinv3", "M", i, j), 5)
-                       for i in range(3) for j in range(3)]
-        statements += [self.set(f"J2[{3 * i + j}]", _product("Hinv3", "H2", i, j), 5)
-                       for i in range(3) for j in range(3)]
-        statements.append({"kind": "return", "value": "0"})
-        notes = ["J1 = dp3/dp1 = H(p3)^-1 R(p2) H(p1), J2 = dp3/dp2 = H(p3)^-1 H(p2) "
-                 "for p3 = compose(p1, p2)",
-                 "(R(p3) = R(p2) R(p1), p3 rescaled: the rescaling is included). Returns compose's status",
-                 "(1: J1, J2 NaN)."]
-        signature = (f"int {self.name('compose_jacobians')}(const {t} p1[3], const {t} p2[3], {t} J1[9], "
-                     f"{t} J2[9])")
-        return self.entry("compose_jacobians", "Jacobians of compose", signature, statements, notes)
+        """J1 = H(p3)⁻¹ R(p2) H(p1), J2 = H(p3)⁻¹ H(p2): the same in every header
+        (``templates/c/shared.h.j2``)."""
+        return self.shared("compose_jacobians")
 
     def rescale_jacobian(self) -> dict[str, Any]:
-        t = self.ctype
-        identity = [self.set(f"J[{i}]", "1" if i % 4 == 0 else "0") for i in range(9)]
-        statements: list[Statement] = [
-            {"kind": "declare", "type": t, "names": ["e[4]", "q[3]", "Hinv[9]", "H[9]"]},
-            {"kind": "call", "value": f"{self.name('to_quaternion')}(p, e)"},
-            {"kind": "if", "condition": "isnan(e[0])", "then": self.nan_out("J", 9, "1"), "otherwise": []},
-            {"kind": "if", "condition": "e[0] >= 0", "then": [*identity, {"kind": "return", "value": "0"}],
-             "otherwise": []},
-            {"kind": "if", "condition": f"{self.name('rescale')}(p, q) != 0",
-             "then": self.nan_out("J", 9, "1"),
-             "otherwise": []},
-            {"kind": "call", "value": f"{self.name('tangent_inverse')}(q, Hinv)"},
-            {"kind": "call", "value": f"{self.name('tangent')}(p, H)"},
-        ]
-        statements += [self.set(f"J[{3 * i + j}]", _product("Hinv", "H", i, j), 5)
-                       for i in range(3) for j in range(3)]
-        statements.append({"kind": "return", "value": "0"})
-        notes = ["J = d rescale(p)/dp: H(q)^-1 H(p) where p is replaced by q = rescale(p) "
-                 "(the same rotation),",
-                 "the identity where p is kept (|phi| <= pi). Returns 0, or 1 with J = NaN out of range."]
-        signature = f"int {self.name('rescale_jacobian')}(const {t} p[3], {t} J[9])"
-        return self.entry("rescale_jacobian", "Jacobian of rescale", signature, statements, notes)
+        """H(q)⁻¹ H(p) for q = rescale(p), the identity where p is kept: the same in every header
+        (``templates/c/shared.h.j2``)."""
+        return self.shared("rescale_jacobian")
 
     def all(self) -> list[dict[str, Any]]:
         """After the operations of the header (they call compose, rescale, to_quaternion)."""

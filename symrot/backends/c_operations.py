@@ -27,15 +27,8 @@ from typing import Any
 
 import sympy as sp
 
-from symrot.backends.c_writer import (
-    LARGEST,
-    PHI_SYMBOL,
-    PLAN_LABEL,
-    T_SYMBOL,
-    FunctionWriter,
-    Statement,
-    ops_of,
-)
+from symrot.backends.c_statements import LARGEST, PHI_SYMBOL, PLAN_LABEL, T_SYMBOL, Statement, ops_of
+from symrot.backends.c_writer import FunctionWriter
 from symrot.core.parsing import PHI
 from symrot.plan.ir import Branch
 from symrot.plan.quaternion import E0, ROTATION_TOLERANCE_POWER
@@ -172,60 +165,13 @@ class OperationWriter(FunctionWriter):
             return "every rotation is, for this parameterization"
         return f"needs |phi| < {self.plan.phi_max:.17g}, i.e. e0 > {self.plan.e0_min:.17g}"
 
-    # -- from_rotation_matrix --------------------------------------------------------------------
+    # -- from_rotation_matrix and rescale: the same in every header (templates/c/shared.h.j2) -------
     def from_rotation_matrix(self) -> dict[str, Any]:
-        t = self.ctype
-        h = self.helper
-        rows = [
-            "1 + tr, R[7] - R[5], R[2] - R[6], R[3] - R[1]",
-            "R[7] - R[5], 1 + R[0] - R[4] - R[8], R[1] + R[3], R[2] + R[6]",
-            "R[2] - R[6], R[1] + R[3], 1 - R[0] + R[4] - R[8], R[5] + R[7]",
-            "R[3] - R[1], R[2] + R[6], R[5] + R[7], 1 - R[0] - R[4] + R[8]",
-        ]
-        statements: list[Statement] = [*self.rotation_check(),
-            {"kind": "let", "type": t, "name": "tr", "value": "R[0] + R[4] + R[8]", "ops": 2},
-            {"kind": "if", "condition": "tr >= R[0] && tr >= R[4] && tr >= R[8]",
-             "then": [{"kind": "return", "value": f"{h}({rows[0]}, p)", "ops": 4}], "otherwise": []},
-            {"kind": "if", "condition": "R[0] >= R[4] && R[0] >= R[8]",
-             "then": [{"kind": "return", "value": f"{h}({rows[1]}, p)", "ops": 6}], "otherwise": []},
-            {"kind": "if", "condition": "R[4] >= R[8]",
-             "then": [{"kind": "return", "value": f"{h}({rows[2]}, p)", "ops": 6}], "otherwise": []},
-            {"kind": "return", "value": f"{h}({rows[3]}, p)", "ops": 6},
-        ]
+        """Shepperd's largest pivot (eqs 61–65) after the check of R: max |RᵀR − I| ≤ 2^power and
+        det R > 0 (:data:`~symrot.plan.quaternion.ROTATION_TOLERANCE_POWER`); NaN fails every
+        comparison, so non-finite R and R whose products overflow are refused too."""
         power = ROTATION_TOLERANCE_POWER[PLAN_LABEL[self.precision]]
-        notes = ["Shepperd's method: the largest of (trace, R00, R11, R22) selects the row 4 e_k e of the",
-                 "quaternion (eqs 62-65), which from_quaternion normalizes. R must be a rotation:",
-                 f"max |R^T R - I| <= 2^{power} and det R > 0, otherwise (non-finite, singular, scaled, a",
-                 "reflection) status 1 and NaN. No orthogonalization: for R = Q + D with Q a rotation",
-                 "the result differs from Q's parameters by O(|D|)."]
-        return self.entry(self.name("from_rotation_matrix"), "parameter vector from a rotation matrix",
-                          "61-65", f"int {self.name('from_rotation_matrix')}(const {t} R[9], {t} p[3])",
-                          statements, notes)
-
-    def rotation_check(self) -> list[Statement]:
-        """Status 1 and NaN unless max |RᵀR − I| ≤ 2^power and det R > 0
-        (:data:`~symrot.plan.quaternion.ROTATION_TOLERANCE_POWER`); NaN fails every comparison, so
-        non-finite R and R whose products overflow are refused too."""
-        t = self.ctype
-        f = "" if t == "double" else "f"
-        power = ROTATION_TOLERANCE_POWER[PLAN_LABEL[self.precision]]
-        tolerance = self.printer.literal(sp.Integer(2) ** power)
-        statements: list[Statement] = []
-        checks = []
-        for i in range(3):
-            for j in range(i, 3):
-                column = " + ".join(f"R[{3 * k + i}] * R[{3 * k + j}]" for k in range(3))  # (RᵀR)_ij
-                value = f"{column} - 1" if i == j else column
-                statements.append({"kind": "let", "type": t, "name": f"g{i}{j}", "value": value,
-                                   "ops": 6 if i == j else 5})
-                checks.append(f"fabs{f}(g{i}{j}) <= {tolerance}")
-        statements.append({"kind": "let", "type": t, "name": "det",
-                           "value": "R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6])"
-                                    " + R[2] * (R[3] * R[7] - R[4] * R[6])", "ops": 14})
-        checks.append("det > 0")
-        statements.append({"kind": "if", "condition": "!(" + " && ".join(checks) + ")",
-                           "then": self.nan_out("p", 3), "otherwise": []})
-        return statements
+        return self.shared("from_rotation_matrix", self.printer.literal(sp.Integer(2) ** power), str(power))
 
     # -- compose and rescale ---------------------------------------------------------------------
     def compose(self) -> dict[str, Any]:
@@ -250,21 +196,8 @@ class OperationWriter(FunctionWriter):
                           statements, notes)
 
     def rescale(self) -> dict[str, Any]:
-        t = self.ctype
-        statements: list[Statement] = [
-            {"kind": "declare", "type": t, "names": ["e[4]"]},
-            {"kind": "call", "value": f"{self.name('to_quaternion')}(p, e)"},
-            {"kind": "if", "condition": "isnan(e[0])", "then": self.nan_out("q", 3), "otherwise": []},
-            {"kind": "if", "condition": "e[0] >= 0",
-             "then": [self.set(f"q[{i}]", f"p[{i}]") for i in range(3)] + [{"kind": "return", "value": "0"}],
-             "otherwise": []},
-            {"kind": "return", "value": f"{self.helper}(-e[0], -e[1], -e[2], -e[3], q)"},
-        ]
-        notes = ["The equivalent parameter vector with |phi| <= pi (eqs 40-47): p itself when |phi| <= pi,",
-                 "otherwise the parameters of the quaternion -e. Returns 0, or 1 with q = NaN when p is out",
-                 "of range."]
-        return self.entry(self.name("rescale"), "rescaling to |phi| <= pi", "40-47",
-                          f"int {self.name('rescale')}(const {t} p[3], {t} q[3])", statements, notes)
+        """**p** itself when e₀ ≥ 0, otherwise ``from_quaternion`` of −e."""
+        return self.shared("rescale")
 
     def all(self) -> list[dict[str, Any]]:
         """Helper first, then the public functions (C needs declaration before use)."""

@@ -31,3 +31,9 @@ def environment() -> jinja2.Environment:
 def render(template_name: str, **context: Any) -> str:
     """Render ``templates/<template_name>`` with ``context``."""
     return environment().get_template(template_name).render(**context)
+
+
+def macro(template_name: str, name: str, *args: Any) -> str:
+    """The text of macro ``name`` of ``templates/<template_name>`` called with ``args`` (for
+    functions that are the same in every output but for a few names, e.g. ``c/shared.h.j2``)."""
+    return str(getattr(environment().get_template(template_name).module, name)(*args))
