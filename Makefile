@@ -63,7 +63,7 @@ generate: check-versions ## Rewrite generated/ for the named parameterizations (
 check-generated: check-versions ## Fail with a diff when generated/ is stale
 	$(PYTHON) -m symrot.generate --check generated
 
-mutations: ## Mutation check: every fault of bench/mutation_list.py must fail a test of make test; writes docs/mutations.md
+mutations: ## Mutation check (CI runs it after the tests): every fault of bench/mutation_list.py must fail a test of make test; writes docs/mutations.md
 	$(PYTHON) bench/mutations.py --out docs/mutations.md
 
 bench: ## Benchmarks (accuracy and speed); writes docs/*.md
