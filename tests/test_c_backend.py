@@ -415,8 +415,10 @@ def test_functions_with_algebraic_plans_are_trig_free(name: str) -> None:
     comment lists each coefficient's plan); the angle needs the inverse function, e.g. 4 atan(s/4)."""
     text = (GENERATED / f"symrot_{name}.h").read_text(encoding="utf-8")
     functions = re.findall(r"/\* (symrot_\w+): (.*?)\*/\nstatic inline [^\n]*\n{(.*?)\n}\n", text, flags=re.S)
-    # the coefficient blocks several functions share (symrot/backends/c_shared.py): checked in their callers
-    shared = {c_name: body for c_name, _, body in functions if "__coefficients_" in c_name}
+    # the coefficient blocks and the entries several functions share (symrot/backends/c_shared.py,
+    # c_entries.py): checked in their callers
+    shared = {c_name: body for c_name, _, body in functions
+              if "__coefficients_" in c_name or re.search(r"__\w*entries", c_name)}
     functions = [function for function in functions if function[0] not in shared]
     derivatives = len(DERIVATIVES) + 3  # + angular_acceleration, compose_jacobians, rescale_jacobian
     assert len(functions) in (2 * (len(FUNCTIONS) + 1 + 5 + 6 + derivatives),
@@ -427,7 +429,7 @@ def test_functions_with_algebraic_plans_are_trig_free(name: str) -> None:
         if not plans or "__phi" in c_name or "_angle" in c_name or any(not kind for _, kind in plans):
             continue
         algebraic += 1
-        body += "".join(shared[called] for called in re.findall(r"\b(symrot_\w+__coefficients_\w+)\(", body))
+        body += "".join(shared[called] for called in re.findall(r"\b(symrot_\w+__\w+)\(", body) if called in shared)
         assert not re.search(r"\b(sin|cos|tan|asin|acos|atan|atan2)f?\(", body), c_name
     if name == "wiener_milenkovic":  # every coefficient of 4 tan(φ/4) is algebraic in x, and every slope
         # all but angle, plus to_quaternion; the derivatives of R, H, H⁻¹ and angular_acceleration

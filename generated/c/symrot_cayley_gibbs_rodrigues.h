@@ -88,6 +88,32 @@ static inline double symrot_cayley_gibbs_rodrigues_angle(const double p[3])
     return symrot_cayley_gibbs_rodrigues__phi(s);
 }
 
+/* symrot_cayley_gibbs_rodrigues__tensor_entries: internal: the entries that rotation_matrix, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_cayley_gibbs_rodrigues__tensor_entries(double c_1, double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const double out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const double out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const double out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const double out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix: rotation tensor R (eq 14).
  * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
@@ -114,25 +140,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[
     const double c_R_1 = 4/(x + 4);
     const double c_R_2 = 2/(x + 4);
     const double t = -c_R_2*x + 1;
-    const double out0 = c_R_2*(p[0]*p[0]) + t;
-    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out4 = c_R_2*(p[1]*p[1]) + t;
-    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tensor_entries(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_batch: symrot_cayley_gibbs_rodrigues_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -427,25 +435,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], 
     const double c_G_1 = 1.0/sqrt(x + 4);
     const double c_G_2 = 1.0/(x + 2*sqrt(x + 4) + 4);
     const double t = -c_G_2*x + 1;
-    const double out0 = c_G_2*(p[0]*p[0]) + t;
-    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out4 = c_G_2*(p[1]*p[1]) + t;
-    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tensor_entries(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_batch: symrot_cayley_gibbs_rodrigues_root_matrix for n vectors p[3*k..3*k+2] into
@@ -544,25 +534,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3],
     const double c_K_across = 1.0/sqrt(x + 4);
     const double c_K_1 = 1.0/(x + 2*sqrt(x + 4) + 4);
     const double c_K_2 = -1/((x + 4)*(sqrt(x + 4) + 2));
-    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tensor_entries(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_batch: symrot_cayley_gibbs_rodrigues_root_tangent for n vectors p[3*k..3*k+2] into
@@ -848,6 +820,58 @@ static inline int symrot_cayley_gibbs_rodrigues_rescale(const double p[3], doubl
     return symrot_cayley_gibbs_rodrigues__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_cayley_gibbs_rodrigues__rotation_derivative_entries: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_cayley_gibbs_rodrigues__rotation_derivative_entries(double c_1, double c_1_x, double c_R_2, double c_R_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_R_2_x*dw13;
+    const double dw15 = a[2]*c_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_1_x;
+    const double dw18 = a[1]*c_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_R_2_x*dw20;
+    const double dw23 = a[0]*c_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_R_2_x*dw24;
+    const double out0 = c_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_cayley_gibbs_rodrigues_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for every p with |p|^2 < 2^600 (|phi| < 3.1415926535897931), the largest power
@@ -878,51 +902,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative(const doubl
     const double c_R_2 = 2/(x + 4);
     const double c_R_1_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
     const double c_R_2_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = 2*p[0];
-    const double dw6 = a[0]*p[1];
-    const double dw7 = -a[1]*p[0] + dw6;
-    const double dw8 = -dw7;
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8*p[1];
-    const double dw14 = c_R_2_x*dw13;
-    const double dw15 = a[2]*c_R_1;
-    const double dw16 = dw4*p[1];
-    const double dw17 = 2*c_R_1_x;
-    const double dw18 = a[1]*c_R_1;
-    const double dw19 = dw8*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = 2*c_R_2_x*dw20;
-    const double dw23 = a[0]*c_R_1;
-    const double dw24 = dw11*p[0] - dw16;
-    const double dw25 = c_R_2_x*dw24;
-    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_cayley_gibbs_rodrigues__rotation_derivative_entries(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -935,7 +915,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative(const doubl
  * R_0_x = 0 (constant)
  * R_1_x = -(4/(x + 4))**2/4 (algebraic in x)
  * R_2_x = -(4/(x + 4))**2/8 (algebraic in x)
- * ops: 141 */
+ * ops: 142 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -955,39 +935,40 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative(c
     const double c_R_2 = 2/(x + 4);
     const double c_R_1_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
     const double c_R_2_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = a[0]*p[1];
-    const double dw6 = -a[1]*p[0] + dw5;
-    const double dw7 = -dw6;
-    const double dw8 = dw7*p[1];
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8;
-    const double dw14 = a[2]*c_R_1;
-    const double dw15 = dw4*p[1];
-    const double dw16 = 2*c_R_1_x;
-    const double dw17 = a[1]*c_R_1;
-    const double dw18 = dw11*p[0];
-    const double dw19 = dw7*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = a[0]*c_R_1;
-    const double dw23 = -dw15 + dw18;
-    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double c_R_T_1 = -c_R_1;
+    const double c_R_T_1_x = -c_R_1_x;
+    symrot_cayley_gibbs_rodrigues__rotation_derivative_entries(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
+}
+
+/* symrot_cayley_gibbs_rodrigues__tangent_derivative_entries: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 58 */
+static inline void symrot_cayley_gibbs_rodrigues__tangent_derivative_entries(double c_1, double c_1_x, double c_H_0_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = 2*p[0];
+    const double dw1 = a[1]*p[2];
+    const double dw2 = c_1_x*(a[2]*p[1] - dw1);
+    const double dw3 = a[2]*c_1;
+    const double dw4 = a[0]*p[1];
+    const double dw5 = 2*c_H_0_x;
+    const double dw6 = 2*dw2;
+    const double dw7 = a[1]*c_1;
+    const double dw8 = a[0]*p[2];
+    const double dw9 = a[2]*p[0];
+    const double dw10 = c_1_x*(dw8 - dw9);
+    const double dw11 = 2*dw10;
+    const double dw12 = a[0]*c_1;
+    const double dw13 = c_1_x*(a[1]*p[0] - dw4);
+    const double dw14 = 2*dw13;
+    const double out0 = a[0]*c_H_0_x*dw0 + dw0*dw2;
+    const double out1 = dw3 + dw4*dw5 + dw6*p[1];
+    const double out2 = dw5*dw8 + dw6*p[2] - dw7;
+    const double out3 = a[1]*dw5*p[0] + dw0*dw10 - dw3;
+    const double out4 = a[1]*dw5*p[1] + dw11*p[1];
+    const double out5 = dw1*dw5 + dw11*p[2] + dw12;
+    const double out6 = dw0*dw13 + dw5*dw9 + dw7;
+    const double out7 = a[2]*dw5*p[1] - dw12 + dw14*p[1];
+    const double out8 = a[2]*dw5*p[2] + dw14*p[2];
     /* stored last: an output may be the same array as an input */
     D[0] = out0;
     D[1] = out1;
@@ -1029,40 +1010,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative(const double
     const double c_H_1 = 2/(x + 4);
     const double c_H_0_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
     const double c_H_1_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
-    const double dw0 = 2*p[0];
-    const double dw1 = a[1]*p[2];
-    const double dw2 = c_H_1_x*(a[2]*p[1] - dw1);
-    const double dw3 = a[2]*c_H_1;
-    const double dw4 = a[0]*p[1];
-    const double dw5 = 2*c_H_0_x;
-    const double dw6 = 2*dw2;
-    const double dw7 = a[1]*c_H_1;
-    const double dw8 = a[0]*p[2];
-    const double dw9 = a[2]*p[0];
-    const double dw10 = c_H_1_x*(dw8 - dw9);
-    const double dw11 = 2*dw10;
-    const double dw12 = a[0]*c_H_1;
-    const double dw13 = c_H_1_x*(a[1]*p[0] - dw4);
-    const double dw14 = 2*dw13;
-    const double out0 = a[0]*c_H_0_x*dw0 + dw0*dw2;
-    const double out1 = dw3 + dw4*dw5 + dw6*p[1];
-    const double out2 = dw5*dw8 + dw6*p[2] - dw7;
-    const double out3 = a[1]*dw5*p[0] + dw0*dw10 - dw3;
-    const double out4 = a[1]*dw5*p[1] + dw11*p[1];
-    const double out5 = dw1*dw5 + dw11*p[2] + dw12;
-    const double out6 = dw0*dw13 + dw5*dw9 + dw7;
-    const double out7 = a[2]*dw5*p[1] - dw12 + dw14*p[1];
-    const double out8 = a[2]*dw5*p[2] + dw14*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tangent_derivative_entries(c_H_1, c_H_1_x, c_H_0_x, p, a, D);
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1075,7 +1023,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative(const double
  * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
  * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 82 */
+ * ops: 78 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1094,37 +1042,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(co
     const double c_H_1 = 2/(x + 4);
     const double c_H_0_x = -1.0/4.0*((4/(x + 4))*(4/(x + 4)));
     const double c_H_1_x = -1.0/8.0*((4/(x + 4))*(4/(x + 4)));
-    const double dw0 = 2*p[0];
-    const double dw1 = c_H_1_x*(-a[1]*p[2] + a[2]*p[1]);
-    const double dw2 = a[2]*c_H_1;
-    const double dw3 = 2*dw1;
-    const double dw4 = a[1]*c_H_1;
-    const double dw5 = a[0]*p[2];
-    const double dw6 = 2*c_H_0_x;
-    const double dw7 = c_H_1_x*(-a[2]*p[0] + dw5);
-    const double dw8 = 2*dw7;
-    const double dw9 = a[0]*c_H_1;
-    const double dw10 = c_H_1_x*(-a[0]*p[1] + a[1]*p[0]);
-    const double dw11 = 2*dw10;
-    const double out0 = a[0]*c_H_0_x*dw0 - dw0*dw1;
-    const double out1 = 2*a[0]*c_H_0_x*p[1] - dw2 - dw3*p[1];
-    const double out2 = -dw3*p[2] + dw4 + dw5*dw6;
-    const double out3 = a[1]*dw6*p[0] - dw0*dw7 + dw2;
-    const double out4 = a[1]*dw6*p[1] - dw8*p[1];
-    const double out5 = 2*a[1]*c_H_0_x*p[2] - dw8*p[2] - dw9;
-    const double out6 = 2*a[2]*c_H_0_x*p[0] - dw0*dw10 - dw4;
-    const double out7 = a[2]*dw6*p[1] - dw11*p[1] + dw9;
-    const double out8 = a[2]*dw6*p[2] - dw11*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_H_T_1 = -c_H_1;
+    const double c_H_T_1_x = -c_H_1_x;
+    symrot_cayley_gibbs_rodrigues__tangent_derivative_entries(c_H_T_1, c_H_T_1_x, c_H_0_x, p, a, D);
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1377,6 +1297,32 @@ static inline float symrot_cayley_gibbs_rodrigues_angle_f(const float p[3])
     return symrot_cayley_gibbs_rodrigues__phi_f(s);
 }
 
+/* symrot_cayley_gibbs_rodrigues__tensor_entries_f: internal: the entries that rotation_matrix, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_cayley_gibbs_rodrigues__tensor_entries_f(float c_1, float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const float out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const float out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const float out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const float out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
  * of two up to which every printed form was checked against 50+ digits; otherwise, and for
@@ -1403,25 +1349,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p
     const float c_R_1 = 4/(x + 4);
     const float c_R_2 = 2/(x + 4);
     const float t = -c_R_2*x + 1;
-    const float out0 = c_R_2*(p[0]*p[0]) + t;
-    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out4 = c_R_2*(p[1]*p[1]) + t;
-    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tensor_entries_f(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch: symrot_cayley_gibbs_rodrigues_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1716,25 +1644,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3],
     const float c_G_1 = 1.0F/sqrtf(x + 4);
     const float c_G_2 = 1.0F/(x + 2*sqrtf(x + 4) + 4);
     const float t = -c_G_2*x + 1;
-    const float out0 = c_G_2*(p[0]*p[0]) + t;
-    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out4 = c_G_2*(p[1]*p[1]) + t;
-    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tensor_entries_f(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_matrix_f_batch: symrot_cayley_gibbs_rodrigues_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1833,25 +1743,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3]
     const float c_K_across = 1.0F/sqrtf(x + 4);
     const float c_K_1 = 1.0F/(x + 2*sqrtf(x + 4) + 4);
     const float c_K_2 = -1/((x + 4)*(sqrtf(x + 4) + 2));
-    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tensor_entries_f(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_cayley_gibbs_rodrigues_root_tangent_f_batch: symrot_cayley_gibbs_rodrigues_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2137,6 +2029,58 @@ static inline int symrot_cayley_gibbs_rodrigues_rescale_f(const float p[3], floa
     return symrot_cayley_gibbs_rodrigues__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_cayley_gibbs_rodrigues__rotation_derivative_entries_f: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_cayley_gibbs_rodrigues__rotation_derivative_entries_f(float c_1, float c_1_x, float c_R_2, float c_R_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_R_2_x*dw13;
+    const float dw15 = a[2]*c_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_1_x;
+    const float dw18 = a[1]*c_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_R_2_x*dw20;
+    const float dw23 = a[0]*c_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_R_2_x*dw24;
+    const float out0 = c_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_cayley_gibbs_rodrigues_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for every p with |p|^2 < 2^85 (|phi| < 3.1415926535897931), the largest power
@@ -2167,51 +2111,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative_f(const flo
     const float c_R_2 = 2/(x + 4);
     const float c_R_1_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
     const float c_R_2_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = 2*p[0];
-    const float dw6 = a[0]*p[1];
-    const float dw7 = -a[1]*p[0] + dw6;
-    const float dw8 = -dw7;
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8*p[1];
-    const float dw14 = c_R_2_x*dw13;
-    const float dw15 = a[2]*c_R_1;
-    const float dw16 = dw4*p[1];
-    const float dw17 = 2*c_R_1_x;
-    const float dw18 = a[1]*c_R_1;
-    const float dw19 = dw8*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = 2*c_R_2_x*dw20;
-    const float dw23 = a[0]*c_R_1;
-    const float dw24 = dw11*p[0] - dw16;
-    const float dw25 = c_R_2_x*dw24;
-    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_cayley_gibbs_rodrigues__rotation_derivative_entries_f(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2224,7 +2124,7 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative_f(const flo
  * R_0_x = 0 (constant)
  * R_1_x = -(4/(x + 4))**2/4 (algebraic in x)
  * R_2_x = -(4/(x + 4))**2/8 (algebraic in x)
- * ops: 141 */
+ * ops: 142 */
 static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2244,39 +2144,40 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f
     const float c_R_2 = 2/(x + 4);
     const float c_R_1_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
     const float c_R_2_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = a[0]*p[1];
-    const float dw6 = -a[1]*p[0] + dw5;
-    const float dw7 = -dw6;
-    const float dw8 = dw7*p[1];
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8;
-    const float dw14 = a[2]*c_R_1;
-    const float dw15 = dw4*p[1];
-    const float dw16 = 2*c_R_1_x;
-    const float dw17 = a[1]*c_R_1;
-    const float dw18 = dw11*p[0];
-    const float dw19 = dw7*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = a[0]*c_R_1;
-    const float dw23 = -dw15 + dw18;
-    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float c_R_T_1 = -c_R_1;
+    const float c_R_T_1_x = -c_R_1_x;
+    symrot_cayley_gibbs_rodrigues__rotation_derivative_entries_f(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
+}
+
+/* symrot_cayley_gibbs_rodrigues__tangent_derivative_entries_f: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 58 */
+static inline void symrot_cayley_gibbs_rodrigues__tangent_derivative_entries_f(float c_1, float c_1_x, float c_H_0_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = 2*p[0];
+    const float dw1 = a[1]*p[2];
+    const float dw2 = c_1_x*(a[2]*p[1] - dw1);
+    const float dw3 = a[2]*c_1;
+    const float dw4 = a[0]*p[1];
+    const float dw5 = 2*c_H_0_x;
+    const float dw6 = 2*dw2;
+    const float dw7 = a[1]*c_1;
+    const float dw8 = a[0]*p[2];
+    const float dw9 = a[2]*p[0];
+    const float dw10 = c_1_x*(dw8 - dw9);
+    const float dw11 = 2*dw10;
+    const float dw12 = a[0]*c_1;
+    const float dw13 = c_1_x*(a[1]*p[0] - dw4);
+    const float dw14 = 2*dw13;
+    const float out0 = a[0]*c_H_0_x*dw0 + dw0*dw2;
+    const float out1 = dw3 + dw4*dw5 + dw6*p[1];
+    const float out2 = dw5*dw8 + dw6*p[2] - dw7;
+    const float out3 = a[1]*dw5*p[0] + dw0*dw10 - dw3;
+    const float out4 = a[1]*dw5*p[1] + dw11*p[1];
+    const float out5 = dw1*dw5 + dw11*p[2] + dw12;
+    const float out6 = dw0*dw13 + dw5*dw9 + dw7;
+    const float out7 = a[2]*dw5*p[1] - dw12 + dw14*p[1];
+    const float out8 = a[2]*dw5*p[2] + dw14*p[2];
     /* stored last: an output may be the same array as an input */
     D[0] = out0;
     D[1] = out1;
@@ -2318,40 +2219,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative_f(const floa
     const float c_H_1 = 2/(x + 4);
     const float c_H_0_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
     const float c_H_1_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
-    const float dw0 = 2*p[0];
-    const float dw1 = a[1]*p[2];
-    const float dw2 = c_H_1_x*(a[2]*p[1] - dw1);
-    const float dw3 = a[2]*c_H_1;
-    const float dw4 = a[0]*p[1];
-    const float dw5 = 2*c_H_0_x;
-    const float dw6 = 2*dw2;
-    const float dw7 = a[1]*c_H_1;
-    const float dw8 = a[0]*p[2];
-    const float dw9 = a[2]*p[0];
-    const float dw10 = c_H_1_x*(dw8 - dw9);
-    const float dw11 = 2*dw10;
-    const float dw12 = a[0]*c_H_1;
-    const float dw13 = c_H_1_x*(a[1]*p[0] - dw4);
-    const float dw14 = 2*dw13;
-    const float out0 = a[0]*c_H_0_x*dw0 + dw0*dw2;
-    const float out1 = dw3 + dw4*dw5 + dw6*p[1];
-    const float out2 = dw5*dw8 + dw6*p[2] - dw7;
-    const float out3 = a[1]*dw5*p[0] + dw0*dw10 - dw3;
-    const float out4 = a[1]*dw5*p[1] + dw11*p[1];
-    const float out5 = dw1*dw5 + dw11*p[2] + dw12;
-    const float out6 = dw0*dw13 + dw5*dw9 + dw7;
-    const float out7 = a[2]*dw5*p[1] - dw12 + dw14*p[1];
-    const float out8 = a[2]*dw5*p[2] + dw14*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_cayley_gibbs_rodrigues__tangent_derivative_entries_f(c_H_1, c_H_1_x, c_H_0_x, p, a, D);
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2364,7 +2232,7 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative_f(const floa
  * H_0_x = -(4/(x + 4))**2/4 (algebraic in x)
  * H_1_x = -(4/(x + 4))**2/8 (algebraic in x)
  * H_2_x = 0 (constant)
- * ops: 82 */
+ * ops: 78 */
 static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2383,37 +2251,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(
     const float c_H_1 = 2/(x + 4);
     const float c_H_0_x = -1.0F/4.0F*((4/(x + 4))*(4/(x + 4)));
     const float c_H_1_x = -1.0F/8.0F*((4/(x + 4))*(4/(x + 4)));
-    const float dw0 = 2*p[0];
-    const float dw1 = c_H_1_x*(-a[1]*p[2] + a[2]*p[1]);
-    const float dw2 = a[2]*c_H_1;
-    const float dw3 = 2*dw1;
-    const float dw4 = a[1]*c_H_1;
-    const float dw5 = a[0]*p[2];
-    const float dw6 = 2*c_H_0_x;
-    const float dw7 = c_H_1_x*(-a[2]*p[0] + dw5);
-    const float dw8 = 2*dw7;
-    const float dw9 = a[0]*c_H_1;
-    const float dw10 = c_H_1_x*(-a[0]*p[1] + a[1]*p[0]);
-    const float dw11 = 2*dw10;
-    const float out0 = a[0]*c_H_0_x*dw0 - dw0*dw1;
-    const float out1 = 2*a[0]*c_H_0_x*p[1] - dw2 - dw3*p[1];
-    const float out2 = -dw3*p[2] + dw4 + dw5*dw6;
-    const float out3 = a[1]*dw6*p[0] - dw0*dw7 + dw2;
-    const float out4 = a[1]*dw6*p[1] - dw8*p[1];
-    const float out5 = 2*a[1]*c_H_0_x*p[2] - dw8*p[2] - dw9;
-    const float out6 = 2*a[2]*c_H_0_x*p[0] - dw0*dw10 - dw4;
-    const float out7 = a[2]*dw6*p[1] - dw11*p[1] + dw9;
-    const float out8 = a[2]*dw6*p[2] - dw11*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_H_T_1 = -c_H_1;
+    const float c_H_T_1_x = -c_H_1_x;
+    symrot_cayley_gibbs_rodrigues__tangent_derivative_entries_f(c_H_T_1, c_H_T_1_x, c_H_0_x, p, a, D);
 }
 
 /* symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).

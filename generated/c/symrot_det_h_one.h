@@ -284,6 +284,32 @@ static inline double symrot_det_h_one_angle(const double p[3])
     return symrot_det_h_one__phi(s);
 }
 
+/* symrot_det_h_one__tensor_entries: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_det_h_one__tensor_entries(double c_1, double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const double out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const double out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const double out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const double out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_det_h_one_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -318,25 +344,7 @@ static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[
         c_R_2 = 2*(w1*w1)/x;
     }
     const double t = -c_R_2*x + 1;
-    const double out0 = c_R_2*(p[0]*p[0]) + t;
-    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out4 = c_R_2*(p[1]*p[1]) + t;
-    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_det_h_one__tensor_entries(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_det_h_one_rotation_matrix_batch: symrot_det_h_one_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -451,25 +459,7 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
     }
     double c_H_across, c_H_1, c_H_2;
     symrot_det_h_one__coefficients_H_across_H_1_H_2(x, &c_H_across, &c_H_1, &c_H_2);
-    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_det_h_one__tensor_entries(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_det_h_one_tangent_batch: symrot_det_h_one_tangent for n vectors p[3*k..3*k+2] into
@@ -760,25 +750,7 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
-    const double out0 = c_G_2*(p[0]*p[0]) + t;
-    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out4 = c_G_2*(p[1]*p[1]) + t;
-    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_det_h_one__tensor_entries(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_det_h_one_root_matrix_batch: symrot_det_h_one_root_matrix for n vectors p[3*k..3*k+2] into
@@ -914,25 +886,7 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
         c_K_1 = 2*w2*pow(sin((1.0/4.0)*phi), 2);
         c_K_2 = x < 1.4342812090283275 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.3462827495637501e-20)*x + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0 : w2*(-w1 + (1.0/8.0)*x/(w0*w0));
     }
-    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_det_h_one__tensor_entries(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_det_h_one_root_tangent_batch: symrot_det_h_one_root_tangent for n vectors p[3*k..3*k+2] into
@@ -1258,6 +1212,58 @@ static inline int symrot_det_h_one_rescale(const double p[3], double q[3])
     return symrot_det_h_one__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_det_h_one__rotation_derivative_entries: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_det_h_one__rotation_derivative_entries(double c_1, double c_1_x, double c_R_2, double c_R_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_R_2_x*dw13;
+    const double dw15 = a[2]*c_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_1_x;
+    const double dw18 = a[1]*c_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_R_2_x*dw20;
+    const double dw23 = a[0]*c_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_R_2_x*dw24;
+    const double out0 = c_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_det_h_one_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -1284,51 +1290,7 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_det_h_one__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = 2*p[0];
-    const double dw6 = a[0]*p[1];
-    const double dw7 = -a[1]*p[0] + dw6;
-    const double dw8 = -dw7;
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8*p[1];
-    const double dw14 = c_R_2_x*dw13;
-    const double dw15 = a[2]*c_R_1;
-    const double dw16 = dw4*p[1];
-    const double dw17 = 2*c_R_1_x;
-    const double dw18 = a[1]*c_R_1;
-    const double dw19 = dw8*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = 2*c_R_2_x*dw20;
-    const double dw23 = a[0]*c_R_1;
-    const double dw24 = dw11*p[0] - dw16;
-    const double dw25 = c_R_2_x*dw24;
-    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_det_h_one__rotation_derivative_entries(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_det_h_one_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1339,7 +1301,7 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 16 in x below x = 1.43428, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 862 */
+ * ops: 863 */
 static inline void symrot_det_h_one_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1357,39 +1319,54 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_det_h_one__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = a[0]*p[1];
-    const double dw6 = -a[1]*p[0] + dw5;
-    const double dw7 = -dw6;
-    const double dw8 = dw7*p[1];
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8;
-    const double dw14 = a[2]*c_R_1;
-    const double dw15 = dw4*p[1];
-    const double dw16 = 2*c_R_1_x;
-    const double dw17 = a[1]*c_R_1;
-    const double dw18 = dw11*p[0];
-    const double dw19 = dw7*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = a[0]*c_R_1;
-    const double dw23 = -dw15 + dw18;
-    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double c_R_T_1 = -c_R_1;
+    const double c_R_T_1_x = -c_R_1_x;
+    symrot_det_h_one__rotation_derivative_entries(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
+}
+
+/* symrot_det_h_one__tangent_derivative_entries: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_det_h_one__tangent_derivative_entries(double c_1, double c_1_x, double c_H_0_x, double c_H_2, double c_H_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = a[0]*p[2];
+    const double dw12 = a[2]*p[0];
+    const double dw13 = dw11 - dw12;
+    const double dw14 = dw13*p[2];
+    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const double dw16 = a[2]*c_1;
+    const double dw17 = dw6*p[1];
+    const double dw18 = 2*c_1_x;
+    const double dw19 = 2*dw15;
+    const double dw20 = a[1]*c_1;
+    const double dw21 = a[1]*p[0];
+    const double dw22 = dw13*p[0];
+    const double dw23 = dw10*p[0];
+    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const double dw25 = 2*dw24;
+    const double dw26 = a[0]*c_1;
+    const double dw27 = -dw17 + dw22;
+    const double dw28 = c_H_2_x*dw27;
+    const double out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
     /* stored last: an output may be the same array as an input */
     D[0] = out0;
     D[1] = out1;
@@ -1428,54 +1405,7 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_det_h_one__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = a[0]*p[2];
-    const double dw12 = a[2]*p[0];
-    const double dw13 = dw11 - dw12;
-    const double dw14 = dw13*p[2];
-    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const double dw16 = a[2]*c_H_1;
-    const double dw17 = dw6*p[1];
-    const double dw18 = 2*c_H_1_x;
-    const double dw19 = 2*dw15;
-    const double dw20 = a[1]*c_H_1;
-    const double dw21 = a[1]*p[0];
-    const double dw22 = dw13*p[0];
-    const double dw23 = dw10*p[0];
-    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const double dw25 = 2*dw24;
-    const double dw26 = a[0]*c_H_1;
-    const double dw27 = -dw17 + dw22;
-    const double dw28 = c_H_2_x*dw27;
-    const double out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_det_h_one__tangent_derivative_entries(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_det_h_one_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1486,7 +1416,7 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
  * H_0_x: Horner degree 19 in x below x = 1.43428, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 21 in x below x = 2.63022, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 19 in x below x = 1.43428, else ((-6*phi + 8*sin(phi) - sin(2*phi))*sin(phi)/(8*sin(phi/2)**4) - (4*cos(phi) - cos(2*phi) - 3)/(2*sin(phi/2)**2) + (-6*phi + 8*sin(phi) - sin(2*phi))/(2*(phi - sin(phi))))*cbrt(6*(phi - sin(phi)))/(48*(phi - sin(phi))*sin(phi/2)**2)
- * ops: 1015 */
+ * ops: 1011 */
 static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1504,56 +1434,9 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_det_h_one__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = dw10*p[1];
-    const double dw12 = a[0]*p[2];
-    const double dw13 = a[2]*p[0];
-    const double dw14 = dw12 - dw13;
-    const double dw15 = dw14*p[2];
-    const double dw16 = dw11 - dw15;
-    const double dw17 = c_H_2_x*dw16;
-    const double dw18 = a[2]*c_H_1;
-    const double dw19 = dw6*p[1];
-    const double dw20 = 2*c_H_1_x;
-    const double dw21 = a[1]*c_H_1;
-    const double dw22 = a[1]*p[0];
-    const double dw23 = dw14*p[0];
-    const double dw24 = dw10*p[0];
-    const double dw25 = -dw24 + dw6*p[2];
-    const double dw26 = c_H_2_x*dw25;
-    const double dw27 = a[0]*c_H_1;
-    const double dw28 = -dw19 + dw23;
-    const double dw29 = a[2]*p[1];
-    const double dw30 = 2*c_H_2_x*dw28;
-    const double out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const double out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const double out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_H_T_1 = -c_H_1;
+    const double c_H_T_1_x = -c_H_1_x;
+    symrot_det_h_one__tangent_derivative_entries(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_det_h_one_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2056,6 +1939,32 @@ static inline float symrot_det_h_one_angle_f(const float p[3])
     return symrot_det_h_one__phi_f(s);
 }
 
+/* symrot_det_h_one__tensor_entries_f: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_det_h_one__tensor_entries_f(float c_1, float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const float out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const float out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const float out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const float out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_det_h_one_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -2089,25 +1998,7 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
         c_R_2 = (1 - cosf(phi))/x;
     }
     const float t = -c_R_2*x + 1;
-    const float out0 = c_R_2*(p[0]*p[0]) + t;
-    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out4 = c_R_2*(p[1]*p[1]) + t;
-    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_det_h_one__tensor_entries_f(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_det_h_one_rotation_matrix_f_batch: symrot_det_h_one_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2233,25 +2124,7 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
     }
     float c_H_across, c_H_1, c_H_2;
     symrot_det_h_one__coefficients_H_across_H_1_H_2_f(x, &c_H_across, &c_H_1, &c_H_2);
-    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_det_h_one__tensor_entries_f(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_det_h_one_tangent_f_batch: symrot_det_h_one_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2528,25 +2401,7 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
-    const float out0 = c_G_2*(p[0]*p[0]) + t;
-    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out4 = c_G_2*(p[1]*p[1]) + t;
-    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_det_h_one__tensor_entries_f(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_det_h_one_root_matrix_f_batch: symrot_det_h_one_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2683,25 +2538,7 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = x < 4.619481F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F : (-w1/w2 + (1.0F/8.0F)*w3/(w1*w1))/w3;
     }
-    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_det_h_one__tensor_entries_f(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_det_h_one_root_tangent_f_batch: symrot_det_h_one_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -3029,6 +2866,58 @@ static inline int symrot_det_h_one_rescale_f(const float p[3], float q[3])
     return symrot_det_h_one__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_det_h_one__rotation_derivative_entries_f: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_det_h_one__rotation_derivative_entries_f(float c_1, float c_1_x, float c_R_2, float c_R_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_R_2_x*dw13;
+    const float dw15 = a[2]*c_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_1_x;
+    const float dw18 = a[1]*c_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_R_2_x*dw20;
+    const float dw23 = a[0]*c_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_R_2_x*dw24;
+    const float out0 = c_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_det_h_one_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3.3530783864394875 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -3055,51 +2944,7 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_det_h_one__coefficients_R_1_R_2_R_1_x_R_2_x_f(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = 2*p[0];
-    const float dw6 = a[0]*p[1];
-    const float dw7 = -a[1]*p[0] + dw6;
-    const float dw8 = -dw7;
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8*p[1];
-    const float dw14 = c_R_2_x*dw13;
-    const float dw15 = a[2]*c_R_1;
-    const float dw16 = dw4*p[1];
-    const float dw17 = 2*c_R_1_x;
-    const float dw18 = a[1]*c_R_1;
-    const float dw19 = dw8*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = 2*c_R_2_x*dw20;
-    const float dw23 = a[0]*c_R_1;
-    const float dw24 = dw11*p[0] - dw16;
-    const float dw25 = c_R_2_x*dw24;
-    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_det_h_one__rotation_derivative_entries_f(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_det_h_one_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -3110,7 +2955,7 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 10 in x below x = 2.63022, else (cos(phi) - 2*sin(phi/2)**2*sin(phi)/(3*(phi - sin(phi))))/(8*sin(phi/2)**2)
  * R_2_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
- * ops: 635 */
+ * ops: 636 */
 static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3128,39 +2973,54 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_det_h_one__coefficients_R_1_R_2_R_1_x_R_2_x_f(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = a[0]*p[1];
-    const float dw6 = -a[1]*p[0] + dw5;
-    const float dw7 = -dw6;
-    const float dw8 = dw7*p[1];
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8;
-    const float dw14 = a[2]*c_R_1;
-    const float dw15 = dw4*p[1];
-    const float dw16 = 2*c_R_1_x;
-    const float dw17 = a[1]*c_R_1;
-    const float dw18 = dw11*p[0];
-    const float dw19 = dw7*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = a[0]*c_R_1;
-    const float dw23 = -dw15 + dw18;
-    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float c_R_T_1 = -c_R_1;
+    const float c_R_T_1_x = -c_R_1_x;
+    symrot_det_h_one__rotation_derivative_entries_f(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
+}
+
+/* symrot_det_h_one__tangent_derivative_entries_f: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_det_h_one__tangent_derivative_entries_f(float c_1, float c_1_x, float c_H_0_x, float c_H_2, float c_H_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = a[0]*p[2];
+    const float dw12 = a[2]*p[0];
+    const float dw13 = dw11 - dw12;
+    const float dw14 = dw13*p[2];
+    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const float dw16 = a[2]*c_1;
+    const float dw17 = dw6*p[1];
+    const float dw18 = 2*c_1_x;
+    const float dw19 = 2*dw15;
+    const float dw20 = a[1]*c_1;
+    const float dw21 = a[1]*p[0];
+    const float dw22 = dw13*p[0];
+    const float dw23 = dw10*p[0];
+    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const float dw25 = 2*dw24;
+    const float dw26 = a[0]*c_1;
+    const float dw27 = -dw17 + dw22;
+    const float dw28 = c_H_2_x*dw27;
+    const float out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
     /* stored last: an output may be the same array as an input */
     D[0] = out0;
     D[1] = out1;
@@ -3199,54 +3059,7 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_det_h_one__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x_f(x, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = a[0]*p[2];
-    const float dw12 = a[2]*p[0];
-    const float dw13 = dw11 - dw12;
-    const float dw14 = dw13*p[2];
-    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const float dw16 = a[2]*c_H_1;
-    const float dw17 = dw6*p[1];
-    const float dw18 = 2*c_H_1_x;
-    const float dw19 = 2*dw15;
-    const float dw20 = a[1]*c_H_1;
-    const float dw21 = a[1]*p[0];
-    const float dw22 = dw13*p[0];
-    const float dw23 = dw10*p[0];
-    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const float dw25 = 2*dw24;
-    const float dw26 = a[0]*c_H_1;
-    const float dw27 = -dw17 + dw22;
-    const float dw28 = c_H_2_x*dw27;
-    const float out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_det_h_one__tangent_derivative_entries_f(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_det_h_one_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -3257,7 +3070,7 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
  * H_0_x: Horner degree 21 in x below x = 4.61948, else (6*phi - 12*sin(phi/2)*cos(phi/2))*(-3*cos(phi/2)/(2*sin(phi/2)**3) + 2/(phi - 2*sin(phi/2)*cos(phi/2)))/(48*sin(phi/2)**2)
  * H_1_x: Horner degree 17 in x below x = 4.61948, else (2*sin(phi/2)*cos(phi/2) - 8*sin(phi/2)**4/(3*(phi - 2*sin(phi/2)*cos(phi/2))))/(8*sin(phi/2)**2*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2)))
  * H_2_x: Horner degree 21 in x below x = 4.61948, else ((-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))*cos(phi/2)/(4*sin(phi/2)**3) - (-8*sin(phi/2)**2 - cos(2*phi) + 1)/(2*sin(phi/2)**2) + (-6*phi + 16*sin(phi/2)*cos(phi/2) - sin(2*phi))/(2*(phi - 2*sin(phi/2)*cos(phi/2))))*cbrt(6*phi - 12*sin(phi/2)*cos(phi/2))/(48*(phi - 2*sin(phi/2)*cos(phi/2))*sin(phi/2)**2)
- * ops: 817 */
+ * ops: 813 */
 static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3275,56 +3088,9 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_det_h_one__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x_f(x, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = dw10*p[1];
-    const float dw12 = a[0]*p[2];
-    const float dw13 = a[2]*p[0];
-    const float dw14 = dw12 - dw13;
-    const float dw15 = dw14*p[2];
-    const float dw16 = dw11 - dw15;
-    const float dw17 = c_H_2_x*dw16;
-    const float dw18 = a[2]*c_H_1;
-    const float dw19 = dw6*p[1];
-    const float dw20 = 2*c_H_1_x;
-    const float dw21 = a[1]*c_H_1;
-    const float dw22 = a[1]*p[0];
-    const float dw23 = dw14*p[0];
-    const float dw24 = dw10*p[0];
-    const float dw25 = -dw24 + dw6*p[2];
-    const float dw26 = c_H_2_x*dw25;
-    const float dw27 = a[0]*c_H_1;
-    const float dw28 = -dw19 + dw23;
-    const float dw29 = a[2]*p[1];
-    const float dw30 = 2*c_H_2_x*dw28;
-    const float out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const float out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const float out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_H_T_1 = -c_H_1;
+    const float c_H_T_1_x = -c_H_1_x;
+    symrot_det_h_one__tangent_derivative_entries_f(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_det_h_one_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).

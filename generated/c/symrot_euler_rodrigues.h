@@ -220,6 +220,32 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
     }
 }
 
+/* symrot_euler_rodrigues__tensor_entries: internal: the entries that tangent, root_matrix compute alike from their own coefficients (eq 22).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_euler_rodrigues__tensor_entries(double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = c_2*p[0]*p[1] - 1.0/2.0*p[2];
+    const double out2 = c_2*p[0]*p[2] + (1.0/2.0)*p[1];
+    const double out3 = c_2*p[0]*p[1] + (1.0/2.0)*p[2];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = c_2*p[1]*p[2] - 1.0/2.0*p[0];
+    const double out6 = c_2*p[0]*p[2] - 1.0/2.0*p[1];
+    const double out7 = c_2*p[1]*p[2] + (1.0/2.0)*p[0];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_euler_rodrigues_tangent: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
  * H_across = sqrt(d)/2 (algebraic in x)
@@ -244,25 +270,7 @@ static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9]
     }
     const double c_H_across = (1.0/2.0)*sqrt(d);
     const double c_H_2 = (1.0/2.0)/sqrt(d);
-    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const double out1 = c_H_2*p[0]*p[1] - 1.0/2.0*p[2];
-    const double out2 = c_H_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    const double out3 = c_H_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const double out5 = c_H_2*p[1]*p[2] - 1.0/2.0*p[0];
-    const double out6 = c_H_2*p[0]*p[2] - 1.0/2.0*p[1];
-    const double out7 = c_H_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_euler_rodrigues__tensor_entries(c_H_2, c_H_across, p, H);
 }
 
 /* symrot_euler_rodrigues_tangent_batch: symrot_euler_rodrigues_tangent for n vectors p[3*k..3*k+2] into
@@ -479,25 +487,7 @@ static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double 
     }
     const double c_G_2 = (1.0/2.0)/(sqrt(d) + 2);
     const double t = -c_G_2*x + 1;
-    const double out0 = c_G_2*(p[0]*p[0]) + t;
-    const double out1 = c_G_2*p[0]*p[1] - 1.0/2.0*p[2];
-    const double out2 = c_G_2*p[0]*p[2] + (1.0/2.0)*p[1];
-    const double out3 = c_G_2*p[0]*p[1] + (1.0/2.0)*p[2];
-    const double out4 = c_G_2*(p[1]*p[1]) + t;
-    const double out5 = c_G_2*p[1]*p[2] - 1.0/2.0*p[0];
-    const double out6 = c_G_2*p[0]*p[2] - 1.0/2.0*p[1];
-    const double out7 = c_G_2*p[1]*p[2] + (1.0/2.0)*p[0];
-    const double out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_euler_rodrigues__tensor_entries(c_G_2, t, p, G);
 }
 
 /* symrot_euler_rodrigues_root_matrix_batch: symrot_euler_rodrigues_root_matrix for n vectors p[3*k..3*k+2] into
@@ -895,6 +885,51 @@ static inline int symrot_euler_rodrigues_rescale(const double p[3], double q[3])
     return symrot_euler_rodrigues__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_euler_rodrigues__rotation_derivative_entries: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 70 */
+static inline void symrot_euler_rodrigues__rotation_derivative_entries(double c_1, double c_1_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = (1.0/2.0)*a[1]*p[1];
+    const double dw1 = (1.0/2.0)*a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = a[2]*p[1];
+    const double dw4 = -dw2 + dw3;
+    const double dw5 = 2*c_1_x;
+    const double dw6 = dw4*dw5;
+    const double dw7 = a[2]*c_1;
+    const double dw8 = a[0]*p[1];
+    const double dw9 = a[1]*p[0];
+    const double dw10 = a[0]*p[2];
+    const double dw11 = a[1]*c_1;
+    const double dw12 = -dw9;
+    const double dw13 = -a[2]*p[0];
+    const double dw14 = dw5*(dw10 + dw13);
+    const double dw15 = (1.0/2.0)*a[0]*p[0];
+    const double dw16 = a[0]*c_1;
+    const double dw17 = -dw12 - dw8;
+    const double dw18 = dw17*dw5;
+    const double out0 = dw0 + dw1 + dw6*p[0];
+    const double out1 = dw6*p[1] + dw7 - dw8 + (1.0/2.0)*dw9;
+    const double out2 = (1.0/2.0)*a[2]*p[0] + 2*c_1_x*dw4*p[2] - dw10 - dw11;
+    const double out3 = dw12 + dw14*p[0] - dw7 + (1.0/2.0)*dw8;
+    const double out4 = dw1 + dw14*p[1] + dw15;
+    const double out5 = dw14*p[2] + dw16 - dw2 + (1.0/2.0)*dw3;
+    const double out6 = (1.0/2.0)*dw10 + dw11 + dw13 + dw18*p[0];
+    const double out7 = (1.0/2.0)*a[1]*p[2] + 2*c_1_x*dw17*p[1] - dw16 - dw3;
+    const double out8 = dw0 + dw15 + dw18*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_euler_rodrigues_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
@@ -922,44 +957,7 @@ static inline void symrot_euler_rodrigues_rotation_derivative(const double p[3],
     }
     const double c_R_1 = (1.0/2.0)*sqrt(d);
     const double c_R_1_x = -(1.0/4.0)/sqrt(d);
-    const double dw0 = (1.0/2.0)*a[1]*p[1];
-    const double dw1 = (1.0/2.0)*a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = a[2]*p[1];
-    const double dw4 = -dw2 + dw3;
-    const double dw5 = 2*c_R_1_x;
-    const double dw6 = dw4*dw5;
-    const double dw7 = a[2]*c_R_1;
-    const double dw8 = a[0]*p[1];
-    const double dw9 = a[1]*p[0];
-    const double dw10 = a[0]*p[2];
-    const double dw11 = a[1]*c_R_1;
-    const double dw12 = -dw9;
-    const double dw13 = -a[2]*p[0];
-    const double dw14 = dw5*(dw10 + dw13);
-    const double dw15 = (1.0/2.0)*a[0]*p[0];
-    const double dw16 = a[0]*c_R_1;
-    const double dw17 = -dw12 - dw8;
-    const double dw18 = dw17*dw5;
-    const double out0 = dw0 + dw1 + dw6*p[0];
-    const double out1 = dw6*p[1] + dw7 - dw8 + (1.0/2.0)*dw9;
-    const double out2 = (1.0/2.0)*a[2]*p[0] + 2*c_R_1_x*dw4*p[2] - dw10 - dw11;
-    const double out3 = dw12 + dw14*p[0] - dw7 + (1.0/2.0)*dw8;
-    const double out4 = dw1 + dw14*p[1] + dw15;
-    const double out5 = dw14*p[2] + dw16 - dw2 + (1.0/2.0)*dw3;
-    const double out6 = (1.0/2.0)*dw10 + dw11 + dw13 + dw18*p[0];
-    const double out7 = (1.0/2.0)*a[1]*p[2] + 2*c_R_1_x*dw17*p[1] - dw16 - dw3;
-    const double out8 = dw0 + dw15 + dw18*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_euler_rodrigues__rotation_derivative_entries(c_R_1, c_R_1_x, p, a, D);
 }
 
 /* symrot_euler_rodrigues_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -970,7 +968,7 @@ static inline void symrot_euler_rodrigues_rotation_derivative(const double p[3],
  * R_0_x = 0 (constant)
  * R_1_x = -1/(4*sqrt(d)) (algebraic in x)
  * R_2_x = 0 (constant)
- * ops: 103 */
+ * ops: 106 */
 static inline void symrot_euler_rodrigues_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -989,41 +987,9 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative(const do
     }
     const double c_R_1 = (1.0/2.0)*sqrt(d);
     const double c_R_1_x = -(1.0/4.0)/sqrt(d);
-    const double dw0 = (1.0/2.0)*a[1]*p[1];
-    const double dw1 = (1.0/2.0)*a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1];
-    const double dw4 = 2*c_R_1_x;
-    const double dw5 = dw4*(-dw2 - dw3);
-    const double dw6 = a[0]*p[1];
-    const double dw7 = a[2]*c_R_1;
-    const double dw8 = a[0]*p[2];
-    const double dw9 = a[1]*c_R_1;
-    const double dw10 = -a[1]*p[0];
-    const double dw11 = a[2]*p[0];
-    const double dw12 = dw4*(-dw11 + dw8);
-    const double dw13 = (1.0/2.0)*a[0]*p[0];
-    const double dw14 = a[0]*c_R_1;
-    const double dw15 = dw4*(-dw10 - dw6);
-    const double out0 = dw0 + dw1 - dw5*p[0];
-    const double out1 = (1.0/2.0)*a[1]*p[0] - dw5*p[1] - dw6 - dw7;
-    const double out2 = (1.0/2.0)*a[2]*p[0] - dw5*p[2] - dw8 + dw9;
-    const double out3 = dw10 - dw12*p[0] + (1.0/2.0)*dw6 + dw7;
-    const double out4 = dw1 - dw12*p[1] + dw13;
-    const double out5 = (1.0/2.0)*a[2]*p[1] - dw12*p[2] - dw14 - dw2;
-    const double out6 = (1.0/2.0)*a[0]*p[2] - dw11 - dw15*p[0] - dw9;
-    const double out7 = dw14 - dw15*p[1] + (1.0/2.0)*dw2 + dw3;
-    const double out8 = dw0 + dw13 - dw15*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_R_T_1 = -c_R_1;
+    const double c_R_T_1_x = -c_R_1_x;
+    symrot_euler_rodrigues__rotation_derivative_entries(c_R_T_1, c_R_T_1_x, p, a, D);
 }
 
 /* symrot_euler_rodrigues_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1554,6 +1520,32 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
     }
 }
 
+/* symrot_euler_rodrigues__tensor_entries_f: internal: the entries that tangent, root_matrix compute alike from their own coefficients (eq 22).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_euler_rodrigues__tensor_entries_f(float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = c_2*p[0]*p[1] - 1.0F/2.0F*p[2];
+    const float out2 = c_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
+    const float out3 = c_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = c_2*p[1]*p[2] - 1.0F/2.0F*p[0];
+    const float out6 = c_2*p[0]*p[2] - 1.0F/2.0F*p[1];
+    const float out7 = c_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_euler_rodrigues_tangent_f: tangent tensor H, omega = H pdot (eq 20) (eq 22).
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
  * H_across = sqrt(d)/2 (algebraic in x)
@@ -1578,25 +1570,7 @@ static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9]
     }
     const float c_H_across = (1.0F/2.0F)*sqrtf(d);
     const float c_H_2 = (1.0F/2.0F)/sqrtf(d);
-    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const float out1 = c_H_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    const float out2 = c_H_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    const float out3 = c_H_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const float out5 = c_H_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    const float out6 = c_H_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    const float out7 = c_H_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_euler_rodrigues__tensor_entries_f(c_H_2, c_H_across, p, H);
 }
 
 /* symrot_euler_rodrigues_tangent_f_batch: symrot_euler_rodrigues_tangent_f for n vectors p[3*k..3*k+2] into
@@ -1813,25 +1787,7 @@ static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float 
     }
     const float c_G_2 = (1.0F/2.0F)/(sqrtf(d) + 2);
     const float t = -c_G_2*x + 1;
-    const float out0 = c_G_2*(p[0]*p[0]) + t;
-    const float out1 = c_G_2*p[0]*p[1] - 1.0F/2.0F*p[2];
-    const float out2 = c_G_2*p[0]*p[2] + (1.0F/2.0F)*p[1];
-    const float out3 = c_G_2*p[0]*p[1] + (1.0F/2.0F)*p[2];
-    const float out4 = c_G_2*(p[1]*p[1]) + t;
-    const float out5 = c_G_2*p[1]*p[2] - 1.0F/2.0F*p[0];
-    const float out6 = c_G_2*p[0]*p[2] - 1.0F/2.0F*p[1];
-    const float out7 = c_G_2*p[1]*p[2] + (1.0F/2.0F)*p[0];
-    const float out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_euler_rodrigues__tensor_entries_f(c_G_2, t, p, G);
 }
 
 /* symrot_euler_rodrigues_root_matrix_f_batch: symrot_euler_rodrigues_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2228,6 +2184,51 @@ static inline int symrot_euler_rodrigues_rescale_f(const float p[3], float q[3])
     return symrot_euler_rodrigues__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_euler_rodrigues__rotation_derivative_entries_f: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 70 */
+static inline void symrot_euler_rodrigues__rotation_derivative_entries_f(float c_1, float c_1_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = (1.0F/2.0F)*a[1]*p[1];
+    const float dw1 = (1.0F/2.0F)*a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = a[2]*p[1];
+    const float dw4 = -dw2 + dw3;
+    const float dw5 = 2*c_1_x;
+    const float dw6 = dw4*dw5;
+    const float dw7 = a[2]*c_1;
+    const float dw8 = a[0]*p[1];
+    const float dw9 = a[1]*p[0];
+    const float dw10 = a[0]*p[2];
+    const float dw11 = a[1]*c_1;
+    const float dw12 = -dw9;
+    const float dw13 = -a[2]*p[0];
+    const float dw14 = dw5*(dw10 + dw13);
+    const float dw15 = (1.0F/2.0F)*a[0]*p[0];
+    const float dw16 = a[0]*c_1;
+    const float dw17 = -dw12 - dw8;
+    const float dw18 = dw17*dw5;
+    const float out0 = dw0 + dw1 + dw6*p[0];
+    const float out1 = dw6*p[1] + dw7 - dw8 + (1.0F/2.0F)*dw9;
+    const float out2 = (1.0F/2.0F)*a[2]*p[0] + 2*c_1_x*dw4*p[2] - dw10 - dw11;
+    const float out3 = dw12 + dw14*p[0] - dw7 + (1.0F/2.0F)*dw8;
+    const float out4 = dw1 + dw14*p[1] + dw15;
+    const float out5 = dw14*p[2] + dw16 - dw2 + (1.0F/2.0F)*dw3;
+    const float out6 = (1.0F/2.0F)*dw10 + dw11 + dw13 + dw18*p[0];
+    const float out7 = (1.0F/2.0F)*a[1]*p[2] + 2*c_1_x*dw17*p[1] - dw16 - dw3;
+    const float out8 = dw0 + dw15 + dw18*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_euler_rodrigues_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 2 (|phi| < 3.1415926535897931); outside it, and for non-finite p, every output is NaN.
@@ -2255,44 +2256,7 @@ static inline void symrot_euler_rodrigues_rotation_derivative_f(const float p[3]
     }
     const float c_R_1 = (1.0F/2.0F)*sqrtf(d);
     const float c_R_1_x = -(1.0F/4.0F)/sqrtf(d);
-    const float dw0 = (1.0F/2.0F)*a[1]*p[1];
-    const float dw1 = (1.0F/2.0F)*a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = a[2]*p[1];
-    const float dw4 = -dw2 + dw3;
-    const float dw5 = 2*c_R_1_x;
-    const float dw6 = dw4*dw5;
-    const float dw7 = a[2]*c_R_1;
-    const float dw8 = a[0]*p[1];
-    const float dw9 = a[1]*p[0];
-    const float dw10 = a[0]*p[2];
-    const float dw11 = a[1]*c_R_1;
-    const float dw12 = -dw9;
-    const float dw13 = -a[2]*p[0];
-    const float dw14 = dw5*(dw10 + dw13);
-    const float dw15 = (1.0F/2.0F)*a[0]*p[0];
-    const float dw16 = a[0]*c_R_1;
-    const float dw17 = -dw12 - dw8;
-    const float dw18 = dw17*dw5;
-    const float out0 = dw0 + dw1 + dw6*p[0];
-    const float out1 = dw6*p[1] + dw7 - dw8 + (1.0F/2.0F)*dw9;
-    const float out2 = (1.0F/2.0F)*a[2]*p[0] + 2*c_R_1_x*dw4*p[2] - dw10 - dw11;
-    const float out3 = dw12 + dw14*p[0] - dw7 + (1.0F/2.0F)*dw8;
-    const float out4 = dw1 + dw14*p[1] + dw15;
-    const float out5 = dw14*p[2] + dw16 - dw2 + (1.0F/2.0F)*dw3;
-    const float out6 = (1.0F/2.0F)*dw10 + dw11 + dw13 + dw18*p[0];
-    const float out7 = (1.0F/2.0F)*a[1]*p[2] + 2*c_R_1_x*dw17*p[1] - dw16 - dw3;
-    const float out8 = dw0 + dw15 + dw18*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_euler_rodrigues__rotation_derivative_entries_f(c_R_1, c_R_1_x, p, a, D);
 }
 
 /* symrot_euler_rodrigues_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2303,7 +2267,7 @@ static inline void symrot_euler_rodrigues_rotation_derivative_f(const float p[3]
  * R_0_x = 0 (constant)
  * R_1_x = -1/(4*sqrt(d)) (algebraic in x)
  * R_2_x = 0 (constant)
- * ops: 103 */
+ * ops: 106 */
 static inline void symrot_euler_rodrigues_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2322,41 +2286,9 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative_f(const 
     }
     const float c_R_1 = (1.0F/2.0F)*sqrtf(d);
     const float c_R_1_x = -(1.0F/4.0F)/sqrtf(d);
-    const float dw0 = (1.0F/2.0F)*a[1]*p[1];
-    const float dw1 = (1.0F/2.0F)*a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1];
-    const float dw4 = 2*c_R_1_x;
-    const float dw5 = dw4*(-dw2 - dw3);
-    const float dw6 = a[0]*p[1];
-    const float dw7 = a[2]*c_R_1;
-    const float dw8 = a[0]*p[2];
-    const float dw9 = a[1]*c_R_1;
-    const float dw10 = -a[1]*p[0];
-    const float dw11 = a[2]*p[0];
-    const float dw12 = dw4*(-dw11 + dw8);
-    const float dw13 = (1.0F/2.0F)*a[0]*p[0];
-    const float dw14 = a[0]*c_R_1;
-    const float dw15 = dw4*(-dw10 - dw6);
-    const float out0 = dw0 + dw1 - dw5*p[0];
-    const float out1 = (1.0F/2.0F)*a[1]*p[0] - dw5*p[1] - dw6 - dw7;
-    const float out2 = (1.0F/2.0F)*a[2]*p[0] - dw5*p[2] - dw8 + dw9;
-    const float out3 = dw10 - dw12*p[0] + (1.0F/2.0F)*dw6 + dw7;
-    const float out4 = dw1 - dw12*p[1] + dw13;
-    const float out5 = (1.0F/2.0F)*a[2]*p[1] - dw12*p[2] - dw14 - dw2;
-    const float out6 = (1.0F/2.0F)*a[0]*p[2] - dw11 - dw15*p[0] - dw9;
-    const float out7 = dw14 - dw15*p[1] + (1.0F/2.0F)*dw2 + dw3;
-    const float out8 = dw0 + dw13 - dw15*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_R_T_1 = -c_R_1;
+    const float c_R_T_1_x = -c_R_1_x;
+    symrot_euler_rodrigues__rotation_derivative_entries_f(c_R_T_1, c_R_T_1_x, p, a, D);
 }
 
 /* symrot_euler_rodrigues_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).

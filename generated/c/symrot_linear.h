@@ -494,6 +494,32 @@ static inline double symrot_linear_tangent_det(const double p[3])
     return c_det_H;
 }
 
+/* symrot_linear__root_entries: internal: the entries that root_matrix, root_tangent compute alike from their own coefficients (eq 81).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_linear__root_entries(double c_1, double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const double out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const double out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const double out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const double out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_linear_root_matrix: square root G of R, G G = R (eq 81).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
@@ -525,25 +551,7 @@ static inline void symrot_linear_root_matrix(const double p[3], double G[9])
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
-    const double out0 = c_G_2*(p[0]*p[0]) + t;
-    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out4 = c_G_2*(p[1]*p[1]) + t;
-    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_linear__root_entries(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_linear_root_matrix_batch: symrot_linear_root_matrix for n vectors p[3*k..3*k+2] into
@@ -665,25 +673,7 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
         c_K_1 = 2*w0*pow(sin((1.0/4.0)*phi), 2);
         c_K_2 = w0*(-(1.0/2.0)/cos((1.0/2.0)*phi) + (1.0/2.0)/sqrt(d));
     }
-    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_linear__root_entries(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_linear_root_tangent_batch: symrot_linear_root_tangent for n vectors p[3*k..3*k+2] into
@@ -1143,6 +1133,61 @@ static inline void symrot_linear_rotation_transpose_derivative(const double p[3]
     D[8] = out8;
 }
 
+/* symrot_linear__tangent_derivative_entries: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_linear__tangent_derivative_entries(double c_1, double c_1_x, double c_H_0_x, double c_H_2, double c_H_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = a[0]*p[2];
+    const double dw12 = a[2]*p[0];
+    const double dw13 = dw11 - dw12;
+    const double dw14 = dw13*p[2];
+    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const double dw16 = a[2]*c_1;
+    const double dw17 = dw6*p[1];
+    const double dw18 = 2*c_1_x;
+    const double dw19 = 2*dw15;
+    const double dw20 = a[1]*c_1;
+    const double dw21 = a[1]*p[0];
+    const double dw22 = dw13*p[0];
+    const double dw23 = dw10*p[0];
+    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const double dw25 = 2*dw24;
+    const double dw26 = a[0]*c_1;
+    const double dw27 = -dw17 + dw22;
+    const double dw28 = c_H_2_x*dw27;
+    const double out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_linear_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
@@ -1182,54 +1227,7 @@ static inline void symrot_linear_tangent_derivative(const double p[3], const dou
         c_H_2 = w1*w2;
         c_H_2_x = (1.0/2.0)*w2*(w1 + w2)/d;
     }
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = a[0]*p[2];
-    const double dw12 = a[2]*p[0];
-    const double dw13 = dw11 - dw12;
-    const double dw14 = dw13*p[2];
-    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const double dw16 = a[2]*c_H_1;
-    const double dw17 = dw6*p[1];
-    const double dw18 = 2*c_H_1_x;
-    const double dw19 = 2*dw15;
-    const double dw20 = a[1]*c_H_1;
-    const double dw21 = a[1]*p[0];
-    const double dw22 = dw13*p[0];
-    const double dw23 = dw10*p[0];
-    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const double dw25 = 2*dw24;
-    const double dw26 = a[0]*c_H_1;
-    const double dw27 = -dw17 + dw22;
-    const double dw28 = c_H_2_x*dw27;
-    const double out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_linear__tangent_derivative_entries(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_linear_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1240,7 +1238,7 @@ static inline void symrot_linear_tangent_derivative(const double p[3], const dou
  * H_0_x = 1/(2*d**(3/2)) (algebraic in x)
  * H_1_x = 1/(2*sqrt(d)*(sqrt(d) + 1)**2) (algebraic in x)
  * H_2_x: Horner degree 7 in x below x = 0.0059512, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
- * ops: 228 */
+ * ops: 224 */
 static inline void symrot_linear_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1271,56 +1269,9 @@ static inline void symrot_linear_tangent_transpose_derivative(const double p[3],
         c_H_2 = w1*w2;
         c_H_2_x = (1.0/2.0)*w2*(w1 + w2)/d;
     }
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = dw10*p[1];
-    const double dw12 = a[0]*p[2];
-    const double dw13 = a[2]*p[0];
-    const double dw14 = dw12 - dw13;
-    const double dw15 = dw14*p[2];
-    const double dw16 = dw11 - dw15;
-    const double dw17 = c_H_2_x*dw16;
-    const double dw18 = a[2]*c_H_1;
-    const double dw19 = dw6*p[1];
-    const double dw20 = 2*c_H_1_x;
-    const double dw21 = a[1]*c_H_1;
-    const double dw22 = a[1]*p[0];
-    const double dw23 = dw14*p[0];
-    const double dw24 = dw10*p[0];
-    const double dw25 = -dw24 + dw6*p[2];
-    const double dw26 = c_H_2_x*dw25;
-    const double dw27 = a[0]*c_H_1;
-    const double dw28 = -dw19 + dw23;
-    const double dw29 = a[2]*p[1];
-    const double dw30 = 2*c_H_2_x*dw28;
-    const double out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const double out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const double out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_H_T_1 = -c_H_1;
+    const double c_H_T_1_x = -c_H_1_x;
+    symrot_linear__tangent_derivative_entries(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_linear_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1991,6 +1942,32 @@ static inline float symrot_linear_tangent_det_f(const float p[3])
     return c_det_H;
 }
 
+/* symrot_linear__root_entries_f: internal: the entries that root_matrix, root_tangent compute alike from their own coefficients (eq 81).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_linear__root_entries_f(float c_1, float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const float out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const float out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const float out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const float out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_linear_root_matrix_f: square root G of R, G G = R (eq 81).
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
  * G_0 = 1 (constant)
@@ -2022,25 +1999,7 @@ static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
-    const float out0 = c_G_2*(p[0]*p[0]) + t;
-    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out4 = c_G_2*(p[1]*p[1]) + t;
-    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_linear__root_entries_f(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_linear_root_matrix_f_batch: symrot_linear_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2163,25 +2122,7 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = x < 0.35302037F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F : (1.0F/4.0F)*(-(1.0F/2.0F)/w1 + (1.0F/2.0F)/sqrtf(d))/((w1*w1)*powf(sinf(w0), 2));
     }
-    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_linear__root_entries_f(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_linear_root_tangent_f_batch: symrot_linear_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2641,6 +2582,61 @@ static inline void symrot_linear_rotation_transpose_derivative_f(const float p[3
     D[8] = out8;
 }
 
+/* symrot_linear__tangent_derivative_entries_f: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_linear__tangent_derivative_entries_f(float c_1, float c_1_x, float c_H_0_x, float c_H_2, float c_H_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = a[0]*p[2];
+    const float dw12 = a[2]*p[0];
+    const float dw13 = dw11 - dw12;
+    const float dw14 = dw13*p[2];
+    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const float dw16 = a[2]*c_1;
+    const float dw17 = dw6*p[1];
+    const float dw18 = 2*c_1_x;
+    const float dw19 = 2*dw15;
+    const float dw20 = a[1]*c_1;
+    const float dw21 = a[1]*p[0];
+    const float dw22 = dw13*p[0];
+    const float dw23 = dw10*p[0];
+    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const float dw25 = 2*dw24;
+    const float dw26 = a[0]*c_1;
+    const float dw27 = -dw17 + dw22;
+    const float dw28 = c_H_2_x*dw27;
+    const float out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_linear_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 1 (|phi| < 1.5707963267948966); outside it, and for non-finite p, every output is NaN.
@@ -2680,54 +2676,7 @@ static inline void symrot_linear_tangent_derivative_f(const float p[3], const fl
         c_H_2 = x < 0.11647221F ? x*(x*(x*(x*(x*(x*((6435.0F/32768.0F)*x + 429.0F/2048.0F) + 231.0F/1024.0F) + 63.0F/256.0F) + 35.0F/128.0F) + 5.0F/16.0F) + 3.0F/8.0F) + 1.0F/2.0F : w1*w2;
         c_H_2_x = (1.0F/2.0F)*w2*(w1 + w2)/d;
     }
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = a[0]*p[2];
-    const float dw12 = a[2]*p[0];
-    const float dw13 = dw11 - dw12;
-    const float dw14 = dw13*p[2];
-    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const float dw16 = a[2]*c_H_1;
-    const float dw17 = dw6*p[1];
-    const float dw18 = 2*c_H_1_x;
-    const float dw19 = 2*dw15;
-    const float dw20 = a[1]*c_H_1;
-    const float dw21 = a[1]*p[0];
-    const float dw22 = dw13*p[0];
-    const float dw23 = dw10*p[0];
-    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const float dw25 = 2*dw24;
-    const float dw26 = a[0]*c_H_1;
-    const float dw27 = -dw17 + dw22;
-    const float dw28 = c_H_2_x*dw27;
-    const float out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_linear__tangent_derivative_entries_f(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_linear_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2738,7 +2687,7 @@ static inline void symrot_linear_tangent_derivative_f(const float p[3], const fl
  * H_0_x = 1/(2*d**(3/2)) (algebraic in x)
  * H_1_x = 1/(2*sqrt(d)*(sqrt(d) + 1)**2) (algebraic in x)
  * H_2_x: Horner degree 6 in x below x = 0.0649445, else (1/(sqrt(d) + 1) + 1/sqrt(d))/(2*d*(sqrt(d) + 1))
- * ops: 225 */
+ * ops: 221 */
 static inline void symrot_linear_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2769,56 +2718,9 @@ static inline void symrot_linear_tangent_transpose_derivative_f(const float p[3]
         c_H_2 = x < 0.11647221F ? x*(x*(x*(x*(x*(x*((6435.0F/32768.0F)*x + 429.0F/2048.0F) + 231.0F/1024.0F) + 63.0F/256.0F) + 35.0F/128.0F) + 5.0F/16.0F) + 3.0F/8.0F) + 1.0F/2.0F : w1*w2;
         c_H_2_x = (1.0F/2.0F)*w2*(w1 + w2)/d;
     }
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = dw10*p[1];
-    const float dw12 = a[0]*p[2];
-    const float dw13 = a[2]*p[0];
-    const float dw14 = dw12 - dw13;
-    const float dw15 = dw14*p[2];
-    const float dw16 = dw11 - dw15;
-    const float dw17 = c_H_2_x*dw16;
-    const float dw18 = a[2]*c_H_1;
-    const float dw19 = dw6*p[1];
-    const float dw20 = 2*c_H_1_x;
-    const float dw21 = a[1]*c_H_1;
-    const float dw22 = a[1]*p[0];
-    const float dw23 = dw14*p[0];
-    const float dw24 = dw10*p[0];
-    const float dw25 = -dw24 + dw6*p[2];
-    const float dw26 = c_H_2_x*dw25;
-    const float dw27 = a[0]*c_H_1;
-    const float dw28 = -dw19 + dw23;
-    const float dw29 = a[2]*p[1];
-    const float dw30 = 2*c_H_2_x*dw28;
-    const float out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const float out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const float out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_H_T_1 = -c_H_1;
+    const float c_H_T_1_x = -c_H_1_x;
+    symrot_linear__tangent_derivative_entries_f(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_linear_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).

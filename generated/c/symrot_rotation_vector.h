@@ -165,6 +165,32 @@ static inline double symrot_rotation_vector_angle(const double p[3])
     return symrot_rotation_vector__phi(s);
 }
 
+/* symrot_rotation_vector__tensor_entries: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_rotation_vector__tensor_entries(double c_1, double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const double out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const double out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const double out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const double out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_rotation_vector_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -198,25 +224,7 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
         c_R_2 = x < 0.7851233626304374 ? x*(x*(x*(x*(x*(x*(1.0/87178291200.0 + (-1.0/20922789888000.0)*x) - 1.0/479001600.0) + 1.0/3628800.0) - 1.0/40320.0) + 1.0/720.0) - 1.0/24.0) + 1.0/2.0 : 2*(w1*w1)/(phi*phi);
     }
     const double t = -c_R_2*x + 1;
-    const double out0 = c_R_2*(p[0]*p[0]) + t;
-    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out4 = c_R_2*(p[1]*p[1]) + t;
-    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_rotation_vector__tensor_entries(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_rotation_vector_rotation_matrix_batch: symrot_rotation_vector_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -335,25 +343,7 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
         c_H_2 = (phi - sin(phi))/(phi*phi*phi);
     }
     const double t = -c_H_2*x + 1;
-    const double out0 = c_H_2*(p[0]*p[0]) + t;
-    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out4 = c_H_2*(p[1]*p[1]) + t;
-    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out8 = c_H_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_rotation_vector__tensor_entries(c_H_1, c_H_2, t, p, H);
 }
 
 /* symrot_rotation_vector_tangent_batch: symrot_rotation_vector_tangent for n vectors p[3*k..3*k+2] into
@@ -631,25 +621,7 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
         c_G_2 = x < 2.897865491219683 ? x*(x*(x*(x*(x*(x*(1.0/1428329123020800.0 + (-7.292903644389931e-19)*x) - 1.0/1961990553600.0) + 1.0/3715891200.0) - 1.0/10321920.0) + 1.0/46080.0) - 1.0/384.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/(phi*phi);
     }
     const double t = -c_G_2*x + 1;
-    const double out0 = c_G_2*(p[0]*p[0]) + t;
-    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out4 = c_G_2*(p[1]*p[1]) + t;
-    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_rotation_vector__tensor_entries(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_rotation_vector_root_matrix_batch: symrot_rotation_vector_root_matrix for n vectors p[3*k..3*k+2] into
@@ -776,25 +748,7 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
         c_K_2 = x < 5.5673482008975155 ? x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0 : (1.0/2.0)*(phi - 2*sin((1.0/2.0)*phi))/(phi*phi*phi);
     }
     const double t = -c_K_2*x + 1.0/2.0;
-    const double out0 = c_K_2*(p[0]*p[0]) + t;
-    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out4 = c_K_2*(p[1]*p[1]) + t;
-    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out8 = c_K_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_rotation_vector__tensor_entries(c_K_1, c_K_2, t, p, K);
 }
 
 /* symrot_rotation_vector_root_tangent_batch: symrot_rotation_vector_root_tangent for n vectors p[3*k..3*k+2] into
@@ -1122,6 +1076,58 @@ static inline int symrot_rotation_vector_rescale(const double p[3], double q[3])
     return symrot_rotation_vector__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_rotation_vector__derivative_entries: internal: the entries that rotation_derivative, rotation_transpose_derivative, tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_rotation_vector__derivative_entries(double c_1, double c_1_x, double c_2, double c_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_2_x*dw13;
+    const double dw15 = a[2]*c_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_1_x;
+    const double dw18 = a[1]*c_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_2_x*dw20;
+    const double dw23 = a[0]*c_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_2_x*dw24;
+    const double out0 = c_1_x*dw4*dw5 - c_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_2*dw6 - c_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_1_x*dw4*p[2] - c_2*dw11 - c_2*dw9 + 2*c_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_2*p[0] + 2*c_1_x*dw11*p[0] - c_2*dw8 + 2*c_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_2*dw2 - c_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_2*dw10 + c_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_2*p[1] + 2*c_1_x*dw8*p[1] - c_2*dw4 + 2*c_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_rotation_vector_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -1148,51 +1154,7 @@ static inline void symrot_rotation_vector_rotation_derivative(const double p[3],
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = 2*p[0];
-    const double dw6 = a[0]*p[1];
-    const double dw7 = -a[1]*p[0] + dw6;
-    const double dw8 = -dw7;
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8*p[1];
-    const double dw14 = c_R_2_x*dw13;
-    const double dw15 = a[2]*c_R_1;
-    const double dw16 = dw4*p[1];
-    const double dw17 = 2*c_R_1_x;
-    const double dw18 = a[1]*c_R_1;
-    const double dw19 = dw8*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = 2*c_R_2_x*dw20;
-    const double dw23 = a[0]*c_R_1;
-    const double dw24 = dw11*p[0] - dw16;
-    const double dw25 = c_R_2_x*dw24;
-    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_rotation_vector__derivative_entries(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1203,7 +1165,7 @@ static inline void symrot_rotation_vector_rotation_derivative(const double p[3],
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 8 in x below x = 0.785123, else (cos(phi) - sin(phi)/phi)/(2*phi**2)
  * R_2_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * ops: 229 */
+ * ops: 230 */
 static inline void symrot_rotation_vector_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1221,49 +1183,9 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative(const do
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = a[0]*p[1];
-    const double dw6 = -a[1]*p[0] + dw5;
-    const double dw7 = -dw6;
-    const double dw8 = dw7*p[1];
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8;
-    const double dw14 = a[2]*c_R_1;
-    const double dw15 = dw4*p[1];
-    const double dw16 = 2*c_R_1_x;
-    const double dw17 = a[1]*c_R_1;
-    const double dw18 = dw11*p[0];
-    const double dw19 = dw7*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = a[0]*c_R_1;
-    const double dw23 = -dw15 + dw18;
-    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_R_T_1 = -c_R_1;
+    const double c_R_T_1_x = -c_R_1_x;
+    symrot_rotation_vector__derivative_entries(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1292,51 +1214,7 @@ static inline void symrot_rotation_vector_tangent_derivative(const double p[3], 
     }
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = 2*p[0];
-    const double dw6 = a[0]*p[1];
-    const double dw7 = -a[1]*p[0] + dw6;
-    const double dw8 = -dw7;
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8*p[1];
-    const double dw14 = c_H_2_x*dw13;
-    const double dw15 = a[2]*c_H_1;
-    const double dw16 = dw4*p[1];
-    const double dw17 = 2*c_H_1_x;
-    const double dw18 = a[1]*c_H_1;
-    const double dw19 = dw8*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = 2*c_H_2_x*dw20;
-    const double dw23 = a[0]*c_H_1;
-    const double dw24 = dw11*p[0] - dw16;
-    const double dw25 = c_H_2_x*dw24;
-    const double out0 = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
-    const double out1 = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const double out2 = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
-    const double out3 = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
-    const double out4 = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const double out5 = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const double out6 = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const double out7 = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
-    const double out8 = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_rotation_vector__derivative_entries(c_H_1, c_H_1_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1347,7 +1225,7 @@ static inline void symrot_rotation_vector_tangent_derivative(const double p[3], 
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 11 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
  * H_2_x: Horner degree 10 in x below x = 5.56735, else (-cos(phi) + 1 - 3*(phi - sin(phi))/phi)/(2*phi**4)
- * ops: 236 */
+ * ops: 237 */
 static inline void symrot_rotation_vector_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1365,49 +1243,9 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative(const dou
     }
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = a[0]*p[1];
-    const double dw6 = -a[1]*p[0] + dw5;
-    const double dw7 = -dw6;
-    const double dw8 = dw7*p[1];
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8;
-    const double dw14 = a[2]*c_H_1;
-    const double dw15 = dw4*p[1];
-    const double dw16 = 2*c_H_1_x;
-    const double dw17 = a[1]*c_H_1;
-    const double dw18 = dw11*p[0];
-    const double dw19 = dw7*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = a[0]*c_H_1;
-    const double dw23 = -dw15 + dw18;
-    const double out0 = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
-    const double out1 = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const double out2 = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const double out3 = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const double out4 = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const double out5 = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const double out6 = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const double out7 = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const double out8 = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_H_T_1 = -c_H_1;
+    const double c_H_T_1_x = -c_H_1_x;
+    symrot_rotation_vector__derivative_entries(c_H_T_1, c_H_T_1_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1741,6 +1579,32 @@ static inline float symrot_rotation_vector_angle_f(const float p[3])
     return symrot_rotation_vector__phi_f(s);
 }
 
+/* symrot_rotation_vector__tensor_entries_f: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_rotation_vector__tensor_entries_f(float c_1, float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const float out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const float out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const float out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const float out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_rotation_vector_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -1774,25 +1638,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
         c_R_2 = 2*(w1*w1)/(phi*phi);
     }
     const float t = -c_R_2*x + 1;
-    const float out0 = c_R_2*(p[0]*p[0]) + t;
-    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out4 = c_R_2*(p[1]*p[1]) + t;
-    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_rotation_vector__tensor_entries_f(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_rotation_vector_rotation_matrix_f_batch: symrot_rotation_vector_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1910,25 +1756,7 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
         c_H_2 = (phi - sinf(phi))/(phi*phi*phi);
     }
     const float t = -c_H_2*x + 1;
-    const float out0 = c_H_2*(p[0]*p[0]) + t;
-    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out4 = c_H_2*(p[1]*p[1]) + t;
-    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out8 = c_H_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_rotation_vector__tensor_entries_f(c_H_1, c_H_2, t, p, H);
 }
 
 /* symrot_rotation_vector_tangent_f_batch: symrot_rotation_vector_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2206,25 +2034,7 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/(phi*phi);
     }
     const float t = -c_G_2*x + 1;
-    const float out0 = c_G_2*(p[0]*p[0]) + t;
-    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out4 = c_G_2*(p[1]*p[1]) + t;
-    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_rotation_vector__tensor_entries_f(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_rotation_vector_root_matrix_f_batch: symrot_rotation_vector_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2350,25 +2160,7 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
         c_K_2 = (1.0F/2.0F)*(phi - 2*sinf((1.0F/2.0F)*phi))/(phi*phi*phi);
     }
     const float t = -c_K_2*x + 1.0F/2.0F;
-    const float out0 = c_K_2*(p[0]*p[0]) + t;
-    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out4 = c_K_2*(p[1]*p[1]) + t;
-    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out8 = c_K_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_rotation_vector__tensor_entries_f(c_K_1, c_K_2, t, p, K);
 }
 
 /* symrot_rotation_vector_root_tangent_f_batch: symrot_rotation_vector_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2696,6 +2488,58 @@ static inline int symrot_rotation_vector_rescale_f(const float p[3], float q[3])
     return symrot_rotation_vector__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_rotation_vector__derivative_entries_f: internal: the entries that rotation_derivative, rotation_transpose_derivative, tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_rotation_vector__derivative_entries_f(float c_1, float c_1_x, float c_2, float c_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_2_x*dw13;
+    const float dw15 = a[2]*c_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_1_x;
+    const float dw18 = a[1]*c_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_2_x*dw20;
+    const float dw23 = a[0]*c_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_2_x*dw24;
+    const float out0 = c_1_x*dw4*dw5 - c_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_2*dw6 - c_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_1_x*dw4*p[2] - c_2*dw11 - c_2*dw9 + 2*c_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_2*p[0] + 2*c_1_x*dw11*p[0] - c_2*dw8 + 2*c_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_2*dw2 - c_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_2*dw10 + c_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_2*p[1] + 2*c_1_x*dw8*p[1] - c_2*dw4 + 2*c_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_rotation_vector_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 6.2831853071795862 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -2722,51 +2566,7 @@ static inline void symrot_rotation_vector_rotation_derivative_f(const float p[3]
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x_f(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = 2*p[0];
-    const float dw6 = a[0]*p[1];
-    const float dw7 = -a[1]*p[0] + dw6;
-    const float dw8 = -dw7;
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8*p[1];
-    const float dw14 = c_R_2_x*dw13;
-    const float dw15 = a[2]*c_R_1;
-    const float dw16 = dw4*p[1];
-    const float dw17 = 2*c_R_1_x;
-    const float dw18 = a[1]*c_R_1;
-    const float dw19 = dw8*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = 2*c_R_2_x*dw20;
-    const float dw23 = a[0]*c_R_1;
-    const float dw24 = dw11*p[0] - dw16;
-    const float dw25 = c_R_2_x*dw24;
-    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_rotation_vector__derivative_entries_f(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2777,7 +2577,7 @@ static inline void symrot_rotation_vector_rotation_derivative_f(const float p[3]
  * R_0_x = 0 (constant)
  * R_1_x: Horner degree 6 in x below x = 5.56735, else (-2*sin(phi/2)**2 + 1 - 2*sin(phi/2)*cos(phi/2)/phi)/(2*phi**2)
  * R_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
- * ops: 205 */
+ * ops: 206 */
 static inline void symrot_rotation_vector_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2795,49 +2595,9 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative_f(const 
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_rotation_vector__coefficients_R_1_R_2_R_1_x_R_2_x_f(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = a[0]*p[1];
-    const float dw6 = -a[1]*p[0] + dw5;
-    const float dw7 = -dw6;
-    const float dw8 = dw7*p[1];
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8;
-    const float dw14 = a[2]*c_R_1;
-    const float dw15 = dw4*p[1];
-    const float dw16 = 2*c_R_1_x;
-    const float dw17 = a[1]*c_R_1;
-    const float dw18 = dw11*p[0];
-    const float dw19 = dw7*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = a[0]*c_R_1;
-    const float dw23 = -dw15 + dw18;
-    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_R_T_1 = -c_R_1;
+    const float c_R_T_1_x = -c_R_1_x;
+    symrot_rotation_vector__derivative_entries_f(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2866,51 +2626,7 @@ static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3],
     }
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x_f(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = 2*p[0];
-    const float dw6 = a[0]*p[1];
-    const float dw7 = -a[1]*p[0] + dw6;
-    const float dw8 = -dw7;
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8*p[1];
-    const float dw14 = c_H_2_x*dw13;
-    const float dw15 = a[2]*c_H_1;
-    const float dw16 = dw4*p[1];
-    const float dw17 = 2*c_H_1_x;
-    const float dw18 = a[1]*c_H_1;
-    const float dw19 = dw8*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = 2*c_H_2_x*dw20;
-    const float dw23 = a[0]*c_H_1;
-    const float dw24 = dw11*p[0] - dw16;
-    const float dw25 = c_H_2_x*dw24;
-    const float out0 = c_H_1_x*dw4*dw5 - c_H_2*(-dw0 - dw1) + dw14*dw5;
-    const float out1 = -c_H_2*dw6 - c_H_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const float out2 = 2*c_H_1_x*dw4*p[2] - c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw18;
-    const float out3 = -a[1]*c_H_2*p[0] + 2*c_H_1_x*dw11*p[0] - c_H_2*dw8 + 2*c_H_2_x*dw20*p[0] - dw15;
-    const float out4 = -c_H_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const float out5 = -c_H_2*dw2 - c_H_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const float out6 = -c_H_2*dw10 + c_H_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const float out7 = -a[2]*c_H_2*p[1] + 2*c_H_1_x*dw8*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw24*p[1] - dw23;
-    const float out8 = -c_H_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_rotation_vector__derivative_entries_f(c_H_1, c_H_1_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2921,7 +2637,7 @@ static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3],
  * H_0_x = 0 (constant)
  * H_1_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)*cos(phi/2) - 4*sin(phi/2)**2/phi)/(2*phi**3)
  * H_2_x: Horner degree 6 in x below x = 5.56735, else (2*sin(phi/2)**2 - 3*(phi - 2*sin(phi/2)*cos(phi/2))/phi)/(2*phi**4)
- * ops: 202 */
+ * ops: 203 */
 static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2939,49 +2655,9 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const f
     }
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
     symrot_rotation_vector__coefficients_H_1_H_2_H_1_x_H_2_x_f(x, &c_H_1, &c_H_2, &c_H_1_x, &c_H_2_x);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = a[0]*p[1];
-    const float dw6 = -a[1]*p[0] + dw5;
-    const float dw7 = -dw6;
-    const float dw8 = dw7*p[1];
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8;
-    const float dw14 = a[2]*c_H_1;
-    const float dw15 = dw4*p[1];
-    const float dw16 = 2*c_H_1_x;
-    const float dw17 = a[1]*c_H_1;
-    const float dw18 = dw11*p[0];
-    const float dw19 = dw7*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = a[0]*c_H_1;
-    const float dw23 = -dw15 + dw18;
-    const float out0 = -2*c_H_1_x*dw4*p[0] - c_H_2*(-dw0 - dw1) + 2*c_H_2_x*dw13*p[0];
-    const float out1 = -c_H_2*dw5 - c_H_2*dw6 + 2*c_H_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const float out2 = -c_H_2*dw11 - c_H_2*dw9 + 2*c_H_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const float out3 = -a[1]*c_H_2*p[0] - c_H_2*dw7 + 2*c_H_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const float out4 = -c_H_2*(-dw1 - dw21) + 2*c_H_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const float out5 = -c_H_2*dw2 - c_H_2*dw3 + 2*c_H_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const float out6 = -c_H_2*dw10 + c_H_2*dw11 + 2*c_H_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const float out7 = -a[2]*c_H_2*p[1] - c_H_2*dw4 + 2*c_H_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const float out8 = -c_H_2*(-dw0 - dw21) + 2*c_H_2_x*dw23*p[2] - dw16*dw7*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_H_T_1 = -c_H_1;
+    const float c_H_T_1_x = -c_H_1_x;
+    symrot_rotation_vector__derivative_entries_f(c_H_T_1, c_H_T_1_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_rotation_vector_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).

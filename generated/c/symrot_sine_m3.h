@@ -194,6 +194,32 @@ static inline double symrot_sine_m3_angle(const double p[3])
     return symrot_sine_m3__phi(s, d);
 }
 
+/* symrot_sine_m3__tensor_entries: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_sine_m3__tensor_entries(double c_1, double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const double out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const double out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const double out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const double out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_sine_m3_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -225,25 +251,7 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
         c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double t = -c_R_2*x + 1;
-    const double out0 = c_R_2*(p[0]*p[0]) + t;
-    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out4 = c_R_2*(p[1]*p[1]) + t;
-    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_sine_m3__tensor_entries(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_sine_m3_rotation_matrix_batch: symrot_sine_m3_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -361,25 +369,7 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
         c_H_1 = w0*w1;
         c_H_2 = w0*(w1 + 4*pow(sin((1.0/6.0)*phi), 2))/sqrt(d);
     }
-    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_sine_m3__tensor_entries(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_sine_m3_tangent_batch: symrot_sine_m3_tangent for n vectors p[3*k..3*k+2] into
@@ -658,25 +648,7 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
         c_G_2 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
-    const double out0 = c_G_2*(p[0]*p[0]) + t;
-    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out4 = c_G_2*(p[1]*p[1]) + t;
-    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_sine_m3__tensor_entries(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_sine_m3_root_matrix_batch: symrot_sine_m3_root_matrix for n vectors p[3*k..3*k+2] into
@@ -812,25 +784,7 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
         c_K_1 = x < 0.8648056668462011 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0 : 2*pow(sin((1.0/4.0)*phi), 2)/x;
         c_K_2 = x < 1.595363771286421 ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0 : (1.0/6.0)*(-6*w0 + 9/sqrt(d))/(s*s);
     }
-    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_sine_m3__tensor_entries(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_sine_m3_root_tangent_batch: symrot_sine_m3_root_tangent for n vectors p[3*k..3*k+2] into
@@ -1319,6 +1273,61 @@ static inline void symrot_sine_m3_rotation_transpose_derivative(const double p[3
     D[8] = out8;
 }
 
+/* symrot_sine_m3__tangent_derivative_entries: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_sine_m3__tangent_derivative_entries(double c_1, double c_1_x, double c_H_0_x, double c_H_2, double c_H_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = a[0]*p[2];
+    const double dw12 = a[2]*p[0];
+    const double dw13 = dw11 - dw12;
+    const double dw14 = dw13*p[2];
+    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const double dw16 = a[2]*c_1;
+    const double dw17 = dw6*p[1];
+    const double dw18 = 2*c_1_x;
+    const double dw19 = 2*dw15;
+    const double dw20 = a[1]*c_1;
+    const double dw21 = a[1]*p[0];
+    const double dw22 = dw13*p[0];
+    const double dw23 = dw10*p[0];
+    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const double dw25 = 2*dw24;
+    const double dw26 = a[0]*c_1;
+    const double dw27 = -dw17 + dw22;
+    const double dw28 = c_H_2_x*dw27;
+    const double out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_sine_m3_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
@@ -1346,54 +1355,7 @@ static inline void symrot_sine_m3_tangent_derivative(const double p[3], const do
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_sine_m3__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x(x, d, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = a[0]*p[2];
-    const double dw12 = a[2]*p[0];
-    const double dw13 = dw11 - dw12;
-    const double dw14 = dw13*p[2];
-    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const double dw16 = a[2]*c_H_1;
-    const double dw17 = dw6*p[1];
-    const double dw18 = 2*c_H_1_x;
-    const double dw19 = 2*dw15;
-    const double dw20 = a[1]*c_H_1;
-    const double dw21 = a[1]*p[0];
-    const double dw22 = dw13*p[0];
-    const double dw23 = dw10*p[0];
-    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const double dw25 = 2*dw24;
-    const double dw26 = a[0]*c_H_1;
-    const double dw27 = -dw17 + dw22;
-    const double dw28 = c_H_2_x*dw27;
-    const double out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_sine_m3__tangent_derivative_entries(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_sine_m3_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1404,7 +1366,7 @@ static inline void symrot_sine_m3_tangent_derivative(const double p[3], const do
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 20 in x below x = 1.59536, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
  * H_2_x: Horner degree 21 in x below x = 1.59536, else (-18*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/s**2 + 9*(-2*sqrt(d)/3 + 2*sin(phi/2)**2 + 2)/d + 9*(2*s/3 + 6*sin(phi/2)*cos(phi/2))/(sqrt(d)*s))/(18*sqrt(d)*s**2)
- * ops: 345 */
+ * ops: 341 */
 static inline void symrot_sine_m3_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1423,56 +1385,9 @@ static inline void symrot_sine_m3_tangent_transpose_derivative(const double p[3]
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_sine_m3__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x(x, d, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = dw10*p[1];
-    const double dw12 = a[0]*p[2];
-    const double dw13 = a[2]*p[0];
-    const double dw14 = dw12 - dw13;
-    const double dw15 = dw14*p[2];
-    const double dw16 = dw11 - dw15;
-    const double dw17 = c_H_2_x*dw16;
-    const double dw18 = a[2]*c_H_1;
-    const double dw19 = dw6*p[1];
-    const double dw20 = 2*c_H_1_x;
-    const double dw21 = a[1]*c_H_1;
-    const double dw22 = a[1]*p[0];
-    const double dw23 = dw14*p[0];
-    const double dw24 = dw10*p[0];
-    const double dw25 = -dw24 + dw6*p[2];
-    const double dw26 = c_H_2_x*dw25;
-    const double dw27 = a[0]*c_H_1;
-    const double dw28 = -dw19 + dw23;
-    const double dw29 = a[2]*p[1];
-    const double dw30 = 2*c_H_2_x*dw28;
-    const double out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const double out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const double out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_H_T_1 = -c_H_1;
+    const double c_H_T_1_x = -c_H_1_x;
+    symrot_sine_m3__tangent_derivative_entries(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_sine_m3_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1856,6 +1771,32 @@ static inline float symrot_sine_m3_angle_f(const float p[3])
     return symrot_sine_m3__phi_f(s, d);
 }
 
+/* symrot_sine_m3__tensor_entries_f: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_sine_m3__tensor_entries_f(float c_1, float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const float out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const float out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const float out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const float out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_sine_m3_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -1887,25 +1828,7 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
         c_R_2 = 2*powf(sinf((1.0F/2.0F)*phi), 2)/x;
     }
     const float t = -c_R_2*x + 1;
-    const float out0 = c_R_2*(p[0]*p[0]) + t;
-    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out4 = c_R_2*(p[1]*p[1]) + t;
-    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_sine_m3__tensor_entries_f(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_sine_m3_rotation_matrix_f_batch: symrot_sine_m3_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2024,25 +1947,7 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
         c_H_1 = w0*w1;
         c_H_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F : w0*(w1 - 2.0F/3.0F*w2 + 2)/w2;
     }
-    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_sine_m3__tensor_entries_f(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_sine_m3_tangent_f_batch: symrot_sine_m3_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2316,25 +2221,7 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
-    const float out0 = c_G_2*(p[0]*p[0]) + t;
-    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out4 = c_G_2*(p[1]*p[1]) + t;
-    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_sine_m3__tensor_entries_f(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_sine_m3_root_matrix_f_batch: symrot_sine_m3_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2470,25 +2357,7 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
         c_K_2 = x < 2.8627653F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F : (-w0 + (3.0F/2.0F)/sqrtf(d))/(s*s);
     }
-    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_sine_m3__tensor_entries_f(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_sine_m3_root_tangent_f_batch: symrot_sine_m3_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2978,6 +2847,61 @@ static inline void symrot_sine_m3_rotation_transpose_derivative_f(const float p[
     D[8] = out8;
 }
 
+/* symrot_sine_m3__tangent_derivative_entries_f: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_sine_m3__tangent_derivative_entries_f(float c_1, float c_1_x, float c_H_0_x, float c_H_2, float c_H_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = a[0]*p[2];
+    const float dw12 = a[2]*p[0];
+    const float dw13 = dw11 - dw12;
+    const float dw14 = dw13*p[2];
+    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const float dw16 = a[2]*c_1;
+    const float dw17 = dw6*p[1];
+    const float dw18 = 2*c_1_x;
+    const float dw19 = 2*dw15;
+    const float dw20 = a[1]*c_1;
+    const float dw21 = a[1]*p[0];
+    const float dw22 = dw13*p[0];
+    const float dw23 = dw10*p[0];
+    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const float dw25 = 2*dw24;
+    const float dw26 = a[0]*c_1;
+    const float dw27 = -dw17 + dw22;
+    const float dw28 = c_H_2_x*dw27;
+    const float out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_sine_m3_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 3 (|phi| < 4.7123889803846897); outside it, and for non-finite p, every output is NaN.
@@ -3005,54 +2929,7 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_sine_m3__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x_f(x, d, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = a[0]*p[2];
-    const float dw12 = a[2]*p[0];
-    const float dw13 = dw11 - dw12;
-    const float dw14 = dw13*p[2];
-    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const float dw16 = a[2]*c_H_1;
-    const float dw17 = dw6*p[1];
-    const float dw18 = 2*c_H_1_x;
-    const float dw19 = 2*dw15;
-    const float dw20 = a[1]*c_H_1;
-    const float dw21 = a[1]*p[0];
-    const float dw22 = dw13*p[0];
-    const float dw23 = dw10*p[0];
-    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const float dw25 = 2*dw24;
-    const float dw26 = a[0]*c_H_1;
-    const float dw27 = -dw17 + dw22;
-    const float dw28 = c_H_2_x*dw27;
-    const float out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_sine_m3__tangent_derivative_entries_f(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_sine_m3_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -3063,7 +2940,7 @@ static inline void symrot_sine_m3_tangent_derivative_f(const float p[3], const f
  * H_0_x = 3/(2*d**(3/2)) (algebraic in x)
  * H_1_x: Horner degree 13 in x below x = 2.86277, else (-4*sqrt(d)*sin(phi/2)**2/s + 6*sin(phi/2)*cos(phi/2))/(2*sqrt(d)*s**3)
  * H_2_x: Horner degree 16 in x below x = 2.86277, else ((12*sqrt(d) + 18*cos(phi) - 54)/x + 9*(-2*sqrt(d)/3 - cos(phi) + 3)/d + 3*(2*s + 9*sin(phi))/(sqrt(d)*s))/(18*sqrt(d)*x)
- * ops: 326 */
+ * ops: 322 */
 static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -3082,56 +2959,9 @@ static inline void symrot_sine_m3_tangent_transpose_derivative_f(const float p[3
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_sine_m3__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x_f(x, d, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = dw10*p[1];
-    const float dw12 = a[0]*p[2];
-    const float dw13 = a[2]*p[0];
-    const float dw14 = dw12 - dw13;
-    const float dw15 = dw14*p[2];
-    const float dw16 = dw11 - dw15;
-    const float dw17 = c_H_2_x*dw16;
-    const float dw18 = a[2]*c_H_1;
-    const float dw19 = dw6*p[1];
-    const float dw20 = 2*c_H_1_x;
-    const float dw21 = a[1]*c_H_1;
-    const float dw22 = a[1]*p[0];
-    const float dw23 = dw14*p[0];
-    const float dw24 = dw10*p[0];
-    const float dw25 = -dw24 + dw6*p[2];
-    const float dw26 = c_H_2_x*dw25;
-    const float dw27 = a[0]*c_H_1;
-    const float dw28 = -dw19 + dw23;
-    const float dw29 = a[2]*p[1];
-    const float dw30 = 2*c_H_2_x*dw28;
-    const float out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const float out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const float out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_H_T_1 = -c_H_1;
+    const float c_H_T_1_x = -c_H_1_x;
+    symrot_sine_m3__tangent_derivative_entries_f(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_sine_m3_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).

@@ -112,6 +112,32 @@ static inline double symrot_sine_m4_angle(const double p[3])
     return symrot_sine_m4__phi(s, d);
 }
 
+/* symrot_sine_m4__tensor_entries: internal: the entries that rotation_matrix, tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_sine_m4__tensor_entries(double c_1, double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const double out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const double out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const double out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const double out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_sine_m4_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -137,25 +163,7 @@ static inline void symrot_sine_m4_rotation_matrix(const double p[3], double R[9]
     const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
     const double c_R_2 = (1.0/32.0)*d;
     const double t = -c_R_2*x + 1;
-    const double out0 = c_R_2*(p[0]*p[0]) + t;
-    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out4 = c_R_2*(p[1]*p[1]) + t;
-    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_sine_m4__tensor_entries(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_sine_m4_rotation_matrix_batch: symrot_sine_m4_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -253,25 +261,7 @@ static inline void symrot_sine_m4_tangent(const double p[3], double H[9])
     const double c_H_across = -1.0/32.0*sqrt(d)*(x - 8);
     const double c_H_1 = (1.0/32.0)*d;
     const double c_H_2 = -1.0/32.0*(x - 24)/sqrt(d);
-    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_sine_m4__tensor_entries(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_sine_m4_tangent_batch: symrot_sine_m4_tangent for n vectors p[3*k..3*k+2] into
@@ -903,6 +893,50 @@ static inline int symrot_sine_m4_rescale(const double p[3], double q[3])
     return symrot_sine_m4__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_sine_m4__rotation_derivative_entries: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 121 */
+static inline void symrot_sine_m4__rotation_derivative_entries(double c_1, double c_1_x, double c_R_2, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = a[0]*p[1];
+    const double dw6 = -a[1]*p[0] + dw5;
+    const double dw7 = -dw6;
+    const double dw8 = a[0]*p[2];
+    const double dw9 = a[2]*p[0];
+    const double dw10 = dw8 - dw9;
+    const double dw11 = -1.0/16.0*dw10*p[2] + (1.0/16.0)*dw7*p[1];
+    const double dw12 = a[2]*c_1;
+    const double dw13 = a[1]*c_1;
+    const double dw14 = (1.0/16.0)*dw4*p[2] - 1.0/16.0*dw7*p[0];
+    const double dw15 = a[0]*p[0];
+    const double dw16 = a[0]*c_1;
+    const double dw17 = (1.0/16.0)*dw10*p[0] - 1.0/16.0*dw4*p[1];
+    const double out0 = 2*c_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) - dw11*p[0];
+    const double out1 = 2*c_1_x*dw4*p[1] - c_R_2*dw5 - c_R_2*dw6 - dw11*p[1] + dw12;
+    const double out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw10 - c_R_2*dw8 - dw11*p[2] - dw13;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw10*p[0] - c_R_2*dw7 - dw12 - dw14*p[0];
+    const double out4 = 2*c_1_x*dw10*p[1] - c_R_2*(-dw1 - dw15) - dw14*p[1];
+    const double out5 = 2*c_1_x*dw10*p[2] - c_R_2*dw2 - c_R_2*dw3 - dw14*p[2] + dw16;
+    const double out6 = 2*c_1_x*dw7*p[0] + c_R_2*dw10 - c_R_2*dw9 + dw13 - dw17*p[0];
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw7*p[1] - c_R_2*dw4 - dw16 - dw17*p[1];
+    const double out8 = 2*c_1_x*dw7*p[2] - c_R_2*(-dw0 - dw15) - dw17*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_sine_m4_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -931,43 +965,7 @@ static inline void symrot_sine_m4_rotation_derivative(const double p[3], const d
     const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
     const double c_R_2 = (1.0/32.0)*d;
     const double c_R_1_x = -1.0/32.0*sqrt(d) + (1.0/64.0)*(x - 8)/sqrt(d);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = a[0]*p[1];
-    const double dw6 = -a[1]*p[0] + dw5;
-    const double dw7 = -dw6;
-    const double dw8 = a[0]*p[2];
-    const double dw9 = a[2]*p[0];
-    const double dw10 = dw8 - dw9;
-    const double dw11 = -1.0/16.0*dw10*p[2] + (1.0/16.0)*dw7*p[1];
-    const double dw12 = a[2]*c_R_1;
-    const double dw13 = a[1]*c_R_1;
-    const double dw14 = (1.0/16.0)*dw4*p[2] - 1.0/16.0*dw7*p[0];
-    const double dw15 = a[0]*p[0];
-    const double dw16 = a[0]*c_R_1;
-    const double dw17 = (1.0/16.0)*dw10*p[0] - 1.0/16.0*dw4*p[1];
-    const double out0 = 2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) - dw11*p[0];
-    const double out1 = 2*c_R_1_x*dw4*p[1] - c_R_2*dw5 - c_R_2*dw6 - dw11*p[1] + dw12;
-    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw10 - c_R_2*dw8 - dw11*p[2] - dw13;
-    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw10*p[0] - c_R_2*dw7 - dw12 - dw14*p[0];
-    const double out4 = 2*c_R_1_x*dw10*p[1] - c_R_2*(-dw1 - dw15) - dw14*p[1];
-    const double out5 = 2*c_R_1_x*dw10*p[2] - c_R_2*dw2 - c_R_2*dw3 - dw14*p[2] + dw16;
-    const double out6 = 2*c_R_1_x*dw7*p[0] + c_R_2*dw10 - c_R_2*dw9 + dw13 - dw17*p[0];
-    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw7*p[1] - c_R_2*dw4 - dw16 - dw17*p[1];
-    const double out8 = 2*c_R_1_x*dw7*p[2] - c_R_2*(-dw0 - dw15) - dw17*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_sine_m4__rotation_derivative_entries(c_R_1, c_R_1_x, c_R_2, p, a, D);
 }
 
 /* symrot_sine_m4_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -978,7 +976,7 @@ static inline void symrot_sine_m4_rotation_derivative(const double p[3], const d
  * R_0_x = 0 (constant)
  * R_1_x = -sqrt(d)/32 + (x - 8)/(64*sqrt(d)) (algebraic in x)
  * R_2_x = -1/32 (constant)
- * ops: 155 */
+ * ops: 165 */
 static inline void symrot_sine_m4_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -998,49 +996,9 @@ static inline void symrot_sine_m4_rotation_transpose_derivative(const double p[3
     const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
     const double c_R_2 = (1.0/32.0)*d;
     const double c_R_1_x = -1.0/32.0*sqrt(d) + (1.0/64.0)*(x - 8)/sqrt(d);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = 2*c_R_1_x;
-    const double dw6 = a[0]*p[1];
-    const double dw7 = -a[1]*p[0] + dw6;
-    const double dw8 = -dw7;
-    const double dw9 = dw8*p[1];
-    const double dw10 = a[0]*p[2];
-    const double dw11 = a[2]*p[0];
-    const double dw12 = dw10 - dw11;
-    const double dw13 = dw12*p[2];
-    const double dw14 = -1.0/16.0*dw13 + (1.0/16.0)*dw9;
-    const double dw15 = a[2]*c_R_1;
-    const double dw16 = dw4*p[1];
-    const double dw17 = a[1]*c_R_1;
-    const double dw18 = dw12*p[0];
-    const double dw19 = dw8*p[0];
-    const double dw20 = -1.0/16.0*dw19 + (1.0/16.0)*dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = a[0]*c_R_1;
-    const double dw23 = -1.0/16.0*dw16 + (1.0/16.0)*dw18;
-    const double out0 = -c_R_2*(-dw0 - dw1) - dw14*p[0] - dw4*dw5*p[0];
-    const double out1 = -c_R_2*dw6 - c_R_2*dw7 - dw14*p[1] - dw15 - dw16*dw5;
-    const double out2 = -c_R_2*dw10 - c_R_2*dw12 - dw14*p[2] + dw17 - dw4*dw5*p[2];
-    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw8 + dw15 - dw18*dw5 - dw20*p[0];
-    const double out4 = -c_R_2*(-dw1 - dw21) - dw12*dw5*p[1] - dw20*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 - dw13*dw5 - dw20*p[2] - dw22;
-    const double out6 = -c_R_2*dw11 + c_R_2*dw12 - dw17 - dw19*dw5 - dw23*p[0];
-    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + dw22 - dw23*p[1] - dw5*dw9;
-    const double out8 = -c_R_2*(-dw0 - dw21) - dw23*p[2] - dw5*dw8*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_R_T_1 = -c_R_1;
+    const double c_R_T_1_x = -c_R_1_x;
+    symrot_sine_m4__rotation_derivative_entries(c_R_T_1, c_R_T_1_x, c_R_2, p, a, D);
 }
 
 /* symrot_sine_m4_tangent_derivative: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1495,6 +1453,32 @@ static inline float symrot_sine_m4_angle_f(const float p[3])
     return symrot_sine_m4__phi_f(s, d);
 }
 
+/* symrot_sine_m4__tensor_entries_f: internal: the entries that rotation_matrix, tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_sine_m4__tensor_entries_f(float c_1, float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const float out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const float out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const float out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const float out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_sine_m4_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -1520,25 +1504,7 @@ static inline void symrot_sine_m4_rotation_matrix_f(const float p[3], float R[9]
     const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
     const float c_R_2 = (1.0F/32.0F)*d;
     const float t = -c_R_2*x + 1;
-    const float out0 = c_R_2*(p[0]*p[0]) + t;
-    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out4 = c_R_2*(p[1]*p[1]) + t;
-    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_sine_m4__tensor_entries_f(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_sine_m4_rotation_matrix_f_batch: symrot_sine_m4_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1636,25 +1602,7 @@ static inline void symrot_sine_m4_tangent_f(const float p[3], float H[9])
     const float c_H_across = -1.0F/32.0F*sqrtf(d)*(x - 8);
     const float c_H_1 = (1.0F/32.0F)*d;
     const float c_H_2 = -1.0F/32.0F*(x - 24)/sqrtf(d);
-    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_sine_m4__tensor_entries_f(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_sine_m4_tangent_f_batch: symrot_sine_m4_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2286,6 +2234,50 @@ static inline int symrot_sine_m4_rescale_f(const float p[3], float q[3])
     return symrot_sine_m4__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_sine_m4__rotation_derivative_entries_f: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 121 */
+static inline void symrot_sine_m4__rotation_derivative_entries_f(float c_1, float c_1_x, float c_R_2, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = a[0]*p[1];
+    const float dw6 = -a[1]*p[0] + dw5;
+    const float dw7 = -dw6;
+    const float dw8 = a[0]*p[2];
+    const float dw9 = a[2]*p[0];
+    const float dw10 = dw8 - dw9;
+    const float dw11 = -1.0F/16.0F*dw10*p[2] + (1.0F/16.0F)*dw7*p[1];
+    const float dw12 = a[2]*c_1;
+    const float dw13 = a[1]*c_1;
+    const float dw14 = (1.0F/16.0F)*dw4*p[2] - 1.0F/16.0F*dw7*p[0];
+    const float dw15 = a[0]*p[0];
+    const float dw16 = a[0]*c_1;
+    const float dw17 = (1.0F/16.0F)*dw10*p[0] - 1.0F/16.0F*dw4*p[1];
+    const float out0 = 2*c_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) - dw11*p[0];
+    const float out1 = 2*c_1_x*dw4*p[1] - c_R_2*dw5 - c_R_2*dw6 - dw11*p[1] + dw12;
+    const float out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw10 - c_R_2*dw8 - dw11*p[2] - dw13;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw10*p[0] - c_R_2*dw7 - dw12 - dw14*p[0];
+    const float out4 = 2*c_1_x*dw10*p[1] - c_R_2*(-dw1 - dw15) - dw14*p[1];
+    const float out5 = 2*c_1_x*dw10*p[2] - c_R_2*dw2 - c_R_2*dw3 - dw14*p[2] + dw16;
+    const float out6 = 2*c_1_x*dw7*p[0] + c_R_2*dw10 - c_R_2*dw9 + dw13 - dw17*p[0];
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw7*p[1] - c_R_2*dw4 - dw16 - dw17*p[1];
+    const float out8 = 2*c_1_x*dw7*p[2] - c_R_2*(-dw0 - dw15) - dw17*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_sine_m4_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 4 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -2314,43 +2306,7 @@ static inline void symrot_sine_m4_rotation_derivative_f(const float p[3], const 
     const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
     const float c_R_2 = (1.0F/32.0F)*d;
     const float c_R_1_x = -1.0F/32.0F*sqrtf(d) + (1.0F/64.0F)*(x - 8)/sqrtf(d);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = a[0]*p[1];
-    const float dw6 = -a[1]*p[0] + dw5;
-    const float dw7 = -dw6;
-    const float dw8 = a[0]*p[2];
-    const float dw9 = a[2]*p[0];
-    const float dw10 = dw8 - dw9;
-    const float dw11 = -1.0F/16.0F*dw10*p[2] + (1.0F/16.0F)*dw7*p[1];
-    const float dw12 = a[2]*c_R_1;
-    const float dw13 = a[1]*c_R_1;
-    const float dw14 = (1.0F/16.0F)*dw4*p[2] - 1.0F/16.0F*dw7*p[0];
-    const float dw15 = a[0]*p[0];
-    const float dw16 = a[0]*c_R_1;
-    const float dw17 = (1.0F/16.0F)*dw10*p[0] - 1.0F/16.0F*dw4*p[1];
-    const float out0 = 2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) - dw11*p[0];
-    const float out1 = 2*c_R_1_x*dw4*p[1] - c_R_2*dw5 - c_R_2*dw6 - dw11*p[1] + dw12;
-    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw10 - c_R_2*dw8 - dw11*p[2] - dw13;
-    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw10*p[0] - c_R_2*dw7 - dw12 - dw14*p[0];
-    const float out4 = 2*c_R_1_x*dw10*p[1] - c_R_2*(-dw1 - dw15) - dw14*p[1];
-    const float out5 = 2*c_R_1_x*dw10*p[2] - c_R_2*dw2 - c_R_2*dw3 - dw14*p[2] + dw16;
-    const float out6 = 2*c_R_1_x*dw7*p[0] + c_R_2*dw10 - c_R_2*dw9 + dw13 - dw17*p[0];
-    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw7*p[1] - c_R_2*dw4 - dw16 - dw17*p[1];
-    const float out8 = 2*c_R_1_x*dw7*p[2] - c_R_2*(-dw0 - dw15) - dw17*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_sine_m4__rotation_derivative_entries_f(c_R_1, c_R_1_x, c_R_2, p, a, D);
 }
 
 /* symrot_sine_m4_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2361,7 +2317,7 @@ static inline void symrot_sine_m4_rotation_derivative_f(const float p[3], const 
  * R_0_x = 0 (constant)
  * R_1_x = -sqrt(d)/32 + (x - 8)/(64*sqrt(d)) (algebraic in x)
  * R_2_x = -1/32 (constant)
- * ops: 155 */
+ * ops: 165 */
 static inline void symrot_sine_m4_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2381,49 +2337,9 @@ static inline void symrot_sine_m4_rotation_transpose_derivative_f(const float p[
     const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
     const float c_R_2 = (1.0F/32.0F)*d;
     const float c_R_1_x = -1.0F/32.0F*sqrtf(d) + (1.0F/64.0F)*(x - 8)/sqrtf(d);
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = 2*c_R_1_x;
-    const float dw6 = a[0]*p[1];
-    const float dw7 = -a[1]*p[0] + dw6;
-    const float dw8 = -dw7;
-    const float dw9 = dw8*p[1];
-    const float dw10 = a[0]*p[2];
-    const float dw11 = a[2]*p[0];
-    const float dw12 = dw10 - dw11;
-    const float dw13 = dw12*p[2];
-    const float dw14 = -1.0F/16.0F*dw13 + (1.0F/16.0F)*dw9;
-    const float dw15 = a[2]*c_R_1;
-    const float dw16 = dw4*p[1];
-    const float dw17 = a[1]*c_R_1;
-    const float dw18 = dw12*p[0];
-    const float dw19 = dw8*p[0];
-    const float dw20 = -1.0F/16.0F*dw19 + (1.0F/16.0F)*dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = a[0]*c_R_1;
-    const float dw23 = -1.0F/16.0F*dw16 + (1.0F/16.0F)*dw18;
-    const float out0 = -c_R_2*(-dw0 - dw1) - dw14*p[0] - dw4*dw5*p[0];
-    const float out1 = -c_R_2*dw6 - c_R_2*dw7 - dw14*p[1] - dw15 - dw16*dw5;
-    const float out2 = -c_R_2*dw10 - c_R_2*dw12 - dw14*p[2] + dw17 - dw4*dw5*p[2];
-    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw8 + dw15 - dw18*dw5 - dw20*p[0];
-    const float out4 = -c_R_2*(-dw1 - dw21) - dw12*dw5*p[1] - dw20*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 - dw13*dw5 - dw20*p[2] - dw22;
-    const float out6 = -c_R_2*dw11 + c_R_2*dw12 - dw17 - dw19*dw5 - dw23*p[0];
-    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + dw22 - dw23*p[1] - dw5*dw9;
-    const float out8 = -c_R_2*(-dw0 - dw21) - dw23*p[2] - dw5*dw8*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_R_T_1 = -c_R_1;
+    const float c_R_T_1_x = -c_R_1_x;
+    symrot_sine_m4__rotation_derivative_entries_f(c_R_T_1, c_R_T_1_x, c_R_2, p, a, D);
 }
 
 /* symrot_sine_m4_tangent_derivative_f: d(H a)/dp for a fixed vector a (eq D1-D5 of the sheet).

@@ -159,6 +159,32 @@ static inline double symrot_tangent_m6_angle(const double p[3])
     return symrot_tangent_m6__phi(s);
 }
 
+/* symrot_tangent_m6__tensor_entries: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_tangent_m6__tensor_entries(double c_1, double c_2, double t, const double p[3], double T[9])
+{
+    const double out0 = c_2*(p[0]*p[0]) + t;
+    const double out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const double out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const double out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const double out4 = c_2*(p[1]*p[1]) + t;
+    const double out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const double out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const double out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const double out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_tangent_m6_rotation_matrix: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -189,25 +215,7 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
         c_R_2 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
     const double t = -c_R_2*x + 1;
-    const double out0 = c_R_2*(p[0]*p[0]) + t;
-    const double out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const double out4 = c_R_2*(p[1]*p[1]) + t;
-    const double out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const double out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const double out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_tangent_m6__tensor_entries(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_tangent_m6_rotation_matrix_batch: symrot_tangent_m6_rotation_matrix for n vectors p[3*k..3*k+2] into
@@ -320,25 +328,7 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         c_H_1 = 2*pow(sin((1.0/2.0)*phi), 2)/x;
     }
-    const double out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const double out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const double out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const double out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const double out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const double out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_tangent_m6__tensor_entries(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_tangent_m6_tangent_batch: symrot_tangent_m6_tangent for n vectors p[3*k..3*k+2] into
@@ -567,25 +557,7 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
         c_G_2 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
     const double t = -c_G_2*x + 1;
-    const double out0 = c_G_2*(p[0]*p[0]) + t;
-    const double out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const double out4 = c_G_2*(p[1]*p[1]) + t;
-    const double out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const double out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const double out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_tangent_m6__tensor_entries(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_tangent_m6_root_matrix_batch: symrot_tangent_m6_root_matrix for n vectors p[3*k..3*k+2] into
@@ -703,25 +675,7 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
         const double phi = symrot_tangent_m6__phi(sqrt(x));
         c_K_1 = 2*pow(sin((1.0/4.0)*phi), 2)/x;
     }
-    const double out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const double out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const double out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const double out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const double out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const double out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_tangent_m6__tensor_entries(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_tangent_m6_root_tangent_batch: symrot_tangent_m6_root_tangent for n vectors p[3*k..3*k+2] into
@@ -1031,6 +985,58 @@ static inline int symrot_tangent_m6_rescale(const double p[3], double q[3])
     return symrot_tangent_m6__from_quaternion(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_tangent_m6__rotation_derivative_entries: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_tangent_m6__rotation_derivative_entries(double c_1, double c_1_x, double c_R_2, double c_R_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[1]*p[1];
+    const double dw1 = a[2]*p[2];
+    const double dw2 = a[1]*p[2];
+    const double dw3 = -a[2]*p[1] + dw2;
+    const double dw4 = -dw3;
+    const double dw5 = 2*p[0];
+    const double dw6 = a[0]*p[1];
+    const double dw7 = -a[1]*p[0] + dw6;
+    const double dw8 = -dw7;
+    const double dw9 = a[0]*p[2];
+    const double dw10 = a[2]*p[0];
+    const double dw11 = -dw10 + dw9;
+    const double dw12 = dw11*p[2];
+    const double dw13 = -dw12 + dw8*p[1];
+    const double dw14 = c_R_2_x*dw13;
+    const double dw15 = a[2]*c_1;
+    const double dw16 = dw4*p[1];
+    const double dw17 = 2*c_1_x;
+    const double dw18 = a[1]*c_1;
+    const double dw19 = dw8*p[0];
+    const double dw20 = -dw19 + dw4*p[2];
+    const double dw21 = a[0]*p[0];
+    const double dw22 = 2*c_R_2_x*dw20;
+    const double dw23 = a[0]*c_1;
+    const double dw24 = dw11*p[0] - dw16;
+    const double dw25 = c_R_2_x*dw24;
+    const double out0 = c_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const double out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const double out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const double out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_tangent_m6_rotation_derivative: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -1057,51 +1063,7 @@ static inline void symrot_tangent_m6_rotation_derivative(const double p[3], cons
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_tangent_m6__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = 2*p[0];
-    const double dw6 = a[0]*p[1];
-    const double dw7 = -a[1]*p[0] + dw6;
-    const double dw8 = -dw7;
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8*p[1];
-    const double dw14 = c_R_2_x*dw13;
-    const double dw15 = a[2]*c_R_1;
-    const double dw16 = dw4*p[1];
-    const double dw17 = 2*c_R_1_x;
-    const double dw18 = a[1]*c_R_1;
-    const double dw19 = dw8*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = 2*c_R_2_x*dw20;
-    const double dw23 = a[0]*c_R_1;
-    const double dw24 = dw11*p[0] - dw16;
-    const double dw25 = c_R_2_x*dw24;
-    const double out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const double out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const double out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const double out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const double out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const double out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const double out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_tangent_m6__rotation_derivative_entries(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_tangent_m6_rotation_transpose_derivative: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1112,7 +1074,7 @@ static inline void symrot_tangent_m6_rotation_derivative(const double p[3], cons
  * R_0_x = 0 (constant)
  * R_1_x = -108*(x - 108)*(x - 12)/(x + 36)**4 + 36*(x - 108)/(x + 36)**3 + 36*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2_x: Horner degree 18 in x below x = 3.06078, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
- * ops: 233 */
+ * ops: 234 */
 static inline void symrot_tangent_m6_rotation_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1130,39 +1092,54 @@ static inline void symrot_tangent_m6_rotation_transpose_derivative(const double 
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
     symrot_tangent_m6__coefficients_R_1_R_2_R_1_x_R_2_x(x, &c_R_1, &c_R_2, &c_R_1_x, &c_R_2_x);
-    const double dw0 = a[1]*p[1];
-    const double dw1 = a[2]*p[2];
-    const double dw2 = a[1]*p[2];
-    const double dw3 = -a[2]*p[1] + dw2;
-    const double dw4 = -dw3;
-    const double dw5 = a[0]*p[1];
-    const double dw6 = -a[1]*p[0] + dw5;
-    const double dw7 = -dw6;
-    const double dw8 = dw7*p[1];
-    const double dw9 = a[0]*p[2];
-    const double dw10 = a[2]*p[0];
-    const double dw11 = -dw10 + dw9;
-    const double dw12 = dw11*p[2];
-    const double dw13 = -dw12 + dw8;
-    const double dw14 = a[2]*c_R_1;
-    const double dw15 = dw4*p[1];
-    const double dw16 = 2*c_R_1_x;
-    const double dw17 = a[1]*c_R_1;
-    const double dw18 = dw11*p[0];
-    const double dw19 = dw7*p[0];
-    const double dw20 = -dw19 + dw4*p[2];
-    const double dw21 = a[0]*p[0];
-    const double dw22 = a[0]*c_R_1;
-    const double dw23 = -dw15 + dw18;
-    const double out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const double out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const double out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const double out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const double out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const double out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const double out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const double out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const double out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const double c_R_T_1 = -c_R_1;
+    const double c_R_T_1_x = -c_R_1_x;
+    symrot_tangent_m6__rotation_derivative_entries(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
+}
+
+/* symrot_tangent_m6__tangent_derivative_entries: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_tangent_m6__tangent_derivative_entries(double c_1, double c_1_x, double c_H_0_x, double c_H_2, double c_H_2_x, const double p[3], const double a[3], double D[9])
+{
+    const double dw0 = a[0]*p[0];
+    const double dw1 = 2*c_H_0_x;
+    const double dw2 = a[1]*p[1];
+    const double dw3 = a[2]*p[2];
+    const double dw4 = a[1]*p[2];
+    const double dw5 = -a[2]*p[1] + dw4;
+    const double dw6 = -dw5;
+    const double dw7 = 2*p[0];
+    const double dw8 = a[0]*p[1];
+    const double dw9 = -a[1]*p[0] + dw8;
+    const double dw10 = -dw9;
+    const double dw11 = a[0]*p[2];
+    const double dw12 = a[2]*p[0];
+    const double dw13 = dw11 - dw12;
+    const double dw14 = dw13*p[2];
+    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const double dw16 = a[2]*c_1;
+    const double dw17 = dw6*p[1];
+    const double dw18 = 2*c_1_x;
+    const double dw19 = 2*dw15;
+    const double dw20 = a[1]*c_1;
+    const double dw21 = a[1]*p[0];
+    const double dw22 = dw13*p[0];
+    const double dw23 = dw10*p[0];
+    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const double dw25 = 2*dw24;
+    const double dw26 = a[0]*c_1;
+    const double dw27 = -dw17 + dw22;
+    const double dw28 = c_H_2_x*dw27;
+    const double out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
     /* stored last: an output may be the same array as an input */
     D[0] = out0;
     D[1] = out1;
@@ -1201,54 +1178,7 @@ static inline void symrot_tangent_m6_tangent_derivative(const double p[3], const
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_tangent_m6__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = a[0]*p[2];
-    const double dw12 = a[2]*p[0];
-    const double dw13 = dw11 - dw12;
-    const double dw14 = dw13*p[2];
-    const double dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const double dw16 = a[2]*c_H_1;
-    const double dw17 = dw6*p[1];
-    const double dw18 = 2*c_H_1_x;
-    const double dw19 = 2*dw15;
-    const double dw20 = a[1]*c_H_1;
-    const double dw21 = a[1]*p[0];
-    const double dw22 = dw13*p[0];
-    const double dw23 = dw10*p[0];
-    const double dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const double dw25 = 2*dw24;
-    const double dw26 = a[0]*c_H_1;
-    const double dw27 = -dw17 + dw22;
-    const double dw28 = c_H_2_x*dw27;
-    const double out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const double out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const double out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const double out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const double out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const double out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_tangent_m6__tangent_derivative_entries(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_tangent_m6_tangent_transpose_derivative: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1259,7 +1189,7 @@ static inline void symrot_tangent_m6_tangent_derivative(const double p[3], const
  * H_0_x = -36/(x + 36)**2 (algebraic in x)
  * H_1_x: Horner degree 18 in x below x = 3.06078, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
  * H_2_x = -20736/(x + 36)**4 (algebraic in x)
- * ops: 237 */
+ * ops: 233 */
 static inline void symrot_tangent_m6_tangent_transpose_derivative(const double p[3], const double a[3], double D[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -1277,56 +1207,9 @@ static inline void symrot_tangent_m6_tangent_transpose_derivative(const double p
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
     symrot_tangent_m6__coefficients_H_1_H_2_H_0_x_H_1_x_H_2_x(x, &c_H_1, &c_H_2, &c_H_0_x, &c_H_1_x, &c_H_2_x);
-    const double dw0 = a[0]*p[0];
-    const double dw1 = 2*c_H_0_x;
-    const double dw2 = a[1]*p[1];
-    const double dw3 = a[2]*p[2];
-    const double dw4 = a[1]*p[2];
-    const double dw5 = -a[2]*p[1] + dw4;
-    const double dw6 = -dw5;
-    const double dw7 = 2*p[0];
-    const double dw8 = a[0]*p[1];
-    const double dw9 = -a[1]*p[0] + dw8;
-    const double dw10 = -dw9;
-    const double dw11 = dw10*p[1];
-    const double dw12 = a[0]*p[2];
-    const double dw13 = a[2]*p[0];
-    const double dw14 = dw12 - dw13;
-    const double dw15 = dw14*p[2];
-    const double dw16 = dw11 - dw15;
-    const double dw17 = c_H_2_x*dw16;
-    const double dw18 = a[2]*c_H_1;
-    const double dw19 = dw6*p[1];
-    const double dw20 = 2*c_H_1_x;
-    const double dw21 = a[1]*c_H_1;
-    const double dw22 = a[1]*p[0];
-    const double dw23 = dw14*p[0];
-    const double dw24 = dw10*p[0];
-    const double dw25 = -dw24 + dw6*p[2];
-    const double dw26 = c_H_2_x*dw25;
-    const double dw27 = a[0]*c_H_1;
-    const double dw28 = -dw19 + dw23;
-    const double dw29 = a[2]*p[1];
-    const double dw30 = 2*c_H_2_x*dw28;
-    const double out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const double out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const double out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const double out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const double out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const double out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const double out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const double out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const double out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const double c_H_T_1 = -c_H_1;
+    const double c_H_T_1_x = -c_H_1_x;
+    symrot_tangent_m6__tangent_derivative_entries(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_tangent_m6_tangent_inverse_derivative: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -1609,6 +1492,32 @@ static inline float symrot_tangent_m6_angle_f(const float p[3])
     return symrot_tangent_m6__phi_f(s);
 }
 
+/* symrot_tangent_m6__tensor_entries_f: internal: the entries that rotation_matrix, tangent, root_matrix, root_tangent compute alike from their own coefficients (eq 14).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 33 */
+static inline void symrot_tangent_m6__tensor_entries_f(float c_1, float c_2, float t, const float p[3], float T[9])
+{
+    const float out0 = c_2*(p[0]*p[0]) + t;
+    const float out1 = -c_1*p[2] + c_2*p[0]*p[1];
+    const float out2 = c_1*p[1] + c_2*p[0]*p[2];
+    const float out3 = c_1*p[2] + c_2*p[0]*p[1];
+    const float out4 = c_2*(p[1]*p[1]) + t;
+    const float out5 = -c_1*p[0] + c_2*p[1]*p[2];
+    const float out6 = -c_1*p[1] + c_2*p[0]*p[2];
+    const float out7 = c_1*p[0] + c_2*p[1]*p[2];
+    const float out8 = c_2*(p[2]*p[2]) + t;
+    /* stored last: an output may be the same array as an input */
+    T[0] = out0;
+    T[1] = out1;
+    T[2] = out2;
+    T[3] = out3;
+    T[4] = out4;
+    T[5] = out5;
+    T[6] = out6;
+    T[7] = out7;
+    T[8] = out8;
+}
+
 /* symrot_tangent_m6_rotation_matrix_f: rotation tensor R (eq 14).
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
  * R_0 = 1 (constant)
@@ -1639,25 +1548,7 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
         c_R_2 = (1 - cosf(phi))/x;
     }
     const float t = -c_R_2*x + 1;
-    const float out0 = c_R_2*(p[0]*p[0]) + t;
-    const float out1 = -c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out2 = c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out3 = c_R_1*p[2] + c_R_2*p[0]*p[1];
-    const float out4 = c_R_2*(p[1]*p[1]) + t;
-    const float out5 = -c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out6 = -c_R_1*p[1] + c_R_2*p[0]*p[2];
-    const float out7 = c_R_1*p[0] + c_R_2*p[1]*p[2];
-    const float out8 = c_R_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    R[0] = out0;
-    R[1] = out1;
-    R[2] = out2;
-    R[3] = out3;
-    R[4] = out4;
-    R[5] = out5;
-    R[6] = out6;
-    R[7] = out7;
-    R[8] = out8;
+    symrot_tangent_m6__tensor_entries_f(c_R_1, c_R_2, t, p, R);
 }
 
 /* symrot_tangent_m6_rotation_matrix_f_batch: symrot_tangent_m6_rotation_matrix_f for n vectors p[3*k..3*k+2] into
@@ -1771,25 +1662,7 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         c_H_1 = (1 - cosf(phi))/x;
     }
-    const float out0 = c_H_2*(p[0]*p[0]) + c_H_across;
-    const float out1 = -c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out2 = c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out3 = c_H_1*p[2] + c_H_2*p[0]*p[1];
-    const float out4 = c_H_2*(p[1]*p[1]) + c_H_across;
-    const float out5 = -c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out6 = -c_H_1*p[1] + c_H_2*p[0]*p[2];
-    const float out7 = c_H_1*p[0] + c_H_2*p[1]*p[2];
-    const float out8 = c_H_2*(p[2]*p[2]) + c_H_across;
-    /* stored last: an output may be the same array as an input */
-    H[0] = out0;
-    H[1] = out1;
-    H[2] = out2;
-    H[3] = out3;
-    H[4] = out4;
-    H[5] = out5;
-    H[6] = out6;
-    H[7] = out7;
-    H[8] = out8;
+    symrot_tangent_m6__tensor_entries_f(c_H_1, c_H_2, c_H_across, p, H);
 }
 
 /* symrot_tangent_m6_tangent_f_batch: symrot_tangent_m6_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2019,25 +1892,7 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
         c_G_2 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
     const float t = -c_G_2*x + 1;
-    const float out0 = c_G_2*(p[0]*p[0]) + t;
-    const float out1 = -c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out2 = c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out3 = c_G_1*p[2] + c_G_2*p[0]*p[1];
-    const float out4 = c_G_2*(p[1]*p[1]) + t;
-    const float out5 = -c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out6 = -c_G_1*p[1] + c_G_2*p[0]*p[2];
-    const float out7 = c_G_1*p[0] + c_G_2*p[1]*p[2];
-    const float out8 = c_G_2*(p[2]*p[2]) + t;
-    /* stored last: an output may be the same array as an input */
-    G[0] = out0;
-    G[1] = out1;
-    G[2] = out2;
-    G[3] = out3;
-    G[4] = out4;
-    G[5] = out5;
-    G[6] = out6;
-    G[7] = out7;
-    G[8] = out8;
+    symrot_tangent_m6__tensor_entries_f(c_G_1, c_G_2, t, p, G);
 }
 
 /* symrot_tangent_m6_root_matrix_f_batch: symrot_tangent_m6_root_matrix_f for n vectors p[3*k..3*k+2] into
@@ -2155,25 +2010,7 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
         const float phi = symrot_tangent_m6__phi_f(sqrtf(x));
         c_K_1 = 2*powf(sinf((1.0F/4.0F)*phi), 2)/x;
     }
-    const float out0 = c_K_2*(p[0]*p[0]) + c_K_across;
-    const float out1 = -c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out2 = c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out3 = c_K_1*p[2] + c_K_2*p[0]*p[1];
-    const float out4 = c_K_2*(p[1]*p[1]) + c_K_across;
-    const float out5 = -c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out6 = -c_K_1*p[1] + c_K_2*p[0]*p[2];
-    const float out7 = c_K_1*p[0] + c_K_2*p[1]*p[2];
-    const float out8 = c_K_2*(p[2]*p[2]) + c_K_across;
-    /* stored last: an output may be the same array as an input */
-    K[0] = out0;
-    K[1] = out1;
-    K[2] = out2;
-    K[3] = out3;
-    K[4] = out4;
-    K[5] = out5;
-    K[6] = out6;
-    K[7] = out7;
-    K[8] = out8;
+    symrot_tangent_m6__tensor_entries_f(c_K_1, c_K_2, c_K_across, p, K);
 }
 
 /* symrot_tangent_m6_root_tangent_f_batch: symrot_tangent_m6_root_tangent_f for n vectors p[3*k..3*k+2] into
@@ -2483,6 +2320,58 @@ static inline int symrot_tangent_m6_rescale_f(const float p[3], float q[3])
     return symrot_tangent_m6__from_quaternion_f(-e[0], -e[1], -e[2], -e[3], q);
 }
 
+/* symrot_tangent_m6__rotation_derivative_entries_f: internal: the entries that rotation_derivative, rotation_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 120 */
+static inline void symrot_tangent_m6__rotation_derivative_entries_f(float c_1, float c_1_x, float c_R_2, float c_R_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[1]*p[1];
+    const float dw1 = a[2]*p[2];
+    const float dw2 = a[1]*p[2];
+    const float dw3 = -a[2]*p[1] + dw2;
+    const float dw4 = -dw3;
+    const float dw5 = 2*p[0];
+    const float dw6 = a[0]*p[1];
+    const float dw7 = -a[1]*p[0] + dw6;
+    const float dw8 = -dw7;
+    const float dw9 = a[0]*p[2];
+    const float dw10 = a[2]*p[0];
+    const float dw11 = -dw10 + dw9;
+    const float dw12 = dw11*p[2];
+    const float dw13 = -dw12 + dw8*p[1];
+    const float dw14 = c_R_2_x*dw13;
+    const float dw15 = a[2]*c_1;
+    const float dw16 = dw4*p[1];
+    const float dw17 = 2*c_1_x;
+    const float dw18 = a[1]*c_1;
+    const float dw19 = dw8*p[0];
+    const float dw20 = -dw19 + dw4*p[2];
+    const float dw21 = a[0]*p[0];
+    const float dw22 = 2*c_R_2_x*dw20;
+    const float dw23 = a[0]*c_1;
+    const float dw24 = dw11*p[0] - dw16;
+    const float dw25 = c_R_2_x*dw24;
+    const float out0 = c_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
+    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
+    const float out2 = 2*c_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
+    const float out3 = -a[1]*c_R_2*p[0] + 2*c_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
+    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
+    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
+    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
+    const float out7 = -a[2]*c_R_2*p[1] + 2*c_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
+    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
+    /* stored last: an output may be the same array as an input */
+    D[0] = out0;
+    D[1] = out1;
+    D[2] = out2;
+    D[3] = out3;
+    D[4] = out4;
+    D[5] = out5;
+    D[6] = out6;
+    D[7] = out7;
+    D[8] = out8;
+}
+
 /* symrot_tangent_m6_rotation_derivative_f: d(R a)/dp for a fixed vector a (eq D1-D5 of the sheet).
  * Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.
  * Valid for |p| < 10.392304845413264 (|phi| < 6.2831853071795862); outside it, and for non-finite p, every output is NaN.
@@ -2521,51 +2410,7 @@ static inline void symrot_tangent_m6_rotation_derivative_f(const float p[3], con
         c_R_2 = (1 - cosf(phi))/x;
         c_R_2_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*(6*w1*cosf(w0) - 12*(w1*w1)*((1.0F/36.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = 2*p[0];
-    const float dw6 = a[0]*p[1];
-    const float dw7 = -a[1]*p[0] + dw6;
-    const float dw8 = -dw7;
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8*p[1];
-    const float dw14 = c_R_2_x*dw13;
-    const float dw15 = a[2]*c_R_1;
-    const float dw16 = dw4*p[1];
-    const float dw17 = 2*c_R_1_x;
-    const float dw18 = a[1]*c_R_1;
-    const float dw19 = dw8*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = 2*c_R_2_x*dw20;
-    const float dw23 = a[0]*c_R_1;
-    const float dw24 = dw11*p[0] - dw16;
-    const float dw25 = c_R_2_x*dw24;
-    const float out0 = c_R_1_x*dw4*dw5 - c_R_2*(-dw0 - dw1) + dw14*dw5;
-    const float out1 = -c_R_2*dw6 - c_R_2*dw7 + 2*dw14*p[1] + dw15 + dw16*dw17;
-    const float out2 = 2*c_R_1_x*dw4*p[2] - c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw18;
-    const float out3 = -a[1]*c_R_2*p[0] + 2*c_R_1_x*dw11*p[0] - c_R_2*dw8 + 2*c_R_2_x*dw20*p[0] - dw15;
-    const float out4 = -c_R_2*(-dw1 - dw21) + dw11*dw17*p[1] + dw22*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + dw12*dw17 + dw22*p[2] + dw23;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + dw17*dw19 + dw18 + dw25*dw5;
-    const float out7 = -a[2]*c_R_2*p[1] + 2*c_R_1_x*dw8*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw24*p[1] - dw23;
-    const float out8 = -c_R_2*(-dw0 - dw21) + dw17*dw8*p[2] + 2*dw25*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_tangent_m6__rotation_derivative_entries_f(c_R_1, c_R_1_x, c_R_2, c_R_2_x, p, a, D);
 }
 
 /* symrot_tangent_m6_rotation_transpose_derivative_f: d(R^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2576,7 +2421,7 @@ static inline void symrot_tangent_m6_rotation_derivative_f(const float p[3], con
  * R_0_x = 0 (constant)
  * R_1_x = -108*(x - 108)*(x - 12)/(x + 36)**4 + 36*(x - 108)/(x + 36)**3 + 36*(x - 12)/(x + 36)**3 (algebraic in x)
  * R_2_x: Horner degree 13 in x below x = 6.19603, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
- * ops: 213 */
+ * ops: 214 */
 static inline void symrot_tangent_m6_rotation_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2606,39 +2451,54 @@ static inline void symrot_tangent_m6_rotation_transpose_derivative_f(const float
         c_R_2 = (1 - cosf(phi))/x;
         c_R_2_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*(6*w1*cosf(w0) - 12*(w1*w1)*((1.0F/36.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
-    const float dw0 = a[1]*p[1];
-    const float dw1 = a[2]*p[2];
-    const float dw2 = a[1]*p[2];
-    const float dw3 = -a[2]*p[1] + dw2;
-    const float dw4 = -dw3;
-    const float dw5 = a[0]*p[1];
-    const float dw6 = -a[1]*p[0] + dw5;
-    const float dw7 = -dw6;
-    const float dw8 = dw7*p[1];
-    const float dw9 = a[0]*p[2];
-    const float dw10 = a[2]*p[0];
-    const float dw11 = -dw10 + dw9;
-    const float dw12 = dw11*p[2];
-    const float dw13 = -dw12 + dw8;
-    const float dw14 = a[2]*c_R_1;
-    const float dw15 = dw4*p[1];
-    const float dw16 = 2*c_R_1_x;
-    const float dw17 = a[1]*c_R_1;
-    const float dw18 = dw11*p[0];
-    const float dw19 = dw7*p[0];
-    const float dw20 = -dw19 + dw4*p[2];
-    const float dw21 = a[0]*p[0];
-    const float dw22 = a[0]*c_R_1;
-    const float dw23 = -dw15 + dw18;
-    const float out0 = -2*c_R_1_x*dw4*p[0] - c_R_2*(-dw0 - dw1) + 2*c_R_2_x*dw13*p[0];
-    const float out1 = -c_R_2*dw5 - c_R_2*dw6 + 2*c_R_2_x*dw13*p[1] - dw14 - dw15*dw16;
-    const float out2 = -c_R_2*dw11 - c_R_2*dw9 + 2*c_R_2_x*dw13*p[2] - dw16*dw4*p[2] + dw17;
-    const float out3 = -a[1]*c_R_2*p[0] - c_R_2*dw7 + 2*c_R_2_x*dw20*p[0] + dw14 - dw16*dw18;
-    const float out4 = -c_R_2*(-dw1 - dw21) + 2*c_R_2_x*dw20*p[1] - dw11*dw16*p[1];
-    const float out5 = -c_R_2*dw2 - c_R_2*dw3 + 2*c_R_2_x*dw20*p[2] - dw12*dw16 - dw22;
-    const float out6 = -c_R_2*dw10 + c_R_2*dw11 + 2*c_R_2_x*dw23*p[0] - dw16*dw19 - dw17;
-    const float out7 = -a[2]*c_R_2*p[1] - c_R_2*dw4 + 2*c_R_2_x*dw23*p[1] - dw16*dw8 + dw22;
-    const float out8 = -c_R_2*(-dw0 - dw21) + 2*c_R_2_x*dw23*p[2] - dw16*dw7*p[2];
+    const float c_R_T_1 = -c_R_1;
+    const float c_R_T_1_x = -c_R_1_x;
+    symrot_tangent_m6__rotation_derivative_entries_f(c_R_T_1, c_R_T_1_x, c_R_2, c_R_2_x, p, a, D);
+}
+
+/* symrot_tangent_m6__tangent_derivative_entries_f: internal: the entries that tangent_derivative, tangent_transpose_derivative compute alike from their own coefficients (eq D1-D5 of the sheet).
+ * The same statements in every caller but for the names they read: printed once here, called with each caller's names.
+ * ops: 134 */
+static inline void symrot_tangent_m6__tangent_derivative_entries_f(float c_1, float c_1_x, float c_H_0_x, float c_H_2, float c_H_2_x, const float p[3], const float a[3], float D[9])
+{
+    const float dw0 = a[0]*p[0];
+    const float dw1 = 2*c_H_0_x;
+    const float dw2 = a[1]*p[1];
+    const float dw3 = a[2]*p[2];
+    const float dw4 = a[1]*p[2];
+    const float dw5 = -a[2]*p[1] + dw4;
+    const float dw6 = -dw5;
+    const float dw7 = 2*p[0];
+    const float dw8 = a[0]*p[1];
+    const float dw9 = -a[1]*p[0] + dw8;
+    const float dw10 = -dw9;
+    const float dw11 = a[0]*p[2];
+    const float dw12 = a[2]*p[0];
+    const float dw13 = dw11 - dw12;
+    const float dw14 = dw13*p[2];
+    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
+    const float dw16 = a[2]*c_1;
+    const float dw17 = dw6*p[1];
+    const float dw18 = 2*c_1_x;
+    const float dw19 = 2*dw15;
+    const float dw20 = a[1]*c_1;
+    const float dw21 = a[1]*p[0];
+    const float dw22 = dw13*p[0];
+    const float dw23 = dw10*p[0];
+    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
+    const float dw25 = 2*dw24;
+    const float dw26 = a[0]*c_1;
+    const float dw27 = -dw17 + dw22;
+    const float dw28 = c_H_2_x*dw27;
+    const float out0 = c_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
+    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
+    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
+    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
+    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
+    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
+    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
+    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
+    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
     /* stored last: an output may be the same array as an input */
     D[0] = out0;
     D[1] = out1;
@@ -2690,54 +2550,7 @@ static inline void symrot_tangent_m6_tangent_derivative_f(const float p[3], cons
         c_H_1 = (1 - cosf(phi))/x;
         c_H_1_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*(6*w1*cosf(w0) - 12*(w1*w1)*((1.0F/36.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = a[0]*p[2];
-    const float dw12 = a[2]*p[0];
-    const float dw13 = dw11 - dw12;
-    const float dw14 = dw13*p[2];
-    const float dw15 = c_H_2_x*(dw10*p[1] - dw14);
-    const float dw16 = a[2]*c_H_1;
-    const float dw17 = dw6*p[1];
-    const float dw18 = 2*c_H_1_x;
-    const float dw19 = 2*dw15;
-    const float dw20 = a[1]*c_H_1;
-    const float dw21 = a[1]*p[0];
-    const float dw22 = dw13*p[0];
-    const float dw23 = dw10*p[0];
-    const float dw24 = c_H_2_x*(-dw23 + dw6*p[2]);
-    const float dw25 = 2*dw24;
-    const float dw26 = a[0]*c_H_1;
-    const float dw27 = -dw17 + dw22;
-    const float dw28 = c_H_2_x*dw27;
-    const float out0 = c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw15*dw7;
-    const float out1 = -c_H_2*dw8 - c_H_2*dw9 + dw1*dw8 + dw16 + dw17*dw18 + dw19*p[1];
-    const float out2 = -c_H_2*dw11 - c_H_2*dw13 + dw1*dw11 + dw18*dw6*p[2] + dw19*p[2] - dw20;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw21 + dw1*dw21 - dw16 + dw18*dw22 + dw24*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 + dw13*dw18*p[1] + dw25*p[1];
-    const float out5 = -c_H_2*dw4 - c_H_2*dw5 + dw1*dw4 + dw14*dw18 + dw25*p[2] + dw26;
-    const float out6 = -c_H_2*dw12 + c_H_2*dw13 + dw1*dw12 + dw18*dw23 + dw20 + dw28*dw7;
-    const float out7 = 2*a[2]*c_H_0_x*p[1] - a[2]*c_H_2*p[1] + 2*c_H_1_x*dw10*p[1] - c_H_2*dw6 + 2*c_H_2_x*dw27*p[1] - dw26;
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 + dw10*dw18*p[2] + 2*dw28*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    symrot_tangent_m6__tangent_derivative_entries_f(c_H_1, c_H_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_tangent_m6_tangent_transpose_derivative_f: d(H^T a)/dp for a fixed vector a (eq D1-D5 of the sheet).
@@ -2748,7 +2561,7 @@ static inline void symrot_tangent_m6_tangent_derivative_f(const float p[3], cons
  * H_0_x = -36/(x + 36)**2 (algebraic in x)
  * H_1_x: Horner degree 13 in x below x = 6.19603, else 6*(6*sin(phi/2)*cos(phi/2) - 12*(s**2/36 + 1)*sin(phi/2)**2/s)/(s**3*(x + 36))
  * H_2_x = -20736/(x + 36)**4 (algebraic in x)
- * ops: 217 */
+ * ops: 213 */
 static inline void symrot_tangent_m6_tangent_transpose_derivative_f(const float p[3], const float a[3], float D[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
@@ -2779,56 +2592,9 @@ static inline void symrot_tangent_m6_tangent_transpose_derivative_f(const float 
         c_H_1 = (1 - cosf(phi))/x;
         c_H_1_x = x < 6.1960254F ? x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.281047e-19F)*x - 6.6429547e-18F) + 1.9036037e-16F) - 5.353305e-15F) + 1.4724016e-13F) - 3.9434836e-12F) + 1.02245025e-10F) - 2.5458065e-09F) + 6.018057e-08F) - 1.3276476e-06F) + 67.0F/2519424.0F) - 43.0F/93312.0F) + 73.0F/11664.0F) - 11.0F/216.0F : 6*(6*w1*cosf(w0) - 12*(w1*w1)*((1.0F/36.0F)*(s*s) + 1)/s)/((s*s*s)*(x + 36));
     }
-    const float dw0 = a[0]*p[0];
-    const float dw1 = 2*c_H_0_x;
-    const float dw2 = a[1]*p[1];
-    const float dw3 = a[2]*p[2];
-    const float dw4 = a[1]*p[2];
-    const float dw5 = -a[2]*p[1] + dw4;
-    const float dw6 = -dw5;
-    const float dw7 = 2*p[0];
-    const float dw8 = a[0]*p[1];
-    const float dw9 = -a[1]*p[0] + dw8;
-    const float dw10 = -dw9;
-    const float dw11 = dw10*p[1];
-    const float dw12 = a[0]*p[2];
-    const float dw13 = a[2]*p[0];
-    const float dw14 = dw12 - dw13;
-    const float dw15 = dw14*p[2];
-    const float dw16 = dw11 - dw15;
-    const float dw17 = c_H_2_x*dw16;
-    const float dw18 = a[2]*c_H_1;
-    const float dw19 = dw6*p[1];
-    const float dw20 = 2*c_H_1_x;
-    const float dw21 = a[1]*c_H_1;
-    const float dw22 = a[1]*p[0];
-    const float dw23 = dw14*p[0];
-    const float dw24 = dw10*p[0];
-    const float dw25 = -dw24 + dw6*p[2];
-    const float dw26 = c_H_2_x*dw25;
-    const float dw27 = a[0]*c_H_1;
-    const float dw28 = -dw19 + dw23;
-    const float dw29 = a[2]*p[1];
-    const float dw30 = 2*c_H_2_x*dw28;
-    const float out0 = -c_H_1_x*dw6*dw7 - c_H_2*(-dw2 - dw3) + dw0*dw1 + dw17*dw7;
-    const float out1 = 2*a[0]*c_H_0_x*p[1] - c_H_2*dw8 - c_H_2*dw9 + 2*c_H_2_x*dw16*p[1] - dw18 - dw19*dw20;
-    const float out2 = -c_H_2*dw12 - c_H_2*dw14 + dw1*dw12 + 2*dw17*p[2] - dw20*dw6*p[2] + dw21;
-    const float out3 = -c_H_2*dw10 - c_H_2*dw22 + dw1*dw22 + dw18 - dw20*dw23 + dw26*dw7;
-    const float out4 = -c_H_2*(-dw0 - dw3) + dw1*dw2 - dw14*dw20*p[1] + 2*dw26*p[1];
-    const float out5 = 2*a[1]*c_H_0_x*p[2] - c_H_2*dw4 - c_H_2*dw5 + 2*c_H_2_x*dw25*p[2] - dw15*dw20 - dw27;
-    const float out6 = 2*a[2]*c_H_0_x*p[0] - c_H_2*dw13 + c_H_2*dw14 + 2*c_H_2_x*dw28*p[0] - dw20*dw24 - dw21;
-    const float out7 = -c_H_2*dw29 - c_H_2*dw6 + dw1*dw29 - dw11*dw20 + dw27 + dw30*p[1];
-    const float out8 = -c_H_2*(-dw0 - dw2) + dw1*dw3 - dw10*dw20*p[2] + dw30*p[2];
-    /* stored last: an output may be the same array as an input */
-    D[0] = out0;
-    D[1] = out1;
-    D[2] = out2;
-    D[3] = out3;
-    D[4] = out4;
-    D[5] = out5;
-    D[6] = out6;
-    D[7] = out7;
-    D[8] = out8;
+    const float c_H_T_1 = -c_H_1;
+    const float c_H_T_1_x = -c_H_1_x;
+    symrot_tangent_m6__tangent_derivative_entries_f(c_H_T_1, c_H_T_1_x, c_H_0_x, c_H_2, c_H_2_x, p, a, D);
 }
 
 /* symrot_tangent_m6_tangent_inverse_derivative_f: d(H^-1 a)/dp for a fixed vector a (eq D1-D5 of the sheet).

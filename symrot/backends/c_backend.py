@@ -22,6 +22,7 @@ import sympy as sp
 from symrot.backends.c_aliasing import stored_last
 from symrot.backends.c_batch import DEFAULT_BLOCK, BatchWriter
 from symrot.backends.c_derivatives import DerivativeWriter
+from symrot.backends.c_entries import share_entries
 from symrot.backends.c_functions import FUNCTIONS, CFunction
 from symrot.backends.c_operations import OperationWriter
 from symrot.backends.c_printer import PRECISIONS, Precision
@@ -78,7 +79,8 @@ def _precision_functions(plan: EvaluationPlan, name: str, precision: Precision) 
     """The functions of one precision, in header order: angle, public functions with their batch
     kernels, operations, derivatives, with the coefficient blocks several of them compute alike
     printed once as helpers after the angle's (:mod:`symrot.backends.c_shared`); each stores its
-    outputs after reading its inputs (:func:`~symrot.backends.c_aliasing.stored_last`)."""
+    outputs after reading its inputs (:func:`~symrot.backends.c_aliasing.stored_last`); the entries
+    that several compute alike but for names are one helper too (:mod:`symrot.backends.c_entries`)."""
     writer = FunctionWriter(plan, name, precision)
     batch = BatchWriter(writer)
     angle = []
@@ -94,7 +96,8 @@ def _precision_functions(plan: EvaluationPlan, name: str, precision: Precision) 
     derivatives = DerivativeWriter(plan, name, precision).all()
     callers, helpers = share_coefficients([*public, *operations, *derivatives], writer)
     functions = [*angle, *helpers, *callers]  # the shared coefficients after phi, before their callers
-    return [stored_last(function) for function in functions]  # outputs may alias inputs
+    stored = [stored_last(function) for function in functions]  # outputs may alias inputs
+    return share_entries(stored, writer)  # the same entries but for names, once
 
 
 def angle_kind(plan: EvaluationPlan) -> str:

@@ -6,8 +6,9 @@ Single calls in double and, suffixed ``_f``, float; no allocation; matrices row-
 * ``rotation_derivative(p, a, D)``, ``rotation_transpose_derivative``, ``tangent_derivative``,
   ``tangent_transpose_derivative``, ``tangent_inverse_derivative``: ∂(T a)/∂p printed entry by entry
   from the form the core derives (:func:`symrot.core.derivatives.tensor_derivative`), with the planned
-  coefficients c_k and slopes c_k′ = dc_k/dx (Tᵀ: c1, c1′ negated); NaN outside the range, as
-  every function of the header;
+  coefficients c_k and slopes c_k′ = dc_k/dx (Tᵀ: T's statements on c1, c1′ negated, so that the two
+  share one helper, :mod:`symrot.backends.c_entries`); NaN outside the range, as every function of
+  the header;
 * ``angular_acceleration(p, pdot, pddot, alpha)``: α = H p̈ + Ḣ ṗ with Ḣ ṗ from
   :func:`symrot.core.derivatives.rate_value`;
 * ``compose_jacobians(p1, p2, J1, J2)``: ∂p₃/∂p₁ = H(p₃)⁻¹ R(p₂) H(p₁), ∂p₃/∂p₂ = H(p₃)⁻¹ H(p₂) for
@@ -18,6 +19,7 @@ Single calls in double and, suffixed ``_f``, float; no allocation; matrices row-
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from typing import Any
 
@@ -87,17 +89,47 @@ class DerivativeWriter(FunctionWriter):
                    for symbol, n in symbols.items()}
         return body, scalars, names
 
+    def transposed(self, tensor: str, plain: dict[sp.Symbol, sp.Expr]
+                   ) -> tuple[list[Statement], dict[str, str]] | None:
+        """Tᵀ = c0 I − c1 (p×) + c2 (p×)²: c1 and c1′ negated into variables of their own
+        (``c_R_T_1 = -c_R_1``), and the renaming that turns T's entries into Tᵀ's. The entries are
+        T's statements as printed, on the new names, so the two functions call one helper for them
+        (:mod:`symrot.backends.c_entries`); the negation is exact. None where c1 or c1′ is a
+        nonzero constant (folded into T's expressions: Tᵀ's print on their own)."""
+        statements: list[Statement] = []
+        names: dict[str, str] = {}
+        for symbol in (VALUES[1], SLOPES[1]):
+            value = plain[symbol]
+            if value == 0:
+                continue
+            if not isinstance(value, sp.Symbol):
+                return None
+            name = f"c_{tensor}_T{str(value)[len(tensor) + 2:]}"
+            statements.append(self.let(name, -value))
+            names[str(value)] = name
+        return statements, names
+
     def derivative(self, function: str) -> dict[str, Any]:
         tensor, sign, summary = DERIVATIVES[function]
         t = self.ctype
         statements: list[Statement] = [*self.prologue(), {"kind": "if", "condition": self.out_of_range(),
                                                           "then": self.nan_out("D", 9), "otherwise": []}]
-        body, scalars, names = self.scalars(tensor, sign, set(tensor_derivative().terms))
+        body, scalars, names = self.scalars(tensor, 1, set(tensor_derivative().terms))
         statements += body
+        transposed = self.transposed(tensor, scalars) if sign < 0 else None
+        if sign < 0 and transposed is None:
+            scalars = self.scalars(tensor, sign, set(tensor_derivative().terms))[1]
         matrix = tensor_derivative().matrix(sp.Matrix(P), _vector("a"), scalars)
         replacements, entries = common_subexpressions(list(matrix), "dw")
-        statements += [self.let(str(symbol), value) for symbol, value in replacements]
-        statements += [self.set(f"D[{i}]", entry) for i, entry in enumerate(entries)]
+        lets = [self.let(str(symbol), value) for symbol, value in replacements]
+        lets += [self.set(f"D[{i}]", entry) for i, entry in enumerate(entries)]
+        if transposed is not None:
+            negated, renamed = transposed
+            pattern = re.compile(r"\b(" + "|".join(map(re.escape, renamed)) + r")\b") if renamed else None
+            lets = [{**s, "value": pattern.sub(lambda m: renamed[m[1]], s["value"])} if pattern else s
+                    for s in lets]
+            statements += negated
+        statements += lets
         notes = ["Row-major D[3*i + j] = d(T a)_i / dp_j (column j: the derivative by p_j), a fixed.",
                  *self.validity_notes(), *self.coefficient_notes(names)]
         signature = f"void {self.name(function)}(const {t} p[3], const {t} a[3], {t} D[9])"

@@ -30,15 +30,15 @@ def _worth(lines: int, uses: int, outputs: int) -> bool:
     return uses >= 2 and lines >= SHORTEST and uses * lines > lines + 6 + outputs + 2 * uses
 
 
-def _lines(statements: list[Statement]) -> int:
+def printed_lines(statements: list[Statement]) -> int:
     """Lines ``templates/c/statements.j2`` prints for ``statements``."""
     total = 0
     for statement in statements:
         if statement["kind"] == "if":
-            total += 2 + _lines(statement["then"]) + (1 + _lines(statement["otherwise"])
+            total += 2 + printed_lines(statement["then"]) + (1 + printed_lines(statement["otherwise"])
                                                       if statement["otherwise"] else 0)
         elif statement["kind"] == "loop":
-            total += 2 + _lines(statement["body"])
+            total += 2 + printed_lines(statement["body"])
         else:
             total += 1
     return total
@@ -83,7 +83,8 @@ def share_coefficients(functions: list[Function],
         key = repr(block)
         computed: list[str] = statements[span[0]]["computed"]
         text = repr(block)
-        if not computed or not _worth(_lines(block), uses[key], len(computed)) or re.search(r"\bp\[", text):
+        worth = _worth(printed_lines(block), uses[key], len(computed))
+        if not computed or not worth or re.search(r"\bp\[", text):
             shared.append({**function, "statements": [*statements[:span[0]], *block, *statements[span[1]:]]})
             continue
         if key not in helpers:
@@ -122,4 +123,4 @@ def _helper(writer: PlanWriter, block: list[Statement], computed: list[str], nam
             "statements": statements, "batch_signature": None, "output": None, "takes_d": takes_d}
 
 
-__all__ = ["share_coefficients"]
+__all__ = ["printed_lines", "share_coefficients"]
