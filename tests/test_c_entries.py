@@ -134,3 +134,29 @@ def test_a_transposed_derivative_calls_the_helper_of_the_plain_one(name: str) ->
             assert called[0] == called[1] and called[0].endswith(f"derivative_entries{suffix}"), called
             shared += 1
     assert shared >= 2, shared  # at least R or H in both precisions
+
+
+def _batch(output: str, tensor: str, entries: list[str]) -> list[dict[str, Any]]:
+    """A ``_batch`` kernel's outer loop whose last loop (the assembly) prints ``entries``."""
+    assembly = [{"kind": "let", "type": "const double *const", "name": "pk", "value": "p + 3 * (start + k)"},
+                *({"kind": "let", "type": "double", "name": f"p{i}", "value": f"pk[{i}]"} for i in range(3)),
+                {"kind": "declare", "type": "double *const", "names": [f"out = {output} + 9 * (start + k)"]},
+                *(_set(f"out[{i}]", entry) for i, entry in enumerate(entries))]
+    return [{"kind": "declare", "type": "size_t", "names": ["end", "start", "k"]},
+            {"kind": "loop", "header": "end = n; end > 0; end = start", "times": 1, "body": [
+                {"kind": "comment", "text": f"the passes of {tensor}"},
+                {"kind": "loop", "header": "k = m; k-- > 0;", "times": 1, "body": assembly}]}]
+
+
+def test_a_batch_kernel_whose_entries_are_the_helpers_on_the_lanes_calls_it() -> None:
+    functions = [_function("rotation_matrix", "R", "R"), _function("root_matrix", "G", "G")]
+    lanes = [f"c_R_2_lanes[k]*p{i % 3} + c_R_1_lanes[k]*x_lanes[k]*p{i // 3}" for i in range(9)]
+    functions[0]["batch_statements"] = _batch("R", "R", lanes)
+    other = [*lanes[:8], "c_R_2_lanes[k]*p2"]  # one entry another shape: the kernel keeps its own
+    functions[1]["batch_statements"] = _batch("G", "G", other)
+    shared = share_entries(functions, WRITER)
+    calling = shared[1]["batch_statements"][-1]["body"][-1]["body"]
+    assert [s["kind"] for s in calling] == ["let", "call"] and calling[0]["name"] == "pk"
+    assert calling[1]["value"] == ("symrot_demo__matrix_entries(c_R_1_lanes[k], c_R_2_lanes[k], x_lanes[k], "
+                                   "pk, R + 9 * (start + k))")
+    assert shared[2]["batch_statements"] == functions[1]["batch_statements"]

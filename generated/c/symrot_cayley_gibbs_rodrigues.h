@@ -126,15 +126,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix(const double p[
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        R[0] = (double)NAN;
-        R[1] = (double)NAN;
-        R[2] = (double)NAN;
-        R[3] = (double)NAN;
-        R[4] = (double)NAN;
-        R[5] = (double)NAN;
-        R[6] = (double)NAN;
-        R[7] = (double)NAN;
-        R[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = 4/(x + 4);
@@ -182,20 +176,8 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_batch(size_t n,
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_cayley_gibbs_rodrigues__tensor_entries(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -212,15 +194,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent(const double p[3], doub
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        H[0] = (double)NAN;
-        H[1] = (double)NAN;
-        H[2] = (double)NAN;
-        H[3] = (double)NAN;
-        H[4] = (double)NAN;
-        H[5] = (double)NAN;
-        H[6] = (double)NAN;
-        H[7] = (double)NAN;
-        H[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_across = 4/(x + 4);
@@ -314,15 +290,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse(const double p[
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = (double)NAN;
+        }
         return;
     }
     const double out0 = (1.0/4.0)*(p[0]*p[0]) + 1;
@@ -421,15 +391,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix(const double p[3], 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        G[0] = (double)NAN;
-        G[1] = (double)NAN;
-        G[2] = (double)NAN;
-        G[3] = (double)NAN;
-        G[4] = (double)NAN;
-        G[5] = (double)NAN;
-        G[6] = (double)NAN;
-        G[7] = (double)NAN;
-        G[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = (double)NAN;
+        }
         return;
     }
     const double c_G_1 = 1.0/sqrt(x + 4);
@@ -490,20 +454,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_cayley_gibbs_rodrigues__tensor_entries(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -520,15 +472,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent(const double p[3],
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        K[0] = (double)NAN;
-        K[1] = (double)NAN;
-        K[2] = (double)NAN;
-        K[3] = (double)NAN;
-        K[4] = (double)NAN;
-        K[5] = (double)NAN;
-        K[6] = (double)NAN;
-        K[7] = (double)NAN;
-        K[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = (double)NAN;
+        }
         return;
     }
     const double c_K_across = 1.0/sqrt(x + 4);
@@ -592,19 +538,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
-            double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
+            symrot_cayley_gibbs_rodrigues__tensor_entries(c_K_1_lanes[k], c_K_2_lanes[k], c_K_across_lanes[k], pk, K + 9 * (start + k));
         }
     }
 }
@@ -887,15 +821,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative(const doubl
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = 4/(x + 4);
@@ -920,15 +848,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative(c
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = 4/(x + 4);
@@ -996,15 +918,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative(const double
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = 2/(x + 4);
@@ -1028,15 +944,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative(co
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = 2/(x + 4);
@@ -1062,15 +972,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative(cons
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.149515568880993e+180)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double dw0 = (1.0/2.0)*a[0];
@@ -1335,15 +1239,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f(const float p
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = 4/(x + 4);
@@ -1391,20 +1289,8 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_matrix_f_batch(size_t 
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_cayley_gibbs_rodrigues__tensor_entries_f(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -1421,15 +1307,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_f(const float p[3], flo
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = NAN;
+        }
         return;
     }
     const float c_H_across = 4/(x + 4);
@@ -1523,15 +1403,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_f(const float p
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = NAN;
+        }
         return;
     }
     const float out0 = (1.0F/4.0F)*(p[0]*p[0]) + 1;
@@ -1630,15 +1504,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f(const float p[3],
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = NAN;
+        }
         return;
     }
     const float c_G_1 = 1.0F/sqrtf(x + 4);
@@ -1699,20 +1567,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_cayley_gibbs_rodrigues__tensor_entries_f(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -1729,15 +1585,9 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f(const float p[3]
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = NAN;
+        }
         return;
     }
     const float c_K_across = 1.0F/sqrtf(x + 4);
@@ -1801,19 +1651,7 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
-            float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
+            symrot_cayley_gibbs_rodrigues__tensor_entries_f(c_K_1_lanes[k], c_K_2_lanes[k], c_K_across_lanes[k], pk, K + 9 * (start + k));
         }
     }
 }
@@ -2096,15 +1934,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_derivative_f(const flo
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = 4/(x + 4);
@@ -2129,15 +1961,9 @@ static inline void symrot_cayley_gibbs_rodrigues_rotation_transpose_derivative_f
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = 4/(x + 4);
@@ -2205,15 +2031,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_derivative_f(const floa
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = 2/(x + 4);
@@ -2237,15 +2057,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_transpose_derivative_f(
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = 2/(x + 4);
@@ -2271,15 +2085,9 @@ static inline void symrot_cayley_gibbs_rodrigues_tangent_inverse_derivative_f(co
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 3.8685626e+25F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float dw0 = (1.0F/2.0F)*a[0];

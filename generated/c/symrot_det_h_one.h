@@ -320,15 +320,9 @@ static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        R[0] = (double)NAN;
-        R[1] = (double)NAN;
-        R[2] = (double)NAN;
-        R[3] = (double)NAN;
-        R[4] = (double)NAN;
-        R[5] = (double)NAN;
-        R[6] = (double)NAN;
-        R[7] = (double)NAN;
-        R[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = (double)NAN;
+        }
         return;
     }
     double c_R_1, c_R_2;
@@ -418,20 +412,8 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_det_h_one__tensor_entries(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -446,15 +428,9 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        H[0] = (double)NAN;
-        H[1] = (double)NAN;
-        H[2] = (double)NAN;
-        H[3] = (double)NAN;
-        H[4] = (double)NAN;
-        H[5] = (double)NAN;
-        H[6] = (double)NAN;
-        H[7] = (double)NAN;
-        H[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = (double)NAN;
+        }
         return;
     }
     double c_H_across, c_H_1, c_H_2;
@@ -541,19 +517,7 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
-            double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_det_h_one__tensor_entries(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -568,15 +532,9 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = (double)NAN;
+        }
         return;
     }
     double c_H_inverse_across, c_H_inverse_2;
@@ -728,15 +686,9 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        G[0] = (double)NAN;
-        G[1] = (double)NAN;
-        G[2] = (double)NAN;
-        G[3] = (double)NAN;
-        G[4] = (double)NAN;
-        G[5] = (double)NAN;
-        G[6] = (double)NAN;
-        G[7] = (double)NAN;
-        G[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = (double)NAN;
+        }
         return;
     }
     double c_G_1, c_G_2;
@@ -832,20 +784,8 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_det_h_one__tensor_entries(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -860,15 +800,9 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        K[0] = (double)NAN;
-        K[1] = (double)NAN;
-        K[2] = (double)NAN;
-        K[3] = (double)NAN;
-        K[4] = (double)NAN;
-        K[5] = (double)NAN;
-        K[6] = (double)NAN;
-        K[7] = (double)NAN;
-        K[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = (double)NAN;
+        }
         return;
     }
     double c_K_across, c_K_1, c_K_2;
@@ -975,19 +909,7 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
-            double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
+            symrot_det_h_one__tensor_entries(c_K_1_lanes[k], c_K_2_lanes[k], c_K_across_lanes[k], pk, K + 9 * (start + k));
         }
     }
 }
@@ -1277,15 +1199,9 @@ static inline void symrot_det_h_one_rotation_derivative(const double p[3], const
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -1306,15 +1222,9 @@ static inline void symrot_det_h_one_rotation_transpose_derivative(const double p
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -1392,15 +1302,9 @@ static inline void symrot_det_h_one_tangent_derivative(const double p[3], const 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
@@ -1421,15 +1325,9 @@ static inline void symrot_det_h_one_tangent_transpose_derivative(const double p[
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
@@ -1452,15 +1350,9 @@ static inline void symrot_det_h_one_tangent_inverse_derivative(const double p[3]
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.243134665607636)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_H_inverse_2, c_H_inverse_0_x, c_H_inverse_2_x;
@@ -1975,15 +1867,9 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = NAN;
+        }
         return;
     }
     float c_R_1, c_R_2;
@@ -2083,20 +1969,8 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_det_h_one__tensor_entries_f(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -2111,15 +1985,9 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = NAN;
+        }
         return;
     }
     float c_H_across, c_H_1, c_H_2;
@@ -2206,19 +2074,7 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
-            float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_det_h_one__tensor_entries_f(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -2233,15 +2089,9 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = NAN;
+        }
         return;
     }
     float c_H_inverse_across, c_H_inverse_2;
@@ -2379,15 +2229,9 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = NAN;
+        }
         return;
     }
     float c_G_1, c_G_2;
@@ -2483,20 +2327,8 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_det_h_one__tensor_entries_f(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -2511,15 +2343,9 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = NAN;
+        }
         return;
     }
     float c_K_across, c_K_1, c_K_2;
@@ -2631,19 +2457,7 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
-            float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
+            symrot_det_h_one__tensor_entries_f(c_K_1_lanes[k], c_K_2_lanes[k], c_K_across_lanes[k], pk, K + 9 * (start + k));
         }
     }
 }
@@ -2931,15 +2745,9 @@ static inline void symrot_det_h_one_rotation_derivative_f(const float p[3], cons
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -2960,15 +2768,9 @@ static inline void symrot_det_h_one_rotation_transpose_derivative_f(const float 
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -3046,15 +2848,9 @@ static inline void symrot_det_h_one_tangent_derivative_f(const float p[3], const
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
@@ -3075,15 +2871,9 @@ static inline void symrot_det_h_one_tangent_transpose_derivative_f(const float p
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_H_1, c_H_2, c_H_0_x, c_H_1_x, c_H_2_x;
@@ -3106,15 +2896,9 @@ static inline void symrot_det_h_one_tangent_inverse_derivative_f(const float p[3
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 11.2431345F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_H_inverse_2, c_H_inverse_0_x, c_H_inverse_2_x;

@@ -123,15 +123,9 @@ static inline void symrot_euler_rodrigues_rotation_matrix(const double p[3], dou
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        R[0] = (double)NAN;
-        R[1] = (double)NAN;
-        R[2] = (double)NAN;
-        R[3] = (double)NAN;
-        R[4] = (double)NAN;
-        R[5] = (double)NAN;
-        R[6] = (double)NAN;
-        R[7] = (double)NAN;
-        R[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = (1.0/2.0)*sqrt(d);
@@ -257,15 +251,9 @@ static inline void symrot_euler_rodrigues_tangent(const double p[3], double H[9]
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        H[0] = (double)NAN;
-        H[1] = (double)NAN;
-        H[2] = (double)NAN;
-        H[3] = (double)NAN;
-        H[4] = (double)NAN;
-        H[5] = (double)NAN;
-        H[6] = (double)NAN;
-        H[7] = (double)NAN;
-        H[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_across = (1.0/2.0)*sqrt(d);
@@ -353,15 +341,9 @@ static inline void symrot_euler_rodrigues_tangent_inverse(const double p[3], dou
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_inverse_across = (1.0/2.0)*sqrt(d);
@@ -474,15 +456,9 @@ static inline void symrot_euler_rodrigues_root_matrix(const double p[3], double 
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        G[0] = (double)NAN;
-        G[1] = (double)NAN;
-        G[2] = (double)NAN;
-        G[3] = (double)NAN;
-        G[4] = (double)NAN;
-        G[5] = (double)NAN;
-        G[6] = (double)NAN;
-        G[7] = (double)NAN;
-        G[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = (double)NAN;
+        }
         return;
     }
     const double c_G_2 = (1.0/2.0)/(sqrt(d) + 2);
@@ -564,15 +540,9 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        K[0] = (double)NAN;
-        K[1] = (double)NAN;
-        K[2] = (double)NAN;
-        K[3] = (double)NAN;
-        K[4] = (double)NAN;
-        K[5] = (double)NAN;
-        K[6] = (double)NAN;
-        K[7] = (double)NAN;
-        K[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = (double)NAN;
+        }
         return;
     }
     const double c_K_1 = (1.0/2.0)/(sqrt(d) + 2);
@@ -944,15 +914,9 @@ static inline void symrot_euler_rodrigues_rotation_derivative(const double p[3],
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = (1.0/2.0)*sqrt(d);
@@ -974,15 +938,9 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative(const do
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = (1.0/2.0)*sqrt(d);
@@ -1006,15 +964,9 @@ static inline void symrot_euler_rodrigues_tangent_derivative(const double p[3], 
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_2 = (1.0/2.0)/sqrt(d);
@@ -1078,15 +1030,9 @@ static inline void symrot_euler_rodrigues_tangent_transpose_derivative(const dou
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_2 = (1.0/2.0)/sqrt(d);
@@ -1152,15 +1098,9 @@ static inline void symrot_euler_rodrigues_tangent_inverse_derivative(const doubl
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_euler_rodrigues__complement(p, x);
     if (!(x < 4.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_inverse_0_x = -(1.0/4.0)/sqrt(d);
@@ -1423,15 +1363,9 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f(const float p[3], fl
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = (1.0F/2.0F)*sqrtf(d);
@@ -1557,15 +1491,9 @@ static inline void symrot_euler_rodrigues_tangent_f(const float p[3], float H[9]
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = NAN;
+        }
         return;
     }
     const float c_H_across = (1.0F/2.0F)*sqrtf(d);
@@ -1653,15 +1581,9 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f(const float p[3], fl
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = NAN;
+        }
         return;
     }
     const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(d);
@@ -1774,15 +1696,9 @@ static inline void symrot_euler_rodrigues_root_matrix_f(const float p[3], float 
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = NAN;
+        }
         return;
     }
     const float c_G_2 = (1.0F/2.0F)/(sqrtf(d) + 2);
@@ -1864,15 +1780,9 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = NAN;
+        }
         return;
     }
     const float c_K_1 = (1.0F/2.0F)/(sqrtf(d) + 2);
@@ -2243,15 +2153,9 @@ static inline void symrot_euler_rodrigues_rotation_derivative_f(const float p[3]
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = (1.0F/2.0F)*sqrtf(d);
@@ -2273,15 +2177,9 @@ static inline void symrot_euler_rodrigues_rotation_transpose_derivative_f(const 
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = (1.0F/2.0F)*sqrtf(d);
@@ -2305,15 +2203,9 @@ static inline void symrot_euler_rodrigues_tangent_derivative_f(const float p[3],
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_2 = (1.0F/2.0F)/sqrtf(d);
@@ -2377,15 +2269,9 @@ static inline void symrot_euler_rodrigues_tangent_transpose_derivative_f(const f
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_2 = (1.0F/2.0F)/sqrtf(d);
@@ -2451,15 +2337,9 @@ static inline void symrot_euler_rodrigues_tangent_inverse_derivative_f(const flo
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_euler_rodrigues__complement_f(p, x);
     if (!(x < 4.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_inverse_0_x = -(1.0F/4.0F)/sqrtf(d);

@@ -201,15 +201,9 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        R[0] = (double)NAN;
-        R[1] = (double)NAN;
-        R[2] = (double)NAN;
-        R[3] = (double)NAN;
-        R[4] = (double)NAN;
-        R[5] = (double)NAN;
-        R[6] = (double)NAN;
-        R[7] = (double)NAN;
-        R[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = (double)NAN;
+        }
         return;
     }
     double c_R_1, c_R_2;
@@ -294,20 +288,8 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -322,15 +304,9 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        H[0] = (double)NAN;
-        H[1] = (double)NAN;
-        H[2] = (double)NAN;
-        H[3] = (double)NAN;
-        H[4] = (double)NAN;
-        H[5] = (double)NAN;
-        H[6] = (double)NAN;
-        H[7] = (double)NAN;
-        H[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = (double)NAN;
+        }
         return;
     }
     double c_H_1, c_H_2;
@@ -421,20 +397,8 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_H_0_lanes[k] - c_H_2_lanes[k]*x_lanes[k];
-            double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries(c_H_1_lanes[k], c_H_2_lanes[k], t, pk, H + 9 * (start + k));
         }
     }
 }
@@ -449,15 +413,9 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = (double)NAN;
+        }
         return;
     }
     double c_H_inverse_2;
@@ -600,15 +558,9 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        G[0] = (double)NAN;
-        G[1] = (double)NAN;
-        G[2] = (double)NAN;
-        G[3] = (double)NAN;
-        G[4] = (double)NAN;
-        G[5] = (double)NAN;
-        G[6] = (double)NAN;
-        G[7] = (double)NAN;
-        G[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = (double)NAN;
+        }
         return;
     }
     double c_G_1, c_G_2;
@@ -699,20 +651,8 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -727,15 +667,9 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        K[0] = (double)NAN;
-        K[1] = (double)NAN;
-        K[2] = (double)NAN;
-        K[3] = (double)NAN;
-        K[4] = (double)NAN;
-        K[5] = (double)NAN;
-        K[6] = (double)NAN;
-        K[7] = (double)NAN;
-        K[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = (double)NAN;
+        }
         return;
     }
     double c_K_1, c_K_2;
@@ -826,20 +760,8 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_K_0_lanes[k] - c_K_2_lanes[k]*x_lanes[k];
-            double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries(c_K_1_lanes[k], c_K_2_lanes[k], t, pk, K + 9 * (start + k));
         }
     }
 }
@@ -1141,15 +1063,9 @@ static inline void symrot_rotation_vector_rotation_derivative(const double p[3],
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -1170,15 +1086,9 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative(const do
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -1201,15 +1111,9 @@ static inline void symrot_rotation_vector_tangent_derivative(const double p[3], 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
@@ -1230,15 +1134,9 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative(const dou
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_H_1, c_H_2, c_H_1_x, c_H_2_x;
@@ -1261,15 +1159,9 @@ static inline void symrot_rotation_vector_tangent_inverse_derivative(const doubl
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.47841760435743)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     double c_H_inverse_2, c_H_inverse_2_x;
@@ -1615,15 +1507,9 @@ static inline void symrot_rotation_vector_rotation_matrix_f(const float p[3], fl
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = NAN;
+        }
         return;
     }
     float c_R_1, c_R_2;
@@ -1707,20 +1593,8 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries_f(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -1735,15 +1609,9 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = NAN;
+        }
         return;
     }
     float c_H_1, c_H_2;
@@ -1834,20 +1702,8 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_H_0_lanes[k] - c_H_2_lanes[k]*x_lanes[k];
-            float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries_f(c_H_1_lanes[k], c_H_2_lanes[k], t, pk, H + 9 * (start + k));
         }
     }
 }
@@ -1862,15 +1718,9 @@ static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], fl
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = NAN;
+        }
         return;
     }
     float c_H_inverse_2;
@@ -2013,15 +1863,9 @@ static inline void symrot_rotation_vector_root_matrix_f(const float p[3], float 
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = NAN;
+        }
         return;
     }
     float c_G_1, c_G_2;
@@ -2111,20 +1955,8 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries_f(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -2139,15 +1971,9 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = NAN;
+        }
         return;
     }
     float c_K_1, c_K_2;
@@ -2238,20 +2064,8 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_K_0_lanes[k] - c_K_2_lanes[k]*x_lanes[k];
-            float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + t;
+            symrot_rotation_vector__tensor_entries_f(c_K_1_lanes[k], c_K_2_lanes[k], t, pk, K + 9 * (start + k));
         }
     }
 }
@@ -2553,15 +2367,9 @@ static inline void symrot_rotation_vector_rotation_derivative_f(const float p[3]
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -2582,15 +2390,9 @@ static inline void symrot_rotation_vector_rotation_transpose_derivative_f(const 
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_R_1, c_R_2, c_R_1_x, c_R_2_x;
@@ -2613,15 +2415,9 @@ static inline void symrot_rotation_vector_tangent_derivative_f(const float p[3],
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
@@ -2642,15 +2438,9 @@ static inline void symrot_rotation_vector_tangent_transpose_derivative_f(const f
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_H_1, c_H_2, c_H_1_x, c_H_2_x;
@@ -2673,15 +2463,9 @@ static inline void symrot_rotation_vector_tangent_inverse_derivative_f(const flo
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x <= 39.478416F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     float c_H_inverse_2, c_H_inverse_2_x;

@@ -149,15 +149,9 @@ static inline void symrot_sine_m4_rotation_matrix(const double p[3], double R[9]
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        R[0] = (double)NAN;
-        R[1] = (double)NAN;
-        R[2] = (double)NAN;
-        R[3] = (double)NAN;
-        R[4] = (double)NAN;
-        R[5] = (double)NAN;
-        R[6] = (double)NAN;
-        R[7] = (double)NAN;
-        R[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
@@ -218,20 +212,8 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_sine_m4__tensor_entries(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -247,15 +229,9 @@ static inline void symrot_sine_m4_tangent(const double p[3], double H[9])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        H[0] = (double)NAN;
-        H[1] = (double)NAN;
-        H[2] = (double)NAN;
-        H[3] = (double)NAN;
-        H[4] = (double)NAN;
-        H[5] = (double)NAN;
-        H[6] = (double)NAN;
-        H[7] = (double)NAN;
-        H[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_across = -1.0/32.0*sqrt(d)*(x - 8);
@@ -323,19 +299,7 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
-            double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_sine_m4__tensor_entries(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -351,15 +315,9 @@ static inline void symrot_sine_m4_tangent_inverse(const double p[3], double Hinv
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_inverse_across = -1.0/2.0*(x - 8)/sqrt(d);
@@ -476,15 +434,9 @@ static inline void symrot_sine_m4_root_matrix(const double p[3], double G[9])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        G[0] = (double)NAN;
-        G[1] = (double)NAN;
-        G[2] = (double)NAN;
-        G[3] = (double)NAN;
-        G[4] = (double)NAN;
-        G[5] = (double)NAN;
-        G[6] = (double)NAN;
-        G[7] = (double)NAN;
-        G[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = (double)NAN;
+        }
         return;
     }
     const double c_G_1 = (1.0/8.0)*sqrt(d);
@@ -584,15 +536,9 @@ static inline void symrot_sine_m4_root_tangent(const double p[3], double K[9])
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        K[0] = (double)NAN;
-        K[1] = (double)NAN;
-        K[2] = (double)NAN;
-        K[3] = (double)NAN;
-        K[4] = (double)NAN;
-        K[5] = (double)NAN;
-        K[6] = (double)NAN;
-        K[7] = (double)NAN;
-        K[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = (double)NAN;
+        }
         return;
     }
     const double c_K_across = (1.0/8.0)*sqrt(d);
@@ -951,15 +897,9 @@ static inline void symrot_sine_m4_rotation_derivative(const double p[3], const d
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
@@ -982,15 +922,9 @@ static inline void symrot_sine_m4_rotation_transpose_derivative(const double p[3
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = -1.0/32.0*sqrt(d)*(x - 8);
@@ -1015,15 +949,9 @@ static inline void symrot_sine_m4_tangent_derivative(const double p[3], const do
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = (1.0/32.0)*d;
@@ -1093,15 +1021,9 @@ static inline void symrot_sine_m4_tangent_transpose_derivative(const double p[3]
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = (1.0/32.0)*d;
@@ -1170,15 +1092,9 @@ static inline void symrot_sine_m4_tangent_inverse_derivative(const double p[3], 
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const double d = symrot_sine_m4__complement(p, x);
     if (!(x < 16.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_inverse_2 = (1.0/4.0)/sqrt(d);
@@ -1490,15 +1406,9 @@ static inline void symrot_sine_m4_rotation_matrix_f(const float p[3], float R[9]
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
@@ -1559,20 +1469,8 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_sine_m4__tensor_entries_f(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -1588,15 +1486,9 @@ static inline void symrot_sine_m4_tangent_f(const float p[3], float H[9])
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = NAN;
+        }
         return;
     }
     const float c_H_across = -1.0F/32.0F*sqrtf(d)*(x - 8);
@@ -1664,19 +1556,7 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
-            float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_sine_m4__tensor_entries_f(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -1692,15 +1572,9 @@ static inline void symrot_sine_m4_tangent_inverse_f(const float p[3], float Hinv
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = NAN;
+        }
         return;
     }
     const float c_H_inverse_across = -1.0F/2.0F*(x - 8)/sqrtf(d);
@@ -1817,15 +1691,9 @@ static inline void symrot_sine_m4_root_matrix_f(const float p[3], float G[9])
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = NAN;
+        }
         return;
     }
     const float c_G_1 = (1.0F/8.0F)*sqrtf(d);
@@ -1925,15 +1793,9 @@ static inline void symrot_sine_m4_root_tangent_f(const float p[3], float K[9])
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = NAN;
+        }
         return;
     }
     const float c_K_across = (1.0F/8.0F)*sqrtf(d);
@@ -2292,15 +2154,9 @@ static inline void symrot_sine_m4_rotation_derivative_f(const float p[3], const 
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
@@ -2323,15 +2179,9 @@ static inline void symrot_sine_m4_rotation_transpose_derivative_f(const float p[
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = -1.0F/32.0F*sqrtf(d)*(x - 8);
@@ -2356,15 +2206,9 @@ static inline void symrot_sine_m4_tangent_derivative_f(const float p[3], const f
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = (1.0F/32.0F)*d;
@@ -2434,15 +2278,9 @@ static inline void symrot_sine_m4_tangent_transpose_derivative_f(const float p[3
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = (1.0F/32.0F)*d;
@@ -2511,15 +2349,9 @@ static inline void symrot_sine_m4_tangent_inverse_derivative_f(const float p[3],
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     const float d = symrot_sine_m4__complement_f(p, x);
     if (!(x < 16.0F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_inverse_2 = (1.0F/4.0F)/sqrtf(d);

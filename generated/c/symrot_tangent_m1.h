@@ -145,15 +145,9 @@ static inline void symrot_tangent_m1_rotation_matrix(const double p[3], double R
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 6.703903964971299e+153)) {
-        R[0] = (double)NAN;
-        R[1] = (double)NAN;
-        R[2] = (double)NAN;
-        R[3] = (double)NAN;
-        R[4] = (double)NAN;
-        R[5] = (double)NAN;
-        R[6] = (double)NAN;
-        R[7] = (double)NAN;
-        R[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = 1.0/sqrt(x + 1);
@@ -214,20 +208,8 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_tangent_m1__tensor_entries(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -244,15 +226,9 @@ static inline void symrot_tangent_m1_tangent(const double p[3], double H[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 6.703903964971299e+153)) {
-        H[0] = (double)NAN;
-        H[1] = (double)NAN;
-        H[2] = (double)NAN;
-        H[3] = (double)NAN;
-        H[4] = (double)NAN;
-        H[5] = (double)NAN;
-        H[6] = (double)NAN;
-        H[7] = (double)NAN;
-        H[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_across = 1.0/sqrt(x + 1);
@@ -316,19 +292,7 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
-            double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_tangent_m1__tensor_entries(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -345,15 +309,9 @@ static inline void symrot_tangent_m1_tangent_inverse(const double p[3], double H
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 6.703903964971299e+153)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_inverse_across = (1.0/2.0)*sqrt(x + 1) + 1.0/2.0;
@@ -470,15 +428,9 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 6.703903964971299e+153)) {
-        G[0] = (double)NAN;
-        G[1] = (double)NAN;
-        G[2] = (double)NAN;
-        G[3] = (double)NAN;
-        G[4] = (double)NAN;
-        G[5] = (double)NAN;
-        G[6] = (double)NAN;
-        G[7] = (double)NAN;
-        G[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = (double)NAN;
+        }
         return;
     }
     const double c_G_1 = (1.0/2.0)*sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
@@ -565,20 +517,8 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_tangent_m1__tensor_entries(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -595,15 +535,9 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 6.703903964971299e+153)) {
-        K[0] = (double)NAN;
-        K[1] = (double)NAN;
-        K[2] = (double)NAN;
-        K[3] = (double)NAN;
-        K[4] = (double)NAN;
-        K[5] = (double)NAN;
-        K[6] = (double)NAN;
-        K[7] = (double)NAN;
-        K[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = (double)NAN;
+        }
         return;
     }
     const double c_K_across = (1.0/2.0)*sqrt(2)/(pow(x + 1, 1.0/4.0)*sqrt(sqrt(x + 1) + 1));
@@ -727,19 +661,7 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
-            double *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
+            symrot_tangent_m1__tensor_entries(c_K_1_lanes[k], c_K_2_lanes[k], c_K_across_lanes[k], pk, K + 9 * (start + k));
         }
     }
 }
@@ -1032,15 +954,9 @@ static inline void symrot_tangent_m1_rotation_derivative(const double p[3], cons
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4294967296.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = 1.0/sqrt(x + 1);
@@ -1065,15 +981,9 @@ static inline void symrot_tangent_m1_rotation_transpose_derivative(const double 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4294967296.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = 1.0/sqrt(x + 1);
@@ -1155,15 +1065,9 @@ static inline void symrot_tangent_m1_tangent_derivative(const double p[3], const
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4294967296.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
@@ -1189,15 +1093,9 @@ static inline void symrot_tangent_m1_tangent_transpose_derivative(const double p
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4294967296.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = 1.0/(x + sqrt(x + 1) + 1);
@@ -1225,15 +1123,9 @@ static inline void symrot_tangent_m1_tangent_inverse_derivative(const double p[3
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4294967296.0)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_inverse_2 = (1.0/2.0)*(2*sqrt(x + 1) + 1)/(sqrt(x + 1) + 1);
@@ -1521,15 +1413,9 @@ static inline void symrot_tangent_m1_rotation_matrix_f(const float p[3], float R
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 9.223372e+18F)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = 1.0F/sqrtf(x + 1);
@@ -1590,20 +1476,8 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_tangent_m1__tensor_entries_f(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -1620,15 +1494,9 @@ static inline void symrot_tangent_m1_tangent_f(const float p[3], float H[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 9.223372e+18F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = NAN;
+        }
         return;
     }
     const float c_H_across = 1.0F/sqrtf(x + 1);
@@ -1692,19 +1560,7 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
-            float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_tangent_m1__tensor_entries_f(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -1721,15 +1577,9 @@ static inline void symrot_tangent_m1_tangent_inverse_f(const float p[3], float H
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 9.223372e+18F)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = NAN;
+        }
         return;
     }
     const float c_H_inverse_across = (1.0F/2.0F)*sqrtf(x + 1) + 1.0F/2.0F;
@@ -1846,15 +1696,9 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 9.223372e+18F)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = NAN;
+        }
         return;
     }
     const float c_G_1 = (1.0F/2.0F)*sqrtf(2)/(powf(x + 1, 1.0F/4.0F)*sqrtf(sqrtf(x + 1) + 1));
@@ -1941,20 +1785,8 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_tangent_m1__tensor_entries_f(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -1971,15 +1803,9 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 9.223372e+18F)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = NAN;
+        }
         return;
     }
     const float c_K_across = (1.0F/2.0F)*sqrtf(2)/(powf(x + 1, 1.0F/4.0F)*sqrtf(sqrtf(x + 1) + 1));
@@ -2089,19 +1915,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
-            float *const out = K + 9 * (start + k);
-            out[0] = c_K_2_lanes[k]*(p0*p0) + c_K_across_lanes[k];
-            out[1] = -c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[2] = c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[3] = c_K_1_lanes[k]*p2 + c_K_2_lanes[k]*p0*p1;
-            out[4] = c_K_2_lanes[k]*(p1*p1) + c_K_across_lanes[k];
-            out[5] = -c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[6] = -c_K_1_lanes[k]*p1 + c_K_2_lanes[k]*p0*p2;
-            out[7] = c_K_1_lanes[k]*p0 + c_K_2_lanes[k]*p1*p2;
-            out[8] = c_K_2_lanes[k]*(p2*p2) + c_K_across_lanes[k];
+            symrot_tangent_m1__tensor_entries_f(c_K_1_lanes[k], c_K_2_lanes[k], c_K_across_lanes[k], pk, K + 9 * (start + k));
         }
     }
 }
@@ -2394,15 +2208,9 @@ static inline void symrot_tangent_m1_rotation_derivative_f(const float p[3], con
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.2949673e+09F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = 1.0F/sqrtf(x + 1);
@@ -2427,15 +2235,9 @@ static inline void symrot_tangent_m1_rotation_transpose_derivative_f(const float
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.2949673e+09F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = 1.0F/sqrtf(x + 1);
@@ -2517,15 +2319,9 @@ static inline void symrot_tangent_m1_tangent_derivative_f(const float p[3], cons
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.2949673e+09F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
@@ -2551,15 +2347,9 @@ static inline void symrot_tangent_m1_tangent_transpose_derivative_f(const float 
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.2949673e+09F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = 1.0F/(x + sqrtf(x + 1) + 1);
@@ -2587,15 +2377,9 @@ static inline void symrot_tangent_m1_tangent_inverse_derivative_f(const float p[
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 4.2949673e+09F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_inverse_2 = (1.0F/2.0F)*(2*sqrtf(x + 1) + 1)/(sqrtf(x + 1) + 1);

@@ -126,15 +126,9 @@ static inline void symrot_wiener_milenkovic_rotation_matrix(const double p[3], d
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        R[0] = (double)NAN;
-        R[1] = (double)NAN;
-        R[2] = (double)NAN;
-        R[3] = (double)NAN;
-        R[4] = (double)NAN;
-        R[5] = (double)NAN;
-        R[6] = (double)NAN;
-        R[7] = (double)NAN;
-        R[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -183,20 +177,8 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_batch(size_t n, cons
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            double *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_wiener_milenkovic__tensor_entries(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -213,15 +195,9 @@ static inline void symrot_wiener_milenkovic_tangent(const double p[3], double H[
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        H[0] = (double)NAN;
-        H[1] = (double)NAN;
-        H[2] = (double)NAN;
-        H[3] = (double)NAN;
-        H[4] = (double)NAN;
-        H[5] = (double)NAN;
-        H[6] = (double)NAN;
-        H[7] = (double)NAN;
-        H[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_across = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -273,19 +249,7 @@ static inline void symrot_wiener_milenkovic_tangent_batch(size_t n, const double
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
-            double *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_wiener_milenkovic__tensor_entries(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -302,15 +266,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse(const double p[3], d
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        Hinv[0] = (double)NAN;
-        Hinv[1] = (double)NAN;
-        Hinv[2] = (double)NAN;
-        Hinv[3] = (double)NAN;
-        Hinv[4] = (double)NAN;
-        Hinv[5] = (double)NAN;
-        Hinv[6] = (double)NAN;
-        Hinv[7] = (double)NAN;
-        Hinv[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_inverse_across = 1 - 1.0/16.0*x;
@@ -416,15 +374,9 @@ static inline void symrot_wiener_milenkovic_root_matrix(const double p[3], doubl
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        G[0] = (double)NAN;
-        G[1] = (double)NAN;
-        G[2] = (double)NAN;
-        G[3] = (double)NAN;
-        G[4] = (double)NAN;
-        G[5] = (double)NAN;
-        G[6] = (double)NAN;
-        G[7] = (double)NAN;
-        G[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = (double)NAN;
+        }
         return;
     }
     const double c_G_1 = 8/(x + 16);
@@ -472,20 +424,8 @@ static inline void symrot_wiener_milenkovic_root_matrix_batch(size_t n, const do
         }
         for (k = m; k-- > 0;) {
             const double *const pk = p + 3 * (start + k);
-            const double p0 = pk[0];
-            const double p1 = pk[1];
-            const double p2 = pk[2];
             const double t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            double *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_wiener_milenkovic__tensor_entries(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -502,15 +442,9 @@ static inline void symrot_wiener_milenkovic_root_tangent(const double p[3], doub
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        K[0] = (double)NAN;
-        K[1] = (double)NAN;
-        K[2] = (double)NAN;
-        K[3] = (double)NAN;
-        K[4] = (double)NAN;
-        K[5] = (double)NAN;
-        K[6] = (double)NAN;
-        K[7] = (double)NAN;
-        K[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = (double)NAN;
+        }
         return;
     }
     const double c_K_across = 8/(x + 16);
@@ -867,15 +801,9 @@ static inline void symrot_wiener_milenkovic_rotation_derivative(const double p[3
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -900,15 +828,9 @@ static inline void symrot_wiener_milenkovic_rotation_transpose_derivative(const 
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -990,15 +912,9 @@ static inline void symrot_wiener_milenkovic_tangent_derivative(const double p[3]
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
@@ -1024,15 +940,9 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative(const d
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double c_H_1 = (1.0/2.0)*((16/(x + 16))*(16/(x + 16)));
@@ -1060,15 +970,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_derivative(const dou
 {
     const double x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 8.580997075163262e+155)) {
-        D[0] = (double)NAN;
-        D[1] = (double)NAN;
-        D[2] = (double)NAN;
-        D[3] = (double)NAN;
-        D[4] = (double)NAN;
-        D[5] = (double)NAN;
-        D[6] = (double)NAN;
-        D[7] = (double)NAN;
-        D[8] = (double)NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = (double)NAN;
+        }
         return;
     }
     const double dw0 = (1.0/8.0)*a[0];
@@ -1327,15 +1231,9 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f(const float p[3], 
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        R[0] = NAN;
-        R[1] = NAN;
-        R[2] = NAN;
-        R[3] = NAN;
-        R[4] = NAN;
-        R[5] = NAN;
-        R[6] = NAN;
-        R[7] = NAN;
-        R[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            R[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -1384,20 +1282,8 @@ static inline void symrot_wiener_milenkovic_rotation_matrix_f_batch(size_t n, co
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_R_0_lanes[k] - c_R_2_lanes[k]*x_lanes[k];
-            float *const out = R + 9 * (start + k);
-            out[0] = c_R_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[2] = c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[3] = c_R_1_lanes[k]*p2 + c_R_2_lanes[k]*p0*p1;
-            out[4] = c_R_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[6] = -c_R_1_lanes[k]*p1 + c_R_2_lanes[k]*p0*p2;
-            out[7] = c_R_1_lanes[k]*p0 + c_R_2_lanes[k]*p1*p2;
-            out[8] = c_R_2_lanes[k]*(p2*p2) + t;
+            symrot_wiener_milenkovic__tensor_entries_f(c_R_1_lanes[k], c_R_2_lanes[k], t, pk, R + 9 * (start + k));
         }
     }
 }
@@ -1414,15 +1300,9 @@ static inline void symrot_wiener_milenkovic_tangent_f(const float p[3], float H[
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        H[0] = NAN;
-        H[1] = NAN;
-        H[2] = NAN;
-        H[3] = NAN;
-        H[4] = NAN;
-        H[5] = NAN;
-        H[6] = NAN;
-        H[7] = NAN;
-        H[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            H[i] = NAN;
+        }
         return;
     }
     const float c_H_across = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -1474,19 +1354,7 @@ static inline void symrot_wiener_milenkovic_tangent_f_batch(size_t n, const floa
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
-            float *const out = H + 9 * (start + k);
-            out[0] = c_H_2_lanes[k]*(p0*p0) + c_H_across_lanes[k];
-            out[1] = -c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[2] = c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[3] = c_H_1_lanes[k]*p2 + c_H_2_lanes[k]*p0*p1;
-            out[4] = c_H_2_lanes[k]*(p1*p1) + c_H_across_lanes[k];
-            out[5] = -c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[6] = -c_H_1_lanes[k]*p1 + c_H_2_lanes[k]*p0*p2;
-            out[7] = c_H_1_lanes[k]*p0 + c_H_2_lanes[k]*p1*p2;
-            out[8] = c_H_2_lanes[k]*(p2*p2) + c_H_across_lanes[k];
+            symrot_wiener_milenkovic__tensor_entries_f(c_H_1_lanes[k], c_H_2_lanes[k], c_H_across_lanes[k], pk, H + 9 * (start + k));
         }
     }
 }
@@ -1503,15 +1371,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_f(const float p[3], 
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        Hinv[0] = NAN;
-        Hinv[1] = NAN;
-        Hinv[2] = NAN;
-        Hinv[3] = NAN;
-        Hinv[4] = NAN;
-        Hinv[5] = NAN;
-        Hinv[6] = NAN;
-        Hinv[7] = NAN;
-        Hinv[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            Hinv[i] = NAN;
+        }
         return;
     }
     const float c_H_inverse_across = 1 - 1.0F/16.0F*x;
@@ -1617,15 +1479,9 @@ static inline void symrot_wiener_milenkovic_root_matrix_f(const float p[3], floa
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        G[0] = NAN;
-        G[1] = NAN;
-        G[2] = NAN;
-        G[3] = NAN;
-        G[4] = NAN;
-        G[5] = NAN;
-        G[6] = NAN;
-        G[7] = NAN;
-        G[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            G[i] = NAN;
+        }
         return;
     }
     const float c_G_1 = 8/(x + 16);
@@ -1673,20 +1529,8 @@ static inline void symrot_wiener_milenkovic_root_matrix_f_batch(size_t n, const 
         }
         for (k = m; k-- > 0;) {
             const float *const pk = p + 3 * (start + k);
-            const float p0 = pk[0];
-            const float p1 = pk[1];
-            const float p2 = pk[2];
             const float t = c_G_0_lanes[k] - c_G_2_lanes[k]*x_lanes[k];
-            float *const out = G + 9 * (start + k);
-            out[0] = c_G_2_lanes[k]*(p0*p0) + t;
-            out[1] = -c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[2] = c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[3] = c_G_1_lanes[k]*p2 + c_G_2_lanes[k]*p0*p1;
-            out[4] = c_G_2_lanes[k]*(p1*p1) + t;
-            out[5] = -c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[6] = -c_G_1_lanes[k]*p1 + c_G_2_lanes[k]*p0*p2;
-            out[7] = c_G_1_lanes[k]*p0 + c_G_2_lanes[k]*p1*p2;
-            out[8] = c_G_2_lanes[k]*(p2*p2) + t;
+            symrot_wiener_milenkovic__tensor_entries_f(c_G_1_lanes[k], c_G_2_lanes[k], t, pk, G + 9 * (start + k));
         }
     }
 }
@@ -1703,15 +1547,9 @@ static inline void symrot_wiener_milenkovic_root_tangent_f(const float p[3], flo
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        K[0] = NAN;
-        K[1] = NAN;
-        K[2] = NAN;
-        K[3] = NAN;
-        K[4] = NAN;
-        K[5] = NAN;
-        K[6] = NAN;
-        K[7] = NAN;
-        K[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            K[i] = NAN;
+        }
         return;
     }
     const float c_K_across = 8/(x + 16);
@@ -2068,15 +1906,9 @@ static inline void symrot_wiener_milenkovic_rotation_derivative_f(const float p[
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -2101,15 +1933,9 @@ static inline void symrot_wiener_milenkovic_rotation_transpose_derivative_f(cons
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_R_1 = -(x - 16)*(16/(x + 16))/(x + 16);
@@ -2191,15 +2017,9 @@ static inline void symrot_wiener_milenkovic_tangent_derivative_f(const float p[3
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
@@ -2225,15 +2045,9 @@ static inline void symrot_wiener_milenkovic_tangent_transpose_derivative_f(const
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float c_H_1 = (1.0F/2.0F)*((16/(x + 16))*(16/(x + 16)));
@@ -2261,15 +2075,9 @@ static inline void symrot_wiener_milenkovic_tangent_inverse_derivative_f(const f
 {
     const float x = (p[0]*p[0]) + (p[1]*p[1]) + (p[2]*p[2]);
     if (!(x < 5.902958e+20F)) {
-        D[0] = NAN;
-        D[1] = NAN;
-        D[2] = NAN;
-        D[3] = NAN;
-        D[4] = NAN;
-        D[5] = NAN;
-        D[6] = NAN;
-        D[7] = NAN;
-        D[8] = NAN;
+        for (int i = 0; i < 9; ++i) {
+            D[i] = NAN;
+        }
         return;
     }
     const float dw0 = (1.0F/8.0F)*a[0];

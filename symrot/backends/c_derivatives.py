@@ -73,7 +73,7 @@ class DerivativeWriter(FunctionWriter):
                 "statements": statements, "batch_signature": None, "output": None}
 
     def nan_out(self, output: str, count: int, status: str = "") -> list[Statement]:
-        nan = [self.set(f"{output}[{i}]", self.nan) for i in range(count)]
+        nan = self.nan_fill(output, count)
         return [*nan, {"kind": "return", "value": status}]
 
     def scalars(self, tensor: str, sign: int, used: set[sp.Symbol]

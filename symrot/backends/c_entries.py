@@ -174,8 +174,56 @@ def share_entries(functions: list[Function], writer: PlanWriter) -> list[Functio
         statements = function["statements"]
         arguments = [*(scalars[i] for i in helper["order"]), *arrays]
         call = {"kind": "call", "value": f"{helper['c_name']}({', '.join(arguments)})", "ops": helper["ops"]}
-        result.append({**function, "statements": [*statements[:_tail_start(statements)], call]})
+        changed = {**function, "statements": [*statements[:_tail_start(statements)], call]}
+        if function.get("batch_statements"):
+            changed["batch_statements"] = _batch_calling(function["batch_statements"], helper,
+                                                         [scalars[i] for i in helper["order"]])
+        result.append(changed)
     return result
+
+
+def _entries_of(helper: Function) -> list[str] | None:
+    """The expression of each output entry of a tensor helper (``T[i]``, in order), or None where
+    its body computes anything else first."""
+    lets = {s["name"]: s["value"] for s in helper["statements"] if s["kind"] == "let"}
+    stores = [s for s in helper["statements"] if s["kind"] == "set"]
+    if len(stores) != 9 or any(s["name"] != f"T[{i}]" for i, s in enumerate(stores)):
+        return None
+    values = [lets.get(s["value"], s["value"]) for s in stores]
+    if len(lets) != sum(s["value"] in lets for s in stores):
+        return None  # a let that is not an entry (a subexpression)
+    return values
+
+
+def _batch_calling(batch: list[Statement], helper: Function, scalars: list[str]) -> list[Statement]:
+    """A ``_batch`` kernel whose assembly loop calls the tensor helper of its single call, where the
+    entries it prints are the helper's on the lanes (``c_R_1`` → ``c_R_1_lanes[k]``, ``p[0]`` →
+    ``p0``): the same operations on the same values. Otherwise the kernel as it was. The helper
+    reads p before it writes T, so vector k = 0 of an in-place call (out at pk) stays right."""
+    entries = _entries_of(helper)
+    outer = batch[-1]
+    assembly = outer["body"][-1] if outer["kind"] == "loop" else None
+    if entries is None or assembly is None or assembly["kind"] != "loop":
+        return batch
+    body = assembly["body"]
+    lets = {s["name"] for s in body if s["kind"] == "let"}
+    arguments = [name if name in lets else "x_lanes[k]" if name == "x" else f"{name}_lanes[k]"
+                 for name in scalars]
+    parameters = re.findall(r"\w+ (\w+)(?:\[\d+\])?(?:, |\)$)", helper["signature"])
+    places = dict(zip(parameters, [*arguments, "pk", "out"], strict=True))
+    places.update({f"p[{i}]": f"p{i}" for i in range(3)})
+    pattern = re.compile(r"p\[\d\]|(?<![\w.])[A-Za-z_]\w*")
+    printed = [pattern.sub(lambda m: places.get(m[0], m[0]), entry) for entry in entries]
+    sets = [s for s in body if s["kind"] == "set"]
+    if [s["value"] for s in sets] != printed:
+        return batch
+    declared = next(s for s in body if s["kind"] == "declare")
+    output = declared["names"][0].split(" = ")[1]
+    kept = [s for s in body if s["kind"] == "let" and s["name"] not in ("p0", "p1", "p2")]
+    call = {"kind": "call", "value": f"{helper['c_name']}({', '.join([*arguments, 'pk', output])})",
+            "ops": helper["ops"]}
+    new_assembly = {**assembly, "body": [*kept, call]}
+    return [*batch[:-1], {**outer, "body": [*outer["body"][:-1], new_assembly]}]
 
 
 def _helper(callers: list[Function], found: dict[int, Any], labels: dict[str, int],

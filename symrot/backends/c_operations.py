@@ -47,7 +47,7 @@ class OperationWriter(FunctionWriter):
         return f"symrot_{self.header}_{operation}{self.suffix}"
 
     def nan_out(self, output: str, count: int, status: bool = True) -> list[Statement]:
-        statements: list[Statement] = [self.set(f"{output}[{i}]", self.nan) for i in range(count)]
+        statements: list[Statement] = self.nan_fill(output, count)
         statements.append({"kind": "return", "value": "1" if status else ""})
         return statements
 

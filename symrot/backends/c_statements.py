@@ -70,6 +70,14 @@ class PlanWriter:
         promotion: the header compiles cleanly with -Wdouble-promotion)."""
         return "NAN" if self.precision == "float" else "(double)NAN"
 
+    def nan_fill(self, output: str, count: int) -> list[Statement]:
+        """Every entry of ``output`` NaN: one loop for a 3×3 matrix (a line, not nine), the stores
+        for a vector or a quaternion."""
+        if count < 9:
+            return [self.set(f"{output}[{i}]", self.nan) for i in range(count)]
+        return [{"kind": "loop", "header": f"int i = 0; i < {count}; ++i",
+                 "body": [self.set(f"{output}[i]", self.nan)], "times": count}]
+
     @property
     def infinity(self) -> str:
         """+∞ of this precision (``INFINITY`` is a float in C99, cast like :attr:`nan`)."""

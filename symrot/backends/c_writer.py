@@ -166,14 +166,14 @@ class FunctionWriter(AngleWriter):
         if spec.kind == "matrix":
             output = OUTPUT_NAMES[spec.name]
             signature = f"void {name}(const {t} p[3], {t} {output}[9])"
-            nan = [self.set(f"{output}[{i}]", self.nan) for i in range(9)] + [{"kind": "return", "value": ""}]
+            nan = [*self.nan_fill(output, 9), {"kind": "return", "value": ""}]
             outputs = [self.set(f"{output}[{i}]", entry)
                        for i, entry in enumerate(tensor_entries(t_value, b, c))]
             batch = f"void {name}_batch(size_t n, const {t} *p, {t} *{output})"
         else:
             given, output = VECTOR_NAMES[spec.name]
             signature = f"void {name}(const {t} p[3], const {t} {given}[3], {t} {output}[3])"
-            nan = [self.set(f"{output}[{i}]", self.nan) for i in range(3)] + [{"kind": "return", "value": ""}]
+            nan = [*self.nan_fill(output, 3), {"kind": "return", "value": ""}]
             v = tuple(sp.Symbol(f"{given}[{i}]", real=True) for i in range(3))
             w = tuple(sp.Symbol(f"w{i}", real=True) for i in range(3))
             dot = sp.Symbol("p_dot_v", real=True)
