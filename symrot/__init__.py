@@ -20,12 +20,15 @@ if TYPE_CHECKING:
     from symrot.core.errors import SymrotError
     from symrot.core.parsing import PHI, parse_expression
     from symrot.core.registry import lookup
+    from symrot.kernels_api import emit, kernels
 
-__all__ = ["PHI", "DerivationResult", "SymrotError", "derive", "lookup", "parse_expression"]
+__all__ = ["PHI", "DerivationResult", "SymrotError", "derive", "emit", "kernels", "lookup",
+           "parse_expression"]
 __version__ = "0.1.0"
 
 _HOME = {"DerivationResult": "api", "derive": "api", "SymrotError": "core.errors", "PHI": "core.parsing",
-         "parse_expression": "core.parsing", "lookup": "core.registry"}
+         "parse_expression": "core.parsing", "lookup": "core.registry", "kernels": "kernels_api",
+         "emit": "kernels_api"}
 
 
 def __getattr__(name: str) -> Any:
