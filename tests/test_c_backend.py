@@ -429,7 +429,8 @@ def test_functions_with_algebraic_plans_are_trig_free(name: str) -> None:
         if not plans or "__phi" in c_name or "_angle" in c_name or any(not kind for _, kind in plans):
             continue
         algebraic += 1
-        body += "".join(shared[called] for called in re.findall(r"\b(symrot_\w+__\w+)\(", body) if called in shared)
+        called = re.findall(r"\b(symrot_\w+__\w+)\(", body)
+        body += "".join(shared[helper] for helper in called if helper in shared)
         assert not re.search(r"\b(sin|cos|tan|asin|acos|atan|atan2)f?\(", body), c_name
     if name == "wiener_milenkovic":  # every coefficient of 4 tan(φ/4) is algebraic in x, and every slope
         # all but angle, plus to_quaternion; the derivatives of R, H, H⁻¹ and angular_acceleration
@@ -508,3 +509,23 @@ def test_bad_name_is_a_one_line_error(tmp_path: Path) -> None:
                             timeout=120, check=False)
     assert result.returncode == 2
     assert result.stderr.startswith("symrot: error:") and len(result.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("standard", ["c89", "gnu89", "c90"])
+@pytest.mark.parametrize("compiler", ["gcc", "clang"])
+def test_a_compiler_before_c99_gets_one_error_that_says_so(compiler: str, standard: str,
+                                                           tmp_path: Path) -> None:
+    """Issue 58: -std=c89 meets one #error naming the need for C99, not hundreds of parse errors."""
+    import shutil
+
+    if shutil.which(compiler) is None:
+        pytest.skip(f"{compiler} not installed")
+    for name in ("wiener_milenkovic", "sine_m3"):
+        source = tmp_path / f"{name}.c"
+        source.write_text(f'#include "symrot_{name}.h"\nint main(void) {{ return 0; }}\n', encoding="utf-8")
+        result = subprocess.run([compiler, f"-std={standard}", "-I", str(GENERATED), "-c", str(source), "-o",
+                                 str(tmp_path / f"{name}.o")], capture_output=True, text=True, timeout=120,
+                                check=False)
+        errors = re.findall(r"\berror\b: .*", result.stderr)
+        assert result.returncode != 0 and len(errors) == 1, result.stderr
+        assert f"symrot_{name}.h needs C99 or later" in errors[0]

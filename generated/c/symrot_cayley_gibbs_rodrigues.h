@@ -37,6 +37,11 @@
 #ifndef SYMROT_CAYLEY_GIBBS_RODRIGUES_H
 #define SYMROT_CAYLEY_GIBBS_RODRIGUES_H
 
+#if !defined(__cplusplus) && (!defined(__STDC_VERSION__) || __STDC_VERSION__ < 199901L)
+/* Before C99 there is no inline, no NAN and no declaration in a for loop: one error, not hundreds. */
+#error "symrot_cayley_gibbs_rodrigues.h needs C99 or later (e.g. -std=c99), or C++"
+#else
+
 #include <math.h>
 #include <stddef.h>
 
@@ -2286,4 +2291,5 @@ static inline int symrot_cayley_gibbs_rodrigues_rescale_jacobian_f(const float p
 }
 #endif
 
+#endif /* C99 or later */
 #endif /* SYMROT_CAYLEY_GIBBS_RODRIGUES_H */

@@ -37,6 +37,11 @@
 #ifndef SYMROT_DET_H_ONE_H
 #define SYMROT_DET_H_ONE_H
 
+#if !defined(__cplusplus) && (!defined(__STDC_VERSION__) || __STDC_VERSION__ < 199901L)
+/* Before C99 there is no inline, no NAN and no declaration in a for loop: one error, not hundreds. */
+#error "symrot_det_h_one.h needs C99 or later (e.g. -std=c99), or C++"
+#else
+
 #include <math.h>
 #include <stddef.h>
 
@@ -3171,4 +3176,5 @@ static inline int symrot_det_h_one_rescale_jacobian_f(const float p[3], float J[
 }
 #endif
 
+#endif /* C99 or later */
 #endif /* SYMROT_DET_H_ONE_H */

@@ -37,6 +37,11 @@
 #ifndef SYMROT_TANGENT_M3_H
 #define SYMROT_TANGENT_M3_H
 
+#if !defined(__cplusplus) && (!defined(__STDC_VERSION__) || __STDC_VERSION__ < 199901L)
+/* Before C99 there is no inline, no NAN and no declaration in a for loop: one error, not hundreds. */
+#error "symrot_tangent_m3.h needs C99 or later (e.g. -std=c99), or C++"
+#else
+
 #include <math.h>
 #include <stddef.h>
 
@@ -2866,4 +2871,5 @@ static inline int symrot_tangent_m3_rescale_jacobian_f(const float p[3], float J
 }
 #endif
 
+#endif /* C99 or later */
 #endif /* SYMROT_TANGENT_M3_H */
