@@ -417,6 +417,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double u0_safe = 1.0/sqrt(x_safe + 4);
+    const double u1_safe = sqrt(x_safe + 4);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -426,8 +430,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.149515568880993e+180)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const double u0 = 1.0/sqrt(x + 4);
                 const double u1 = sqrt(x + 4);
@@ -437,8 +441,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_batch(size_t n, con
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -498,6 +502,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double u0_safe = 1.0/sqrt(x_safe + 4);
+    const double u1_safe = sqrt(x_safe + 4);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -507,8 +515,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.149515568880993e+180)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const double u0 = 1.0/sqrt(x + 4);
                 const double u1 = sqrt(x + 4);
@@ -518,8 +526,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_batch(size_t n, co
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1530,6 +1538,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float u0_safe = 1.0F/sqrtf(x_safe + 4);
+    const float u1_safe = sqrtf(x_safe + 4);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1539,8 +1551,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 3.8685626e+25F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float u0 = 1.0F/sqrtf(x + 4);
                 const float u1 = sqrtf(x + 4);
@@ -1550,8 +1562,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_matrix_f_batch(size_t n, c
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1611,6 +1623,10 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float u0_safe = 1.0F/sqrtf(x_safe + 4);
+    const float u1_safe = sqrtf(x_safe + 4);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1620,8 +1636,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 3.8685626e+25F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float u0 = 1.0F/sqrtf(x + 4);
                 const float u1 = sqrtf(x + 4);
@@ -1631,8 +1647,8 @@ static inline void symrot_cayley_gibbs_rodrigues_root_tangent_f_batch(size_t n, 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

@@ -355,8 +355,12 @@ static inline void symrot_det_h_one_rotation_matrix(const double p[3], double R[
  */
 static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.1103124080629894;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_det_h_one__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -365,24 +369,29 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.1103124080629894 ? x : 0;
             if (!(x <= 11.243134665607636) || x < 0.1103124080629894) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -398,9 +407,9 @@ static inline void symrot_det_h_one_rotation_matrix_batch(size_t n, const double
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+            poly_R_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((33227.0/38118080000000.0)*xp0_lanes[k] + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-3.236771326819846e-10)*xp0_lanes[k] - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -452,8 +461,12 @@ static inline void symrot_det_h_one_tangent(const double p[3], double H[9])
  */
 static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.4342812090283275;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_det_h_one__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -462,24 +475,31 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.1103124080629894 ? x : 0;
+            xp1_lanes[k] = x < 1.4342812090283275 ? x : 0;
             if (!(x <= 11.243134665607636) || x < 0.1103124080629894) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -496,13 +516,13 @@ static inline void symrot_det_h_one_tangent_batch(size_t n, const double *p, dou
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const double w0 = 2*cos0*sin0/s;
             const double w1 = (sin0*sin0);
-            const double w2 = 1.0/x;
+            const double w2 = 1.0/xc;
             c_H_across_lanes[k] = w0;
-            poly_H_across_lanes[k] = x*(x*(x*(x*(x*(x*((33227.0/38118080000000.0)*x + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
+            poly_H_across_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((33227.0/38118080000000.0)*xp0_lanes[k] + 151439.0/12713500800000.0) + 1213.0/7207200000.0) + 43.0/17248000.0) + 1.0/25200.0) + 1.0/1400.0) - 3.0/20.0) + 1;
             c_H_1_lanes[k] = 2*w1*w2;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((-3.236771326819846e-10)*x - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
-            c_H_2_lanes[k] = w2*(-w0 + (1.0/4.0)*x/w1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224371929e-20)*x + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-3.236771326819846e-10)*xp0_lanes[k] - 604523.0/127135008000000.0) - 3293.0/44844800000.0) - 947.0/776160000.0) - 23.0/1008000.0) - 3.0/5600.0) - 1.0/40.0) + 1.0/2.0;
+            c_H_2_lanes[k] = w2*(-w0 + (1.0/4.0)*xc/w1);
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((2.5501224371929e-20)*xp1_lanes[k] + 2.918170543767923e-19) + 3.3425985887827363e-18) + 3.8329294257465515e-17) + 4.4005658265072545e-16) + 5.0592551808267075e-15) + 5.825704915999495e-14) + 6.720412596247862e-13) + 7.768808765054745e-12) + 9.002866267756873e-11) + 1.046342173054307e-09) + 33227.0/2722720000000.0) + 151439.0/1059458400000.0) + 1213.0/720720000.0) + 43.0/2156000.0) + 1.0/4200.0) + 1.0/350.0) + 1.0/5.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -574,8 +594,12 @@ static inline void symrot_det_h_one_tangent_inverse(const double p[3], double Hi
  */
 static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 2.6302227241416043;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_det_h_one__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -584,24 +608,31 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.1103124080629894 ? x : 0;
+            xp1_lanes[k] = x < 2.6302227241416043 ? x : 0;
             if (!(x <= 11.243134665607636) || x < 0.1103124080629894) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -629,12 +660,12 @@ static inline void symrot_det_h_one_tangent_inverse_batch(size_t n, const double
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const double w0 = 1.0/s;
-            const double w1 = 1.0/x;
+            const double w1 = 1.0/xc;
             const double w2 = 4*w1;
             c_H_inverse_across_lanes[k] = 2*cos0*sin0*w0/((cos0*cos0)*(sin0*sin0)*w2 + (sin0*sin0*sin0*sin0)*w2);
-            poly_H_inverse_across_lanes[k] = x*(x*(x*(x*(x*(x*((-11192989.0/2161295136000000.0)*x - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
+            poly_H_inverse_across_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-11192989.0/2161295136000000.0)*xp0_lanes[k] - 604523.0/9081072000000.0) - 9879.0/11211200000.0) - 947.0/77616000.0) - 23.0/126000.0) - 9.0/2800.0) - 1.0/10.0) + 1;
             c_H_inverse_2_lanes[k] = w1*(-sin1*w0/((sin1*sin1)*w1 + w1*((1 - cos1)*(1 - cos1))) + (1.0/3.0)*w1*(6 - 6*cos1));
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.42701592796967e-25)*x + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
+            poly_H_inverse_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((3.42701592796967e-25)*xp1_lanes[k] + 3.982335375612905e-24) + 4.6352839539983977e-23) + 5.40513214847762e-22) + 6.315600653020195e-21) + 7.396110286959959e-20) + 8.683469103988305e-19) + 1.0224187860604788e-17) + 1.207771859033198e-16) + 1.4321083368003567e-15) + 1.7055656901807745e-14) + 2.0417396933193335e-13) + 2.4592808133854965e-12) + 2.9844879309052296e-11) + 3.65573324363898e-10) + 11192989.0/2470051584000000.0) + 604523.0/10594584000000.0) + 3293.0/4484480000.0) + 947.0/97020000.0) + 23.0/168000.0) + 3.0/1400.0) + 1.0/20.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -719,8 +750,12 @@ static inline void symrot_det_h_one_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.1103124080629894;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_det_h_one__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -729,24 +764,29 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.1103124080629894 ? x : 0;
             if (!(x <= 11.243134665607636) || x < 0.1103124080629894) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -770,9 +810,9 @@ static inline void symrot_det_h_one_root_matrix_batch(size_t n, const double *p,
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*(x*((-4.517630699305304e-10)*x - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*((5.844969408074523e-11)*x + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
+            poly_G_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-4.517630699305304e-10)*xp0_lanes[k] - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((5.844969408074523e-11)*xp0_lanes[k] + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -837,8 +877,12 @@ static inline void symrot_det_h_one_root_tangent(const double p[3], double K[9])
  */
 static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.4342812090283275;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_det_h_one__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -847,24 +891,31 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.1103124080629894 ? x : 0;
+            xp1_lanes[k] = x < 1.4342812090283275 ? x : 0;
             if (!(x <= 11.243134665607636) || x < 0.1103124080629894) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_det_h_one__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -888,13 +939,13 @@ static inline void symrot_det_h_one_root_tangent_batch(size_t n, const double *p
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = sin0/s;
-            const double w1 = 1.0/x;
+            const double w1 = 1.0/xc;
             c_K_across_lanes[k] = w0;
-            poly_K_across_lanes[k] = x*(x*(x*(x*(x*(x*((-4.517630699305304e-10)*x - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
+            poly_K_across_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-4.517630699305304e-10)*xp0_lanes[k] - 6.22104590536751e-09) - 1312063.0/14760345600000.0) - 17753.0/13246464000.0) - 71.0/3225600.0) - 19.0/44800.0) - 1.0/80.0) + 1.0/2.0;
             c_K_1_lanes[k] = 2*(sin1*sin1)*w1;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*((5.844969408074523e-11)*x + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
-            c_K_2_lanes[k] = w1*(-w0 + (1.0/8.0)*x/(sin0*sin0));
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.3462827495637501e-20)*x + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
+            poly_K_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((5.844969408074523e-11)*xp0_lanes[k] + 8.286380574805527e-10) + 3362377.0/275526451200000.0) + 150653.0/794787840000.0) + 823.0/258048000.0) + 11.0/179200.0) + 1.0/640.0) + 1.0/8.0;
+            c_K_2_lanes[k] = w1*(-w0 + (1.0/8.0)*xc/(sin0*sin0));
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((1.3462827495637501e-20)*xp1_lanes[k] + 1.5454156215361094e-19) + 1.7764157194142527e-18) + 2.0451064003372294e-17) + 2.3586252560910385e-16) + 2.725820183855303e-15) + 3.157810155130715e-14) + 3.6688033619582197e-13) + 4.277333653830018e-12) + 5.008208696060211e-11) + 5.895736922222117e-10) + 6.9894087225971915e-09) + 8.364688757440645e-08) + 998353.0/984023040000.0) + 166361.0/13246464000.0) + 173.0/1075200.0) + 99.0/44800.0) + 3.0/80.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1901,8 +1952,12 @@ static inline void symrot_det_h_one_rotation_matrix_f(const float p[3], float R[
  */
 static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.4342812F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_det_h_one__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1911,24 +1966,29 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.4342812F ? x : 0;
             if (!(x <= 11.2431345F) || x < 1.4342812F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -1955,9 +2015,9 @@ static inline void symrot_det_h_one_rotation_matrix_f_batch(size_t n, const floa
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_R_1_lanes[k] = 2*cos0*sin0/s;
-            poly_R_1_lanes[k] = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
-            c_R_2_lanes[k] = (1 - cos1)/x;
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+            poly_R_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((1.1911668e-08F)*xp0_lanes[k] + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
+            c_R_2_lanes[k] = (1 - cos1)/xc;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-4.754969e-09F)*xp0_lanes[k] - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2009,8 +2069,12 @@ static inline void symrot_det_h_one_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_across_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 4.619481F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_det_h_one__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2019,24 +2083,31 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.4342812F ? x : 0;
+            xp1_lanes[k] = x < 4.619481F ? x : 0;
             if (!(x <= 11.2431345F) || x < 1.4342812F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2053,13 +2124,13 @@ static inline void symrot_det_h_one_tangent_f_batch(size_t n, const float *p, fl
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const float w0 = 2*cos0*sin0/s;
             const float w1 = (sin0*sin0);
-            const float w2 = 1.0F/x;
+            const float w2 = 1.0F/xc;
             c_H_across_lanes[k] = w0;
-            poly_H_across_lanes[k] = x*(x*(x*(x*(x*((1.1911668e-08F)*x + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
+            poly_H_across_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((1.1911668e-08F)*xp0_lanes[k] + 1.6830391e-07F) + 2.4930428e-06F) + 1.0F/25200.0F) + 1.0F/1400.0F) - 3.0F/20.0F) + 1;
             c_H_1_lanes[k] = 2*w1*w2;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*((-4.754969e-09F)*x - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w2*(-w0 + (1.0F/4.0F)*x/w1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.5501224e-20F)*x + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-4.754969e-09F)*xp0_lanes[k] - 7.343103e-08F) - 1.2201093e-06F) - 23.0F/1008000.0F) - 3.0F/5600.0F) - 1.0F/40.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = w2*(-w0 + (1.0F/4.0F)*xc/w1);
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((2.5501224e-20F)*xp1_lanes[k] + 2.9181704e-19F) + 3.3425986e-18F) + 3.8329293e-17F) + 4.400566e-16F) + 5.0592554e-15F) + 5.825705e-14F) + 6.7204125e-13F) + 7.768809e-12F) + 9.0028665e-11F) + 1.0463421e-09F) + 1.2203605e-08F) + 1.4294001e-07F) + 1.6830392e-06F) + 43.0F/2156000.0F) + 1.0F/4200.0F) + 1.0F/350.0F) + 1.0F/5.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2131,8 +2202,12 @@ static inline void symrot_det_h_one_tangent_inverse_f(const float p[3], float Hi
  */
 static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 4.619481F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_det_h_one__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2141,9 +2216,11 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.4342812F ? x : 0;
+            xp1_lanes[k] = x < 4.619481F ? x : 0;
             if (!(x <= 11.2431345F) || x < 1.4342812F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
@@ -2153,12 +2230,13 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2175,9 +2253,9 @@ static inline void symrot_det_h_one_tangent_inverse_f_batch(size_t n, const floa
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const float w0 = (sin0*sin0);
             c_H_inverse_across_lanes[k] = (1.0F/2.0F)*cos0*s/sin0;
-            poly_H_inverse_across_lanes[k] = x*(x*(x*(x*(x*(x*((-5.1788343e-09F)*x - 6.656956e-08F) - 8.811724e-07F) - 1.2201092e-05F) - 23.0F/126000.0F) - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
+            poly_H_inverse_across_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-5.1788343e-09F)*xp0_lanes[k] - 6.656956e-08F) - 8.811724e-07F) - 1.2201092e-05F) - 23.0F/126000.0F) - 9.0F/2800.0F) - 1.0F/10.0F) + 1;
             c_H_inverse_2_lanes[k] = -1.0F/2.0F*(6*cos0*phi*sin0 - 8*w0 + ((1 - 2*w0)*(1 - 2*w0)) - 1)/((s*s*s*s)*w0);
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.3156007e-21F)*x + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
+            poly_H_inverse_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((6.3156007e-21F)*xp1_lanes[k] + 7.39611e-20F) + 8.683469e-19F) + 1.0224188e-17F) + 1.2077718e-16F) + 1.4321084e-15F) + 1.7055657e-14F) + 2.0417397e-13F) + 2.4592808e-12F) + 2.984488e-11F) + 3.6557332e-10F) + 4.5314796e-09F) + 5.7059626e-08F) + 7.3431033e-07F) + 9.7608745e-06F) + 23.0F/168000.0F) + 3.0F/1400.0F) + 1.0F/20.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2262,8 +2340,12 @@ static inline void symrot_det_h_one_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.4342812F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_det_h_one__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2272,24 +2354,29 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.4342812F ? x : 0;
             if (!(x <= 11.2431345F) || x < 1.4342812F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2313,9 +2400,9 @@ static inline void symrot_det_h_one_root_matrix_f_batch(size_t n, const float *p
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            poly_G_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-6.221046e-09F)*xp0_lanes[k] - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((8.2863805e-10F)*xp0_lanes[k] + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2381,8 +2468,13 @@ static inline void symrot_det_h_one_root_tangent_f(const float p[3], float K[9])
  */
 static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 4.619481F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_det_h_one__phi_f(s_safe);
+    const float u0_safe = cbrtf(6*phi_safe - 12*sinf((1.0F/2.0F)*phi_safe)*cosf((1.0F/2.0F)*phi_safe));
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2391,14 +2483,18 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.4342812F ? x : 0;
+            xp1_lanes[k] = x < 4.619481F ? x : 0;
             if (!(x <= 11.2431345F) || x < 1.4342812F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_det_h_one__phi_f(s);
                 const float u0 = cbrtf(6*phi - 12*sinf((1.0F/2.0F)*phi)*cosf((1.0F/2.0F)*phi));
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
@@ -2406,13 +2502,16 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
@@ -2438,11 +2537,11 @@ static inline void symrot_det_h_one_root_tangent_f_batch(size_t n, const float *
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = (u0*u0);
             c_K_across_lanes[k] = sin0/s;
-            poly_K_across_lanes[k] = x*(x*(x*(x*(x*((-6.221046e-09F)*x - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*((8.2863805e-10F)*x + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
+            poly_K_across_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-6.221046e-09F)*xp0_lanes[k] - 8.889108e-08F) - 1.3402067e-06F) - 71.0F/3225600.0F) - 19.0F/44800.0F) - 1.0F/80.0F) + 1.0F/2.0F;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_K_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((8.2863805e-10F)*xp0_lanes[k] + 1.2203463e-08F) + 1.8955122e-07F) + 3.1893292e-06F) + 11.0F/179200.0F) + 1.0F/640.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (-sin0/u0 + (1.0F/8.0F)*w0/(sin0*sin0))/w0;
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.1742209e-21F)*x + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((1.1742209e-21F)*xp1_lanes[k] + 1.3462827e-20F) + 1.5454156e-19F) + 1.7764157e-18F) + 2.0451065e-17F) + 2.3586252e-16F) + 2.7258202e-15F) + 3.1578103e-14F) + 3.6688033e-13F) + 4.2773337e-12F) + 5.0082088e-11F) + 5.8957367e-10F) + 6.9894086e-09F) + 8.364689e-08F) + 1.0145626e-06F) + 1.2558899e-05F) + 173.0F/1075200.0F) + 99.0F/44800.0F) + 3.0F/80.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

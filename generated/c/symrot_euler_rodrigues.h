@@ -166,6 +166,10 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 4.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -175,7 +179,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -184,7 +188,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_batch(size_t n, const 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -276,6 +280,11 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 4.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
+    const double u1_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -285,8 +294,8 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -297,8 +306,8 @@ static inline void symrot_euler_rodrigues_tangent_batch(size_t n, const double *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -383,6 +392,10 @@ static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const 
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 4.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -392,7 +405,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const 
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -401,7 +414,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_batch(size_t n, const 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -481,6 +494,10 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 4.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -490,7 +507,7 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -499,7 +516,7 @@ static inline void symrot_euler_rodrigues_root_matrix_batch(size_t n, const doub
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -587,8 +604,13 @@ static inline void symrot_euler_rodrigues_root_tangent(const double p[3], double
  */
 static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], u1_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 9.99999999999999e-15;
+    const double d_safe = 4.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
+    const double u1_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -597,30 +619,35 @@ static inline void symrot_euler_rodrigues_root_tangent_batch(size_t n, const dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 9.99999999999999e-15 ? x : 0;
             if (!(x < 4.0)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u0_b_lanes[k] = u0_safe;
+                u1_b_lanes[k] = u1_safe;
             } else {
                 const double d = symrot_euler_rodrigues__complement(pk, x);
                 const double u0 = sqrt(d);
                 const double u1 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
+                u0_b_lanes[k] = x < 9.99999999999999e-15 ? u0_safe : u0;
+                u1_b_lanes[k] = x < 9.99999999999999e-15 ? u1_safe : u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u0_b_lanes[k] = u0_safe;
+            u1_b_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
+            const double u0_b = u0_b_lanes[k];
+            const double u1_b = u1_b_lanes[k];
             c_K_1_lanes[k] = (1.0/2.0)/(u0 + 2);
-            c_K_2_lanes[k] = (1.0/4.0)*u1/((1.0/2.0)*u0 + 1);
-            poly_K_2_lanes[k] = (3.0/256.0)*x + 1.0/16.0;
+            c_K_2_lanes[k] = (1.0/4.0)*u1_b/((1.0/2.0)*u0_b + 1);
+            poly_K_2_lanes[k] = (3.0/256.0)*xp0_lanes[k] + 1.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1406,6 +1433,10 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 4.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1415,7 +1446,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1424,7 +1455,7 @@ static inline void symrot_euler_rodrigues_rotation_matrix_f_batch(size_t n, cons
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1516,6 +1547,11 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 4.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
+    const float u1_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1525,8 +1561,8 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1537,8 +1573,8 @@ static inline void symrot_euler_rodrigues_tangent_f_batch(size_t n, const float 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1623,6 +1659,10 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, cons
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 4.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1632,7 +1672,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, cons
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1641,7 +1681,7 @@ static inline void symrot_euler_rodrigues_tangent_inverse_f_batch(size_t n, cons
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1721,6 +1761,10 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 4.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1730,7 +1774,7 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1739,7 +1783,7 @@ static inline void symrot_euler_rodrigues_root_matrix_f_batch(size_t n, const fl
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1827,8 +1871,13 @@ static inline void symrot_euler_rodrigues_root_tangent_f(const float p[3], float
  */
 static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], u1_b_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1e-14F;
+    const float d_safe = 4.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
+    const float u1_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1838,27 +1887,31 @@ static inline void symrot_euler_rodrigues_root_tangent_f_batch(size_t n, const f
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 4.0F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u0_b_lanes[k] = u0_safe;
+                u1_b_lanes[k] = u1_safe;
             } else {
                 const float d = symrot_euler_rodrigues__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 const float u1 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
+                u0_b_lanes[k] = x < 1e-14F ? u0_safe : u0;
+                u1_b_lanes[k] = x < 1e-14F ? u1_safe : u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u0_b_lanes[k] = u0_safe;
+            u1_b_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
+            const float u0_b = u0_b_lanes[k];
+            const float u1_b = u1_b_lanes[k];
             c_K_1_lanes[k] = (1.0F/2.0F)/(u0 + 2);
-            c_K_2_lanes[k] = (1.0F/4.0F)*u1/((1.0F/2.0F)*u0 + 1);
+            c_K_2_lanes[k] = (1.0F/4.0F)*u1_b/((1.0F/2.0F)*u0_b + 1);
             poly_K_2_lanes[k] = 1.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */

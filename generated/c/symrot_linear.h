@@ -185,6 +185,10 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.25;
+    const double d_safe = 1.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -194,7 +198,7 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_linear__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -203,7 +207,7 @@ static inline void symrot_linear_rotation_matrix_batch(size_t n, const double *p
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -291,8 +295,13 @@ static inline void symrot_linear_tangent(const double p[3], double H[9])
  */
 static inline void symrot_linear_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], u1_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 9.999999999999965e-15;
+    const double d_safe = 1.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
+    const double u1_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -301,31 +310,35 @@ static inline void symrot_linear_tangent_batch(size_t n, const double *p, double
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 9.999999999999965e-15 ? x : 0;
             if (!(x < 1.0)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u0_b_lanes[k] = u0_safe;
+                u1_b_lanes[k] = u1_safe;
             } else {
                 const double d = symrot_linear__complement(pk, x);
                 const double u0 = sqrt(d);
                 const double u1 = 1.0/sqrt(d);
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
+                u0_b_lanes[k] = x < 9.999999999999965e-15 ? u0_safe : u0;
+                u1_b_lanes[k] = x < 9.999999999999965e-15 ? u1_safe : u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u0_b_lanes[k] = u0_safe;
+            u1_b_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
-            const double w0 = 1.0/(u0 + 1);
-            c_H_1_lanes[k] = w0;
-            c_H_2_lanes[k] = u1*w0;
-            poly_H_2_lanes[k] = (3.0/8.0)*x + 1.0/2.0;
+            const double u0_b = u0_b_lanes[k];
+            const double u1_b = u1_b_lanes[k];
+            c_H_1_lanes[k] = 1.0/(u0 + 1);
+            c_H_2_lanes[k] = u1_b/(u0_b + 1);
+            poly_H_2_lanes[k] = (3.0/8.0)*xp0_lanes[k] + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -406,6 +419,10 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.25;
+    const double d_safe = 1.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -415,7 +432,7 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_linear__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -424,7 +441,7 @@ static inline void symrot_linear_tangent_inverse_batch(size_t n, const double *p
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -544,8 +561,14 @@ static inline void symrot_linear_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.116472206314816;
+    const double d_safe = 1.0 - x_safe;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_linear__phi(s_safe, d_safe);
+    const double u0_safe = 1.0/sqrt(sqrt(d_safe) + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -554,29 +577,34 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.116472206314816 ? x : 0;
             if (!(x < 1.0)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double d = symrot_linear__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_linear__phi(s, d);
                 const double u0 = 1.0/sqrt(sqrt(d) + 1);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 0.116472206314816 ? x_safe : x;
+                phi_b_lanes[k] = x < 0.116472206314816 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -587,8 +615,8 @@ static inline void symrot_linear_root_matrix_batch(size_t n, const double *p, do
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.7071067811865476*u0;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((0.0015769325991740776)*xp0_lanes[k] + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -648,8 +676,15 @@ static inline void symrot_linear_root_tangent(const double p[3], double K[9])
  */
 static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], u1_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.116472206314816;
+    const double d_safe = 1.0 - x_safe;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_linear__phi(s_safe, d_safe);
+    const double u0_safe = 1.0/sqrt(sqrt(d_safe) + 1);
+    const double u1_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -658,34 +693,39 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.116472206314816 ? x : 0;
             if (!(x < 1.0)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
+                u1_b_lanes[k] = u1_safe;
             } else {
                 const double d = symrot_linear__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_linear__phi(s, d);
                 const double u0 = 1.0/sqrt(sqrt(d) + 1);
                 const double u1 = 1.0/sqrt(d);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.116472206314816 ? x_safe : x;
+                phi_b_lanes[k] = x < 0.116472206314816 ? phi_safe : phi;
+                u1_b_lanes[k] = x < 0.116472206314816 ? u1_safe : u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
+            u1_b_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double u1_b = u1_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -695,7 +735,7 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             const double a0_h = SYMROT_NEAREST(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = (1.0/2.0)*phi_b;
             const double a1_q = SYMROT_NEAREST(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -706,12 +746,12 @@ static inline void symrot_linear_root_tangent_batch(size_t n, const double *p, d
             const double a1_odd = a1_j - 2*a1_h;
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double w0 = 1.0/x;
+            const double wb0 = 1.0/x_b;
             c_K_across_lanes[k] = 0.7071067811865476*u0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.0015769325991740776)*x + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
-            c_K_2_lanes[k] = w0*((1.0/2.0)*u1 - (1.0/2.0)/cos1);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06653969900370939)*x + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*wb0;
+            poly_K_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((0.0015769325991740776)*xp0_lanes[k] + 0.0017386131018401613) + 17383387729001.0/9007199254740992.0) + 1215486600363.0/562949953421312.0) + 171529806825.0/70368744177664.0) + 6116566755.0/2199023255552.0) + 883631595.0/274877906944.0) + 64822395.0/17179869184.0) + 9694845.0/2147483648.0) + 185725.0/33554432.0) + 29393.0/4194304.0) + 2431.0/262144.0) + 429.0/32768.0) + 21.0/1024.0) + 5.0/128.0) + 1.0/8.0;
+            c_K_2_lanes[k] = wb0*((1.0/2.0)*u1_b - (1.0/2.0)/cos1);
+            poly_K_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((0.06653969900370939)*xp0_lanes[k] + 0.06846971320104332) + 0.07057773738575546) + 0.07289287133907002) + 84950637230781.0/1125899906842624.0) + 11019576290593.0/140737488355328.0) + 358414211961.0/4398046511104.0) + 46791646759.0/549755813888.0) + 3066950645.0/34359738368.0) + 404045325.0/4294967296.0) + 6694431.0/67108864.0) + 894173.0/8388608.0) + 60313.0/524288.0) + 8245.0/65536.0) + 287.0/2048.0) + 41.0/256.0) + 3.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1550,6 +1590,10 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.25F;
+    const float d_safe = 1.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1559,7 +1603,7 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_linear__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1568,7 +1612,7 @@ static inline void symrot_linear_rotation_matrix_f_batch(size_t n, const float *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1656,8 +1700,13 @@ static inline void symrot_linear_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], u1_b_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1e-14F;
+    const float d_safe = 1.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
+    const float u1_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1667,28 +1716,31 @@ static inline void symrot_linear_tangent_f_batch(size_t n, const float *p, float
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u0_b_lanes[k] = u0_safe;
+                u1_b_lanes[k] = u1_safe;
             } else {
                 const float d = symrot_linear__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 const float u1 = 1.0F/sqrtf(d);
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
+                u0_b_lanes[k] = x < 1e-14F ? u0_safe : u0;
+                u1_b_lanes[k] = x < 1e-14F ? u1_safe : u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u0_b_lanes[k] = u0_safe;
+            u1_b_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
-            const float w0 = 1.0F/(u0 + 1);
-            c_H_1_lanes[k] = w0;
-            c_H_2_lanes[k] = u1*w0;
+            const float u0_b = u0_b_lanes[k];
+            const float u1_b = u1_b_lanes[k];
+            c_H_1_lanes[k] = 1.0F/(u0 + 1);
+            c_H_2_lanes[k] = u1_b/(u0_b + 1);
             poly_H_2_lanes[k] = 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1770,6 +1822,10 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.25F;
+    const float d_safe = 1.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1779,7 +1835,7 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 1.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_linear__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1788,7 +1844,7 @@ static inline void symrot_linear_tangent_inverse_f_batch(size_t n, const float *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1908,8 +1964,14 @@ static inline void symrot_linear_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 7.888951e-06F;
+    const float d_safe = 1.0F - x_safe;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_linear__phi_f(s_safe, d_safe);
+    const float u0_safe = 1.0F/sqrtf(sqrtf(d_safe) + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1918,29 +1980,34 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 7.888951e-06F ? x : 0;
             if (!(x < 1.0F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float d = symrot_linear__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_linear__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(sqrtf(d) + 1);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 7.888951e-06F ? x_safe : x;
+                phi_b_lanes[k] = x < 7.888951e-06F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1951,8 +2018,8 @@ static inline void symrot_linear_root_matrix_f_batch(size_t n, const float *p, f
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.70710677F*u0;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = (5.0F/128.0F)*x + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = (5.0F/128.0F)*xp0_lanes[k] + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2013,8 +2080,15 @@ static inline void symrot_linear_root_tangent_f(const float p[3], float K[9])
  */
 static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], u1_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.35302037F;
+    const float d_safe = 1.0F - x_safe;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_linear__phi_f(s_safe, d_safe);
+    const float u0_safe = 1.0F/sqrtf(sqrtf(d_safe) + 1);
+    const float u1_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2023,34 +2097,41 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 7.888951e-06F ? x : 0;
+            xp1_lanes[k] = x < 0.35302037F ? x : 0;
             if (!(x < 1.0F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
+                u1_b_lanes[k] = u1_safe;
             } else {
                 const float d = symrot_linear__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_linear__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(sqrtf(d) + 1);
                 const float u1 = 1.0F/sqrtf(d);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
-                u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 7.888951e-06F ? x_safe : x;
+                phi_b_lanes[k] = x < 7.888951e-06F ? phi_safe : phi;
+                u1_b_lanes[k] = x < 7.888951e-06F ? u1_safe : u1;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
+            u1_b_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float u1_b = u1_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2060,7 +2141,7 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float a0_h = SYMROT_NEARESTF(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = (1.0F/2.0F)*phi_b;
             const float a1_q = SYMROT_NEARESTF(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -2073,10 +2154,10 @@ static inline void symrot_linear_root_tangent_f_batch(size_t n, const float *p, 
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             c_K_across_lanes[k] = 0.70710677F*u0;
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_K_1_lanes[k] = (5.0F/128.0F)*x + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/4.0F)*((1.0F/2.0F)*u1 - (1.0F/2.0F)/cos1)/((cos1*cos1)*(sin1*sin1));
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.06846971F)*x + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_K_1_lanes[k] = (5.0F/128.0F)*xp0_lanes[k] + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/4.0F)*((1.0F/2.0F)*u1_b - (1.0F/2.0F)/cos1)/((cos1*cos1)*(sin1*sin1));
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((0.06846971F)*xp1_lanes[k] + 0.07057774F) + 0.072892874F) + 0.07545132F) + 0.0782988F) + 0.08149396F) + 0.08511351F) + 0.08926001F) + 0.09407413F) + 0.099754795F) + 894173.0F/8388608.0F) + 60313.0F/524288.0F) + 8245.0F/65536.0F) + 287.0F/2048.0F) + 41.0F/256.0F) + 3.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

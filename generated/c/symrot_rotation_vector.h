@@ -235,8 +235,12 @@ static inline void symrot_rotation_vector_rotation_matrix(const double p[3], dou
  */
 static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 5.028297529613116e-13;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_rotation_vector__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -245,8 +249,9 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.028297529613116e-13 ? x : 0;
             if (!(x <= 39.47841760435743) || x < 5.028297529613116e-13) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_rotation_vector__phi(s);
@@ -255,11 +260,11 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -274,9 +279,9 @@ static inline void symrot_rotation_vector_rotation_matrix_batch(size_t n, const 
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 2*cos0*sin0/phi;
-            poly_R_1_lanes[k] = 1 + (-1.0/6.0)*x;
+            poly_R_1_lanes[k] = 1 + (-1.0/6.0)*xp0_lanes[k];
             c_R_2_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_R_2_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
+            poly_R_2_lanes[k] = 1.0/2.0 + (-1.0/24.0)*xp0_lanes[k];
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -336,8 +341,12 @@ static inline void symrot_rotation_vector_tangent(const double p[3], double H[9]
  */
 static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.7851233626304374;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_rotation_vector__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -346,8 +355,10 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.028297529613116e-13 ? x : 0;
+            xp1_lanes[k] = x < 0.7851233626304374 ? x : 0;
             if (!(x <= 39.47841760435743) || x < 5.028297529613116e-13) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_rotation_vector__phi(s);
@@ -356,11 +367,12 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -383,9 +395,9 @@ static inline void symrot_rotation_vector_tangent_batch(size_t n, const double *
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_H_1_lanes[k] = 1.0/2.0 + (-1.0/24.0)*x;
+            poly_H_1_lanes[k] = 1.0/2.0 + (-1.0/24.0)*xp0_lanes[k];
             c_H_2_lanes[k] = (phi - sin1)/(phi*phi*phi);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*x) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(1.0/1307674368000.0 + (-1.0/355687428096000.0)*xp1_lanes[k]) - 1.0/6227020800.0) + 1.0/39916800.0) - 1.0/362880.0) + 1.0/5040.0) - 1.0/120.0) + 1.0/6.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -462,8 +474,12 @@ static inline void symrot_rotation_vector_tangent_inverse(const double p[3], dou
  */
 static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 5.5673482008975155;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_rotation_vector__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -472,8 +488,9 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.5673482008975155 ? x : 0;
             if (!(x <= 39.47841760435743) || x < 5.5673482008975155) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_rotation_vector__phi(s);
@@ -482,11 +499,11 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -501,7 +518,7 @@ static inline void symrot_rotation_vector_tangent_inverse_batch(size_t n, const 
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_H_inverse_2_lanes[k] = (-1.0/2.0*cos0*phi/sin0 + 1)/(phi*phi);
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((9.336734257095045e-31)*x + 3.6859949406653103e-29) + 1.455172475614865e-27) + 5.744790668872202e-26) + 2.267952452337683e-24) + 8.953517427037546e-23) + 3.534707039629467e-21) + 1.3954464685812522e-19) + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
+            poly_H_inverse_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((9.336734257095045e-31)*xp0_lanes[k] + 3.6859949406653103e-29) + 1.455172475614865e-27) + 5.744790668872202e-26) + 2.267952452337683e-24) + 8.953517427037546e-23) + 3.534707039629467e-21) + 1.3954464685812522e-19) + 5.5090028283602295e-18) + 2.174868698558062e-16) + 8.586062056277845e-15) + 3.3896802963225827e-13) + 1.0/74724249600.0) + 691.0/1307674368000.0) + 1.0/47900160.0) + 1.0/1209600.0) + 1.0/30240.0) + 1.0/720.0) + 1.0/12.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -590,8 +607,12 @@ static inline void symrot_rotation_vector_root_matrix(const double p[3], double 
  */
 static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.8559287093218047e-12;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_rotation_vector__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -600,8 +621,9 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.8559287093218047e-12 ? x : 0;
             if (!(x <= 39.47841760435743) || x < 1.8559287093218047e-12) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_rotation_vector__phi(s);
@@ -610,11 +632,11 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -637,9 +659,9 @@ static inline void symrot_rotation_vector_root_matrix_batch(size_t n, const doub
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/phi;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-1.0/48.0)*x;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-1.0/48.0)*xp0_lanes[k];
             c_G_2_lanes[k] = 2*(sin1*sin1)/(phi*phi);
-            poly_G_2_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
+            poly_G_2_lanes[k] = 1.0/8.0 + (-1.0/384.0)*xp0_lanes[k];
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -699,8 +721,12 @@ static inline void symrot_rotation_vector_root_tangent(const double p[3], double
  */
 static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 5.5673482008975155;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_rotation_vector__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -709,8 +735,10 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.8559287093218047e-12 ? x : 0;
+            xp1_lanes[k] = x < 5.5673482008975155 ? x : 0;
             if (!(x <= 39.47841760435743) || x < 1.8559287093218047e-12) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_rotation_vector__phi(s);
@@ -719,11 +747,12 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -746,9 +775,9 @@ static inline void symrot_rotation_vector_root_tangent_batch(size_t n, const dou
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
-            poly_K_1_lanes[k] = 1.0/8.0 + (-1.0/384.0)*x;
+            poly_K_1_lanes[k] = 1.0/8.0 + (-1.0/384.0)*xp0_lanes[k];
             c_K_2_lanes[k] = (1.0/2.0)*(phi - 2*sin1)/(phi*phi*phi);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((1.5679617398499164e-23)*x - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((1.5679617398499164e-23)*xp1_lanes[k] - 2.1449716601146855e-20) + 2.333729166204778e-17) - 1.0/51011754393600.0) + 1.0/81749606400.0) - 1.0/185794560.0) + 1.0/645120.0) - 1.0/3840.0) + 1.0/48.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1543,6 +1572,10 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_1_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.028297e-13F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_rotation_vector__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1552,7 +1585,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x <= 39.478416F) || x < 5.028297e-13F) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_rotation_vector__phi_f(s);
@@ -1561,7 +1594,7 @@ static inline void symrot_rotation_vector_rotation_matrix_f_batch(size_t n, cons
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1641,8 +1674,12 @@ static inline void symrot_rotation_vector_tangent_f(const float p[3], float H[9]
  */
 static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_0_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.5083706F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_rotation_vector__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1651,8 +1688,9 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.5083706F ? x : 0;
             if (!(x <= 39.478416F) || x < 5.028297e-13F) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_rotation_vector__phi_f(s);
@@ -1661,11 +1699,11 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1690,7 +1728,7 @@ static inline void symrot_rotation_vector_tangent_f_batch(size_t n, const float 
             c_H_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
             poly_H_1_lanes[k] = 1.0F/2.0F;
             c_H_2_lanes[k] = (phi - sin1)/(phi*phi*phi);
-            poly_H_2_lanes[k] = x*(x*(x*((2.5052108e-08F)*x - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
+            poly_H_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((2.5052108e-08F)*xp0_lanes[k] - 1.0F/362880.0F) + 1.0F/5040.0F) - 1.0F/120.0F) + 1.0F/6.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1767,8 +1805,12 @@ static inline void symrot_rotation_vector_tangent_inverse_f(const float p[3], fl
  */
 static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.567348F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_rotation_vector__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1777,8 +1819,9 @@ static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, cons
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.567348F ? x : 0;
             if (!(x <= 39.478416F) || x < 5.567348F) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_rotation_vector__phi_f(s);
@@ -1787,11 +1830,11 @@ static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, cons
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1806,7 +1849,7 @@ static inline void symrot_rotation_vector_tangent_inverse_f_batch(size_t n, cons
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_H_inverse_2_lanes[k] = (-1.0F/2.0F*cos0*phi/sin0 + 1)/(phi*phi);
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((8.586062e-15F)*x + 3.3896803e-13F) + 1.3382536e-11F) + 5.2841903e-10F) + 2.0876756e-08F) + 1.0F/1209600.0F) + 1.0F/30240.0F) + 1.0F/720.0F) + 1.0F/12.0F;
+            poly_H_inverse_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((8.586062e-15F)*xp0_lanes[k] + 3.3896803e-13F) + 1.3382536e-11F) + 5.2841903e-10F) + 2.0876756e-08F) + 1.0F/1209600.0F) + 1.0F/30240.0F) + 1.0F/720.0F) + 1.0F/12.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1897,6 +1940,10 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
 {
     float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.8559286e-12F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_rotation_vector__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1906,7 +1953,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x <= 39.478416F) || x < 1.8559286e-12F) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_rotation_vector__phi_f(s);
@@ -1915,7 +1962,7 @@ static inline void symrot_rotation_vector_root_matrix_f_batch(size_t n, const fl
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2003,8 +2050,12 @@ static inline void symrot_rotation_vector_root_tangent_f(const float p[3], float
  */
 static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_K_0_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.567348F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_rotation_vector__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2013,8 +2064,9 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.567348F ? x : 0;
             if (!(x <= 39.478416F) || x < 1.8559286e-12F) {
-                phi_lanes[k] = 0;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_rotation_vector__phi_f(s);
@@ -2023,11 +2075,11 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -2052,7 +2104,7 @@ static inline void symrot_rotation_vector_root_tangent_f_batch(size_t n, const f
             c_K_1_lanes[k] = 2*(sin0*sin0)/(phi*phi);
             poly_K_1_lanes[k] = 1.0F/8.0F;
             c_K_2_lanes[k] = (1.0F/2.0F)*(phi - 2*sin1)/(phi*phi*phi);
-            poly_K_2_lanes[k] = x*(x*(x*((1.2232475e-11F)*x - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
+            poly_K_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((1.2232475e-11F)*xp0_lanes[k] - 5.382289e-09F) + 1.0F/645120.0F) - 1.0F/3840.0F) + 1.0F/48.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

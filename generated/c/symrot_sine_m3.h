@@ -262,8 +262,13 @@ static inline void symrot_sine_m3_rotation_matrix(const double p[3], double R[9]
  */
 static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.1294709423110197;
+    const double d_safe = 9.0 - x_safe;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m3__phi(s_safe, d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -272,22 +277,28 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.1294709423110197 ? x : 0;
             if (!(x < 9.0) || x < 0.1294709423110197) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -300,8 +311,8 @@ static inline void symrot_sine_m3_rotation_matrix_batch(size_t n, const double *
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = 1 - 4.0/27.0*x;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-187.0/156728328192.0)*xp0_lanes[k] - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -362,8 +373,14 @@ static inline void symrot_sine_m3_tangent(const double p[3], double H[9])
  */
 static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.1294709423110197;
+    const double d_safe = 9.0 - x_safe;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m3__phi(s_safe, d_safe);
+    const double u0_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -372,26 +389,32 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.1294709423110197 ? x : 0;
             if (!(x < 9.0) || x < 0.1294709423110197) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
                 const double u0 = 1.0/sqrt(d);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -414,13 +437,13 @@ static inline void symrot_sine_m3_tangent_batch(size_t n, const double *p, doubl
             const double a1_h = SYMROT_NEAREST(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = 1.0/x;
+            const double w0 = 1.0/xc;
             const double w1 = 2*(sin0*sin0);
             c_H_across_lanes[k] = 1 - 4.0/27.0*x;
             c_H_1_lanes[k] = w0*w1;
-            poly_H_1_lanes[k] = x*(x*(x*(x*(x*(x*((-187.0/156728328192.0)*x - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-187.0/156728328192.0)*xp0_lanes[k] - 5.0/362797056.0) - 91.0/544195584.0) - 11.0/5038848.0) - 1.0/31104.0) - 7.0/11664.0) - 5.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u0*w0*(4*(sin1*sin1) + w1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*((12155.0/25389989167104.0)*x + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
+            poly_H_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((12155.0/25389989167104.0)*xp0_lanes[k] + 715.0/156728328192.0) + 143.0/3265173504.0) + 77.0/181398528.0) + 7.0/1679616.0) + 35.0/839808.0) + 5.0/11664.0) + 1.0/216.0) + 11.0/54.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -496,8 +519,12 @@ static inline void symrot_sine_m3_tangent_inverse(const double p[3], double Hinv
  */
 static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.9011961863057287e-14;
+    const double d_safe = 9.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -506,26 +533,35 @@ static inline void symrot_sine_m3_tangent_inverse_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.9011961863057287e-14 ? x : 0;
             if (!(x < 9.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                u0_b_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_sine_m3__complement(pk, x);
                 const double u0 = sqrt(d);
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 1.9011961863057287e-14 ? x_safe : x;
+                u0_b_lanes[k] = x < 1.9011961863057287e-14 ? u0_safe : u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            u0_b_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
-            const double w0 = (1.0/6.0)*(2*u0 + 9)/(-9*u0 + 2*x - 27);
-            c_H_inverse_across_lanes[k] = (1.0/3.0)*u0 + w0*x;
-            poly_H_inverse_across_lanes[k] = 1 + (-11.0/108.0)*x;
-            c_H_inverse_2_lanes[k] = -w0;
+            const double x_b = x_b_lanes[k];
+            const double u0_b = u0_b_lanes[k];
+            c_H_inverse_across_lanes[k] = (1.0/3.0)*u0_b + (1.0/6.0)*x_b*(2*u0_b + 9)/(-9*u0_b + 2*x_b - 27);
+            poly_H_inverse_across_lanes[k] = 1 + (-11.0/108.0)*xp0_lanes[k];
+            c_H_inverse_2_lanes[k] = -1.0/6.0*(2*u0 + 9)/(-9*u0 + 2*x - 27);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -617,8 +653,13 @@ static inline void symrot_sine_m3_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.8648056668462011;
+    const double d_safe = 9.0 - x_safe;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m3__phi(s_safe, d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -627,25 +668,32 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.9011961863057287e-14 ? x : 0;
+            xp1_lanes[k] = x < 0.8648056668462011 ? x : 0;
             if (!(x < 9.0) || x < 1.9011961863057287e-14) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -669,9 +717,9 @@ static inline void symrot_sine_m3_root_matrix_batch(size_t n, const double *p, d
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-5.0/432.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-5.0/432.0)*xp0_lanes[k];
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((2.6263801616969847e-16)*xp1_lanes[k] + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -735,8 +783,14 @@ static inline void symrot_sine_m3_root_tangent(const double p[3], double K[9])
  */
 static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], xp2_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.595363771286421;
+    const double d_safe = 9.0 - x_safe;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m3__phi(s_safe, d_safe);
+    const double u0_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -745,15 +799,20 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.9011961863057287e-14 ? x : 0;
+            xp1_lanes[k] = x < 0.8648056668462011 ? x : 0;
+            xp2_lanes[k] = x < 1.595363771286421 ? x : 0;
             if (!(x < 9.0) || x < 1.9011961863057287e-14) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_sine_m3__complement(pk, x);
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m3__phi(s, d);
                 const double u0 = 1.0/sqrt(d);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
@@ -761,13 +820,17 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xp2_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
@@ -793,11 +856,11 @@ static inline void symrot_sine_m3_root_tangent_batch(size_t n, const double *p, 
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = sin0/s;
             c_K_across_lanes[k] = w0;
-            poly_K_across_lanes[k] = 1.0/2.0 + (-5.0/432.0)*x;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
-            poly_K_1_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.6263801616969847e-16)*x + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-5.0/432.0)*xp0_lanes[k];
+            c_K_1_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_K_1_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((2.6263801616969847e-16)*xp1_lanes[k] + 2.6523028749812665e-15) + 2.7043088137063895e-14) + 2.7887921508029775e-13) + 2.9153482748054755e-12) + 3.0988317326603656e-11) + 1151495.0/3423782572130304.0) + 7429.0/1981355655168.0) + 96577.0/2229025112064.0) + 2717.0/5159780352.0) + 55.0/7962624.0) + 77.0/746496.0) + 7.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/6.0)*(9*u0 - 6*w0)/(s*s);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((5.686986404434585e-22)*x + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
+            poly_K_2_lanes[k] = xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*((5.686986404434585e-22)*xp2_lanes[k] + 5.2474947350038126e-21) + 4.848302255228995e-20) + 4.485987309590691e-19) + 4.157487258827684e-18) + 3.860077032999521e-17) + 3.591354044730225e-16) + 3.3492308584280645e-15) + 3.131938026351592e-14) + 2.9380412329868797e-13) + 2.766479970006097e-12) + 2.616640710832771e-11) + 2.488488853030543e-10) + 2.3828073175775768e-09) + 22163413.0/962938848411648.0) + 1002701.0/4458050224128.0) + 23051.0/10319560704.0) + 29311.0/1289945088.0) + 359.0/1492992.0) + 19.0/6912.0) + 17.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1731,8 +1794,13 @@ static inline void symrot_sine_m3_rotation_matrix_f(const float p[3], float R[9]
  */
 static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.03594455F;
+    const float d_safe = 9.0F - x_safe;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m3__phi_f(s_safe, d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1741,22 +1809,28 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.03594455F ? x : 0;
             if (!(x < 9.0F) || x < 0.03594455F) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1769,8 +1843,8 @@ static inline void symrot_sine_m3_rotation_matrix_f_batch(size_t n, const float 
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = 1 - 4.0F/27.0F*x;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_R_2_lanes[k] = xp0_lanes[k]*((-7.0F/11664.0F)*xp0_lanes[k] - 5.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1832,8 +1906,15 @@ static inline void symrot_sine_m3_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 2.8627653F;
+    const float d_safe = 9.0F - x_safe;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m3__phi_f(s_safe, d_safe);
+    const float u0_safe = 1.0F/sqrtf(d_safe);
+    const float u1_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1842,16 +1923,20 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.03594455F ? x : 0;
+            xp1_lanes[k] = x < 2.8627653F ? x : 0;
             if (!(x < 9.0F) || x < 0.03594455F) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(d);
                 const float u1 = sqrtf(d);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
@@ -1859,13 +1944,17 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
@@ -1879,13 +1968,13 @@ static inline void symrot_sine_m3_tangent_f_batch(size_t n, const float *p, floa
             const float a0_h = SYMROT_NEARESTF(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float w0 = 1.0F/x;
+            const float w0 = 1.0F/xc;
             const float w1 = 2*(sin0*sin0);
             c_H_across_lanes[k] = 1 - 4.0F/27.0F*x;
             c_H_1_lanes[k] = w0*w1;
-            poly_H_1_lanes[k] = x*((-7.0F/11664.0F)*x - 5.0F/216.0F) + 1.0F/2.0F;
+            poly_H_1_lanes[k] = xp0_lanes[k]*((-7.0F/11664.0F)*xp0_lanes[k] - 5.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u0*w0*(-2.0F/3.0F*u1 + w1 + 2);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.532646e-15F)*x + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((6.532646e-15F)*xp1_lanes[k] + 6.097136e-14F) + 5.7069193e-13F) + 5.359542e-12F) + 5.053282e-11F) + 4.78732e-10F) + 4.5620343e-09F) + 4.3795527e-08F) + 4.2447974e-07F) + 7.0F/1679616.0F) + 35.0F/839808.0F) + 5.0F/11664.0F) + 1.0F/216.0F) + 11.0F/54.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1961,8 +2050,12 @@ static inline void symrot_sine_m3_tangent_inverse_f(const float p[3], float Hinv
  */
 static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.9011963e-14F;
+    const float d_safe = 9.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1972,25 +2065,32 @@ static inline void symrot_sine_m3_tangent_inverse_f_batch(size_t n, const float 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                u0_b_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_sine_m3__complement_f(pk, x);
                 const float u0 = sqrtf(d);
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 1.9011963e-14F ? x_safe : x;
+                u0_b_lanes[k] = x < 1.9011963e-14F ? u0_safe : u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            u0_b_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
-            const float w0 = (1.0F/6.0F)*(2*u0 + 9)/(-9*u0 + 2*x - 27);
-            c_H_inverse_across_lanes[k] = (1.0F/3.0F)*u0 + w0*x;
+            const float x_b = x_b_lanes[k];
+            const float u0_b = u0_b_lanes[k];
+            c_H_inverse_across_lanes[k] = (1.0F/3.0F)*u0_b + (1.0F/6.0F)*x_b*(2*u0_b + 9)/(-9*u0_b + 2*x_b - 27);
             poly_H_inverse_across_lanes[k] = 1;
-            c_H_inverse_2_lanes[k] = -w0;
+            c_H_inverse_2_lanes[k] = -1.0F/6.0F*(2*u0 + 9)/(-9*u0 + 2*x - 27);
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2082,8 +2182,13 @@ static inline void symrot_sine_m3_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.24508163F;
+    const float d_safe = 9.0F - x_safe;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m3__phi_f(s_safe, d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2092,25 +2197,30 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.24508163F ? x : 0;
             if (!(x < 9.0F) || x < 1.9011963e-14F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2135,8 +2245,8 @@ static inline void symrot_sine_m3_root_matrix_f_batch(size_t n, const float *p, 
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*(x*((55.0F/7962624.0F)*x + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*((55.0F/7962624.0F)*xp0_lanes[k] + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2200,8 +2310,14 @@ static inline void symrot_sine_m3_root_tangent_f(const float p[3], float K[9])
  */
 static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 2.8627653F;
+    const float d_safe = 9.0F - x_safe;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m3__phi_f(s_safe, d_safe);
+    const float u0_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2210,15 +2326,19 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.24508163F ? x : 0;
+            xp1_lanes[k] = x < 2.8627653F ? x : 0;
             if (!(x < 9.0F) || x < 1.9011963e-14F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_sine_m3__complement_f(pk, x);
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m3__phi_f(s, d);
                 const float u0 = 1.0F/sqrtf(d);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
@@ -2226,13 +2346,16 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
@@ -2259,10 +2382,10 @@ static inline void symrot_sine_m3_root_tangent_f_batch(size_t n, const float *p,
             const float w0 = sin0/s;
             c_K_across_lanes[k] = w0;
             poly_K_across_lanes[k] = 1.0F/2.0F;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
-            poly_K_1_lanes[k] = x*(x*((55.0F/7962624.0F)*x + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_K_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*((55.0F/7962624.0F)*xp0_lanes[k] + 77.0F/746496.0F) + 7.0F/3456.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = ((3.0F/2.0F)*u0 - w0)/(s*s);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.349231e-15F)*x + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((3.349231e-15F)*xp1_lanes[k] + 3.131938e-14F) + 2.9380412e-13F) + 2.76648e-12F) + 2.6166408e-11F) + 2.4884889e-10F) + 2.3828073e-09F) + 2.3016428e-08F) + 2.2491918e-07F) + 2.2337192e-06F) + 2.2722672e-05F) + 359.0F/1492992.0F) + 19.0F/6912.0F) + 17.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

@@ -175,6 +175,10 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
 {
     double x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 16.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -184,8 +188,8 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0)) {
-                d_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                d_lanes[k] = d_safe;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -195,8 +199,8 @@ static inline void symrot_sine_m4_rotation_matrix_batch(size_t n, const double *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            d_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            d_lanes[k] = d_safe;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -255,6 +259,11 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
 {
     double x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 16.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
+    const double u1_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -264,9 +273,9 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0)) {
-                d_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                d_lanes[k] = d_safe;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -278,9 +287,9 @@ static inline void symrot_sine_m4_tangent_batch(size_t n, const double *p, doubl
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            d_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            d_lanes[k] = d_safe;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -358,6 +367,10 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 16.0 - x_safe;
+    const double u0_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -367,7 +380,7 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = 1.0/sqrt(d);
@@ -376,7 +389,7 @@ static inline void symrot_sine_m4_tangent_inverse_batch(size_t n, const double *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -477,6 +490,10 @@ static inline void symrot_sine_m4_root_matrix_batch(size_t n, const double *p, d
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 16.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -486,7 +503,7 @@ static inline void symrot_sine_m4_root_matrix_batch(size_t n, const double *p, d
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -495,7 +512,7 @@ static inline void symrot_sine_m4_root_matrix_batch(size_t n, const double *p, d
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -579,6 +596,11 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double d_safe = 16.0 - x_safe;
+    const double u0_safe = sqrt(d_safe);
+    const double u1_safe = 1.0/sqrt(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -588,8 +610,8 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const double d = symrot_sine_m4__complement(pk, x);
                 const double u0 = sqrt(d);
@@ -600,8 +622,8 @@ static inline void symrot_sine_m4_root_tangent_batch(size_t n, const double *p, 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1432,6 +1454,10 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
 {
     float x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 16.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1441,8 +1467,8 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0F)) {
-                d_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                d_lanes[k] = d_safe;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1452,8 +1478,8 @@ static inline void symrot_sine_m4_rotation_matrix_f_batch(size_t n, const float 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            d_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            d_lanes[k] = d_safe;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1512,6 +1538,11 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
 {
     float x_lanes[SYMROT_BATCH_BLOCK], d_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 16.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
+    const float u1_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1521,9 +1552,9 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0F)) {
-                d_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                d_lanes[k] = d_safe;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1535,9 +1566,9 @@ static inline void symrot_sine_m4_tangent_f_batch(size_t n, const float *p, floa
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            d_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            d_lanes[k] = d_safe;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1615,6 +1646,10 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 16.0F - x_safe;
+    const float u0_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1624,7 +1659,7 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = 1.0F/sqrtf(d);
@@ -1633,7 +1668,7 @@ static inline void symrot_sine_m4_tangent_inverse_f_batch(size_t n, const float 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1734,6 +1769,10 @@ static inline void symrot_sine_m4_root_matrix_f_batch(size_t n, const float *p, 
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 16.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1743,7 +1782,7 @@ static inline void symrot_sine_m4_root_matrix_f_batch(size_t n, const float *p, 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1752,7 +1791,7 @@ static inline void symrot_sine_m4_root_matrix_f_batch(size_t n, const float *p, 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1836,6 +1875,11 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float d_safe = 16.0F - x_safe;
+    const float u0_safe = sqrtf(d_safe);
+    const float u1_safe = 1.0F/sqrtf(d_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1845,8 +1889,8 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 16.0F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float d = symrot_sine_m4__complement_f(pk, x);
                 const float u0 = sqrtf(d);
@@ -1857,8 +1901,8 @@ static inline void symrot_sine_m4_root_tangent_f_batch(size_t n, const float *p,
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

@@ -286,8 +286,12 @@ static inline void symrot_sine_m5_rotation_matrix(const double p[3], double R[9]
  */
 static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.4064433613155127;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m5__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -296,21 +300,27 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.4064433613155127 ? x : 0;
             if (!(x < 22.612712429686844) || x < 0.4064433613155127) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -324,8 +334,8 @@ static inline void symrot_sine_m5_rotation_matrix_batch(size_t n, const double *
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
-            c_R_2_lanes[k] = (1 - cos0)/x;
-            poly_R_2_lanes[k] = x*(x*(x*(x*(x*(x*((969.0/1000000000000000.0)*x + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            c_R_2_lanes[k] = (1 - cos0)/xc;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((969.0/1000000000000000.0)*xp0_lanes[k] + 17.0/500000000000.0) + 13.0/10000000000.0) + 143.0/2500000000.0) + 33.0/10000000.0) + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -375,8 +385,12 @@ static inline void symrot_sine_m5_tangent(const double p[3], double H[9])
  */
 static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 2.787613413593369;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m5__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -385,24 +399,32 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.000596571734285774 ? x : 0;
+            xp1_lanes[k] = x < 2.787613413593369 ? x : 0;
             if (!(x < 22.612712429686844) || x < 0.000596571734285774) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -428,12 +450,12 @@ static inline void symrot_sine_m5_tangent_batch(size_t n, const double *p, doubl
             const double a1_odd = a1_j - 2*a1_h;
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double w0 = 1.0/x;
+            const double w0 = 1.0/xc;
             c_H_across_lanes[k] = (16.0/3125.0)*(x*x) - 4.0/25.0*x + 1;
             c_H_1_lanes[k] = 2*(sin0*sin0)*w0;
-            poly_H_1_lanes[k] = x*(x*((33.0/10000000.0)*x + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*((33.0/10000000.0)*xp0_lanes[k] + 21.0/50000.0) - 7.0/200.0) + 1.0/2.0;
             c_H_2_lanes[k] = w0*(-2*cos0*sin0/s + 1.0/cos1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.0108039e-24)*x + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((6.0108039e-24)*xp1_lanes[k] + 1.5511752e-22) + 4.01166e-21) + 1.04006e-19) + 2.704156e-18) + 7.05432e-17) + 1.84756e-15) + 4.862e-14) + 1287.0/1000000000000000.0) + 429.0/12500000000000.0) + 231.0/250000000000.0) + 63.0/2500000000.0) + 7.0/10000000.0) + 1.0/50000.0) - 113.0/25000.0) + 9.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -503,8 +525,12 @@ static inline void symrot_sine_m5_tangent_inverse(const double p[3], double Hinv
  */
 static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 2.787613413593369;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m5__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -513,24 +539,31 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 3.327466626289853e-08 ? x : 0;
+            xp1_lanes[k] = x < 2.787613413593369 ? x : 0;
             if (!(x < 22.612712429686844) || x < 3.327466626289853e-08) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -567,11 +600,11 @@ static inline void symrot_sine_m5_tangent_inverse_batch(size_t n, const double *
             const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             const double a2_up = fabs(a2_j - 1.5) - 0.5;
             const double cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
-            const double w0 = 1.0/x;
+            const double w0 = 1.0/xc;
             c_H_inverse_across_lanes[k] = sin1/(s*(4*(sin0*sin0*sin0*sin0)*w0 + (sin1*sin1)*w0));
-            poly_H_inverse_across_lanes[k] = 1 + (-9.0/100.0)*x;
+            poly_H_inverse_across_lanes[k] = 1 + (-9.0/100.0)*xp0_lanes[k];
             c_H_inverse_2_lanes[k] = (1.0/25.0)*(-5.0/2.0*cos0*sin2/sin0 + cos2)/(sin2*sin2);
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.605701862613439e-25)*x + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
+            poly_H_inverse_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((2.605701862613439e-25)*xp1_lanes[k] + 5.900417829284953e-24) + 1.3365047404418915e-22) + 3.0284550580440063e-21) + 6.865597085797888e-20) + 1.55740040672512e-18) + 3.5356237886336e-17) + 8.03498131072e-16) + 1.82856922432e-14) + 4.16937232e-13) + 9.53238064e-12) + 683731.0/3125000000000000.0) + 315743.0/62500000000000.0) + 14721.0/125000000000.0) + 6979.0/2500000000.0) + 171.0/2500000.0) + 91.0/50000.0) + 7.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -661,8 +694,14 @@ static inline void symrot_sine_m5_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 4.692488584147999e-09;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m5__phi(s_safe);
+    const double u0_safe = 1.0/sqrt(sqrt(25 - x_safe) + 5);
+    const double u1_safe = sqrt(25 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -671,33 +710,39 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 4.692488584147999e-09 ? x : 0;
             if (!(x < 22.612712429686844)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
                 const double u0 = 1.0/sqrt(sqrt(25 - x) + 5);
                 const double u1 = sqrt(25 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 4.692488584147999e-09 ? x_safe : x;
+                phi_b_lanes[k] = x < 4.692488584147999e-09 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -708,8 +753,8 @@ static inline void symrot_sine_m5_root_matrix_batch(size_t n, const double *p, d
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = 1.0/8.0 + (-3.0/3200.0)*x;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = 1.0/8.0 + (-3.0/3200.0)*xp0_lanes[k];
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -769,8 +814,14 @@ static inline void symrot_sine_m5_root_tangent(const double p[3], double K[9])
  */
 static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 5.166154456090205;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m5__phi(s_safe);
+    const double u0_safe = 1.0/sqrt(sqrt(25 - x_safe) + 5);
+    const double u1_safe = sqrt(25 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -779,33 +830,41 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 4.692488584147999e-09 ? x : 0;
+            xp1_lanes[k] = x < 5.166154456090205 ? x : 0;
             if (!(x < 22.612712429686844)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m5__phi(s);
                 const double u0 = 1.0/sqrt(sqrt(25 - x) + 5);
                 const double u1 = sqrt(25 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 4.692488584147999e-09 ? x_safe : x;
+                phi_b_lanes[k] = x < 4.692488584147999e-09 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -815,7 +874,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double a0_h = SYMROT_NEAREST(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/5.0)*phi;
+            const double a1_a = (1.0/5.0)*phi_b;
             const double a1_q = SYMROT_NEAREST(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -827,7 +886,7 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double a1_up = fabs(a1_j - 1.5) - 0.5;
             const double cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const double a2_a = (1.0/2.0)*phi;
+            const double a2_a = (1.0/2.0)*phi_b;
             const double a2_q = SYMROT_NEAREST(a2_a*0.6366197723675814);
             const double a2_r = ((a2_a - a2_q*1.5707963267341256) - a2_q*6.077100506303966e-11) - a2_q*2.0222662487959506e-21;
             const double a2_z = a2_r*a2_r;
@@ -838,10 +897,10 @@ static inline void symrot_sine_m5_root_tangent_batch(size_t n, const double *p, 
             const double a2_odd = a2_j - 2*a2_h;
             const double sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             c_K_across_lanes[k] = -0.012649110640673518*u0*(-10*u1 + 4*x - 75);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_K_1_lanes[k] = 1.0/8.0 + (-3.0/3200.0)*x;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_K_1_lanes[k] = 1.0/8.0 + (-3.0/3200.0)*xp0_lanes[k];
             c_K_2_lanes[k] = (1.0/250.0)*(-2*sin2/sin1 + 5/cos1)/(sin1*sin1);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.0697981074175421e-32)*x + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((1.0697981074175421e-32)*xp1_lanes[k] + 2.7389657778490754e-31) + 7.020858443690296e-30) + 1.8020531692725015e-28) + 4.6321535044888044e-27) + 1.1926468757803257e-25) + 3.0764111425157872e-24) + 7.952225063358658e-23) + 2.0605184183658435e-21) + 5.353904274344742e-20) + 1.395645757814145e-18) + 3.6521750869846345e-17) + 9.601558677482604e-16) + 2.538666416168213e-14) + 6.760569534301757e-13) + 1.817205615234375e-11) + 1013037.0/2048000000000000.0) + 70193.0/5120000000000.0) + 2001.0/5120000000.0) + 3.0/256000.0) + 317.0/800000.0) + 11.0/400.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1724,8 +1783,12 @@ static inline void symrot_sine_m5_rotation_matrix_f(const float p[3], float R[9]
  */
 static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.0022018803F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m5__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1734,21 +1797,27 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.0022018803F ? x : 0;
             if (!(x < 22.612713F) || x < 0.0022018803F) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1761,8 +1830,8 @@ static inline void symrot_sine_m5_rotation_matrix_f_batch(size_t n, const float 
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = 1.0F/2.0F + (-7.0F/200.0F)*x;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_R_2_lanes[k] = 1.0F/2.0F + (-7.0F/200.0F)*xp0_lanes[k];
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1812,8 +1881,12 @@ static inline void symrot_sine_m5_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 2.7876132F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m5__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1822,24 +1895,32 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.0022018803F ? x : 0;
+            xp1_lanes[k] = x < 2.7876132F ? x : 0;
             if (!(x < 22.612713F) || x < 0.0022018803F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -1865,12 +1946,12 @@ static inline void symrot_sine_m5_tangent_f_batch(size_t n, const float *p, floa
             const float a1_odd = a1_j - 2*a1_h;
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float w0 = 1.0F/x;
+            const float w0 = 1.0F/xc;
             c_H_across_lanes[k] = (16.0F/3125.0F)*(x*x) - 4.0F/25.0F*x + 1;
             c_H_1_lanes[k] = 2*(sin0*sin0)*w0;
-            poly_H_1_lanes[k] = 1.0F/2.0F + (-7.0F/200.0F)*x;
+            poly_H_1_lanes[k] = 1.0F/2.0F + (-7.0F/200.0F)*xp0_lanes[k];
             c_H_2_lanes[k] = w0*(-2*cos0*sin0/s + 1.0F/cos1);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*((3.432e-11F)*x + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((3.432e-11F)*xp1_lanes[k] + 9.24e-10F) + 2.52e-08F) + 7.0F/10000000.0F) + 1.0F/50000.0F) - 113.0F/25000.0F) + 9.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1940,8 +2021,12 @@ static inline void symrot_sine_m5_tangent_inverse_f(const float p[3], float Hinv
  */
 static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.1661544F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m5__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1950,24 +2035,31 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.1864381e-05F ? x : 0;
+            xp1_lanes[k] = x < 5.1661544F ? x : 0;
             if (!(x < 22.612713F) || x < 1.1864381e-05F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/5.0F)*phi;
@@ -1996,9 +2088,9 @@ static inline void symrot_sine_m5_tangent_inverse_f_batch(size_t n, const float 
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
             const float w0 = cos1/sin1;
             c_H_inverse_across_lanes[k] = (5.0F/2.0F)*sin0*w0;
-            poly_H_inverse_across_lanes[k] = 1 + (-9.0F/100.0F)*x;
-            c_H_inverse_2_lanes[k] = (cos0 - 1.0F/2.0F*s*w0)/x;
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.5356237e-17F)*x + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
+            poly_H_inverse_across_lanes[k] = 1 + (-9.0F/100.0F)*xp0_lanes[k];
+            c_H_inverse_2_lanes[k] = (cos0 - 1.0F/2.0F*s*w0)/xc;
+            poly_H_inverse_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((3.5356237e-17F)*xp1_lanes[k] + 8.0349815e-16F) + 1.8285693e-14F) + 4.1693724e-13F) + 9.532381e-12F) + 2.1879391e-10F) + 5.051888e-09F) + 1.17768e-07F) + 2.7916e-06F) + 171.0F/2500000.0F) + 91.0F/50000.0F) + 7.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2088,8 +2180,14 @@ static inline void symrot_sine_m5_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.008126427F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m5__phi_f(s_safe);
+    const float u0_safe = 1.0F/sqrtf(sqrtf(25 - x_safe) + 5);
+    const float u1_safe = sqrtf(25 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2098,33 +2196,39 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.008126427F ? x : 0;
             if (!(x < 22.612713F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
                 const float u0 = 1.0F/sqrtf(sqrtf(25 - x) + 5);
                 const float u1 = sqrtf(25 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.008126427F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.008126427F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2135,8 +2239,8 @@ static inline void symrot_sine_m5_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = -0.0126491105F*u0*(-10*u1 + 4*x - 75);
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = 1.0F/8.0F + (-3.0F/3200.0F)*x;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = 1.0F/8.0F + (-3.0F/3200.0F)*xp0_lanes[k];
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2196,8 +2300,14 @@ static inline void symrot_sine_m5_root_tangent_f(const float p[3], float K[9])
  */
 static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.1661544F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m5__phi_f(s_safe);
+    const float u0_safe = 1.0F/sqrtf(sqrtf(25 - x_safe) + 5);
+    const float u1_safe = sqrtf(25 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2206,33 +2316,41 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.008126427F ? x : 0;
+            xp1_lanes[k] = x < 5.1661544F ? x : 0;
             if (!(x < 22.612713F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m5__phi_f(s);
                 const float u0 = 1.0F/sqrtf(sqrtf(25 - x) + 5);
                 const float u1 = sqrtf(25 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.008126427F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.008126427F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -2242,7 +2360,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float a0_h = SYMROT_NEARESTF(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/5.0F)*phi;
+            const float a1_a = (1.0F/5.0F)*phi_b;
             const float a1_q = SYMROT_NEARESTF(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -2254,7 +2372,7 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float a2_a = (1.0F/2.0F)*phi;
+            const float a2_a = (1.0F/2.0F)*phi_b;
             const float a2_q = SYMROT_NEARESTF(a2_a*0.63661975F);
             const float a2_r = ((a2_a - a2_q*1.5708008F) - a2_q*-4.4543995e-06F) - a2_q*-5.5644316e-11F;
             const float a2_z = a2_r*a2_r;
@@ -2265,10 +2383,10 @@ static inline void symrot_sine_m5_root_tangent_f_batch(size_t n, const float *p,
             const float a2_odd = a2_j - 2*a2_h;
             const float sin2 = (1 - 2*a2_h)*((1 - a2_odd)*a2_s + a2_odd*a2_c);
             c_K_across_lanes[k] = -0.0126491105F*u0*(-10*u1 + 4*x - 75);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_K_1_lanes[k] = 1.0F/8.0F + (-3.0F/3200.0F)*x;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_K_1_lanes[k] = 1.0F/8.0F + (-3.0F/3200.0F)*xp0_lanes[k];
             c_K_2_lanes[k] = (1.0F/250.0F)*(-2*sin2/sin1 + 5/cos1)/(sin1*sin1);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*((9.601559e-16F)*x + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((9.601559e-16F)*xp1_lanes[k] + 2.5386663e-14F) + 6.76057e-13F) + 1.8172056e-11F) + 4.94647e-10F) + 1.370957e-08F) + 3.908203e-07F) + 3.0F/256000.0F) + 317.0F/800000.0F) + 11.0F/400.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

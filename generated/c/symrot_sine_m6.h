@@ -170,8 +170,11 @@ static inline void symrot_sine_m6_rotation_matrix(const double p[3], double R[9]
  */
 static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 5.286206912907945;
+    const double u0_safe = 1.0/sqrt(36 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -180,24 +183,30 @@ static inline void symrot_sine_m6_rotation_matrix_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.286206912907945 ? x : 0;
             if (!(x < 27.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
             } else {
                 const double u0 = 1.0/sqrt(36 - x);
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 5.286206912907945 ? x_safe : x;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
+            const double x_b = x_b_lanes[k];
             c_R_1_lanes[k] = -1.0/1458.0*u0*(x - 36)*(x - 27)*(x - 9);
-            c_R_2_lanes[k] = (1.0/18.0)*(((1.0/9.0)*x - 3)*((1.0/9.0)*x - 3));
-            poly_R_2_lanes[k] = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
+            c_R_2_lanes[k] = (1.0/18.0)*(((1.0/9.0)*x_b - 3)*((1.0/9.0)*x_b - 3));
+            poly_R_2_lanes[k] = xp0_lanes[k]*((1.0/1458.0)*xp0_lanes[k] - 1.0/27.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -254,8 +263,13 @@ static inline void symrot_sine_m6_tangent(const double p[3], double H[9])
  */
 static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 5.286206912907945;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m6__phi(s_safe);
+    const double u0_safe = 1.0/sqrt(36 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -264,28 +278,30 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.286206912907945 ? x : 0;
             if (!(x < 27.0)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m6__phi(s);
                 const double u0 = 1.0/sqrt(36 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                phi_b_lanes[k] = x < 5.286206912907945 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/3.0)*phi;
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/3.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -299,7 +315,7 @@ static inline void symrot_sine_m6_tangent_batch(size_t n, const double *p, doubl
             const double w0 = (1.0/1458.0)*u0;
             c_H_across_lanes[k] = -w0*(x - 36)*(x - 27)*(x - 9);
             c_H_1_lanes[k] = (1.0/18.0)*((-2*cos0 - 1)*(-2*cos0 - 1));
-            poly_H_1_lanes[k] = x*((1.0/1458.0)*x - 1.0/27.0) + 1.0/2.0;
+            poly_H_1_lanes[k] = xp0_lanes[k]*((1.0/1458.0)*xp0_lanes[k] - 1.0/27.0) + 1.0/2.0;
             c_H_2_lanes[k] = w0*((x*x) - 72*x + 1539);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -369,6 +385,9 @@ static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double u0_safe = sqrt(36 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -378,7 +397,7 @@ static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 27.0)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double u0 = sqrt(36 - x);
                 u0_lanes[k] = u0;
@@ -386,7 +405,7 @@ static inline void symrot_sine_m6_tangent_inverse_batch(size_t n, const double *
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -474,8 +493,12 @@ static inline void symrot_sine_m6_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 2.8209394684181164;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m6__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -484,21 +507,27 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 2.8209394684181164 ? x : 0;
             if (!(x < 27.0) || x < 2.8209394684181164) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m6__phi(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -512,8 +541,8 @@ static inline void symrot_sine_m6_root_matrix_batch(size_t n, const double *p, d
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_G_1_lanes[k] = 1.0/2.0 - 1.0/54.0*x;
-            c_G_2_lanes[k] = (1 - cos0)/x;
-            poly_G_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((-1.2798620772933016e-22)*x - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            c_G_2_lanes[k] = (1 - cos0)/xc;
+            poly_G_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-1.2798620772933016e-22)*xp0_lanes[k] - 5.2819704777183876e-21) - 2.2097540491204167e-19) - 9.39964944884163e-18) - 4.0821334749255076e-16) - 1.820598476104429e-14) - 5.0/5944066965504.0) - 91.0/2229025112064.0) - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -573,8 +602,12 @@ static inline void symrot_sine_m6_root_tangent(const double p[3], double K[9])
  */
 static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 5.286206912907945;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_sine_m6__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -583,21 +616,29 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.05760039934430118 ? x : 0;
+            xp1_lanes[k] = x < 5.286206912907945 ? x : 0;
             if (!(x < 27.0) || x < 0.05760039934430118) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_sine_m6__phi(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/4.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -632,10 +673,10 @@ static inline void symrot_sine_m6_root_tangent_batch(size_t n, const double *p, 
             const double w0 = 2*(sin0*sin0);
             const double w1 = (sin1*sin1);
             c_K_across_lanes[k] = 1.0/2.0 - 1.0/54.0*x;
-            c_K_1_lanes[k] = w0/x;
-            poly_K_1_lanes[k] = x*(x*(x*(x*((-91.0/2229025112064.0)*x - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
+            c_K_1_lanes[k] = w0/xc;
+            poly_K_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((-91.0/2229025112064.0)*xp0_lanes[k] - 11.0/5159780352.0) - 1.0/7962624.0) - 7.0/746496.0) - 5.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = (1.0/216.0)*(w0 + 4*w1)/((sin2*sin2)*(1 - 2*w1));
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.7314656570180201e-31)*x + 6.401743294055816e-30) + 2.370474088313239e-28) + 8.792303891198196e-27) + 3.2673335750517166e-25) + 1.2168000900192599e-23) + 4.542720336071904e-22) + 1.7007944938253208e-20) + 6.389071489848162e-19) + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((1.7314656570180201e-31)*xp1_lanes[k] + 6.401743294055816e-30) + 2.370474088313239e-28) + 8.792303891198196e-27) + 3.2673335750517166e-25) + 1.2168000900192599e-23) + 4.542720336071904e-22) + 1.7007944938253208e-20) + 6.389071489848162e-19) + 2.4095926761713065e-17) + 9.131088036017582e-16) + 3.4805559101996437e-14) + 143.0/106993205379072.0) + 77.0/1486016741376.0) + 7.0/3439853568.0) + 35.0/429981696.0) + 5.0/1492992.0) + 1.0/6912.0) + 11.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1458,8 +1499,11 @@ static inline void symrot_sine_m6_rotation_matrix_f(const float p[3], float R[9]
  */
 static inline void symrot_sine_m6_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.2862067F;
+    const float u0_safe = 1.0F/sqrtf(36 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1468,24 +1512,30 @@ static inline void symrot_sine_m6_rotation_matrix_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.2862067F ? x : 0;
             if (!(x < 27.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
             } else {
                 const float u0 = 1.0F/sqrtf(36 - x);
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 5.2862067F ? x_safe : x;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
+            const float x_b = x_b_lanes[k];
             c_R_1_lanes[k] = -1.0F/1458.0F*u0*(x - 36)*(x - 27)*(x - 9);
-            c_R_2_lanes[k] = (1.0F/18.0F)*(((1.0F/9.0F)*x - 3)*((1.0F/9.0F)*x - 3));
-            poly_R_2_lanes[k] = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1.0F/18.0F)*(((1.0F/9.0F)*x_b - 3)*((1.0F/9.0F)*x_b - 3));
+            poly_R_2_lanes[k] = xp0_lanes[k]*((1.0F/1458.0F)*xp0_lanes[k] - 1.0F/27.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1542,8 +1592,13 @@ static inline void symrot_sine_m6_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.2862067F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m6__phi_f(s_safe);
+    const float u0_safe = 1.0F/sqrtf(36 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1552,28 +1607,30 @@ static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, floa
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 5.2862067F ? x : 0;
             if (!(x < 27.0F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m6__phi_f(s);
                 const float u0 = 1.0F/sqrtf(36 - x);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                phi_b_lanes[k] = x < 5.2862067F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/6.0F)*phi;
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/6.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1586,7 +1643,7 @@ static inline void symrot_sine_m6_tangent_f_batch(size_t n, const float *p, floa
             const float w0 = (1.0F/1458.0F)*u0;
             c_H_across_lanes[k] = -w0*(x - 36)*(x - 27)*(x - 9);
             c_H_1_lanes[k] = (1.0F/18.0F)*((4*(sin0*sin0) - 3)*(4*(sin0*sin0) - 3));
-            poly_H_1_lanes[k] = x*((1.0F/1458.0F)*x - 1.0F/27.0F) + 1.0F/2.0F;
+            poly_H_1_lanes[k] = xp0_lanes[k]*((1.0F/1458.0F)*xp0_lanes[k] - 1.0F/27.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = w0*((x*x) - 72*x + 1539);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1656,6 +1713,9 @@ static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float 
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float u0_safe = sqrtf(36 - x_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1665,7 +1725,7 @@ static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float 
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 27.0F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float u0 = sqrtf(36 - x);
                 u0_lanes[k] = u0;
@@ -1673,7 +1733,7 @@ static inline void symrot_sine_m6_tangent_inverse_f_batch(size_t n, const float 
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1761,8 +1821,12 @@ static inline void symrot_sine_m6_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.2122961F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m6__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1771,21 +1835,27 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.2122961F ? x : 0;
             if (!(x < 27.0F) || x < 0.2122961F) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m6__phi_f(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1798,8 +1868,8 @@ static inline void symrot_sine_m6_root_matrix_f_batch(size_t n, const float *p, 
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 1.0F/2.0F - 1.0F/54.0F*x;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = x*((-7.0F/746496.0F)*x - 5.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_G_2_lanes[k] = xp0_lanes[k]*((-7.0F/746496.0F)*xp0_lanes[k] - 5.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1859,8 +1929,12 @@ static inline void symrot_sine_m6_root_tangent_f(const float p[3], float K[9])
  */
 static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 5.2862067F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_sine_m6__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1869,21 +1943,29 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.2122961F ? x : 0;
+            xp1_lanes[k] = x < 5.2862067F ? x : 0;
             if (!(x < 27.0F) || x < 0.2122961F) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_sine_m6__phi_f(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/4.0F)*phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1919,10 +2001,10 @@ static inline void symrot_sine_m6_root_tangent_f_batch(size_t n, const float *p,
             const float a2_up = fabsf(a2_j - 1.5F) - 0.5F;
             const float cos2 = (2*a2_up - 1)*((1 - a2_odd)*a2_c + a2_odd*a2_s);
             c_K_across_lanes[k] = 1.0F/2.0F - 1.0F/54.0F*x;
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_K_1_lanes[k] = x*((-7.0F/746496.0F)*x - 5.0F/3456.0F) + 1.0F/8.0F;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_K_1_lanes[k] = xp0_lanes[k]*((-7.0F/746496.0F)*xp0_lanes[k] - 5.0F/3456.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (1.0F/216.0F)*(-2*cos1 - cos2 + 3)/(cos1*(sin1*sin1));
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*((3.480556e-14F)*x + 1.3365334e-12F) + 5.1816374e-11F) + 2.0349704e-09F) + 8.139882e-08F) + 5.0F/1492992.0F) + 1.0F/6912.0F) + 11.0F/432.0F;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((3.480556e-14F)*xp1_lanes[k] + 1.3365334e-12F) + 5.1816374e-11F) + 2.0349704e-09F) + 8.139882e-08F) + 5.0F/1492992.0F) + 1.0F/6912.0F) + 11.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

@@ -171,6 +171,10 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double u0_safe = 1.0/sqrt(x_safe + 1);
+    const double u1_safe = sqrt(x_safe + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -180,8 +184,8 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const double u0 = 1.0/sqrt(x + 1);
                 const double u1 = sqrt(x + 1);
@@ -191,8 +195,8 @@ static inline void symrot_tangent_m1_rotation_matrix_batch(size_t n, const doubl
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -252,6 +256,10 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double u0_safe = 1.0/sqrt(x_safe + 1);
+    const double u1_safe = sqrt(x_safe + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -261,8 +269,8 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const double u0 = 1.0/sqrt(x + 1);
                 const double u1 = sqrt(x + 1);
@@ -272,8 +280,8 @@ static inline void symrot_tangent_m1_tangent_batch(size_t n, const double *p, do
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -352,6 +360,9 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
 {
     double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.0;
+    const double u0_safe = sqrt(x_safe + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -361,7 +372,7 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 6.703903964971299e+153)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const double u0 = sqrt(x + 1);
                 u0_lanes[k] = u0;
@@ -369,7 +380,7 @@ static inline void symrot_tangent_m1_tangent_inverse_batch(size_t n, const doubl
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -459,8 +470,14 @@ static inline void symrot_tangent_m1_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 7.889013259849922e-06;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m1__phi(s_safe);
+    const double u0_safe = pow(x_safe + 1, -1.0/4.0);
+    const double u1_safe = 1.0/sqrt(sqrt(x_safe + 1) + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -469,33 +486,38 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 7.889013259849922e-06 ? x : 0;
             if (!(x < 6.703903964971299e+153)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m1__phi(s);
                 const double u0 = pow(x + 1, -1.0/4.0);
                 const double u1 = 1.0/sqrt(sqrt(x + 1) + 1);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 7.889013259849922e-06 ? x_safe : x;
+                phi_b_lanes[k] = x < 7.889013259849922e-06 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -506,8 +528,8 @@ static inline void symrot_tangent_m1_root_matrix_batch(size_t n, const double *p
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.7071067811865476*u0*u1;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(69.0/1024.0 + (-1843.0/32768.0)*xp0_lanes[k]) - 11.0/128.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -572,8 +594,16 @@ static inline void symrot_tangent_m1_root_tangent(const double p[3], double K[9]
  */
 static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], u2_lanes[SYMROT_BATCH_BLOCK], u3_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], s_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], u2_b_lanes[SYMROT_BATCH_BLOCK], u3_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.13182630716008584;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m1__phi(s_safe);
+    const double u0_safe = pow(x_safe + 1, -1.0/4.0);
+    const double u1_safe = 1.0/sqrt(sqrt(x_safe + 1) + 1);
+    const double u2_safe = 1.0/sqrt(x_safe + 1);
+    const double u3_safe = sqrt(x_safe + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -582,13 +612,16 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 7.889013259849922e-06 ? x : 0;
+            xp1_lanes[k] = x < 0.13182630716008584 ? x : 0;
             if (!(x < 6.703903964971299e+153)) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
-                u2_lanes[k] = 0;
-                u3_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                s_b_lanes[k] = s_safe;
+                phi_b_lanes[k] = phi_safe;
+                u2_b_lanes[k] = u2_safe;
+                u3_b_lanes[k] = u3_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m1__phi(s);
@@ -596,33 +629,37 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
                 const double u1 = 1.0/sqrt(sqrt(x + 1) + 1);
                 const double u2 = 1.0/sqrt(x + 1);
                 const double u3 = sqrt(x + 1);
-                s_lanes[k] = s;
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
-                u2_lanes[k] = u2;
-                u3_lanes[k] = u3;
+                x_b_lanes[k] = x < 7.889013259849922e-06 ? x_safe : x;
+                s_b_lanes[k] = x < 7.889013259849922e-06 ? s_safe : s;
+                phi_b_lanes[k] = x < 7.889013259849922e-06 ? phi_safe : phi;
+                u2_b_lanes[k] = x < 7.889013259849922e-06 ? u2_safe : u2;
+                u3_b_lanes[k] = x < 7.889013259849922e-06 ? u3_safe : u3;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
-            u2_lanes[k] = 0;
-            u3_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            s_b_lanes[k] = s_safe;
+            phi_b_lanes[k] = phi_safe;
+            u2_b_lanes[k] = u2_safe;
+            u3_b_lanes[k] = u3_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
-            const double s = s_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double u2 = u2_lanes[k];
-            const double u3 = u3_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double s_b = s_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double u2_b = u2_b_lanes[k];
+            const double u3_b = u3_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -632,7 +669,7 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double a0_h = SYMROT_NEAREST(0.5*a0_j - 0.25);
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const double a1_a = (1.0/2.0)*phi;
+            const double a1_a = (1.0/2.0)*phi_b;
             const double a1_q = SYMROT_NEAREST(a1_a*0.6366197723675814);
             const double a1_r = ((a1_a - a1_q*1.5707963267341256) - a1_q*6.077100506303966e-11) - a1_q*2.0222662487959506e-21;
             const double a1_z = a1_r*a1_r;
@@ -642,13 +679,13 @@ static inline void symrot_tangent_m1_root_tangent_batch(size_t n, const double *
             const double a1_h = SYMROT_NEAREST(0.5*a1_j - 0.25);
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const double w0 = (u2);
-            const double w1 = (w0*w0);
+            const double wb0 = (u2_b);
+            const double wb1 = (wb0*wb0);
             c_K_across_lanes[k] = 0.7071067811865476*u0*u1;
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_K_1_lanes[k] = x*(x*(69.0/1024.0 + (-1843.0/32768.0)*x) - 11.0/128.0) + 1.0/8.0;
-            c_K_2_lanes[k] = w1*((1.0/2.0)*w1 - sin1*u3*w0/s)*(x + 1)/(s*s);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.47625591867487393 + (-0.47722211539750203)*x) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_K_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(69.0/1024.0 + (-1843.0/32768.0)*xp0_lanes[k]) - 11.0/128.0) + 1.0/8.0;
+            c_K_2_lanes[k] = wb1*((1.0/2.0)*wb1 - sin1*u3_b*wb0/s_b)*(x_b + 1)/(s_b*s_b);
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(0.47625591867487393 + (-0.47722211539750203)*xp1_lanes[k]) - 0.475190154200298) + 0.47400783569906246) - 0.47268778690839536) + 0.4712032458464977) - 528632373098951.0/1125899906842624.0) + 65807833774545.0/140737488355328.0) - 2046684569059.0/4398046511104.0) + 254397564703.0/549755813888.0) - 15792803391.0/34359738368.0) + 1957859757.0/4294967296.0) - 30276245.0/67108864.0) + 3734069.0/8388608.0) - 229179.0/524288.0) + 27909.0/65536.0) - 837.0/2048.0) + 97.0/256.0) - 5.0/16.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1439,6 +1476,10 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float u0_safe = 1.0F/sqrtf(x_safe + 1);
+    const float u1_safe = sqrtf(x_safe + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1448,8 +1489,8 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float u0 = 1.0F/sqrtf(x + 1);
                 const float u1 = sqrtf(x + 1);
@@ -1459,8 +1500,8 @@ static inline void symrot_tangent_m1_rotation_matrix_f_batch(size_t n, const flo
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1520,6 +1561,10 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float u0_safe = 1.0F/sqrtf(x_safe + 1);
+    const float u1_safe = sqrtf(x_safe + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1529,8 +1574,8 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
             } else {
                 const float u0 = 1.0F/sqrtf(x + 1);
                 const float u1 = sqrtf(x + 1);
@@ -1540,8 +1585,8 @@ static inline void symrot_tangent_m1_tangent_f_batch(size_t n, const float *p, f
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1620,6 +1665,9 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
 {
     float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.0F;
+    const float u0_safe = sqrtf(x_safe + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1629,7 +1677,7 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
             } else {
                 const float u0 = sqrtf(x + 1);
                 u0_lanes[k] = u0;
@@ -1637,7 +1685,7 @@ static inline void symrot_tangent_m1_tangent_inverse_f_batch(size_t n, const flo
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1727,8 +1775,14 @@ static inline void symrot_tangent_m1_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.0009788593F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m1__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 1, -1.0F/4.0F);
+    const float u1_safe = 1.0F/sqrtf(sqrtf(x_safe + 1) + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1737,33 +1791,38 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.0009788593F ? x : 0;
             if (!(x < 9.223372e+18F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m1__phi_f(s);
                 const float u0 = powf(x + 1, -1.0F/4.0F);
                 const float u1 = 1.0F/sqrtf(sqrtf(x + 1) + 1);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.0009788593F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.0009788593F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1774,8 +1833,8 @@ static inline void symrot_tangent_m1_root_matrix_f_batch(size_t n, const float *
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = 0.70710677F*u0*u1;
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = xp0_lanes[k]*((69.0F/1024.0F)*xp0_lanes[k] - 11.0F/128.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1837,8 +1896,14 @@ static inline void symrot_tangent_m1_root_tangent_f(const float p[3], float K[9]
  */
 static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], s_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.2589544F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m1__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 1, -1.0F/4.0F);
+    const float u1_safe = 1.0F/sqrtf(sqrtf(x_safe + 1) + 1);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1847,37 +1912,44 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.0009788593F ? x : 0;
+            xp1_lanes[k] = x < 0.2589544F ? x : 0;
             if (!(x < 9.223372e+18F)) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                s_b_lanes[k] = s_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m1__phi_f(s);
                 const float u0 = powf(x + 1, -1.0F/4.0F);
                 const float u1 = 1.0F/sqrtf(sqrtf(x + 1) + 1);
-                s_lanes[k] = s;
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.0009788593F ? x_safe : x;
+                s_b_lanes[k] = x < 0.0009788593F ? s_safe : s;
+                phi_b_lanes[k] = x < 0.0009788593F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            s_b_lanes[k] = s_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
-            const float s = s_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float s_b = s_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1887,7 +1959,7 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float a0_h = SYMROT_NEARESTF(0.5F*a0_j - 0.25F);
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
-            const float a1_a = (1.0F/2.0F)*phi;
+            const float a1_a = (1.0F/2.0F)*phi_b;
             const float a1_q = SYMROT_NEARESTF(a1_a*0.63661975F);
             const float a1_r = ((a1_a - a1_q*1.5708008F) - a1_q*-4.4543995e-06F) - a1_q*-5.5644316e-11F;
             const float a1_z = a1_r*a1_r;
@@ -1897,12 +1969,12 @@ static inline void symrot_tangent_m1_root_tangent_f_batch(size_t n, const float 
             const float a1_h = SYMROT_NEARESTF(0.5F*a1_j - 0.25F);
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
-            const float w0 = 1.0F/x;
+            const float wb0 = 1.0F/x_b;
             c_K_across_lanes[k] = 0.70710677F*u0*u1;
-            c_K_1_lanes[k] = 2*(sin0*sin0)*w0;
-            poly_K_1_lanes[k] = x*((69.0F/1024.0F)*x - 11.0F/128.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = w0*((1.0F/2.0F)/(x + 1) - sin1/s);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.47120324F)*x - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
+            c_K_1_lanes[k] = 2*(sin0*sin0)*wb0;
+            poly_K_1_lanes[k] = xp0_lanes[k]*((69.0F/1024.0F)*xp0_lanes[k] - 11.0F/128.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = wb0*((1.0F/2.0F)/(x_b + 1) - sin1/s_b);
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((0.47120324F)*xp1_lanes[k] - 0.46951985F) + 0.46759278F) - 0.4653622F) + 0.46274647F) - 0.4596311F) + 0.45584974F) - 0.4511512F) + 3734069.0F/8388608.0F) - 229179.0F/524288.0F) + 27909.0F/65536.0F) - 837.0F/2048.0F) + 97.0F/256.0F) - 5.0F/16.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

@@ -230,8 +230,13 @@ static inline void symrot_tangent_m3_rotation_matrix(const double p[3], double R
  */
 static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.00021086444550021482;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m3__phi(s_safe);
+    const double u0_safe = pow(x_safe + 9, -3.0/2.0);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -240,28 +245,34 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.00021086444550021482 ? x : 0;
             if (!(x < 6.703903964971299e+153)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m3__phi(s);
                 const double u0 = pow(x + 9, -3.0/2.0);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 0.00021086444550021482 ? x_safe : x;
+                phi_b_lanes[k] = x < 0.00021086444550021482 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/2.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -272,8 +283,8 @@ static inline void symrot_tangent_m3_rotation_matrix_batch(size_t n, const doubl
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = -u0*(x - 27);
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(125.0/11664.0 + (-385.0/279936.0)*xp0_lanes[k]) - 17.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -332,8 +343,14 @@ static inline void symrot_tangent_m3_tangent(const double p[3], double H[9])
  */
 static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.00021086444550021482;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m3__phi(s_safe);
+    const double u0_safe = pow(x_safe + 9, -3.0/2.0);
+    const double u1_safe = sqrt(x_safe + 9);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -342,33 +359,39 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.00021086444550021482 ? x : 0;
             if (!(x < 6.703903964971299e+153)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m3__phi(s);
                 const double u0 = pow(x + 9, -3.0/2.0);
                 const double u1 = sqrt(x + 9);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.00021086444550021482 ? x_safe : x;
+                phi_b_lanes[k] = x < 0.00021086444550021482 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/2.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -379,8 +402,8 @@ static inline void symrot_tangent_m3_tangent_batch(size_t n, const double *p, do
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_H_across_lanes[k] = -u0*(x - 27);
-            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_H_1_lanes[k] = x*(x*(125.0/11664.0 + (-385.0/279936.0)*x) - 17.0/216.0) + 1.0/2.0;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(125.0/11664.0 + (-385.0/279936.0)*xp0_lanes[k]) - 17.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = u0*(u1 + 12)/(u1 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -457,8 +480,12 @@ static inline void symrot_tangent_m3_tangent_inverse(const double p[3], double H
  */
 static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.9011961863057328e-14;
+    const double u0_safe = sqrt(x_safe + 9);
+    const double u1_safe = 1.0/sqrt(x_safe + 9);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -467,31 +494,40 @@ static inline void symrot_tangent_m3_tangent_inverse_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.9011961863057328e-14 ? x : 0;
             if (!(x < 6.703903964971299e+153)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                u0_b_lanes[k] = u0_safe;
             } else {
                 const double u0 = sqrt(x + 9);
                 const double u1 = 1.0/sqrt(x + 9);
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 1.9011961863057328e-14 ? x_safe : x;
+                u0_b_lanes[k] = x < 1.9011961863057328e-14 ? u0_safe : u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            u0_b_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double w0 = 54*u0 + 162;
-            const double w1 = 2*u0*x;
-            c_H_inverse_across_lanes[k] = (w0 - (x*x) + 9*x)/(w0 + w1 + 18*x);
-            poly_H_inverse_across_lanes[k] = 1 + (-5.0/108.0)*x;
-            c_H_inverse_2_lanes[k] = (1.0/18.0)*u1*(72*u0 + w1 + 27*x + 243)/((u0 + 3)*(u0 + 6));
+            const double x_b = x_b_lanes[k];
+            const double u0_b = u0_b_lanes[k];
+            const double wb0 = 54*u0_b + 162;
+            c_H_inverse_across_lanes[k] = (wb0 - (x_b*x_b) + 9*x_b)/(2*u0_b*x_b + wb0 + 18*x_b);
+            poly_H_inverse_across_lanes[k] = 1 + (-5.0/108.0)*xp0_lanes[k];
+            c_H_inverse_2_lanes[k] = (1.0/18.0)*u1*(2*u0*x + 72*u0 + 27*x + 243)/((u0 + 3)*(u0 + 6));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -585,8 +621,12 @@ static inline void symrot_tangent_m3_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.000762210562920323;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m3__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -595,24 +635,31 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.9011961863057328e-14 ? x : 0;
+            xp1_lanes[k] = x < 0.000762210562920323 ? x : 0;
             if (!(x < 6.703903964971299e+153) || x < 1.9011961863057328e-14) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m3__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -636,9 +683,9 @@ static inline void symrot_tangent_m3_root_matrix_batch(size_t n, const double *p
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-17.0/432.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*(x*(893.0/746496.0 + (-8881.0/71663616.0)*x) - 41.0/3456.0) + 1.0/8.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-17.0/432.0)*xp0_lanes[k];
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(893.0/746496.0 + (-8881.0/71663616.0)*xp1_lanes[k]) - 41.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -704,8 +751,12 @@ static inline void symrot_tangent_m3_root_tangent(const double p[3], double K[9]
  */
 static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], xp2_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 1.9390924142768158;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m3__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -714,24 +765,33 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 1.3064949572958123e-13 ? x : 0;
+            xp1_lanes[k] = x < 0.000762210562920323 ? x : 0;
+            xp2_lanes[k] = x < 1.9390924142768158 ? x : 0;
             if (!(x < 6.703903964971299e+153) || x < 1.3064949572958123e-13) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m3__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xp2_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -755,13 +815,13 @@ static inline void symrot_tangent_m3_root_tangent_batch(size_t n, const double *
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = sin0/s;
-            const double w1 = 1.0/x;
+            const double w1 = 1.0/xc;
             c_K_across_lanes[k] = w0;
-            poly_K_across_lanes[k] = 1.0/2.0 + (-17.0/432.0)*x;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-17.0/432.0)*xp0_lanes[k];
             c_K_1_lanes[k] = 2*(sin1*sin1)*w1;
-            poly_K_1_lanes[k] = x*(x*(893.0/746496.0 + (-8881.0/71663616.0)*x) - 41.0/3456.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/6.0)*w1*(-6*w0 + 27/(x + 9));
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.283158801167867e-22)*x - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
+            poly_K_1_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(893.0/746496.0 + (-8881.0/71663616.0)*xp1_lanes[k]) - 41.0/3456.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/6.0)*w1*(-6*w0 + 27/(xc + 9));
+            poly_K_2_lanes[k] = xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*((3.283158801167867e-22)*xp2_lanes[k] - 2.936349968013743e-21) + 2.6250714821939694e-20) - 2.3456830392599986e-19) + 2.09491161556633e-18) - 1.869813694416324e-17) + 1.6677411314795434e-16) - 1.4863102222282952e-15) + 1.3233735440126437e-14) - 1.1769941338107582e-13) + 1.0454215169703628e-12) - 9.27068998004002e-12) + 8.204914131270907e-11) - 7.243621244018309e-10) + 6.374471834668669e-09) - 53787143.0/962938848411648.0) + 241021.0/495338913792.0) - 130099.0/30958682112.0) + 15397.0/429981696.0) - 445.0/1492992.0) + 49.0/20736.0) - 7.0/432.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1577,8 +1637,13 @@ static inline void symrot_tangent_m3_rotation_matrix_f(const float p[3], float R
  */
 static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.036088683F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m3__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 9, -3.0F/2.0F);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1587,28 +1652,34 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.036088683F ? x : 0;
             if (!(x < 9.223372e+18F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m3__phi_f(s);
                 const float u0 = powf(x + 9, -3.0F/2.0F);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 0.036088683F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.036088683F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1619,8 +1690,8 @@ static inline void symrot_tangent_m3_rotation_matrix_f_batch(size_t n, const flo
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = -u0*(x - 27);
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(125.0F/11664.0F + (-385.0F/279936.0F)*xp0_lanes[k]) - 17.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1679,8 +1750,14 @@ static inline void symrot_tangent_m3_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.036088683F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m3__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 9, -3.0F/2.0F);
+    const float u1_safe = sqrtf(x_safe + 9);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1689,33 +1766,39 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.036088683F ? x : 0;
             if (!(x < 9.223372e+18F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m3__phi_f(s);
                 const float u0 = powf(x + 9, -3.0F/2.0F);
                 const float u1 = sqrtf(x + 9);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.036088683F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.036088683F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1726,8 +1809,8 @@ static inline void symrot_tangent_m3_tangent_f_batch(size_t n, const float *p, f
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_H_across_lanes[k] = -u0*(x - 27);
-            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_H_1_lanes[k] = x*(x*(125.0F/11664.0F + (-385.0F/279936.0F)*x) - 17.0F/216.0F) + 1.0F/2.0F;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(125.0F/11664.0F + (-385.0F/279936.0F)*xp0_lanes[k]) - 17.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = u0*(u1 + 12)/(u1 + 3);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1804,8 +1887,12 @@ static inline void symrot_tangent_m3_tangent_inverse_f(const float p[3], float H
  */
 static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], u0_b_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 1.9011963e-14F;
+    const float u0_safe = sqrtf(x_safe + 9);
+    const float u1_safe = 1.0F/sqrtf(x_safe + 9);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1815,30 +1902,37 @@ static inline void symrot_tangent_m3_tangent_inverse_f_batch(size_t n, const flo
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
             if (!(x < 9.223372e+18F)) {
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                u0_b_lanes[k] = u0_safe;
             } else {
                 const float u0 = sqrtf(x + 9);
                 const float u1 = 1.0F/sqrtf(x + 9);
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 1.9011963e-14F ? x_safe : x;
+                u0_b_lanes[k] = x < 1.9011963e-14F ? u0_safe : u0;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            u0_b_lanes[k] = u0_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float w0 = 54*u0 + 162;
-            const float w1 = 2*u0*x;
-            c_H_inverse_across_lanes[k] = (w0 - (x*x) + 9*x)/(w0 + w1 + 18*x);
+            const float x_b = x_b_lanes[k];
+            const float u0_b = u0_b_lanes[k];
+            const float wb0 = 54*u0_b + 162;
+            c_H_inverse_across_lanes[k] = (wb0 - (x_b*x_b) + 9*x_b)/(2*u0_b*x_b + wb0 + 18*x_b);
             poly_H_inverse_across_lanes[k] = 1;
-            c_H_inverse_2_lanes[k] = (1.0F/18.0F)*u1*(72*u0 + w1 + 27*x + 243)/((u0 + 3)*(u0 + 6));
+            c_H_inverse_2_lanes[k] = (1.0F/18.0F)*u1*(2*u0*x + 72*u0 + 27*x + 243)/((u0 + 3)*(u0 + 6));
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1932,8 +2026,12 @@ static inline void symrot_tangent_m3_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.00996503F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m3__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1942,24 +2040,29 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.00996503F ? x : 0;
             if (!(x < 9.223372e+18F) || x < 1.9011963e-14F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m3__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -1984,8 +2087,8 @@ static inline void symrot_tangent_m3_root_matrix_f_batch(size_t n, const float *
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp0_lanes[k]*((893.0F/746496.0F)*xp0_lanes[k] - 41.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2051,8 +2154,12 @@ static inline void symrot_tangent_m3_root_tangent_f(const float p[3], float K[9]
  */
 static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 4.1981263F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m3__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2061,24 +2168,31 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.00996503F ? x : 0;
+            xp1_lanes[k] = x < 4.1981263F ? x : 0;
             if (!(x < 9.223372e+18F) || x < 1.9011963e-14F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m3__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2102,13 +2216,13 @@ static inline void symrot_tangent_m3_root_tangent_f_batch(size_t n, const float 
             const float a1_odd = a1_j - 2*a1_h;
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float w0 = sin0/s;
-            const float w1 = 1.0F/x;
+            const float w1 = 1.0F/xc;
             c_K_across_lanes[k] = w0;
             poly_K_across_lanes[k] = 1.0F/2.0F;
             c_K_1_lanes[k] = 2*(sin1*sin1)*w1;
-            poly_K_1_lanes[k] = x*((893.0F/746496.0F)*x - 41.0F/3456.0F) + 1.0F/8.0F;
-            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(-6*w0 + 27/(x + 9));
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((3.2831588e-22F)*x - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
+            poly_K_1_lanes[k] = xp0_lanes[k]*((893.0F/746496.0F)*xp0_lanes[k] - 41.0F/3456.0F) + 1.0F/8.0F;
+            c_K_2_lanes[k] = (1.0F/6.0F)*w1*(-6*w0 + 27/(xc + 9));
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((3.2831588e-22F)*xp1_lanes[k] - 2.93635e-21F) + 2.6250714e-20F) - 2.345683e-19F) + 2.0949116e-18F) - 1.8698137e-17F) + 1.6677412e-16F) - 1.4863102e-15F) + 1.3233735e-14F) - 1.1769942e-13F) + 1.0454216e-12F) - 9.27069e-12F) + 8.204914e-11F) - 7.243621e-10F) + 6.3744716e-09F) - 5.5857278e-08F) + 4.8657796e-07F) - 4.202343e-06F) + 3.58085e-05F) - 445.0F/1492992.0F) + 49.0F/20736.0F) - 7.0F/432.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

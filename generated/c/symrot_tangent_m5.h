@@ -261,8 +261,13 @@ static inline void symrot_tangent_m5_rotation_matrix(const double p[3], double R
  */
 static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 3.327466630718667e-08;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m5__phi(s_safe);
+    const double u0_safe = pow(x_safe + 25, -5.0/2.0);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -271,28 +276,34 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 3.327466630718667e-08 ? x : 0;
             if (!(x <= 236.80339887498948)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m5__phi(s);
                 const double u0 = pow(x + 25, -5.0/2.0);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 3.327466630718667e-08 ? x_safe : x;
+                phi_b_lanes[k] = x < 3.327466630718667e-08 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/2.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -303,8 +314,8 @@ static inline void symrot_tangent_m5_rotation_matrix_batch(size_t n, const doubl
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = u0*((x*x) - 250*x + 3125);
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = 1.0/2.0 + (-11.0/200.0)*x;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_R_2_lanes[k] = 1.0/2.0 + (-11.0/200.0)*xp0_lanes[k];
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -365,8 +376,13 @@ static inline void symrot_tangent_m5_tangent(const double p[3], double H[9])
  */
 static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], s_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 3.1374537386488126;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m5__phi(s_safe);
+    const double u0_safe = pow(x_safe + 25, -5.0/2.0);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -375,32 +391,40 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 3.327466630718667e-08 ? x : 0;
+            xp1_lanes[k] = x < 3.1374537386488126 ? x : 0;
             if (!(x <= 236.80339887498948)) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                s_b_lanes[k] = s_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m5__phi(s);
                 const double u0 = pow(x + 25, -5.0/2.0);
-                s_lanes[k] = s;
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 3.327466630718667e-08 ? x_safe : x;
+                s_b_lanes[k] = x < 3.327466630718667e-08 ? s_safe : s;
+                phi_b_lanes[k] = x < 3.327466630718667e-08 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            s_b_lanes[k] = s_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double s = s_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/2.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double s_b = s_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/2.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -413,10 +437,10 @@ static inline void symrot_tangent_m5_tangent_batch(size_t n, const double *p, do
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_H_across_lanes[k] = u0*((x*x) - 250*x + 3125);
-            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_H_1_lanes[k] = 1.0/2.0 + (-11.0/200.0)*x;
-            c_H_2_lanes[k] = (-2*cos0*sin0/s + 25/(x + 25))/(s*s);
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((1.051125645265736e-27)*x - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_H_1_lanes[k] = 1.0/2.0 + (-11.0/200.0)*xp0_lanes[k];
+            c_H_2_lanes[k] = (-2*cos0*sin0/s_b + 25/(x_b + 25))/(s_b*s_b);
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((1.051125645265736e-27)*xp1_lanes[k] - 2.44588951572404e-26) + 5.6708756391416e-25) - 1.3095671789444e-23) + 3.01075198814e-22) - 6.88750722374e-21) + 1.56680776016e-19) - 3.5416617464e-18) + 7.947593496e-17) - 1.7685065752e-15) + 3.89671896e-14) - 8.4862964e-13) + 1.822318e-11) - 1923043.0/5000000000000000.0) + 496409.0/62500000000000.0) - 39863.0/250000000000.0) + 7703.0/2500000000.0) - 2819.0/50000000.0) + 237.0/250000.0) - 343.0/25000.0) + 7.0/50.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -486,8 +510,12 @@ static inline void symrot_tangent_m5_tangent_inverse(const double p[3], double H
  */
 static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const double *p, double *Hinv)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 6.511791226584059;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m5__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -496,24 +524,31 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 7.091048955981853e-14 ? x : 0;
+            xp1_lanes[k] = x < 6.511791226584059 ? x : 0;
             if (!(x <= 236.80339887498948) || x < 7.091048955981853e-14) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m5__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -528,12 +563,12 @@ static inline void symrot_tangent_m5_tangent_inverse_batch(size_t n, const doubl
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double a0_up = fabs(a0_j - 1.5) - 0.5;
             const double cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const double w0 = 1.0/x;
+            const double w0 = 1.0/xc;
             const double w1 = 4*w0;
             c_H_inverse_across_lanes[k] = (1.0/2.0)*cos0*s/sin0;
-            poly_H_inverse_across_lanes[k] = 1 + (-7.0/100.0)*x;
-            c_H_inverse_2_lanes[k] = w0*(-2*cos0*sin0/(s*((cos0*cos0)*(sin0*sin0)*w1 + (sin0*sin0*sin0*sin0)*w1)) + (1.0/25.0)*x + 1);
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(5.05280601644032e-31 + (-1.66435732114432e-32)*x) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
+            poly_H_inverse_across_lanes[k] = 1 + (-7.0/100.0)*xp0_lanes[k];
+            c_H_inverse_2_lanes[k] = w0*(-2*cos0*sin0/(s*((cos0*cos0)*(sin0*sin0)*w1 + (sin0*sin0*sin0*sin0)*w1)) + (1.0/25.0)*xc + 1);
+            poly_H_inverse_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(5.05280601644032e-31 + (-1.66435732114432e-32)*xp1_lanes[k]) - 1.5515558303232e-29) + 4.825772940544e-28) - 1.52289317888e-26) + 4.8861925888e-25) - 1.597977344e-23) + 5.34371456e-22) - 1.8345344e-20) + 6.500032e-19) - 2.392e-17) + 9.2624e-16) - 117.0/3125000000000000.0) + 113.0/62500000000000.0) - 7.0/125000000000.0) + 29.0/2500000000.0) + 3.0/2500000.0) + 21.0/50000.0) + 11.0/100.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -625,8 +660,12 @@ static inline void symrot_tangent_m5_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 4.3791113590493824e-05;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m5__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -635,24 +674,31 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 3.690968361342381e-14 ? x : 0;
+            xp1_lanes[k] = x < 4.3791113590493824e-05 ? x : 0;
             if (!(x <= 236.80339887498948) || x < 3.690968361342381e-14) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m5__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -676,9 +722,9 @@ static inline void symrot_tangent_m5_root_matrix_batch(size_t n, const double *p
             const double a1_odd = a1_j - 2*a1_h;
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
-            poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
+            poly_G_1_lanes[k] = 1.0/2.0 + (-11.0/400.0)*xp0_lanes[k];
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp1_lanes[k]*((841.0/3200000.0)*xp1_lanes[k] - 19.0/3200.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -741,8 +787,12 @@ static inline void symrot_tangent_m5_root_tangent(const double p[3], double K[9]
  */
 static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], xp2_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 3.1374537386488126;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m5__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -751,24 +801,33 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 3.327466630718667e-08 ? x : 0;
+            xp1_lanes[k] = x < 4.3791113590493824e-05 ? x : 0;
+            xp2_lanes[k] = x < 3.1374537386488126 ? x : 0;
             if (!(x <= 236.80339887498948) || x < 3.327466630718667e-08) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m5__phi(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xp2_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double s = s_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
@@ -793,11 +852,11 @@ static inline void symrot_tangent_m5_root_tangent_batch(size_t n, const double *
             const double sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const double w0 = sin0/s;
             c_K_across_lanes[k] = w0;
-            poly_K_across_lanes[k] = 1.0/2.0 + (-11.0/400.0)*x;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
-            poly_K_1_lanes[k] = x*((841.0/3200000.0)*x - 19.0/3200.0) + 1.0/8.0;
-            c_K_2_lanes[k] = (1.0/10.0)*(-10*w0 + 125/(x + 25))/(s*s);
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((2.2305248050815852e-27)*x - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
+            poly_K_across_lanes[k] = 1.0/2.0 + (-11.0/400.0)*xp0_lanes[k];
+            c_K_1_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_K_1_lanes[k] = xp1_lanes[k]*((841.0/3200000.0)*xp1_lanes[k] - 19.0/3200.0) + 1.0/8.0;
+            c_K_2_lanes[k] = (1.0/10.0)*(-10*w0 + 125/(xc + 25))/(s*s);
+            poly_K_2_lanes[k] = xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*(xp2_lanes[k]*((2.2305248050815852e-27)*xp2_lanes[k] - 5.458460958113583e-26) + 1.333932147343001e-24) - 3.25475952126253e-23) + 7.927399657712331e-22) - 1.9268743820030812e-20) + 4.672437678169924e-19) - 1.1298506238438677e-17) + 2.7230501380662916e-16) - 6.536519294757843e-15) + 1.561316657180786e-13) - 3.706237333679199e-12) + 8.727252294921875e-11) - 832703.0/409600000000000.0) + 238813.0/5120000000000.0) - 26779.0/25600000000.0) + 723.0/32000000.0) - 363.0/800000.0) + 3.0/400.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1705,8 +1764,13 @@ static inline void symrot_tangent_m5_rotation_matrix_f(const float p[3], float R
  */
 static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.41316044F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m5__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 25, -5.0F/2.0F);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1715,28 +1779,34 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.41316044F ? x : 0;
             if (!(x < 236.8034F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m5__phi_f(s);
                 const float u0 = powf(x + 25, -5.0F/2.0F);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 0.41316044F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.41316044F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1748,8 +1818,8 @@ static inline void symrot_tangent_m5_rotation_matrix_f_batch(size_t n, const flo
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = u0*((x*x) - 250*x + 3125);
-            c_R_2_lanes[k] = (1 - cos0)/x;
-            poly_R_2_lanes[k] = x*(x*(x*((1.38012e-05F)*x - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1 - cos0)/x_b;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((1.38012e-05F)*xp0_lanes[k] - 2471.0F/10000000.0F) + 201.0F/50000.0F) - 11.0F/200.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1799,8 +1869,13 @@ static inline void symrot_tangent_m5_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], s_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK], poly_H_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 3.1374536F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m5__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 25, -5.0F/2.0F);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1809,32 +1884,40 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.0081290705F ? x : 0;
+            xp1_lanes[k] = x < 3.1374536F ? x : 0;
             if (!(x < 236.8034F)) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                s_b_lanes[k] = s_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m5__phi_f(s);
                 const float u0 = powf(x + 25, -5.0F/2.0F);
-                s_lanes[k] = s;
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 0.0081290705F ? x_safe : x;
+                s_b_lanes[k] = x < 0.0081290705F ? s_safe : s;
+                phi_b_lanes[k] = x < 0.0081290705F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            s_b_lanes[k] = s_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float s = s_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/2.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float s_b = s_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/2.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1846,12 +1929,12 @@ static inline void symrot_tangent_m5_tangent_f_batch(size_t n, const float *p, f
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
-            const float w0 = 1.0F/x;
+            const float wb0 = 1.0F/x_b;
             c_H_across_lanes[k] = u0*((x*x) - 250*x + 3125);
-            c_H_1_lanes[k] = 2*(sin0*sin0)*w0;
-            poly_H_1_lanes[k] = x*((201.0F/50000.0F)*x - 11.0F/200.0F) + 1.0F/2.0F;
-            c_H_2_lanes[k] = w0*(-2*cos0*sin0/s + 25/(x + 25));
-            poly_H_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(1.822318e-11F + (-8.4862965e-13F)*x) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
+            c_H_1_lanes[k] = 2*(sin0*sin0)*wb0;
+            poly_H_1_lanes[k] = xp0_lanes[k]*((201.0F/50000.0F)*xp0_lanes[k] - 11.0F/200.0F) + 1.0F/2.0F;
+            c_H_2_lanes[k] = wb0*(-2*cos0*sin0/s_b + 25/(x_b + 25));
+            poly_H_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(1.822318e-11F + (-8.4862965e-13F)*xp1_lanes[k]) - 3.846086e-10F) + 7.942544e-09F) - 1.59452e-07F) + 3.0812e-06F) - 5.638e-05F) + 237.0F/250000.0F) - 343.0F/25000.0F) + 7.0F/50.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1921,8 +2004,12 @@ static inline void symrot_tangent_m5_tangent_inverse_f(const float p[3], float H
  */
 static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const float *p, float *Hinv)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_1_lanes[SYMROT_BATCH_BLOCK], c_H_inverse_2_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_across_lanes[SYMROT_BATCH_BLOCK], poly_H_inverse_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 6.5117908F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m5__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1931,24 +2018,29 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 6.5117908F ? x : 0;
             if (!(x < 236.8034F) || x < 7.0910495e-14F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m5__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -1975,11 +2067,11 @@ static inline void symrot_tangent_m5_tangent_inverse_f_batch(size_t n, const flo
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             const float a1_up = fabsf(a1_j - 1.5F) - 0.5F;
             const float cos1 = (2*a1_up - 1)*((1 - a1_odd)*a1_c + a1_odd*a1_s);
-            const float w0 = 1.0F/x;
+            const float w0 = 1.0F/xc;
             c_H_inverse_across_lanes[k] = (1.0F/2.0F)*cos0*s/sin0;
             poly_H_inverse_across_lanes[k] = 1;
-            c_H_inverse_2_lanes[k] = w0*((1.0F/25.0F)*x + 1 - sin1/(s*((sin1*sin1)*w0 + w0*((1 - cos1)*(1 - cos1)))));
-            poly_H_inverse_2_lanes[k] = x*(x*(x*(x*(x*(1.808e-12F + (-3.744e-14F)*x) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
+            c_H_inverse_2_lanes[k] = w0*((1.0F/25.0F)*xc + 1 - sin1/(s*((sin1*sin1)*w0 + w0*((1 - cos1)*(1 - cos1)))));
+            poly_H_inverse_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*(1.808e-12F + (-3.744e-14F)*xp0_lanes[k]) - 5.6e-11F) + 1.16e-08F) + 3.0F/2500000.0F) + 21.0F/50000.0F) + 11.0F/100.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2071,8 +2163,12 @@ static inline void symrot_tangent_m5_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_1_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.0081290705F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m5__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2081,24 +2177,29 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.0081290705F ? x : 0;
             if (!(x < 236.8034F) || x < 3.6909684e-14F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m5__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2123,8 +2224,8 @@ static inline void symrot_tangent_m5_root_matrix_f_batch(size_t n, const float *
             const float sin1 = (1 - 2*a1_h)*((1 - a1_odd)*a1_s + a1_odd*a1_c);
             c_G_1_lanes[k] = sin0/s;
             poly_G_1_lanes[k] = 1.0F/2.0F;
-            c_G_2_lanes[k] = 2*(sin1*sin1)/x;
-            poly_G_2_lanes[k] = x*((841.0F/3200000.0F)*x - 19.0F/3200.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_G_2_lanes[k] = xp0_lanes[k]*((841.0F/3200000.0F)*xp0_lanes[k] - 19.0F/3200.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -2188,8 +2289,12 @@ static inline void symrot_tangent_m5_root_tangent_f(const float p[3], float K[9]
  */
 static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], s_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], xp1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_across_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK], poly_K_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 6.5117908F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m5__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -2198,24 +2303,31 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.0081290705F ? x : 0;
+            xp1_lanes[k] = x < 6.5117908F ? x : 0;
             if (!(x < 236.8034F) || x < 3.6909684e-14F) {
-                s_lanes[k] = 0;
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                s_lanes[k] = s_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m5__phi_f(s);
+                xc_lanes[k] = x;
                 s_lanes[k] = s;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            s_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xp1_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            s_lanes[k] = s_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
-            const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float s = s_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = (1.0F/2.0F)*phi;
@@ -2242,10 +2354,10 @@ static inline void symrot_tangent_m5_root_tangent_f_batch(size_t n, const float 
             const float w1 = (s*s);
             c_K_across_lanes[k] = w0;
             poly_K_across_lanes[k] = 1.0F/2.0F;
-            c_K_1_lanes[k] = 2*(sin1*sin1)/x;
-            poly_K_1_lanes[k] = x*((841.0F/3200000.0F)*x - 19.0F/3200.0F) + 1.0F/8.0F;
+            c_K_1_lanes[k] = 2*(sin1*sin1)/xc;
+            poly_K_1_lanes[k] = xp0_lanes[k]*((841.0F/3200000.0F)*xp0_lanes[k] - 19.0F/3200.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = (-w0 + (1.0F/2.0F)/((1.0F/25.0F)*w1 + 1))/w1;
-            poly_K_2_lanes[k] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((7.9274e-22F)*x - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
+            poly_K_2_lanes[k] = xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*(xp1_lanes[k]*((7.9274e-22F)*xp1_lanes[k] - 1.9268744e-20F) + 4.6724377e-19F) - 1.1298506e-17F) + 2.7230503e-16F) - 6.5365194e-15F) + 1.5613167e-13F) - 3.706237e-12F) + 8.727252e-11F) - 2.0329662e-09F) + 4.6643166e-08F) - 1.0460546e-06F) + 2.259375e-05F) - 363.0F/800000.0F) + 3.0F/400.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {

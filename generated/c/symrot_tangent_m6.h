@@ -226,8 +226,12 @@ static inline void symrot_tangent_m6_rotation_matrix(const double p[3], double R
  */
 static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const double *p, double *R)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.002202034702797594;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m6__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -236,21 +240,27 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.002202034702797594 ? x : 0;
             if (!(x < 108.0) || x < 0.002202034702797594) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -263,8 +273,8 @@ static inline void symrot_tangent_m6_rotation_matrix_batch(size_t n, const doubl
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_R_1_lanes[k] = 36*(x - 108)*(x - 12)/((x + 36)*(x + 36)*(x + 36));
-            c_R_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_R_2_lanes[k] = x*(x*(x*((67.0/10077696.0)*x - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
+            c_R_2_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((67.0/10077696.0)*xp0_lanes[k] - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -321,8 +331,12 @@ static inline void symrot_tangent_m6_tangent(const double p[3], double H[9])
  */
 static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, double *H)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 0.002202034702797594;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m6__phi(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -331,21 +345,27 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.002202034702797594 ? x : 0;
             if (!(x < 108.0) || x < 0.002202034702797594) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
+            const double xc = xc_lanes[k];
             const double phi = phi_lanes[k];
             const double a0_a = (1.0/2.0)*phi;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
@@ -359,8 +379,8 @@ static inline void symrot_tangent_m6_tangent_batch(size_t n, const double *p, do
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             const double w0 = 1.0/((x + 36)*(x + 36)*(x + 36));
             c_H_across_lanes[k] = 36*w0*(x - 108)*(x - 12);
-            c_H_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_H_1_lanes[k] = x*(x*(x*((67.0/10077696.0)*x - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
+            c_H_1_lanes[k] = 2*(sin0*sin0)/xc;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((67.0/10077696.0)*xp0_lanes[k] - 43.0/279936.0) + 73.0/23328.0) - 11.0/216.0) + 1.0/2.0;
             c_H_2_lanes[k] = 6912*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -526,8 +546,13 @@ static inline void symrot_tangent_m6_root_matrix(const double p[3], double G[9])
  */
 static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p, double *G)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 3.2144365899743845e-06;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m6__phi(s_safe);
+    const double u0_safe = pow(x_safe + 36, -3.0/2.0);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -536,28 +561,34 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 3.2144365899743845e-06 ? x : 0;
             if (!(x < 108.0)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
                 const double u0 = pow(x + 36, -3.0/2.0);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 3.2144365899743845e-06 ? x_safe : x;
+                phi_b_lanes[k] = x < 3.2144365899743845e-06 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -568,8 +599,8 @@ static inline void symrot_tangent_m6_root_matrix_batch(size_t n, const double *p
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = -u0*(x - 108);
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = x*((125.0/746496.0)*x - 17.0/3456.0) + 1.0/8.0;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = xp0_lanes[k]*((125.0/746496.0)*xp0_lanes[k] - 17.0/3456.0) + 1.0/8.0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -626,8 +657,14 @@ static inline void symrot_tangent_m6_root_tangent(const double p[3], double K[9]
  */
 static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *p, double *K)
 {
-    double x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
+    double x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const double x_safe = 3.2144365899743845e-06;
+    const double s_safe = sqrt(x_safe);
+    const double phi_safe = symrot_tangent_m6__phi(s_safe);
+    const double u0_safe = pow(x_safe + 36, -3.0/2.0);
+    const double u1_safe = sqrt(x_safe + 36);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -636,33 +673,39 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
             const double *const pk = p + 3 * (start + k);
             const double x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 3.2144365899743845e-06 ? x : 0;
             if (!(x < 108.0)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const double s = sqrt(x);
                 const double phi = symrot_tangent_m6__phi(s);
                 const double u0 = pow(x + 36, -3.0/2.0);
                 const double u1 = sqrt(x + 36);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 3.2144365899743845e-06 ? x_safe : x;
+                phi_b_lanes[k] = x < 3.2144365899743845e-06 ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const double x = x_lanes[k];
-            const double phi = phi_lanes[k];
             const double u0 = u0_lanes[k];
             const double u1 = u1_lanes[k];
-            const double a0_a = (1.0/4.0)*phi;
+            const double x_b = x_b_lanes[k];
+            const double phi_b = phi_b_lanes[k];
+            const double a0_a = (1.0/4.0)*phi_b;
             const double a0_q = SYMROT_NEAREST(a0_a*0.6366197723675814);
             const double a0_r = ((a0_a - a0_q*1.5707963267341256) - a0_q*6.077100506303966e-11) - a0_q*2.0222662487959506e-21;
             const double a0_z = a0_r*a0_r;
@@ -673,8 +716,8 @@ static inline void symrot_tangent_m6_root_tangent_batch(size_t n, const double *
             const double a0_odd = a0_j - 2*a0_h;
             const double sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_K_across_lanes[k] = -u0*(x - 108);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_K_1_lanes[k] = x*((125.0/746496.0)*x - 17.0/3456.0) + 1.0/8.0;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_K_1_lanes[k] = xp0_lanes[k]*((125.0/746496.0)*xp0_lanes[k] - 17.0/3456.0) + 1.0/8.0;
             c_K_2_lanes[k] = u0*(u1 + 24)/(u1 + 6);
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1451,8 +1494,12 @@ static inline void symrot_tangent_m6_rotation_matrix_f(const float p[3], float R
  */
 static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const float *p, float *R)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_R_0_lanes[SYMROT_BATCH_BLOCK], c_R_1_lanes[SYMROT_BATCH_BLOCK], c_R_2_lanes[SYMROT_BATCH_BLOCK], poly_R_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.41177803F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m6__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1461,21 +1508,27 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.41177803F ? x : 0;
             if (!(x < 108.0F) || x < 0.41177803F) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m6__phi_f(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1489,8 +1542,8 @@ static inline void symrot_tangent_m6_rotation_matrix_f_batch(size_t n, const flo
             const float a0_up = fabsf(a0_j - 1.5F) - 0.5F;
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             c_R_1_lanes[k] = 36*(x - 108)*(x - 12)/((x + 36)*(x + 36)*(x + 36));
-            c_R_2_lanes[k] = (1 - cos0)/x;
-            poly_R_2_lanes[k] = x*(x*(x*((67.0F/10077696.0F)*x - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+            c_R_2_lanes[k] = (1 - cos0)/xc;
+            poly_R_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((67.0F/10077696.0F)*xp0_lanes[k] - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1547,8 +1600,12 @@ static inline void symrot_tangent_m6_tangent_f(const float p[3], float H[9])
  */
 static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, float *H)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], xc_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_H_across_lanes[SYMROT_BATCH_BLOCK], c_H_1_lanes[SYMROT_BATCH_BLOCK], c_H_2_lanes[SYMROT_BATCH_BLOCK], poly_H_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.41177803F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m6__phi_f(s_safe);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1557,21 +1614,27 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.41177803F ? x : 0;
             if (!(x < 108.0F) || x < 0.41177803F) {
-                phi_lanes[k] = 0;
+                xc_lanes[k] = x_safe;
+                phi_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m6__phi_f(s);
+                xc_lanes[k] = x;
                 phi_lanes[k] = phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            xc_lanes[k] = x_safe;
+            phi_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
+            const float xc = xc_lanes[k];
             const float phi = phi_lanes[k];
             const float a0_a = phi;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
@@ -1586,8 +1649,8 @@ static inline void symrot_tangent_m6_tangent_f_batch(size_t n, const float *p, f
             const float cos0 = (2*a0_up - 1)*((1 - a0_odd)*a0_c + a0_odd*a0_s);
             const float w0 = 1.0F/((x + 36)*(x + 36)*(x + 36));
             c_H_across_lanes[k] = 36*w0*(x - 108)*(x - 12);
-            c_H_1_lanes[k] = (1 - cos0)/x;
-            poly_H_1_lanes[k] = x*(x*(x*((67.0F/10077696.0F)*x - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
+            c_H_1_lanes[k] = (1 - cos0)/xc;
+            poly_H_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(xp0_lanes[k]*((67.0F/10077696.0F)*xp0_lanes[k] - 43.0F/279936.0F) + 73.0F/23328.0F) - 11.0F/216.0F) + 1.0F/2.0F;
             c_H_2_lanes[k] = 6912*w0;
         }
         /* select: polynomial below the threshold, NaN outside the range */
@@ -1753,8 +1816,13 @@ static inline void symrot_tangent_m6_root_matrix_f(const float p[3], float G[9])
  */
 static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *p, float *G)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_G_0_lanes[SYMROT_BATCH_BLOCK], c_G_1_lanes[SYMROT_BATCH_BLOCK], c_G_2_lanes[SYMROT_BATCH_BLOCK], poly_G_2_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.21355546F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m6__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 36, -3.0F/2.0F);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1763,28 +1831,34 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.21355546F ? x : 0;
             if (!(x < 108.0F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m6__phi_f(s);
                 const float u0 = powf(x + 36, -3.0F/2.0F);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
+                x_b_lanes[k] = x < 0.21355546F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.21355546F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1795,8 +1869,8 @@ static inline void symrot_tangent_m6_root_matrix_f_batch(size_t n, const float *
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_G_1_lanes[k] = -u0*(x - 108);
-            c_G_2_lanes[k] = 2*(sin0*sin0)/x;
-            poly_G_2_lanes[k] = x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F;
+            c_G_2_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_G_2_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(125.0F/746496.0F + (-5.3723215e-06F)*xp0_lanes[k]) - 17.0F/3456.0F) + 1.0F/8.0F;
         }
         /* select: polynomial below the threshold, NaN outside the range */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
@@ -1853,8 +1927,14 @@ static inline void symrot_tangent_m6_root_tangent_f(const float p[3], float K[9]
  */
 static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float *p, float *K)
 {
-    float x_lanes[SYMROT_BATCH_BLOCK], phi_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
+    float x_lanes[SYMROT_BATCH_BLOCK], u0_lanes[SYMROT_BATCH_BLOCK], u1_lanes[SYMROT_BATCH_BLOCK], x_b_lanes[SYMROT_BATCH_BLOCK], phi_b_lanes[SYMROT_BATCH_BLOCK], xp0_lanes[SYMROT_BATCH_BLOCK], c_K_across_lanes[SYMROT_BATCH_BLOCK], c_K_1_lanes[SYMROT_BATCH_BLOCK], c_K_2_lanes[SYMROT_BATCH_BLOCK], poly_K_1_lanes[SYMROT_BATCH_BLOCK];
     size_t end, start, k;
+    /* where the lanes that discard the closed forms compute them: no 0/0 */
+    const float x_safe = 0.21355546F;
+    const float s_safe = sqrtf(x_safe);
+    const float phi_safe = symrot_tangent_m6__phi_f(s_safe);
+    const float u0_safe = powf(x_safe + 36, -3.0F/2.0F);
+    const float u1_safe = sqrtf(x_safe + 36);
     /* the last block first, its last vector first: in place (the output at p), no entries overwrite a p not yet read */
     for (end = n; end > 0; end = start) {
         start = (end - 1) / SYMROT_BATCH_BLOCK * SYMROT_BATCH_BLOCK;
@@ -1863,33 +1943,39 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
             const float *const pk = p + 3 * (start + k);
             const float x = (pk[0]*pk[0]) + (pk[1]*pk[1]) + (pk[2]*pk[2]);
             x_lanes[k] = x;
+            xp0_lanes[k] = x < 0.21355546F ? x : 0;
             if (!(x < 108.0F)) {
-                phi_lanes[k] = 0;
-                u0_lanes[k] = 0;
-                u1_lanes[k] = 0;
+                u0_lanes[k] = u0_safe;
+                u1_lanes[k] = u1_safe;
+                x_b_lanes[k] = x_safe;
+                phi_b_lanes[k] = phi_safe;
             } else {
                 const float s = sqrtf(x);
                 const float phi = symrot_tangent_m6__phi_f(s);
                 const float u0 = powf(x + 36, -3.0F/2.0F);
                 const float u1 = sqrtf(x + 36);
-                phi_lanes[k] = phi;
                 u0_lanes[k] = u0;
                 u1_lanes[k] = u1;
+                x_b_lanes[k] = x < 0.21355546F ? x_safe : x;
+                phi_b_lanes[k] = x < 0.21355546F ? phi_safe : phi;
             }
         }
         for (; k < SYMROT_BATCH_BLOCK; ++k) {
             x_lanes[k] = 0;
-            phi_lanes[k] = 0;
-            u0_lanes[k] = 0;
-            u1_lanes[k] = 0;
+            xp0_lanes[k] = 0;
+            u0_lanes[k] = u0_safe;
+            u1_lanes[k] = u1_safe;
+            x_b_lanes[k] = x_safe;
+            phi_b_lanes[k] = phi_safe;
         }
         /* every candidate value, unconditionally */
         for (k = 0; k < SYMROT_BATCH_BLOCK; ++k) {
             const float x = x_lanes[k];
-            const float phi = phi_lanes[k];
             const float u0 = u0_lanes[k];
             const float u1 = u1_lanes[k];
-            const float a0_a = (1.0F/4.0F)*phi;
+            const float x_b = x_b_lanes[k];
+            const float phi_b = phi_b_lanes[k];
+            const float a0_a = (1.0F/4.0F)*phi_b;
             const float a0_q = SYMROT_NEARESTF(a0_a*0.63661975F);
             const float a0_r = ((a0_a - a0_q*1.5708008F) - a0_q*-4.4543995e-06F) - a0_q*-5.5644316e-11F;
             const float a0_z = a0_r*a0_r;
@@ -1900,8 +1986,8 @@ static inline void symrot_tangent_m6_root_tangent_f_batch(size_t n, const float 
             const float a0_odd = a0_j - 2*a0_h;
             const float sin0 = (1 - 2*a0_h)*((1 - a0_odd)*a0_s + a0_odd*a0_c);
             c_K_across_lanes[k] = -u0*(x - 108);
-            c_K_1_lanes[k] = 2*(sin0*sin0)/x;
-            poly_K_1_lanes[k] = x*(x*(125.0F/746496.0F + (-5.3723215e-06F)*x) - 17.0F/3456.0F) + 1.0F/8.0F;
+            c_K_1_lanes[k] = 2*(sin0*sin0)/x_b;
+            poly_K_1_lanes[k] = xp0_lanes[k]*(xp0_lanes[k]*(125.0F/746496.0F + (-5.3723215e-06F)*xp0_lanes[k]) - 17.0F/3456.0F) + 1.0F/8.0F;
             c_K_2_lanes[k] = u0*(u1 + 24)/(u1 + 6);
         }
         /* select: polynomial below the threshold, NaN outside the range */
