@@ -166,8 +166,8 @@ MUTATIONS: tuple[Mutation, ...] = (
         "c-in-place-unsafe", "backend",
         "C functions write outputs while inputs are still to be read (the in-place pass off)",
         (Edit("symrot/backends/c_backend.py",
-              "    return [stored_last(function) for function in functions]  # outputs may alias inputs",
-              "    return list(functions)"),),
+              "    stored = [stored_last(function) for function in functions]  # outputs may alias inputs",
+              "    stored = list(functions)"),),
         ("tests/test_c_aliasing.py",), (("c", "rotation_vector"),)),
     Mutation(
         "numpy-apply-transposed", "runtime",
@@ -227,6 +227,20 @@ MUTATIONS: tuple[Mutation, ...] = (
               "    if header != expected or canonical_json(header) != header_line:",
               "    if header[\"key\"] != key:"),),
         ("tests/test_plan_cache.py",)),
+    Mutation(
+        "c-batch-discarded-lanes-at-zero", "backend",
+        "C batch kernels give discarded lanes 0, not the safe point (0/0 raises FE_INVALID)",
+        (Edit("symrot/backends/c_batch.py",
+              '"value": "x_safe" if name == "xc" else f"{name}_safe"} for name in closed]',
+              '"value": "0"} for name in closed]'),),
+        ("tests/test_c_batch_flags.py",), (("c", "rotation_vector"),)),
+    Mutation(
+        "kernels-checksum-skipped", "api",
+        "symrot.kernels imports a kept module without checking its SHA-256",
+        (Edit("symrot/kernels_api.py",
+              'if hashlib.sha256(module.read_bytes()).hexdigest() == checksum.read_text(encoding="ascii")'
+              '.strip():', "if True:"),),
+        ("tests/test_kernels_api.py",)),
     Mutation(
         "atomic-no-rollback", "cli",
         "replace_all does not undo the renames done when a later one fails",
